@@ -1,0 +1,49 @@
+# specref: the two set-up commands (README) and the developer targets.
+# Every target creates .venv and installs the package on first use, so a fresh clone needs nothing else.
+PYTHON ?= python3
+VENV := .venv
+PY := $(VENV)/bin/python
+STAMP := $(VENV)/.installed-stamp
+# One BLAS/OpenMP thread per process: these machines are shared 2-core boxes, and multithreaded BLAS
+# collapses there (see docs/dependencies.md). Code that wants more threads asks threadpoolctl itself.
+export OMP_NUM_THREADS ?= 1
+export OPENBLAS_NUM_THREADS ?= 1
+export MKL_NUM_THREADS ?= 1
+export MPLBACKEND ?= Agg
+
+.PHONY: install demo test bench coverage lint clean
+
+$(STAMP): setup.cfg pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e '.[test]'
+	touch $(STAMP)
+
+install: $(STAMP)
+
+## make demo: install, then run the main job (specref report) on built-in defaults into ./report
+demo: $(STAMP)
+	$(VENV)/bin/specref report --out report
+
+## make test: install, then run the whole suite (doctests and docs examples included, benchmarks off)
+test: $(STAMP)
+	$(PY) -m pytest -q
+
+## make bench: run the pytest-benchmark suite and save JSON (specref report turns it into charts)
+bench: $(STAMP)
+	SPECREF_BENCH=1 $(PY) -m pytest -q tests/benchmarks --benchmark-enable \
+		--benchmark-json=bench.json --benchmark-min-rounds=3 -p no:doctest
+	$(VENV)/bin/specref report --out report --bench bench.json
+
+## make coverage: the suite once with the JIT off, so kernel bodies count as Python
+coverage: $(STAMP)
+	$(PY) -m pip install --quiet coverage
+	NUMBA_DISABLE_JIT=1 $(PY) -m coverage run -m pytest -q -m "not slow and not xslow"
+	$(PY) -m coverage report
+
+lint: $(STAMP)
+	$(VENV)/bin/ruff check .
+	$(VENV)/bin/ruff format --check .
+
+clean:
+	rm -rf $(VENV) report bench.json .benchmarks *.egg-info

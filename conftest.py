@@ -1,0 +1,54 @@
+"""Suite-wide pytest set-up: NumPy printing for doctests, shared fixtures, the benchmark switch."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import colour  # noqa: F401  (imported first: it sets NumPy's legacy print mode, which we undo below)
+import matplotlib
+import numpy as np
+import pytest
+
+matplotlib.use("Agg")
+np.set_printoptions(legacy=False)
+
+ROOT = Path(__file__).resolve().parent
+#: Shared data beside the repository (``../shared/data``), or where SPECREF_SHARED_DATA points.
+SHARED_DATA = Path(os.environ.get("SPECREF_SHARED_DATA", ROOT.parent / "shared" / "data"))
+
+# Benchmarks run only under `make bench` (SPECREF_BENCH=1); the ordinary suite does not collect
+# them.
+collect_ignore = [] if os.environ.get("SPECREF_BENCH") else ["tests/benchmarks"]
+
+
+@pytest.fixture
+def rng():
+    """The suite's seeded generator; other streams use a local generator with a literal seed."""
+    return np.random.default_rng(20261122)
+
+
+@pytest.fixture(scope="session")
+def shared_data() -> Path:
+    """``../shared/data``: real environment maps and measured spectra (see its PROVENANCE.md)."""
+    if not SHARED_DATA.is_dir():
+        raise FileNotFoundError(
+            f"shared data not found at {SHARED_DATA}; set SPECREF_SHARED_DATA to ../shared/data"
+        )
+    return SHARED_DATA
+
+
+@pytest.fixture(autouse=True)
+def _numpy_printing(doctest_namespace):
+    """Doctests see ``np`` and modern NumPy printing, whatever a library did to them."""
+    doctest_namespace["np"] = np
+    np.set_printoptions(legacy=False)
+
+
+def pytest_collection_modifyitems(config, items):
+    """``xslow`` tests run only with SPECREF_XSLOW=1 (the default addopts already deselect them)."""
+    if os.environ.get("SPECREF_XSLOW"):
+        return
+    for item in items:
+        if "xslow" in item.keywords:
+            item.add_marker(pytest.mark.skip(reason="xslow: set SPECREF_XSLOW=1 to run"))

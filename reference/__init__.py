@@ -1,0 +1,120 @@
+"""specref's reference layer: spectral core, geometry and rasterizer, BRDFs, lights and display.
+
+Users write ``reference.band_weights``, ``reference.Camera``; the modules hold the equations and
+their citations. ``reference`` imports none of ``phong_table``, ``shrm`` or ``validation``.
+"""
+
+from reference.camera import MAX_RESOLUTION, PROJECTIONS, Camera, downsample_box
+from reference.colorimetry import (
+    BAND_WEIGHT_METHODS,
+    DEFAULT_OBSERVER,
+    OBSERVERS,
+    XYZ_to_display_RGB,
+    XYZ_to_Lab,
+    XYZ_to_RGB_matrix,
+    band_weights,
+    band_weights_ASTM_E308,
+    band_weights_point_sampled,
+    delta_E_00,
+    display_RGB_to_XYZ,
+    spectra_to_RGB_matrix,
+    spectra_to_XYZ,
+    white_XYZ,
+)
+from reference.display import ENCODINGS, display_to_linear, linear_to_display, to_8bit
+from reference.envmap import (
+    check_latlong_shape,
+    direction_to_latlong_uv,
+    latlong_lookup_bilinear,
+    latlong_pixel_directions,
+    latlong_pixel_solid_angles,
+    latlong_uv_to_direction,
+)
+from reference.errors import SpecrefError, SpecrefWarning, require
+from reference.gbuffer import PRIMITIVES, GBuffer, empty_gbuffer, render_gbuffer
+from reference.geometry import Plane, Sphere, intersect_plane, intersect_sphere
+from reference.images import (
+    atomic_write,
+    read_exr,
+    read_hdr,
+    read_image,
+    read_png,
+    write_exr,
+    write_png,
+)
+from reference.registry import Method, Registry
+from reference.spectra import (
+    DEFAULT_GRID,
+    GRID_31,
+    GRID_41,
+    GRIDS,
+    SpectralGrid,
+    Spectrum,
+    make_spectrum,
+    resample_spectrum,
+    spectrum_constant,
+    spectrum_from_csv,
+    spectrum_from_dataset,
+)
+
+__all__ = [
+    "BAND_WEIGHT_METHODS",
+    "DEFAULT_GRID",
+    "DEFAULT_OBSERVER",
+    "ENCODINGS",
+    "GRIDS",
+    "GRID_31",
+    "GRID_41",
+    "MAX_RESOLUTION",
+    "OBSERVERS",
+    "PRIMITIVES",
+    "PROJECTIONS",
+    "Camera",
+    "GBuffer",
+    "Method",
+    "Plane",
+    "Registry",
+    "SpecrefError",
+    "SpecrefWarning",
+    "SpectralGrid",
+    "Spectrum",
+    "Sphere",
+    "XYZ_to_Lab",
+    "XYZ_to_RGB_matrix",
+    "XYZ_to_display_RGB",
+    "atomic_write",
+    "band_weights",
+    "band_weights_ASTM_E308",
+    "band_weights_point_sampled",
+    "check_latlong_shape",
+    "delta_E_00",
+    "direction_to_latlong_uv",
+    "display_RGB_to_XYZ",
+    "display_to_linear",
+    "downsample_box",
+    "empty_gbuffer",
+    "intersect_plane",
+    "intersect_sphere",
+    "latlong_lookup_bilinear",
+    "latlong_pixel_directions",
+    "latlong_pixel_solid_angles",
+    "latlong_uv_to_direction",
+    "linear_to_display",
+    "make_spectrum",
+    "read_exr",
+    "read_hdr",
+    "read_image",
+    "read_png",
+    "render_gbuffer",
+    "require",
+    "resample_spectrum",
+    "spectra_to_RGB_matrix",
+    "spectra_to_XYZ",
+    "spectrum_constant",
+    "spectrum_from_csv",
+    "spectrum_from_dataset",
+    "to_8bit",
+    "white_XYZ",
+    "write_exr",
+    "write_png",
+]

@@ -1,0 +1,196 @@
+"""Lat-long environment maps: the direction convention, pixel centres, solid angles and lookups.
+
+specref follows Mitsuba 3's axes for lat-long (equirectangular) maps, with y up:
+
+- ``u = atan2(d.x, -d.z) / 2π`` wrapped to [0, 1), ``v = acos(d.y) / π``;
+- so −z is at the left/right seam (u = 0), +x at u = 1/4, +z at the image centre (u = 1/2), −x at u
+= 3/4,
+  and +y is the top row (v = 0);
+- the inverse is ``d = (sin θ sin φ, cos θ, −sin θ cos φ)`` with ``φ = 2πu``, ``θ = πv``.
+
+Pixel ``(j, i)`` (row j, column i) of an ``H × W`` map has its centre at ``u = (i + ½)/W``,
+``v = (j + ½)/H``. The row centres ``θ_j = (j + ½)π/H`` are the nodes of Fejér's first quadrature
+rule, which the SH engine relies on. Mitsuba 3 itself puts row centres at ``v = j/(H − 1)`` (row 0
+on the pole), which differs by up to half a row near the poles (0.18° for 1024×512); see
+``docs/conventions.md``. OpenEXR's ``envmap = LATLONG`` attribute uses the same orientation as
+Mitsuba 3.
+
+References
+----------
+- W. Jakob et al., Mitsuba 3 renderer, ``src/emitters/envmap.cpp`` (2022).
+- L. Fejér, "Mechanische Quadraturen mit positiven Cotesschen Zahlen", Math. Z. 37, 1933.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from reference.errors import require
+
+__all__ = [
+    "check_latlong_shape",
+    "direction_to_latlong_uv",
+    "latlong_lookup_bilinear",
+    "latlong_pixel_directions",
+    "latlong_pixel_solid_angles",
+    "latlong_uv_to_direction",
+]
+
+
+def direction_to_latlong_uv(d) -> tuple[np.ndarray, np.ndarray]:
+    """Lat-long texture coordinates of unit directions (Mitsuba 3 convention).
+
+    Parameters
+    ----------
+    d : array_like, shape (..., 3)
+        Unit directions, y up.
+
+    Returns
+    -------
+    u : ndarray, shape (...,)
+        ``atan2(d.x, -d.z) / 2π`` wrapped to [0, 1).
+    v : ndarray, shape (...,)
+        ``acos(d.y) / π`` in [0, 1].
+
+    Examples
+    --------
+    >>> u, v = direction_to_latlong_uv([[0, 0, -1], [1, 0, 0], [0, 0, 1], [0, 1, 0]])
+    >>> u, v
+    (array([0.  , 0.25, 0.5 , 0.  ]), array([0.5, 0.5, 0.5, 0. ]))
+    """
+    d = np.asarray(d, dtype=np.float64)
+    u = np.arctan2(d[..., 0], -d[..., 2]) / (2.0 * np.pi)
+    u = np.where(u < 0.0, u + 1.0, u)
+    u = np.where(u >= 1.0, 0.0, u)
+    v = np.arccos(np.clip(d[..., 1], -1.0, 1.0)) / np.pi
+    return u, v
+
+
+def latlong_uv_to_direction(u, v) -> np.ndarray:
+    """Unit directions of lat-long texture coordinates (inverse of :func:`direction_to_latlong_uv`).
+
+    Parameters
+    ----------
+    u, v : array_like
+        Texture coordinates in [0, 1].
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        ``(sin θ sin φ, cos θ, −sin θ cos φ)`` with ``φ = 2πu``, ``θ = πv``.
+
+    Examples
+    --------
+    >>> latlong_uv_to_direction([0.5, 0.25], [0.5, 0.5]).round(12)
+    array([[ 0.,  0.,  1.],
+           [ 1.,  0., -0.]])
+    """
+    u, v = np.broadcast_arrays(np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64))
+    phi = 2.0 * np.pi * u
+    theta = np.pi * v
+    s = np.sin(theta)
+    return np.stack([s * np.sin(phi), np.cos(theta), -s * np.cos(phi)], axis=-1)
+
+
+def check_latlong_shape(shape, where: str = "environment map") -> None:
+    """Refuse images that are not 2:1 lat-long maps.
+
+    Raises
+    ------
+    SpecrefError
+        When the width is not twice the height.
+
+    Examples
+    --------
+    >>> check_latlong_shape((512, 1024, 3))
+    >>> check_latlong_shape((512, 512, 3), "sky.hdr")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: sky.hdr: a lat-long map must be 2:1 (width = 2 × height), got
+    512×512
+    """
+    require(len(shape) >= 2, f"{where}: expected an image, got shape {tuple(shape)}")
+    H, W = shape[0], shape[1]
+    require(
+        H >= 1 and W == 2 * H,
+        f"{where}: a lat-long map must be 2:1 (width = 2 × height), got {W}×{H}",
+    )
+
+
+def latlong_pixel_directions(height: int, width: int) -> np.ndarray:
+    """Directions of the pixel centres of an ``height × width`` lat-long map.
+
+    Parameters
+    ----------
+    height, width : int
+        Map size.
+
+    Returns
+    -------
+    ndarray, shape (height, width, 3)
+        Directions at ``u = (i + ½)/W``, ``v = (j + ½)/H``.
+
+    Examples
+    --------
+    >>> d = latlong_pixel_directions(2, 4)
+    >>> d.shape, bool(np.allclose(np.linalg.norm(d, axis=-1), 1))
+    ((2, 4, 3), True)
+    """
+    u = (np.arange(width) + 0.5) / width
+    v = (np.arange(height) + 0.5) / height
+    return latlong_uv_to_direction(u[None, :], v[:, None])
+
+
+def latlong_pixel_solid_angles(height: int, width: int) -> np.ndarray:
+    """Exact solid angle of each pixel of a lat-long map, sr: ``(2π/W)(cos θ_top − cos θ_bottom)``.
+
+    Returns
+    -------
+    ndarray, shape (height, width)
+        Sums to 4π.
+
+    Examples
+    --------
+    >>> float(latlong_pixel_solid_angles(64, 128).sum() / (4 * np.pi)).__round__(12)
+    1.0
+    """
+    edges = np.pi * np.arange(height + 1) / height
+    band = np.cos(edges[:-1]) - np.cos(edges[1:])
+    return np.broadcast_to((2.0 * np.pi / width) * band[:, None], (height, width)).copy()
+
+
+def latlong_lookup_bilinear(image, d) -> np.ndarray:
+    """Bilinearly filtered values of a lat-long map in directions ``d``.
+
+    Texels are point samples at their centres; u wraps around the seam, v clamps at the poles.
+
+    Parameters
+    ----------
+    image : ndarray, shape (H, W, C)
+        The map.
+    d : array_like, shape (..., 3)
+        Unit directions.
+
+    Returns
+    -------
+    ndarray, shape (..., C)
+
+    Examples
+    --------
+    >>> image = np.arange(8.0).reshape(2, 4, 1)
+    >>> latlong_lookup_bilinear(image, [[0.0, 0.0, 1.0]]).round(6)
+    array([[3.5]])
+    """
+    image = np.asarray(image, dtype=np.float64)
+    H, W = image.shape[:2]
+    u, v = direction_to_latlong_uv(d)
+    x = u * W - 0.5
+    y = np.clip(v * H - 0.5, 0.0, H - 1.0)
+    x0 = np.floor(x).astype(np.int64)
+    y0 = np.minimum(np.floor(y).astype(np.int64), H - 1)
+    fx, fy = (x - x0)[..., None], (y - y0)[..., None]
+    x1, y1 = (x0 + 1) % W, np.minimum(y0 + 1, H - 1)
+    x0 = x0 % W
+    top = image[y0, x0] * (1 - fx) + image[y0, x1] * fx
+    bottom = image[y1, x0] * (1 - fx) + image[y1, x1] * fx
+    return top * (1 - fy) + bottom * fy

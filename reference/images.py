@@ -1,0 +1,376 @@
+"""Atomic file writes, and image I/O: PNG (imageio), OpenEXR (OpenEXR), Radiance HDR (imagecodecs).
+
+Every writer goes through :func:`atomic_write`: the data go to a temporary file in the destination
+folder, which is flushed, synced and renamed into place, so an interrupted run never leaves a
+half-written file.
+
+Readers return float64 arrays ``(H, W, C)`` with row 0 at the top and refuse unreadable files with a
+one-line :class:`~reference.errors.SpecrefError` that names the file.
+
+Spectral OpenEXR files follow the layout of Fichet, Pacanowski & Wilkie (2021): one channel per
+band, named ``S0.<wavelength>nm`` with a comma as the decimal separator (``S0.550,000000nm``). The
+reader accepts any channel names that end in a wavelength in nm.
+
+References
+----------
+- A. Fichet, R. Pacanowski, A. Wilkie, "An OpenEXR Layout for Spectral Images", JCGT 10(3), 2021.
+- G. Ward, "Real Pixels", Graphics Gems II, 1991 (the RGBE encoding of Radiance ``.hdr`` files).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import re
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from reference.errors import SpecrefError, require
+
+__all__ = [
+    "MAX_IMAGE_PIXELS",
+    "atomic_write",
+    "read_exr",
+    "read_hdr",
+    "read_image",
+    "read_png",
+    "spectral_channel_names",
+    "write_bytes_atomic",
+    "write_exr",
+    "write_png",
+    "write_text_atomic",
+]
+
+#: Largest image (pixels) that specref reads or writes; larger inputs are refused as absurd.
+MAX_IMAGE_PIXELS = 16384 * 16384
+
+
+@contextlib.contextmanager
+def atomic_write(path, mode: str = "wb"):
+    """Open a temporary file beside ``path``; on success, sync it and rename it to ``path``.
+
+    On an exception the temporary file is removed and ``path`` is untouched.
+
+    Parameters
+    ----------
+    path : str or Path
+        Destination; its folder is created if missing.
+    mode : str
+        ``"wb"`` or ``"w"``.
+
+    Yields
+    ------
+    file object
+        The temporary file, opened in ``mode``.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     p = os.path.join(d, "out.txt")
+    ...     with atomic_write(p, "w") as f:
+    ...         _ = f.write("done")
+    ...     open(p).read()
+    'done'
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, mode) as handle:
+            yield handle
+            handle.flush()
+            os.fsync(handle.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+        raise
+
+
+def write_bytes_atomic(path, data: bytes) -> Path:
+    """Write ``data`` to ``path`` atomically and return the path.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     write_bytes_atomic(os.path.join(d, "a.bin"), b"xy").stat().st_size
+    2
+    """
+    with atomic_write(path, "wb") as handle:
+        handle.write(data)
+    return Path(path)
+
+
+def write_text_atomic(path, text: str) -> Path:
+    """Write ``text`` (UTF-8) to ``path`` atomically and return the path.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     write_text_atomic(os.path.join(d, "a.txt"), "é").read_text(encoding="utf-8")
+    'é'
+    """
+    return write_bytes_atomic(path, text.encode("utf-8"))
+
+
+def write_png(path, image) -> Path:
+    """Write an 8-bit PNG atomically (imageio).
+
+    Parameters
+    ----------
+    path : str or Path
+        Destination.
+    image : ndarray, shape (H, W) or (H, W, 3|4)
+        uint8 values, or floats in [0, 1] that are quantized with round-half-up.
+
+    Returns
+    -------
+    Path
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     p = write_png(os.path.join(d, "a.png"), np.zeros((2, 3, 3)))
+    ...     read_png(p).shape
+    (2, 3, 3)
+    """
+    import imageio.v3 as iio
+
+    from reference.display import to_8bit
+
+    image = np.asarray(image)
+    if image.dtype != np.uint8:
+        image = to_8bit(image)
+    data = iio.imwrite("<bytes>", image, extension=".png")
+    return write_bytes_atomic(path, data)
+
+
+def read_png(path) -> np.ndarray:
+    """Read a PNG (or another image imageio reads without plugins) as float64 in [0, 1], (H, W, C).
+
+    Examples
+    --------
+    >>> read_png("/nonexistent.png")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: /nonexistent.png: file not found
+    """
+    import imageio.v3 as iio
+
+    path = Path(path)
+    require(path.is_file(), f"{path}: file not found")
+    try:
+        image = iio.imread(path)
+    except Exception as error:  # imageio raises many kinds; all mean "not a readable image"
+        raise SpecrefError(f"{path}: cannot read image ({error.__class__.__name__})") from None
+    image = np.asarray(image)
+    scale = float(np.iinfo(image.dtype).max) if image.dtype.kind in "ui" else 1.0
+    image = image.astype(np.float64) / scale
+    return image[..., None] if image.ndim == 2 else image
+
+
+def spectral_channel_names(wavelengths_nm) -> list[str]:
+    """Channel names of the spectral OpenEXR layout (Fichet et al. 2021): ``S0.550,000000nm``.
+
+    Examples
+    --------
+    >>> spectral_channel_names([380.0, 555.5])
+    ['S0.380,000000nm', 'S0.555,500000nm']
+    """
+    return [f"S0.{w:.6f}".replace(".", ",").replace("S0,", "S0.") + "nm" for w in wavelengths_nm]
+
+
+_WAVELENGTH_CHANNEL = re.compile(r"(\d+(?:[.,]\d+)?)\s*nm$")
+
+
+def write_exr(path, image, channels: list[str] | None = None, half: bool = False) -> Path:
+    """Write a linear float image as OpenEXR atomically.
+
+    Parameters
+    ----------
+    path : str or Path
+        Destination.
+    image : ndarray, shape (H, W, C) or (H, W)
+        Linear values.
+    channels : list of str, optional
+        Channel names; default ``R, G, B`` for 3 channels, ``Y`` for 1, and required otherwise (use
+        :func:`spectral_channel_names` for spectral images).
+    half : bool
+        Store 16-bit half floats instead of 32-bit floats.
+
+    Returns
+    -------
+    Path
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     p = write_exr(os.path.join(d, "a.exr"), np.full((2, 2, 3), 0.25))
+    ...     image, names = read_exr(p)
+    ...     image[0, 0], names
+    (array([0.25, 0.25, 0.25]), ['R', 'G', 'B'])
+    """
+    import OpenEXR
+
+    image = np.asarray(image, dtype=np.float64)
+    if image.ndim == 2:
+        image = image[..., None]
+    require(image.ndim == 3, f"{path}: EXR image must be (H, W, C), got shape {image.shape}")
+    n = image.shape[2]
+    if channels is None:
+        require(n in (1, 3), f"{path}: name the {n} channels of this EXR image")
+        channels = ["Y"] if n == 1 else ["R", "G", "B"]
+    require(len(channels) == n, f"{path}: {len(channels)} channel names for {n} channels")
+    dtype = np.float16 if half else np.float32
+    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+    data = {
+        name: np.ascontiguousarray(image[..., i].astype(dtype)) for i, name in enumerate(channels)
+    }
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    # OpenEXR writes by file name, so write a temporary name beside the target and rename it.
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".exr", dir=path.parent)
+    os.close(fd)
+    try:
+        with OpenEXR.File(header, data) as handle:
+            handle.write(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+        raise
+    return path
+
+
+def read_exr(path) -> tuple[np.ndarray, list[str]]:
+    """Read an OpenEXR file (scanline or tiled; the top mip level) as float64.
+
+    Channels are returned in the order R, G, B, A when present; channels whose names end in a
+    wavelength (``S0.550,000000nm``, ``550nm``) are returned sorted by wavelength; anything else in
+    file order.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+
+    Returns
+    -------
+    image : ndarray, shape (H, W, C)
+    names : list of str
+
+    Raises
+    ------
+    SpecrefError
+        Missing or unreadable file.
+
+    Examples
+    --------
+    >>> read_exr("/nonexistent.exr")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: /nonexistent.exr: file not found
+    """
+    import OpenEXR
+
+    path = Path(path)
+    require(path.is_file(), f"{path}: file not found")
+    try:
+        with OpenEXR.File(str(path), separate_channels=True) as handle:
+            channels = {name: np.asarray(ch.pixels) for name, ch in handle.channels().items()}
+    except Exception as error:  # the bindings raise RuntimeError and others for bad files
+        raise SpecrefError(
+            f"{path}: cannot read OpenEXR image ({error.__class__.__name__})"
+        ) from None
+    require(channels, f"{path}: OpenEXR file has no channels")
+    names = list(channels)
+    spectral = {n: _WAVELENGTH_CHANNEL.search(n) for n in names}
+    if all(spectral.values()):
+        names.sort(key=lambda n: float(spectral[n].group(1).replace(",", ".")))
+    else:
+        order = {"R": 0, "G": 1, "B": 2, "A": 3}
+        position = {n: i for i, n in enumerate(names)}
+        names.sort(key=lambda n: (order.get(n, 4), position[n]))
+    shapes = {channels[n].shape for n in names}
+    require(len(shapes) == 1, f"{path}: channels have different sizes {sorted(shapes)}")
+    image = np.stack([channels[n].astype(np.float64) for n in names], axis=-1)
+    require(image.shape[0] * image.shape[1] <= MAX_IMAGE_PIXELS, f"{path}: image too large")
+    return image, names
+
+
+def read_hdr(path) -> np.ndarray:
+    """Read a Radiance RGBE ``.hdr`` file as float64 RGB (imagecodecs).
+
+    RGBE decodes as ``m · 2^(e - 136)`` per channel (no +0.5 offset), as FreeImage and Mitsuba 3 do.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+
+    Returns
+    -------
+    ndarray, shape (H, W, 3)
+
+    Raises
+    ------
+    SpecrefError
+        Missing or unreadable file.
+
+    Examples
+    --------
+    >>> read_hdr("/nonexistent.hdr")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: /nonexistent.hdr: file not found
+    """
+    import imagecodecs
+
+    path = Path(path)
+    require(path.is_file(), f"{path}: file not found")
+    data = path.read_bytes()
+    try:
+        image = imagecodecs.rgbe_decode(data)
+    except Exception as error:  # imagecodecs.RgbeError and others
+        raise SpecrefError(
+            f"{path}: cannot read Radiance HDR image ({error.__class__.__name__})"
+        ) from None
+    image = np.asarray(image, dtype=np.float64)
+    require(
+        image.ndim == 3 and image.shape[2] == 3, f"{path}: expected an RGB image, got {image.shape}"
+    )
+    return image
+
+
+def read_image(path) -> np.ndarray:
+    """Read ``.exr``, ``.hdr`` or ``.png`` by extension as float64 ``(H, W, C)``.
+
+    Raises
+    ------
+    SpecrefError
+        Unknown extension, missing or unreadable file.
+
+    Examples
+    --------
+    >>> read_image("photo.gif")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: photo.gif: unsupported image type '.gif'; allowed: .exr, .hdr,
+    .png
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".exr":
+        return read_exr(path)[0]
+    if suffix in (".hdr", ".rgbe", ".pic"):
+        return read_hdr(path)
+    if suffix == ".png":
+        return read_png(path)
+    raise SpecrefError(f"{path}: unsupported image type {suffix!r}; allowed: .exr, .hdr, .png")

@@ -1,0 +1,1 @@
+"""specref validation: metrics, oracles, report, charts and the command line."""

@@ -1,0 +1,91 @@
+"""The ``specref`` command: argument parsing and dispatch to library functions, nothing else.
+
+Every subcommand is a small function that calls the library. Bad input raises
+:class:`~reference.errors.SpecrefError` in the library; :func:`main` prints its one-line message to
+stderr and exits with code 2, without a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from reference.errors import SpecrefError
+
+__all__ = ["build_parser", "main"]
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line usage errors and exit code 2 (argparse's code for usage errors)."""
+
+    def error(self, message):
+        self.exit(2, f"specref: error: {message} (see specref {self.prog.split()[-1]} --help)\n")
+
+
+def _cmd_report(args) -> int:
+    from validation.report import run_report
+
+    run_report(
+        out_dir=args.out,
+        quick=args.quick,
+        only=args.only,
+        bench_json=args.bench,
+        markdown=args.markdown,
+        markdown_image_prefix=args.markdown_image_prefix,
+    )
+    print(f"wrote {args.out}/index.html and {args.out}/results.json")
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser for all subcommands.
+
+    Examples
+    --------
+    >>> build_parser().parse_args(["report", "--quick"]).quick
+    True
+    """
+    parser = _Parser(prog="specref", description="specref: a spectral rendering reference.")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    p = sub.add_parser(
+        "report", help="run the main job: every section's figures, charts and images"
+    )
+    p.add_argument("--out", default="report", help="output folder (default: report)")
+    p.add_argument("--quick", action="store_true", help="small sizes; under a minute")
+    p.add_argument("--only", nargs="+", metavar="SECTION", help="run only these sections")
+    p.add_argument("--bench", metavar="JSON", help="pytest-benchmark JSON from make bench")
+    p.add_argument(
+        "--markdown", metavar="MD", help="also write a Markdown rendering (docs/results.md)"
+    )
+    p.add_argument(
+        "--markdown-image-prefix",
+        default="",
+        help="path from the Markdown file to the report folder",
+    )
+    p.set_defaults(func=_cmd_report)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the ``specref`` command; return the exit code (2 for bad input).
+
+    Examples
+    --------
+    >>> main(["report", "--only", "no-such-section", "--out", "/tmp/specref-doctest"])
+    2
+    """
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except SpecrefError as error:
+        print(f"specref: error: {error}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("specref: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,6 @@
+"""Report sections; importing this package registers them in ``validation.report.REPORT_SECTIONS``.
+
+Each module registers one section. A new section is a new module plus one import line here.
+"""
+
+from validation.sections import spectral  # noqa: F401
