@@ -27,8 +27,8 @@ Model".
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -64,6 +64,9 @@ class ShadingContext:
         Standard observer for the band weights.
     weights_method : str
         Band-weight method (``"astm_e308"`` or ``"point"``).
+    options : mapping
+        Per-render switches that registered shaders read, e.g. ``{"environment": "bruteforce"}`` for the
+        environment-light oracle; each shader documents the keys it reads and ignores the others.
 
     Examples
     --------
@@ -75,6 +78,7 @@ class ShadingContext:
     grid: SpectralGrid = DEFAULT_GRID
     observer: str = DEFAULT_OBSERVER
     weights_method: str = "astm_e308"
+    options: Mapping = field(default_factory=dict)
 
     def weights(self, spectrum: Spectrum | None) -> np.ndarray:
         """Band weights ``(n_bands, 3)`` with ``spectrum`` folded in (None: equal-energy light)."""
