@@ -28,7 +28,7 @@ import numpy as np
 from reference.envmap import direction_to_latlong_uv
 from reference.errors import require, require_finite
 
-__all__ = ["Hit", "Plane", "Sphere", "intersect_plane", "intersect_sphere"]
+__all__ = ["Hit", "Plane", "Sphere", "intersect_plane", "intersect_sphere", "plane_uv_to_point"]
 
 
 @dataclass(frozen=True)
@@ -230,3 +230,37 @@ def intersect_plane(plane: Plane, origins, directions) -> Hit:
     position = np.where(found[..., None], position, np.nan)
     normal = np.broadcast_to(n, position.shape).copy()
     return Hit(t, position, normal, np.where(found[..., None], uv, np.nan))
+
+
+def plane_uv_to_point(plane: Plane, uv) -> np.ndarray:
+    """World points of texture coordinates on a plane: the inverse of its ``uv`` in hits.
+
+    On a rectangle ``p = p0 + (u − ½) w a + (½ − v) h (n × a)``; on an unbounded plane ``u`` and
+    ``v`` are world units from ``p0`` along ``a`` and ``−(n × a)``.
+
+    Parameters
+    ----------
+    plane : Plane
+        The plane or rectangle.
+    uv : array_like, shape (..., 2)
+        Texture coordinates.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+
+    Examples
+    --------
+    >>> P = Plane((0, 0, 0), (0, 0, 1), (1, 0, 0), size=(2.0, 2.0))
+    >>> plane_uv_to_point(P, [0.75, 0.25])
+    array([0.5, 0.5, 0. ])
+    """
+    uv = np.asarray(uv, dtype=np.float64)
+    p0, n, a = (np.asarray(v) for v in (plane.point, plane.normal, plane.u_axis))
+    b_axis = np.cross(n, a)
+    if plane.size is not None:
+        w, h = plane.size
+        s, r = (uv[..., 0] - 0.5) * w, (0.5 - uv[..., 1]) * h
+    else:
+        s, r = uv[..., 0], -uv[..., 1]
+    return p0 + s[..., None] * a + r[..., None] * b_axis

@@ -32,6 +32,7 @@ from reference.errors import SpecrefError, require
 __all__ = [
     "MAX_IMAGE_PIXELS",
     "atomic_write",
+    "channel_wavelengths_nm",
     "read_exr",
     "read_hdr",
     "read_image",
@@ -187,6 +188,25 @@ def spectral_channel_names(wavelengths_nm) -> list[str]:
 
 
 _WAVELENGTH_CHANNEL = re.compile(r"(\d+(?:[.,]\d+)?)\s*nm$")
+
+
+def channel_wavelengths_nm(names) -> np.ndarray | None:
+    """Wavelengths (nm) named by spectral channel names, or None if any name has no wavelength.
+
+    Accepts the spectral OpenEXR layout (``S0.550,000000nm``) and plain ``550nm`` names, as
+    :func:`read_exr` does when it sorts them.
+
+    Examples
+    --------
+    >>> channel_wavelengths_nm(["S0.380,000000nm", "S0.555,500000nm"])
+    array([380. , 555.5])
+    >>> channel_wavelengths_nm(["R", "G", "B"]) is None
+    True
+    """
+    found = [_WAVELENGTH_CHANNEL.search(str(name)) for name in names]
+    if not found or not all(found):
+        return None
+    return np.array([float(m.group(1).replace(",", ".")) for m in found])
 
 
 def write_exr(path, image, channels: list[str] | None = None, half: bool = False) -> Path:

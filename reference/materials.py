@@ -19,6 +19,7 @@ Model".
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field, fields
 
 import numpy as np
@@ -135,6 +136,13 @@ class MaterialType:
         Parameters with defaults.
     cites : str
         The equation the material implements.
+    parse : callable, optional
+        How a scene file's table becomes the material:
+        ``parse(reader, table, key, name) -> material``, with ``reader`` a
+        ``reference.scene_values.SceneReader``, ``table`` the material's TOML table (``type``
+        included), ``key`` its dotted path (``materials.chart``) and ``name`` the material's name.
+        None (the default) reads every parameter in ``required`` and ``optional`` as a spectrum on
+        the scene's grid and calls :func:`make_material`.
     """
 
     name: str
@@ -142,6 +150,7 @@ class MaterialType:
     required: tuple
     optional: tuple = ()
     cites: str = ""
+    parse: Callable | None = None
 
 
 #: Material types by scene-file key.

@@ -1,0 +1,457 @@
+"""Rendering a scene: G-buffer, deferred shading, box resolve, XYZ to display RGB, encoding.
+
+:func:`render_scene` runs the pipeline of a :class:`~reference.scene.Scene`:
+
+1. the G-buffer at ``supersample ×`` the resolution (``reference.gbuffer.render_gbuffer``);
+2. deferred shading to XYZ, Y = 1 for a white diffuser facing a unit light
+   (``reference.shading.shade_gbuffer``), with the background where no surface is visible;
+3. the box filter back to the image size (``reference.camera.downsample_box``);
+4. XYZ to linear display RGB in the scene's colourspace, with optional chromatic adaptation from the
+   scene light's white to the colourspace white (Eq. (5), Wang et al.);
+5. exposure, clipping to [0, 1] and the display encoding (``reference.display.ENCODINGS``).
+
+The G-buffer is kept in the :class:`RenderResult`, so a material or light edit re-shades without
+re-rasterizing: ``render_scene(edited, gbuffer=result.gbuffer)``. Shading runs in tiles of whole
+rows of at most :data:`SHADING_TILE_SAMPLES` samples, which bounds the memory of spectral
+temporaries.
+
+:func:`write_render` writes the display-encoded PNG and the linear display RGB as float EXR (before
+exposure), each atomically, so an interrupted run never leaves a half-written file.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from reference.camera import downsample_box
+from reference.colorimetry import XYZ_to_RGB_matrix, band_weights, white_XYZ
+from reference.display import linear_to_display
+from reference.envmap import latlong_lookup_bilinear
+from reference.errors import SpecrefError, format_allowed, require
+from reference.gbuffer import GBuffer, render_gbuffer
+from reference.images import write_exr, write_png
+from reference.lights import EnvironmentLight
+from reference.scene import Scene, load_scene
+from reference.shading import SHADERS, shade_gbuffer, shader_key
+from reference.spectra import make_spectrum, resample_spectrum
+
+__all__ = [
+    "SHADING_TILE_SAMPLES",
+    "RenderResult",
+    "XYZ_to_display",
+    "background_XYZ",
+    "check_shaders",
+    "render_scene",
+    "render_scene_file",
+    "scene_gbuffer",
+    "shade_scene",
+    "write_render",
+]
+
+#: Most G-buffer samples shaded at once (whole rows); larger images are shaded in row tiles.
+SHADING_TILE_SAMPLES = 1 << 18
+
+
+@dataclass(frozen=True, eq=False)
+class RenderResult:
+    """The outputs of :func:`render_scene`.
+
+    Attributes
+    ----------
+    XYZ : ndarray, shape (H, W, 3)
+        Tristimulus values, Y = 1 for a white diffuser facing a unit light.
+    RGB_linear : ndarray, shape (H, W, 3)
+        Linear display RGB in the scene's colourspace (adapted if the scene says so), unclipped and
+        before exposure: what the EXR output holds.
+    encoded : ndarray, shape (H, W, 3)
+        Display-encoded values in [0, 1] (exposure, clipping, encoding): what the PNG holds.
+    gbuffer : GBuffer
+        The supersampled G-buffer, ``(supersample·H, supersample·W)``; pass it back to
+        :func:`render_scene` to re-shade without re-rasterizing.
+    supersample : int
+        Sub-samples per pixel per axis.
+    timings : dict
+        Seconds spent in ``"gbuffer"``, ``"shading"`` and ``"display"``, and the ``"total"``.
+    scene : Scene
+        The scene as rendered (with any size override).
+    """
+
+    XYZ: np.ndarray
+    RGB_linear: np.ndarray
+    encoded: np.ndarray
+    gbuffer: GBuffer
+    supersample: int
+    timings: dict = field(default_factory=dict)
+    scene: Scene | None = None
+
+
+def check_shaders(scene: Scene) -> None:
+    """Refuse a scene with a material/light pair that no registered shader handles.
+
+    Runs before rasterizing, so a missing shader fails fast. Shaders from ``phong_table`` and
+    ``shrm`` are registered when those packages are imported (``specref render`` imports them).
+
+    Raises
+    ------
+    SpecrefError
+        Naming the material, the light and the registered shaders.
+
+    Examples
+    --------
+    >>> from reference.scene import loads_scene
+    >>> check_shaders(loads_scene('[[lights]]' + chr(10) + 'type = "ambient"'))
+    """
+    used = sorted({obj.material for obj in scene.objects})
+    for index in used:
+        require(
+            0 <= index < len(scene.materials),
+            f"{scene.file}: an object uses material index {index} but the scene has "
+            f"{len(scene.materials)} materials",
+        )
+        material = scene.materials[index]
+        for j, light in enumerate(scene.lights):
+            key = shader_key(material, light)
+            if key not in SHADERS:
+                raise SpecrefError(
+                    f"{scene.file}: no shader for materials.{scene.material_names[index]} "
+                    f"({type(material).__name__}) under lights[{j}] ({type(light).__name__}); "
+                    f"registered: {format_allowed(SHADERS)}"
+                )
+
+
+def scene_gbuffer(scene: Scene) -> GBuffer:
+    """The scene's G-buffer at ``supersample ×`` its resolution.
+
+    Examples
+    --------
+    >>> from reference.scene import loads_scene
+    >>> scene = loads_scene("[render]" + chr(10) + "width = 4" + chr(10) + "height = 2"
+    ...                     + chr(10) + "supersample = 3")
+    >>> scene_gbuffer(scene).shape
+    (6, 12)
+    """
+    r = scene.render
+    return render_gbuffer(scene.objects, scene.camera, r.width, r.height, r.supersample)
+
+
+def _gbuffer_rows(gbuffer: GBuffer, start: int, stop: int) -> GBuffer:
+    """Rows ``start:stop`` of a G-buffer (views, no copies)."""
+    return GBuffer(
+        **{f.name: getattr(gbuffer, f.name)[start:stop] for f in dataclasses.fields(GBuffer)}
+    )
+
+
+def _adaptation_white(scene: Scene):
+    """XYZ of the white diffuser under the display's white light (None without adaptation)."""
+    display = scene.display
+    if display.chromatic_adaptation is None:
+        return None
+    W = band_weights(scene.grid, display.white, scene.weights_method, scene.observer)
+    return white_XYZ(W)
+
+
+def _XYZ_to_RGB(scene: Scene) -> np.ndarray:
+    display = scene.display
+    return XYZ_to_RGB_matrix(
+        display.colourspace, _adaptation_white(scene), display.chromatic_adaptation
+    )
+
+
+def background_XYZ(scene: Scene, directions) -> np.ndarray:
+    """XYZ seen along camera rays that hit nothing.
+
+    A constant background is given in linear display RGB and mapped back through the scene's
+    XYZ-to-RGB matrix, so the displayed background is exactly that RGB. An ``"environment"``
+    background looks up the first environment light: an RGB map through its colourspace, a spectral
+    map resampled onto the grid and weighted as radiance (equal-energy band weights).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene.
+    directions : ndarray, shape (N, 3)
+        Unit ray directions.
+
+    Returns
+    -------
+    ndarray, shape (N, 3)
+
+    Examples
+    --------
+    >>> from reference.scene import loads_scene
+    >>> scene = loads_scene("[render]" + chr(10) + "background = [1, 1, 1]")
+    >>> background_XYZ(scene, np.zeros((1, 3))).round(4)
+    array([[0.9505, 1.    , 1.089 ]])
+    """
+    directions = np.asarray(directions, dtype=np.float64)
+    background = scene.render.background
+    if background != "environment":
+        XYZ = np.linalg.solve(_XYZ_to_RGB(scene), np.asarray(background, dtype=np.float64))
+        return np.broadcast_to(XYZ, directions.shape).copy()
+    import colour
+
+    env = next(light for light in scene.lights if isinstance(light, EnvironmentLight))
+    values = latlong_lookup_bilinear(env.image, directions) * env.intensity
+    if not env.is_spectral:
+        space = colour.RGB_COLOURSPACES[env.colourspace]
+        return values @ np.asarray(space.matrix_RGB_to_XYZ).T
+    # A spectral map: linear interpolation onto the grid is a matrix (resample each unit channel).
+    columns = []
+    for k in range(env.wavelengths_nm.size):
+        unit = np.zeros(env.wavelengths_nm.size)
+        unit[k] = 1.0
+        channel = make_spectrum(env.wavelengths_nm, unit, env.name)
+        columns.append(resample_spectrum(channel, scene.grid))
+    to_grid = np.stack(columns, axis=-1)
+    W_E = band_weights(scene.grid, None, scene.weights_method, scene.observer)
+    return (values @ to_grid.T) @ W_E
+
+
+def shade_scene(scene: Scene, gbuffer: GBuffer, options: Mapping | None = None) -> np.ndarray:
+    """XYZ of every G-buffer sample: deferred shading plus the background, shape ``(H, W, 3)``.
+
+    Parameters
+    ----------
+    scene : Scene
+        Materials, lights, grid and render options.
+    gbuffer : GBuffer
+        Visible surfaces (any resolution; the background rays are the camera's at that size).
+    options : mapping, optional
+        Merged over the scene's ``render.options`` into ``ShadingContext.options``.
+
+    Returns
+    -------
+    ndarray, shape gbuffer.shape + (3,)
+
+    Examples
+    --------
+    >>> from reference.scene import loads_scene
+    >>> scene = loads_scene("[render]" + chr(10) + "background = 0.5")
+    >>> shade_scene(scene, scene_gbuffer(scene))[0, 0].round(4)
+    array([0.4752, 0.5   , 0.5444])
+    """
+    check_shaders(scene)
+    ctx = scene.shading_context(options)
+    H, W = gbuffer.shape
+    XYZ = np.empty((H, W, 3))
+    rows = max(1, SHADING_TILE_SAMPLES // max(W, 1))
+    for start in range(0, H, rows):
+        tile = _gbuffer_rows(gbuffer, start, min(start + rows, H))
+        XYZ[start : start + rows] = shade_gbuffer(tile, scene.materials, scene.lights, ctx)
+    missed = ~gbuffer.mask
+    if missed.any():
+        if scene.render.background == "environment":
+            _, directions = scene.camera.rays(W, H)
+            XYZ[missed] = background_XYZ(scene, directions[missed])
+        else:
+            XYZ[missed] = background_XYZ(scene, np.zeros((1, 3)))[0]
+    return XYZ
+
+
+def XYZ_to_display(scene: Scene, XYZ) -> tuple[np.ndarray, np.ndarray]:
+    """Linear display RGB (Eq. (5), Wang et al.) and display-encoded values of an XYZ image.
+
+    Parameters
+    ----------
+    scene : Scene
+        Its ``display`` settings: colourspace, chromatic adaptation, exposure, encoding.
+    XYZ : ndarray, shape (..., 3)
+
+    Returns
+    -------
+    RGB_linear : ndarray, shape (..., 3)
+        Unclipped, before exposure.
+    encoded : ndarray, shape (..., 3)
+        In [0, 1].
+
+    Examples
+    --------
+    >>> from reference.scene import loads_scene
+    >>> RGB, encoded = XYZ_to_display(loads_scene(""), np.array([0.95047, 1.0, 1.08883]) * 0.18)
+    >>> RGB.round(3), encoded.round(3)
+    (array([0.18, 0.18, 0.18]), array([0.461, 0.461, 0.461]))
+    """
+    # Eq. (5), Wang et al.: [R G B] = [X Y Z] · XYZtoRGB (with the adaptation folded in)
+    RGB_linear = np.asarray(XYZ, dtype=np.float64) @ _XYZ_to_RGB(scene).T
+    display = scene.display
+    encoded = linear_to_display(RGB_linear, display.encoding, display.exposure)
+    return RGB_linear, encoded
+
+
+def render_scene(
+    scene: Scene,
+    width: int | None = None,
+    height: int | None = None,
+    supersample: int | None = None,
+    options: Mapping | None = None,
+    gbuffer: GBuffer | None = None,
+) -> RenderResult:
+    """Render a scene: G-buffer, shading, box resolve, display conversion and encoding.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (``reference.scene.load_scene``).
+    width, height, supersample : int, optional
+        Override the scene's ``[render]`` values (a lone width or height keeps the aspect ratio);
+        checked against the limits of ``reference.scene.check_render_size``.
+    options : mapping, optional
+        Shader options merged over ``render.options`` (``{"environment": "bruteforce"}`` is what
+        ``specref render --oracle`` passes).
+    gbuffer : GBuffer, optional
+        A G-buffer from an earlier render of the same camera and geometry, to re-shade without
+        re-rasterizing; its shape must be ``(supersample·height, supersample·width)``.
+
+    Returns
+    -------
+    RenderResult
+
+    Raises
+    ------
+    SpecrefError
+        Bad sizes, a material/light pair without a shader, a G-buffer of the wrong shape.
+
+    Examples
+    --------
+    >>> from reference.scene import loads_scene
+    >>> scene = loads_scene('''
+    ... [materials.white]
+    ... type = "lambert"
+    ... k_d = 1.0
+    ... [[objects]]
+    ... type = "sphere"
+    ... material = "white"
+    ... [[lights]]
+    ... type = "point"
+    ... position = [0, 0, 5]
+    ... ''')
+    >>> result = render_scene(scene, width=9, height=9)
+    >>> result.XYZ[4, 4].round(4), result.encoded[4, 4].round(3)
+    (array([0.9505, 1.    , 1.0888]), array([1., 1., 1.]))
+    >>> again = render_scene(scene, width=9, height=9, gbuffer=result.gbuffer)
+    >>> bool((again.XYZ == result.XYZ).all())
+    True
+    """
+    start = time.perf_counter()
+    if width is not None or height is not None or supersample is not None:
+        scene = scene.with_render(width, height, supersample)
+    r = scene.render
+    check_shaders(scene)
+    if gbuffer is None:
+        gbuffer = scene_gbuffer(scene)
+    else:
+        expected = (r.height * r.supersample, r.width * r.supersample)
+        require(
+            gbuffer.shape == expected,
+            f"render_scene: the G-buffer has shape {gbuffer.shape} but the render needs "
+            f"{expected} (height × width × supersample)",
+        )
+    t_gbuffer = time.perf_counter()
+    XYZ = downsample_box(shade_scene(scene, gbuffer, options), r.supersample)
+    t_shading = time.perf_counter()
+    RGB_linear, encoded = XYZ_to_display(scene, XYZ)
+    t_display = time.perf_counter()
+    timings = {
+        "gbuffer": t_gbuffer - start,
+        "shading": t_shading - t_gbuffer,
+        "display": t_display - t_shading,
+        "total": t_display - start,
+    }
+    return RenderResult(XYZ, RGB_linear, encoded, gbuffer, r.supersample, timings, scene)
+
+
+def _check_output(path, suffix: str, flag: str) -> Path:
+    path = Path(path)
+    require(
+        path.suffix.lower() == suffix,
+        f"{flag}: the output must end in {suffix}, got {str(path)!r}",
+    )
+    require(not path.is_dir(), f"{flag}: {path} is a folder; give a file name")
+    return path
+
+
+def write_render(result: RenderResult, png=None, exr=None) -> list[Path]:
+    """Write a render's PNG (display-encoded, 8 bit) and EXR (linear display RGB), atomically.
+
+    Parameters
+    ----------
+    result : RenderResult
+        From :func:`render_scene`.
+    png, exr : str or Path, optional
+        Destinations (``.png`` and ``.exr``).
+
+    Returns
+    -------
+    list of Path
+        The files written.
+
+    Raises
+    ------
+    SpecrefError
+        Wrong suffix, or the file cannot be written (the message names it).
+    """
+    jobs = []
+    if exr is not None:
+        jobs.append((_check_output(exr, ".exr", "--exr"), write_exr, result.RGB_linear))
+    if png is not None:
+        jobs.append((_check_output(png, ".png", "-o"), write_png, result.encoded))
+    written = []
+    for path, writer, image in jobs:
+        try:
+            written.append(writer(path, image))
+        except OSError as error:
+            raise SpecrefError(
+                f"{path}: cannot write ({error.__class__.__name__}: {error.strerror or error})"
+            ) from None
+    return written
+
+
+def render_scene_file(
+    scene_path,
+    png=None,
+    exr=None,
+    width: int | None = None,
+    height: int | None = None,
+    supersample: int | None = None,
+    oracle: bool = False,
+) -> RenderResult:
+    """Load a scene file, render it and write the outputs: what ``specref render`` does.
+
+    Parameters
+    ----------
+    scene_path : str or Path
+        The ``.toml`` scene.
+    png, exr : str or Path, optional
+        Outputs (see :func:`write_render`); checked before rendering.
+    width, height, supersample : int, optional
+        Size overrides (a lone width or height keeps the aspect ratio).
+    oracle : bool
+        Set ``ShadingContext.options["environment"] = "bruteforce"``: environment lights are
+        integrated by brute force (the SH engine's oracle path) instead of the fast method.
+
+    Returns
+    -------
+    RenderResult
+
+    Raises
+    ------
+    SpecrefError
+        Anything wrong with the scene, the sizes or the outputs.
+    """
+    if png is not None:
+        _check_output(png, ".png", "-o")
+    if exr is not None:
+        _check_output(exr, ".exr", "--exr")
+    scene = load_scene(scene_path)
+    if width is not None or height is not None or supersample is not None:
+        scene = scene.with_render(width, height, supersample, where="command line: render")
+    options = {"environment": "bruteforce"} if oracle else None
+    result = render_scene(scene, options=options)
+    write_render(result, png, exr)
+    return result

@@ -1,0 +1,755 @@
+"""Scene files: TOML (``tomllib``) into a :class:`Scene` of camera, objects, materials and lights.
+
+A scene file has the tables ``[spectral]`` (the wavelength grid and colorimetry), ``[camera]``,
+``[render]`` (size, supersampling, background, shader options), ``[display]`` (colourspace,
+encoding, exposure, chromatic adaptation), ``[materials.<name>]``, and the arrays of tables
+``[[objects]]`` and ``[[lights]]``. ``docs/scene-format.md`` gives every key, its type, default and
+allowed values.
+
+The loader is driven by registries, so a later issue adds a type without editing it:
+
+- material ``type`` keys come from ``reference.materials.MATERIAL_TYPES``; a type reads its
+  parameters as spectra on the grid unless its ``MaterialType.parse`` says otherwise;
+- object types from :data:`OBJECT_TYPES` and light types from :data:`LIGHT_TYPES`, each entry a
+  parser from the TOML table to a primitive or a light;
+- spectrum forms from ``reference.scene_values.SPECTRUM_FORMS``.
+
+Every value is checked where it is read, with one-line messages naming the file, the dotted key,
+what is allowed and what was given: ``scene.toml: materials.gold.n: must be >= 0, got -3``.
+Relative paths (CSV spectra, meshes, environment maps) are relative to the scene file's folder.
+
+Resolution limits: each image side is at most ``MAX_RESOLUTION`` (16384) pixels, supersampling at
+most :data:`MAX_SUPERSAMPLE` (16) per axis, and the G-buffer at most :data:`MAX_RENDER_SAMPLES`
+(4096² = 16 777 216) samples, ``width · height · supersample²``; larger requests are refused as
+absurd (the G-buffer alone takes about 100 bytes per sample).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import tomllib
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+import reference.colorchecker  # noqa: F401  (registers the colorchecker material and shaders)
+from reference.camera import MAX_RESOLUTION, PROJECTIONS, Camera
+from reference.colorimetry import BAND_WEIGHT_METHODS, DEFAULT_OBSERVER, OBSERVERS, band_weights
+from reference.display import ENCODINGS
+from reference.errors import SpecrefError, format_allowed
+from reference.geometry import Plane, Sphere
+from reference.images import channel_wavelengths_nm, read_exr, read_hdr
+from reference.lights import AmbientLight, EnvironmentLight, PointLight
+from reference.materials import MATERIAL_TYPES, MaterialType, make_material
+from reference.registry import Registry
+from reference.scene_values import SceneReader
+from reference.shading import ShadingContext
+from reference.spectra import DEFAULT_GRID, GRIDS, SpectralGrid, Spectrum, spectrum_from_dataset
+
+__all__ = [
+    "LIGHT_TYPES",
+    "MAX_RENDER_SAMPLES",
+    "MAX_SUPERSAMPLE",
+    "OBJECT_TYPES",
+    "DisplaySettings",
+    "RenderSettings",
+    "Scene",
+    "SceneItemType",
+    "check_render_size",
+    "load_scene",
+    "loads_scene",
+    "scene_from_dict",
+]
+
+#: Most G-buffer samples (``width · height · supersample²``) a render may ask for.
+MAX_RENDER_SAMPLES = 4096 * 4096
+#: Most sub-samples per pixel per axis.
+MAX_SUPERSAMPLE = 16
+
+_TOP_LEVEL_KEYS = (
+    "title",
+    "description",
+    "spectral",
+    "camera",
+    "render",
+    "display",
+    "materials",
+    "objects",
+    "lights",
+)
+
+
+def check_render_size(width, height, supersample, where: str = "render") -> tuple[int, int, int]:
+    """Check an image size and supersampling against the documented limits.
+
+    Parameters
+    ----------
+    width, height : int
+        Image size in pixels, each in [1, MAX_RESOLUTION].
+    supersample : int
+        Sub-samples per pixel per axis, in [1, MAX_SUPERSAMPLE].
+    where : str
+        Message prefix, e.g. ``"scene.toml: render"``.
+
+    Returns
+    -------
+    tuple of int
+        ``(width, height, supersample)``.
+
+    Raises
+    ------
+    SpecrefError
+        Zero, negative or non-integer values, or more than :data:`MAX_RENDER_SAMPLES` samples.
+
+    Examples
+    --------
+    >>> check_render_size(640, 480, 2)
+    (640, 480, 2)
+    >>> check_render_size(8192, 8192, 4, "scene.toml: render")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: scene.toml: render: width × height × supersample² = 1073741824
+    samples is above the limit of 16777216 (MAX_RENDER_SAMPLES)
+    """
+    reader = SceneReader("")
+    width = reader.integer(width, f"{where}.width", 1, MAX_RESOLUTION)
+    height = reader.integer(height, f"{where}.height", 1, MAX_RESOLUTION)
+    supersample = reader.integer(supersample, f"{where}.supersample", 1, MAX_SUPERSAMPLE)
+    samples = width * height * supersample**2
+    if samples > MAX_RENDER_SAMPLES:
+        raise SpecrefError(
+            f"{where}: width × height × supersample² = {samples} samples is above the limit of "
+            f"{MAX_RENDER_SAMPLES} (MAX_RENDER_SAMPLES)"
+        )
+    return width, height, supersample
+
+
+@dataclass(frozen=True)
+class RenderSettings:
+    """The ``[render]`` table.
+
+    Attributes
+    ----------
+    width, height : int
+        Image size in pixels.
+    supersample : int
+        Sub-samples per pixel per axis (box filter).
+    background : tuple of 3 floats or "environment"
+        Linear display RGB where no surface is visible, or the first environment light's radiance.
+    options : mapping
+        Handed to ``ShadingContext.options`` (e.g. ``{"environment": "bruteforce"}``).
+    """
+
+    width: int = 256
+    height: int = 256
+    supersample: int = 1
+    background: tuple | str = (0.0, 0.0, 0.0)
+    options: Mapping = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class DisplaySettings:
+    """The ``[display]`` table.
+
+    Attributes
+    ----------
+    colourspace : str
+        A key of ``colour.RGB_COLOURSPACES``.
+    encoding : str
+        A key of ``reference.display.ENCODINGS``.
+    exposure : float
+        Multiplier applied to linear display RGB before encoding (not to the EXR output).
+    chromatic_adaptation : str or None
+        None (colorimetric) or a colour-science transform (``"Bradford"``, ``"CAT02"``, ...).
+    white : Spectrum or None
+        The light whose white diffuser is adapted to display white.
+    """
+
+    colourspace: str = "sRGB"
+    encoding: str = "srgb"
+    exposure: float = 1.0
+    chromatic_adaptation: str | None = None
+    white: Spectrum | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class Scene:
+    """A loaded scene: everything :func:`reference.render.render_scene` needs.
+
+    Attributes
+    ----------
+    camera : Camera
+    objects : tuple
+        Primitives (``Sphere``, ``Plane``, ...); each carries its material index.
+    materials : tuple
+        Material instances, in the order of the ``[materials]`` tables.
+    material_names : tuple of str
+        The materials' names in the file.
+    lights : tuple
+        Light instances, in file order.
+    grid : SpectralGrid
+    observer : str
+    weights_method : str
+        A key of ``reference.colorimetry.BAND_WEIGHT_METHODS``.
+    render : RenderSettings
+    display : DisplaySettings
+    file : str
+        The file's label in messages.
+    path : Path or None
+        The file, if loaded from one.
+    title : str
+
+    Examples
+    --------
+    >>> scene = loads_scene('''
+    ... [materials.grey]
+    ... type = "lambert"
+    ... k_d = 0.5
+    ... [[objects]]
+    ... type = "sphere"
+    ... material = "grey"
+    ... [[lights]]
+    ... type = "point"
+    ... position = [0, 0, 5]
+    ... ''')
+    >>> scene.grid.n_bands, scene.material_names, type(scene.lights[0]).__name__
+    (41, ('grey',), 'PointLight')
+    """
+
+    camera: Camera
+    objects: tuple
+    materials: tuple
+    material_names: tuple
+    lights: tuple
+    grid: SpectralGrid = DEFAULT_GRID
+    observer: str = DEFAULT_OBSERVER
+    weights_method: str = "astm_e308"
+    render: RenderSettings = field(default_factory=RenderSettings)
+    display: DisplaySettings = field(default_factory=DisplaySettings)
+    file: str = "<string>"
+    path: Path | None = None
+    title: str = ""
+
+    def shading_context(self, options: Mapping | None = None) -> ShadingContext:
+        """The :class:`~reference.shading.ShadingContext` of this scene, options merged in.
+
+        Examples
+        --------
+        >>> scene = loads_scene('[render.options]' + chr(10) + 'environment = "sh"')
+        >>> dict(scene.shading_context({"environment": "bruteforce"}).options)
+        {'environment': 'bruteforce'}
+        """
+        merged = {**self.render.options, **(options or {})}
+        return ShadingContext(self.grid, self.observer, self.weights_method, merged)
+
+    def with_render(self, width=None, height=None, supersample=None, where="render") -> Scene:
+        """The scene with another size or supersampling; a lone width or height keeps the aspect.
+
+        Examples
+        --------
+        >>> scene = loads_scene('[render]' + chr(10) + 'width = 200' + chr(10) + 'height = 100')
+        >>> s = scene.with_render(width=50).render
+        >>> s.width, s.height
+        (50, 25)
+        """
+        r = self.render
+        if width is not None and height is None:
+            height = max(1, round(width * r.height / r.width)) if _is_count(width) else width
+        if height is not None and width is None:
+            width = max(1, round(height * r.width / r.height)) if _is_count(height) else height
+        width, height, supersample = check_render_size(
+            r.width if width is None else width,
+            r.height if height is None else height,
+            r.supersample if supersample is None else supersample,
+            where,
+        )
+        render = dataclasses.replace(r, width=width, height=height, supersample=supersample)
+        return dataclasses.replace(self, render=render)
+
+    def material_index(self, name: str) -> int:
+        """Index of the material called ``name``."""
+        if name not in self.material_names:
+            raise SpecrefError(
+                f"{self.file}: unknown material {name!r}; allowed: "
+                f"{format_allowed(self.material_names)}"
+            )
+        return self.material_names.index(name)
+
+
+def _is_count(value) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool) and value >= 1
+
+
+# --- object and light types
+# -------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class SceneItemType:
+    """A registered object or light type of scene files.
+
+    Parameters
+    ----------
+    name : str
+        The ``type`` key (``"sphere"``, ``"point"``).
+    parse : callable
+        Objects: ``parse(reader, table, key, materials) -> primitive``, where ``materials`` maps
+        material names to indices; lights: ``parse(reader, table, key) -> light``.
+    keys : tuple of str
+        The keys the table accepts besides ``type`` (for documentation and the docs test).
+    doc : str
+        One line for ``docs/scene-format.md``.
+    """
+
+    name: str
+    parse: Callable
+    keys: tuple = ()
+    doc: str = ""
+
+
+def _material_ref(reader: SceneReader, table: dict, key: str, materials: Mapping) -> int:
+    name = table.get("material")
+    if not isinstance(name, str) or name not in materials:
+        reader.fail(
+            f"{key}.material",
+            f"unknown material {name!r}; allowed: {format_allowed(materials) or 'none defined'}",
+        )
+    return materials[name]
+
+
+def _parse_sphere(reader: SceneReader, table: dict, key: str, materials: Mapping) -> Sphere:
+    reader.table(table, key, ("type", "material", "center", "radius"), ("material",))
+    center = reader.vector(table.get("center", [0.0, 0.0, 0.0]), f"{key}.center")
+    radius = reader.number(table.get("radius", 1.0), f"{key}.radius", 0, exclusive_minimum=True)
+    with reader.context(key, alias="sphere"):
+        return Sphere(center, radius, _material_ref(reader, table, key, materials))
+
+
+def _plane_parser(rectangle: bool):
+    def parse(reader: SceneReader, table: dict, key: str, materials: Mapping) -> Plane:
+        keys = ("type", "material", "point", "normal", "u_axis", "size")
+        required = ("material", "size") if rectangle else ("material",)
+        reader.table(table, key, keys, required)
+        point = reader.vector(table.get("point", [0.0, 0.0, 0.0]), f"{key}.point")
+        normal = reader.vector(table.get("normal", [0.0, 1.0, 0.0]), f"{key}.normal")
+        u_axis = reader.vector(table.get("u_axis", [1.0, 0.0, 0.0]), f"{key}.u_axis")
+        size = None
+        if "size" in table:
+            size = reader.vector(table["size"], f"{key}.size", n=2)
+            for i, s in enumerate(size):
+                reader.number(s, f"{key}.size[{i}]", 0, exclusive_minimum=True)
+        if np.linalg.norm(normal) == 0:
+            reader.fail(f"{key}.normal", f"must be non-zero, got {list(normal)}")
+        with reader.context(key, alias="plane"):
+            return Plane(point, normal, u_axis, size, _material_ref(reader, table, key, materials))
+
+    return parse
+
+
+def _parse_point_light(reader: SceneReader, table: dict, key: str) -> PointLight:
+    keys = ("type", "position", "spectrum", "intensity", "attenuation")
+    reader.table(table, key, keys, ("position",))
+    position = reader.vector(table["position"], f"{key}.position")
+    spectrum = _light_spectrum(reader, table, key)
+    intensity = reader.number(table.get("intensity", 1.0), f"{key}.intensity", minimum=0)
+    c = reader.vector(table.get("attenuation", [1.0, 0.0, 0.0]), f"{key}.attenuation")
+    for i, value in enumerate(c):
+        reader.number(value, f"{key}.attenuation[{i}]", minimum=0)
+    if sum(c) <= 0:
+        reader.fail(f"{key}.attenuation", f"c1, c2, c3 must not all be 0, got {list(c)}")
+    with reader.context(key, alias="light"):
+        return PointLight(position, spectrum, intensity, c)
+
+
+def _light_spectrum(reader: SceneReader, table: dict, key: str) -> Spectrum:
+    if "spectrum" not in table:
+        return spectrum_from_dataset("illuminant", "D65")
+    return reader.light_spectrum(table["spectrum"], f"{key}.spectrum")
+
+
+def _parse_ambient_light(reader: SceneReader, table: dict, key: str) -> AmbientLight:
+    reader.table(table, key, ("type", "spectrum", "intensity"))
+    spectrum = _light_spectrum(reader, table, key)
+    intensity = reader.number(table.get("intensity", 1.0), f"{key}.intensity", minimum=0)
+    with reader.context(key, alias="light"):
+        return AmbientLight(spectrum, intensity)
+
+
+def _parse_environment_light(reader: SceneReader, table: dict, key: str) -> EnvironmentLight:
+    import colour
+
+    reader.table(table, key, ("type", "file", "intensity", "colourspace"), ("file",))
+    path = reader.file_path(table["file"], f"{key}.file")
+    intensity = reader.number(table.get("intensity", 1.0), f"{key}.intensity", minimum=0)
+    colourspace = reader.choice(
+        table.get("colourspace", "sRGB"), f"{key}.colourspace", colour.RGB_COLOURSPACES
+    )
+    suffix = path.suffix.lower()
+    wavelengths = None
+    with reader.context(f"{key}.file"):
+        if suffix == ".exr":
+            image, names = read_exr(path)
+            if names[:3] == ["R", "G", "B"]:
+                image = image[..., :3]
+            else:
+                wavelengths = channel_wavelengths_nm(names)
+                if wavelengths is None:
+                    raise SpecrefError(
+                        f"{path}: channels {', '.join(names)}; an environment needs R, G, B or "
+                        "channels named by wavelength (S0.550,000000nm)"
+                    )
+        elif suffix in (".hdr", ".rgbe", ".pic"):
+            image = read_hdr(path)
+        else:
+            raise SpecrefError(
+                f"{path}: unsupported environment map type {suffix!r}; allowed: .exr, .hdr"
+            )
+        return EnvironmentLight(image, wavelengths, colourspace, intensity, name=str(path))
+
+
+#: Object types of scene files (``[[objects]] type = ...``).
+OBJECT_TYPES = Registry("object type")
+OBJECT_TYPES.register(
+    SceneItemType("sphere", _parse_sphere, ("material", "center", "radius"), "an analytic sphere")
+)
+OBJECT_TYPES.register(
+    SceneItemType(
+        "plane",
+        _plane_parser(rectangle=False),
+        ("material", "point", "normal", "u_axis", "size"),
+        "an analytic plane (a rectangle if `size` is given)",
+    )
+)
+OBJECT_TYPES.register(
+    SceneItemType(
+        "rectangle",
+        _plane_parser(rectangle=True),
+        ("material", "point", "normal", "u_axis", "size"),
+        "a plane with a required `size`; uv spans [0, 1] over it",
+    )
+)
+
+#: Light types of scene files (``[[lights]] type = ...``).
+LIGHT_TYPES = Registry("light type")
+LIGHT_TYPES.register(
+    SceneItemType(
+        "point",
+        _parse_point_light,
+        ("position", "spectrum", "intensity", "attenuation"),
+        "a point light with Wang et al.'s attenuation",
+    )
+)
+LIGHT_TYPES.register(
+    SceneItemType(
+        "ambient", _parse_ambient_light, ("spectrum", "intensity"), "the ambient term I_a"
+    )
+)
+LIGHT_TYPES.register(
+    SceneItemType(
+        "environment",
+        _parse_environment_light,
+        ("file", "intensity", "colourspace"),
+        "a lat-long environment map (.hdr, or .exr with RGB or wavelength channels)",
+    )
+)
+
+
+# --- the scene tables
+# -------------------------------------------------------------------------------------
+
+
+def _parse_spectral(reader: SceneReader, data: dict) -> tuple[SpectralGrid, str, str]:
+    key = "spectral"
+    table = reader.table(
+        data.get(key, {}),
+        key,
+        ("grid", "start_nm", "end_nm", "step_nm", "observer", "weights"),
+    )
+    explicit = [k for k in ("start_nm", "end_nm", "step_nm") if k in table]
+    if explicit and "grid" in table:
+        reader.fail(key, "give either grid or start_nm, end_nm, step_nm, not both")
+    if explicit:
+        if len(explicit) != 3:
+            reader.fail(key, "start_nm, end_nm and step_nm go together; give all three")
+        bounds = [reader.number(table[k], f"{key}.{k}") for k in ("start_nm", "end_nm", "step_nm")]
+        with reader.context(key):
+            grid = SpectralGrid(*bounds)
+    else:
+        grid = GRIDS[reader.choice(str(table.get("grid", "41")), f"{key}.grid", GRIDS)]
+    observer = reader.choice(table.get("observer", DEFAULT_OBSERVER), f"{key}.observer", OBSERVERS)
+    method = reader.choice(table.get("weights", "astm_e308"), f"{key}.weights", BAND_WEIGHT_METHODS)
+    # The band weights check that the grid suits the method (ASTM E308: within 360-780 nm, ...).
+    with reader.context(key):
+        band_weights(grid, None, method, observer)
+    return grid, observer, method
+
+
+def _parse_camera(reader: SceneReader, data: dict) -> Camera:
+    key = "camera"
+    table = reader.table(
+        data.get(key, {}), key, ("eye", "target", "up", "projection", "fov_deg", "extent")
+    )
+    defaults = Camera()
+    kwargs = {}
+    for name in ("eye", "target", "up"):
+        kwargs[name] = reader.vector(
+            table.get(name, list(getattr(defaults, name))), f"{key}.{name}"
+        )
+    kwargs["projection"] = reader.choice(
+        table.get("projection", defaults.projection), f"{key}.projection", PROJECTIONS
+    )
+    kwargs["fov_deg"] = reader.number(
+        table.get("fov_deg", defaults.fov_deg),
+        f"{key}.fov_deg",
+        0,
+        180,
+        exclusive_minimum=True,
+        exclusive_maximum=True,
+    )
+    kwargs["extent"] = reader.number(
+        table.get("extent", defaults.extent), f"{key}.extent", 0, exclusive_minimum=True
+    )
+    with reader.context(key, alias="camera"):
+        return Camera(**kwargs)
+
+
+def _parse_render(reader: SceneReader, data: dict, lights: tuple) -> RenderSettings:
+    key = "render"
+    table = reader.table(
+        data.get(key, {}), key, ("width", "height", "supersample", "background", "options")
+    )
+    defaults = RenderSettings()
+    width, height, supersample = check_render_size(
+        table.get("width", defaults.width),
+        table.get("height", defaults.height),
+        table.get("supersample", defaults.supersample),
+        f"{reader.file}: {key}",
+    )
+    background = table.get("background", 0.0)
+    if background == "environment":
+        if not any(isinstance(light, EnvironmentLight) for light in lights):
+            reader.fail(f"{key}.background", '"environment" needs an environment light')
+    elif isinstance(background, list):
+        background = reader.vector(background, f"{key}.background")
+        for i, value in enumerate(background):
+            reader.number(value, f"{key}.background[{i}]", minimum=0)
+    elif isinstance(background, int | float) and not isinstance(background, bool):
+        background = (reader.number(background, f"{key}.background", minimum=0),) * 3
+    else:
+        reader.fail(
+            f"{key}.background",
+            f'must be a number, a list of 3 linear RGB values or "environment", got '
+            f"{background!r:.60}",
+        )
+    options = reader.table(table.get("options", {}), f"{key}.options")
+    return RenderSettings(width, height, supersample, background, dict(options))
+
+
+def _parse_display(reader: SceneReader, data: dict, lights: tuple) -> DisplaySettings:
+    import colour
+
+    key = "display"
+    table = reader.table(
+        data.get(key, {}),
+        key,
+        ("colourspace", "encoding", "exposure", "chromatic_adaptation", "white"),
+    )
+    colourspace = reader.choice(
+        table.get("colourspace", "sRGB"), f"{key}.colourspace", colour.RGB_COLOURSPACES
+    )
+    encoding = reader.choice(table.get("encoding", "srgb"), f"{key}.encoding", ENCODINGS)
+    exposure = reader.number(
+        table.get("exposure", 1.0), f"{key}.exposure", 0, exclusive_minimum=True
+    )
+    adaptation = reader.choice(
+        table.get("chromatic_adaptation", "none"),
+        f"{key}.chromatic_adaptation",
+        ["none", *colour.CHROMATIC_ADAPTATION_TRANSFORMS],
+    )
+    adaptation = None if adaptation == "none" else adaptation
+    if "white" in table:
+        white = reader.light_spectrum(table["white"], f"{key}.white")
+    else:
+        white = next((light.spectrum for light in lights if hasattr(light, "spectrum")), None)
+    if adaptation is not None and white is None:
+        reader.fail(
+            f"{key}.chromatic_adaptation",
+            "needs display.white when the scene has no point or ambient light",
+        )
+    return DisplaySettings(colourspace, encoding, exposure, adaptation, white)
+
+
+def _parse_material(reader: SceneReader, table, key: str, name: str):
+    reader.table(table, key, required=("type",))
+    kind: MaterialType = MATERIAL_TYPES.lookup(
+        reader.choice(table["type"], f"{key}.type", MATERIAL_TYPES)
+    )
+    if kind.parse is not None:
+        return kind.parse(reader, table, key, name)
+    parameters = (*kind.required, *kind.optional)
+    reader.table(table, key, ("type", *parameters), kind.required)
+    params = {p: reader.spectrum_on_grid(table[p], f"{key}.{p}") for p in parameters if p in table}
+    with reader.context(key, alias=name):
+        return make_material(kind.name, params, name)
+
+
+def _item_type(reader: SceneReader, table: dict, key: str, registry: Registry) -> SceneItemType:
+    reader.table(table, key, required=("type",))
+    return registry.lookup(reader.choice(table["type"], f"{key}.type", registry))
+
+
+def scene_from_dict(data: dict, file: str = "<string>", base_dir=".", path=None) -> Scene:
+    """Build a :class:`Scene` from parsed TOML.
+
+    Parameters
+    ----------
+    data : dict
+        The parsed TOML document.
+    file : str
+        The file's label in messages.
+    base_dir : str or Path
+        Folder for relative paths.
+    path : Path, optional
+        The scene file.
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    SpecrefError
+        Any invalid key or value, naming the file and the dotted key.
+
+    Examples
+    --------
+    >>> scene_from_dict({"camera": {"fov": 30}}, "scene.toml")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: scene.toml: camera: unknown key 'fov'; allowed: extent, eye,
+    fov_deg, projection, target, up
+    """
+    reader = SceneReader(file, Path(base_dir))
+    reader.table(data, "top level", _TOP_LEVEL_KEYS)
+    title = reader.string(data.get("title", "untitled"), "title")
+    if "description" in data:
+        reader.string(data["description"], "description")
+    grid, observer, method = _parse_spectral(reader, data)
+    reader.grid = grid
+
+    materials_table = reader.table(data.get("materials", {}), "materials")
+    materials, names = [], []
+    for name, table in materials_table.items():
+        materials.append(_parse_material(reader, table, f"materials.{name}", name))
+        names.append(name)
+    index = {name: i for i, name in enumerate(names)}
+
+    objects = []
+    for i, table in enumerate(reader.array_of_tables(data.get("objects", []), "objects")):
+        key = f"objects[{i}]"
+        kind = _item_type(reader, table, key, OBJECT_TYPES)
+        objects.append(kind.parse(reader, table, key, index))
+
+    lights = []
+    for i, table in enumerate(reader.array_of_tables(data.get("lights", []), "lights")):
+        key = f"lights[{i}]"
+        kind = _item_type(reader, table, key, LIGHT_TYPES)
+        lights.append(kind.parse(reader, table, key))
+    lights = tuple(lights)
+
+    return Scene(
+        camera=_parse_camera(reader, data),
+        objects=tuple(objects),
+        materials=tuple(materials),
+        material_names=tuple(names),
+        lights=lights,
+        grid=grid,
+        observer=observer,
+        weights_method=method,
+        render=_parse_render(reader, data, lights),
+        display=_parse_display(reader, data, lights),
+        file=file,
+        path=None if path is None else Path(path),
+        title=title,
+    )
+
+
+def loads_scene(text: str, file: str = "<string>", base_dir=".") -> Scene:
+    """Load a scene from TOML text (inline scenes in docs and tests).
+
+    Parameters
+    ----------
+    text : str
+        The TOML document.
+    file : str
+        Label for messages.
+    base_dir : str or Path
+        Folder for relative paths.
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    SpecrefError
+        Malformed TOML, or any invalid key or value.
+
+    Examples
+    --------
+    >>> loads_scene("[camera" + chr(10) + "eye = [0, 0, 5]", "scene.toml")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: scene.toml: malformed TOML: Expected ']' at the end of a table
+    declaration (at line 1, column 8)
+    """
+    if not isinstance(text, str):
+        raise SpecrefError(f"{file}: a scene must be TOML text, got {type(text).__name__}")
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise SpecrefError(f"{file}: malformed TOML: {error}") from None
+    return scene_from_dict(data, file, base_dir)
+
+
+def load_scene(path) -> Scene:
+    """Load a scene file.
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.toml`` file; relative paths inside it are relative to its folder.
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    SpecrefError
+        Missing or unreadable file, malformed TOML, any invalid key or value.
+
+    Examples
+    --------
+    >>> load_scene("no-such-scene.toml")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: no-such-scene.toml: file not found
+    """
+    file = str(path)
+    path = Path(path)
+    if not path.is_file():
+        raise SpecrefError(f"{file}: file not found")
+    try:
+        text = path.read_bytes().decode("utf-8")
+    except UnicodeDecodeError:
+        raise SpecrefError(f"{file}: not UTF-8 text, so not a TOML scene") from None
+    except OSError as error:
+        raise SpecrefError(f"{file}: cannot read ({error.__class__.__name__})") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise SpecrefError(f"{file}: malformed TOML: {error}") from None
+    return scene_from_dict(data, file, path.parent, path)
