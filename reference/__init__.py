@@ -5,6 +5,7 @@ their citations. ``reference`` imports none of ``phong_table``, ``shrm`` or ``va
 """
 
 from reference.camera import MAX_RESOLUTION, PROJECTIONS, Camera, downsample_box
+from reference.colorchecker import ColorCheckerMaterial, colorchecker_material
 from reference.colorimetry import (
     BAND_WEIGHT_METHODS,
     DEFAULT_OBSERVER,
@@ -51,6 +52,16 @@ from reference.lights import (
 )
 from reference.materials import MATERIAL_TYPES, LambertMaterial, PhongMaterial, make_material
 from reference.registry import Method, Registry
+from reference.render import RenderResult, render_scene, render_scene_file, write_render
+from reference.scene import (
+    LIGHT_TYPES,
+    MAX_RENDER_SAMPLES,
+    OBJECT_TYPES,
+    Scene,
+    load_scene,
+    loads_scene,
+)
+from reference.scene_values import SPECTRUM_FORMS
 from reference.shading import (
     SHADERS,
     ShadingContext,
@@ -81,14 +92,19 @@ __all__ = [
     "GRIDS",
     "GRID_31",
     "GRID_41",
+    "LIGHT_TYPES",
     "MATERIAL_TYPES",
+    "MAX_RENDER_SAMPLES",
     "MAX_RESOLUTION",
+    "OBJECT_TYPES",
     "OBSERVERS",
     "PRIMITIVES",
     "PROJECTIONS",
     "SHADERS",
+    "SPECTRUM_FORMS",
     "AmbientLight",
     "Camera",
+    "ColorCheckerMaterial",
     "EnvironmentLight",
     "GBuffer",
     "LambertMaterial",
@@ -97,6 +113,8 @@ __all__ = [
     "Plane",
     "PointLight",
     "Registry",
+    "RenderResult",
+    "Scene",
     "ShadingContext",
     "SpecrefError",
     "SpecrefWarning",
@@ -113,6 +131,7 @@ __all__ = [
     "band_weights_ASTM_E308",
     "band_weights_point_sampled",
     "check_latlong_shape",
+    "colorchecker_material",
     "delta_E_00",
     "direction_to_latlong_uv",
     "display_RGB_to_XYZ",
@@ -126,6 +145,8 @@ __all__ = [
     "latlong_pixel_solid_angles",
     "latlong_uv_to_direction",
     "linear_to_display",
+    "load_scene",
+    "loads_scene",
     "make_material",
     "make_spectrum",
     "phong_cosines",
@@ -136,6 +157,8 @@ __all__ = [
     "read_image",
     "read_png",
     "render_gbuffer",
+    "render_scene",
+    "render_scene_file",
     "require",
     "resample_spectrum",
     "shade_gbuffer",
@@ -148,4 +171,5 @@ __all__ = [
     "white_XYZ",
     "write_exr",
     "write_png",
+    "write_render",
 ]

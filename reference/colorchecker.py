@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from reference.errors import require, require_nonnegative
+from reference.geometry import plane_uv_to_point
 from reference.lights import AmbientLight, PointLight, attenuation_Wang, point_light_vectors
 from reference.materials import MATERIAL_TYPES, MaterialType
 from reference.registry import Method
@@ -50,6 +51,7 @@ __all__ = [
     "colorchecker_material",
     "colorchecker_patch_centres_uv",
     "colorchecker_patch_index",
+    "colorchecker_patch_pixels",
     "shade_colorchecker_ambient",
     "shade_colorchecker_point",
 ]
@@ -170,6 +172,42 @@ def colorchecker_patch_centres_uv() -> np.ndarray:
     columns, rows = COLORCHECKER_LAYOUT
     row, column = np.divmod(np.arange(_N_PATCHES), columns)
     return np.stack([(column + 0.5) / columns, (row + 0.5) / rows], axis=-1)
+
+
+def colorchecker_patch_pixels(camera, chart, width: int, height: int) -> np.ndarray:
+    """Image pixels ``(row, column)`` under the 24 patch centres of a chart seen by a camera.
+
+    Parameters
+    ----------
+    camera : Camera
+        The camera.
+    chart : Plane
+        The rectangle that carries the chart.
+    width, height : int
+        Image size.
+
+    Returns
+    -------
+    ndarray of int, shape (24, 2)
+        Row and column of each patch centre's pixel, in chart order; -1 where the centre falls
+        outside the image or behind the camera.
+
+    Examples
+    --------
+    >>> from reference.camera import Camera
+    >>> from reference.geometry import Plane
+    >>> cam = Camera(projection="orthographic", extent=0.4)
+    >>> chart = Plane((0, 0, 0), (0, 0, 1), (1, 0, 0), size=(0.6, 0.4))
+    >>> colorchecker_patch_pixels(cam, chart, 66, 44)[[0, 23]]
+    array([[ 5,  5],
+           [38, 60]])
+    """
+    points = plane_uv_to_point(chart, colorchecker_patch_centres_uv())
+    x, y, depth = camera.project(points, width, height)
+    with np.errstate(invalid="ignore"):
+        inside = (depth > 0) & (x >= 0) & (x < width) & (y >= 0) & (y < height)
+    pixels = np.stack([np.floor(y), np.floor(x)], axis=-1)
+    return np.where(inside[:, None], np.nan_to_num(pixels, nan=-1), -1).astype(np.int64)
 
 
 def colorchecker_material(

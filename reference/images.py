@@ -47,6 +47,16 @@ __all__ = [
 #: Largest image (pixels) that specref reads or writes; larger inputs are refused as absurd.
 MAX_IMAGE_PIXELS = 16384 * 16384
 
+# The process umask, read once at import: mkstemp creates files 0600, and a finished output should
+# get the permissions an ordinary open() would give it.
+_UMASK = os.umask(0o022)
+os.umask(_UMASK)
+
+
+def _new_file_permissions(tmp) -> None:
+    """Give a temporary file the permissions of a newly created ordinary file (0666 & ~umask)."""
+    os.chmod(tmp, 0o666 & ~_UMASK)
+
 
 @contextlib.contextmanager
 def atomic_write(path, mode: str = "wb"):
@@ -80,6 +90,7 @@ def atomic_write(path, mode: str = "wb"):
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
+        _new_file_permissions(tmp)
         with os.fdopen(fd, mode) as handle:
             yield handle
             handle.flush()
@@ -261,6 +272,7 @@ def write_exr(path, image, channels: list[str] | None = None, half: bool = False
     try:
         with OpenEXR.File(header, data) as handle:
             handle.write(tmp)
+        _new_file_permissions(tmp)
         os.replace(tmp, path)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
