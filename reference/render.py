@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from reference.camera import downsample_box
-from reference.colorimetry import XYZ_to_RGB_matrix, band_weights, white_XYZ
+from reference.colorimetry import XYZ_to_RGB_matrix, band_weights, display_RGB_to_XYZ, white_XYZ
 from reference.display import linear_to_display
 from reference.envmap import latlong_lookup_bilinear
 from reference.errors import SpecrefError, format_allowed, require
@@ -194,13 +194,10 @@ def background_XYZ(scene: Scene, directions) -> np.ndarray:
     if background != "environment":
         XYZ = np.linalg.solve(_XYZ_to_RGB(scene), np.asarray(background, dtype=np.float64))
         return np.broadcast_to(XYZ, directions.shape).copy()
-    import colour
-
     env = next(light for light in scene.lights if isinstance(light, EnvironmentLight))
     values = latlong_lookup_bilinear(env.image, directions) * env.intensity
     if not env.is_spectral:
-        space = colour.RGB_COLOURSPACES[env.colourspace]
-        return values @ np.asarray(space.matrix_RGB_to_XYZ).T
+        return display_RGB_to_XYZ(values, env.colourspace)
     # A spectral map: linear interpolation onto the grid is a matrix (resample each unit channel).
     columns = []
     for k in range(env.wavelengths_nm.size):
