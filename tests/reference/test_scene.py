@@ -151,7 +151,7 @@ def test_load_scene_reads_every_section(tmp_path):
 def test_load_scene_defaults():
     scene = scene_with("")
     assert scene.grid == GRID_41
-    assert scene.objects == () and scene.lights == () and scene.materials == ()
+    assert (scene.objects, scene.lights, scene.materials) == ((), (), ())
     assert (scene.render.width, scene.render.height, scene.render.supersample) == (256, 256, 1)
     assert scene.render.background == (0.0, 0.0, 0.0)
     assert (scene.display.colourspace, scene.display.encoding) == ("sRGB", "srgb")
@@ -293,7 +293,8 @@ def test_environment_light_rgb_and_spectral_exr(tmp_path):
         tmp_path,
     )
     first, second = scene.lights
-    assert isinstance(first, EnvironmentLight) and not first.is_spectral
+    assert isinstance(first, EnvironmentLight)
+    assert not first.is_spectral
     assert_allclose(first.image, rgb)
     assert first.intensity == 2.0
     assert second.is_spectral
@@ -306,7 +307,7 @@ def test_environment_light_reads_shared_hdr(shared_data):
     assert scene.lights[0].image.shape == (512, 1024, 3)
 
 
-# --- bad input: one line naming the file, the key, what is allowed, what was given -----------------
+# --- bad input: one line naming the file, the key, what is allowed, what was given ---------------
 
 
 def test_bad_material_value_message_has_the_documented_form():
