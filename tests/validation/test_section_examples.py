@@ -1,0 +1,36 @@
+"""Report section "Examples": the renders, their times and the ColorChecker check."""
+
+from __future__ import annotations
+
+import validation.sections.examples as examples
+from validation.report import REPORT_SECTIONS, Image, ReportContext, Table, Text
+
+
+def test_examples_section_quick(tmp_path):
+    section = REPORT_SECTIONS.lookup("examples")
+    assert section.order == 30
+    result = section.run(ReportContext(out_dir=tmp_path, quick=True, section="examples"))
+    images = [b for b in result.blocks if isinstance(b, Image)]
+    assert {i.path for i in images} == {
+        "images/examples-colorchecker-d65-a.png",
+        "images/examples-phong-sphere.png",
+    }
+    for image in images:
+        assert (tmp_path / image.path).is_file()
+    assert any(isinstance(b, Table) for b in result.blocks)
+    scenes = result.results["scenes"]
+    assert set(scenes) == {"colorchecker-d65.toml", "colorchecker-a.toml", "phong-sphere.toml"}
+    for entry in scenes.values():
+        assert entry["seconds"]["total"] > 0
+    # The rendered charts reproduce colour-science's E308 XYZ (Y = 1 scale), as the issue asks of
+    # the band weights: |ΔXYZ| <= 1e-9 on the Y = 100 scale.
+    for name in ("colorchecker-d65.toml", "colorchecker-a.toml"):
+        assert scenes[name]["accuracy"]["max_abs_dXYZ"] * 100 <= 1e-9
+
+
+def test_examples_section_says_when_the_scenes_are_missing(tmp_path, monkeypatch):
+    monkeypatch.setattr(examples, "EXAMPLES_DIR", tmp_path / "nowhere")
+    result = examples.run(ReportContext(out_dir=tmp_path, quick=True, section="examples"))
+    assert isinstance(result.blocks[0], Text)
+    assert "missing" in result.blocks[0].text
+    assert result.results["missing"] == [name for name, _ in examples.SCENES]
