@@ -42,6 +42,8 @@ from reference.images import (
     write_exr,
     write_png,
 )
+from reference.mesh import TriangleMesh, grid_mesh, mesh_from_obj, mesh_to_obj, uv_sphere_mesh
+from reference.raster import RASTER_METHODS, pixel_coverage, rasterize_mesh
 from reference.registry import Method, Registry
 from reference.spectra import (
     DEFAULT_GRID,
@@ -69,6 +71,7 @@ __all__ = [
     "OBSERVERS",
     "PRIMITIVES",
     "PROJECTIONS",
+    "RASTER_METHODS",
     "Camera",
     "GBuffer",
     "Method",
@@ -79,6 +82,7 @@ __all__ = [
     "SpectralGrid",
     "Spectrum",
     "Sphere",
+    "TriangleMesh",
     "XYZ_to_Lab",
     "XYZ_to_RGB_matrix",
     "XYZ_to_display_RGB",
@@ -93,6 +97,7 @@ __all__ = [
     "display_to_linear",
     "downsample_box",
     "empty_gbuffer",
+    "grid_mesh",
     "intersect_plane",
     "intersect_sphere",
     "latlong_lookup_bilinear",
@@ -101,6 +106,10 @@ __all__ = [
     "latlong_uv_to_direction",
     "linear_to_display",
     "make_spectrum",
+    "mesh_from_obj",
+    "mesh_to_obj",
+    "pixel_coverage",
+    "rasterize_mesh",
     "read_exr",
     "read_hdr",
     "read_image",
@@ -114,6 +123,7 @@ __all__ = [
     "spectrum_from_csv",
     "spectrum_from_dataset",
     "to_8bit",
+    "uv_sphere_mesh",
     "white_XYZ",
     "write_exr",
     "write_png",
