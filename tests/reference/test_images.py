@@ -20,6 +20,7 @@ from reference.images import (
 def test_atomic_write_leaves_target_untouched_on_failure(tmp_path):
     target = tmp_path / "out.txt"
     target.write_text("old")
+
     def interrupted_write():
         with atomic_write(target, "w") as handle:
             handle.write("half")
