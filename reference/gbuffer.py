@@ -119,6 +119,15 @@ def gbuffer_from_hit(
     Returns
     -------
     GBuffer
+
+    Examples
+    --------
+    >>> from reference.geometry import intersect_sphere, Sphere
+    >>> cam = Camera(eye=(0, 0, 5))
+    >>> origins, directions = cam.rays(4, 4)
+    >>> g = gbuffer_from_hit(intersect_sphere(Sphere(), origins, directions), cam, directions, 0, 0)
+    >>> int(g.mask.sum()), float(g.depth[g.mask].min()).__round__(3)
+    (4, 4.213)
     """
     H, W = hit.t.shape
     g = empty_gbuffer(H, W)

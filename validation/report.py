@@ -309,6 +309,14 @@ def run_report(
     ------
     SpecrefError
         Unknown section key, unreadable benchmark file.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     results = run_report(folder, quick=True, only=["spectral-core"], progress=False)
+    >>> round(results["sections"]["spectral-core"]["380-780/10 FL2 point"]["mean"], 1)
+    4.0
     """
     from tqdm import tqdm
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from reference.spectra import GRID_31, GRID_41
-from validation.metrics import colorchecker_delta_E, delta_E_stats
+from validation.metrics import COLORCHECKER, colorchecker_delta_E, delta_E_stats
 from validation.report import (
     REPORT_SECTIONS,
     ReportContext,
@@ -46,14 +46,17 @@ def run(ctx: ReportContext) -> SectionResult:
             "{:.3f}",
         ),
     ]
-    fig, ax = plt.subplots(figsize=(8, 3))
-    x = np.arange(24)
+    import colour
+
+    names = list(colour.SDS_COLOURCHECKERS[COLORCHECKER])
+    fig, ax = plt.subplots(figsize=(9, 3.6))
+    x = np.arange(len(names))
     for offset, method in ((-0.2, "astm_e308"), (0.2, "point")):
         ax.bar(x + offset, per_patch[(GRID_41.label, "FL2", method)], width=0.4, label=method)
     ax.set_yscale("log")
-    ax.set_xlabel("ColorChecker patch")
+    ax.set_xticks(x, names, rotation=60, ha="right", fontsize=8)
     ax.set_ylabel("ΔE00 under FL2 (41 bands)")
-    ax.legend()
+    ax.legend(ncol=2, loc="lower center", bbox_to_anchor=(0.5, 1.0), frameon=False)
     blocks.append(ctx.figure("fl2-patches", fig, "Per-patch ΔE00 under FL2, 41-band grid"))
     return SectionResult(blocks, results)
 
