@@ -17,7 +17,8 @@ def test_face_normals_counter_clockwise_closed_form():
     mesh = TriangleMesh(TRI, [[0, 1, 2], [0, 2, 1]])
     np.testing.assert_array_equal(mesh.face_normals(), [[0, 0, 1], [0, 0, -1]])
     assert mesh.n_faces == 2
-    assert not mesh.vertices.flags.writeable and not mesh.faces.flags.writeable
+    assert not mesh.vertices.flags.writeable
+    assert not mesh.faces.flags.writeable
 
 
 def test_empty_mesh_is_allowed():
@@ -62,7 +63,7 @@ def test_mesh_bad_input(kwargs, match):
 
 
 def _unique_position_ids(mesh):
-    """Vertex ids merged by bit-identical position (the sphere duplicates seam and pole vertices)."""
+    """Vertex ids merged by bit-identical position (the sphere repeats seam and pole vertices)."""
     _, ids = np.unique(mesh.vertices, axis=0, return_inverse=True)
     return ids.reshape(-1)[mesh.faces]
 
@@ -116,7 +117,9 @@ def test_uv_sphere_bad_input(args, match):
 def test_grid_mesh_matches_intersect_plane():
     plane = Plane((0.5, 1.0, -2.0), (0.2, 1.0, 0.3), (1.0, 0.0, 0.0), size=(3.0, 2.0), material=4)
     mesh = grid_mesh(plane, 3, 5)
-    assert mesh.vertices.shape == (24, 3) and mesh.n_faces == 30 and mesh.material == 4
+    assert mesh.vertices.shape == (24, 3)
+    assert mesh.n_faces == 30
+    assert mesh.material == 4
     # Source: reference.geometry.intersect_plane at rays that hit the face centroids head on; uv
     # is affine on the plane, so the centroid's uv is the mean of the corners'.
     n = np.asarray(plane.normal)
@@ -129,7 +132,7 @@ def test_grid_mesh_matches_intersect_plane():
 
 
 def test_grid_mesh_bad_input():
-    with pytest.raises(SpecrefError, match="grid_mesh: plane.size: must be given"):
+    with pytest.raises(SpecrefError, match=r"grid_mesh: plane\.size: must be given"):
         grid_mesh(Plane())
     with pytest.raises(SpecrefError, match="grid_mesh: n_v: must be an integer >= 1, got 0"):
         grid_mesh(Plane(size=(1.0, 1.0)), 2, 0)
@@ -169,7 +172,8 @@ def test_obj_reader_all_corner_forms(tmp_path):
     np.testing.assert_array_equal(mesh.faces, [[0, 1, 2], [0, 2, 3]])
     np.testing.assert_array_equal(mesh.uvs, [[0, 1], [1, 1], [1, 0], [0, 0]])
     np.testing.assert_array_equal(mesh.normals, np.tile([0.0, 0.0, 1.0], (4, 1)))
-    assert mesh.material == 3 and mesh.source == str(path)
+    assert mesh.material == 3
+    assert mesh.source == str(path)
 
 
 @pytest.mark.parametrize(
@@ -260,11 +264,11 @@ def test_obj_reader_bad_input(tmp_path, text, match):
 
 
 def test_obj_reader_unreadable_files(tmp_path):
-    with pytest.raises(SpecrefError, match="missing.obj: file not found"):
+    with pytest.raises(SpecrefError, match=r"missing\.obj: file not found"):
         mesh_from_obj(tmp_path / "missing.obj")
     with pytest.raises(SpecrefError, match="is a directory"):
         mesh_from_obj(tmp_path)
     binary = tmp_path / "binary.obj"
     binary.write_bytes(b"\xff\xfe\x00v 0 0 0")
-    with pytest.raises(SpecrefError, match="binary.obj: not a text OBJ file"):
+    with pytest.raises(SpecrefError, match=r"binary\.obj: not a text OBJ file"):
         mesh_from_obj(binary)
