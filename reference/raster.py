@@ -415,45 +415,48 @@ def gbuffer_from_raster(
     """
     H, W = depth.shape
     g = empty_gbuffer(H, W)
-    covered = triangle >= 0
-    tri = triangle[covered]
-    face = setup.face[tri]
+    pixel = np.flatnonzero(triangle.ravel() >= 0)  # covered pixels, flat indices
+    tri = triangle.ravel()[pixel]
     # Barycentrics in the original face: the clipped triangle's, mapped through its vertices'.
-    B = setup.bary[tri]
-    b = bary[covered]
-    w = b[:, 0, None] * B[:, 0] + b[:, 1, None] * B[:, 1] + b[:, 2, None] * B[:, 2]
-    corners = mesh.faces[face]
+    w = np.einsum("nk,nkc->nc", bary.reshape(-1, 3)[pixel], setup.bary[tri])
+    corners = mesh.faces[setup.face[tri]]  # (N, 3) vertex ids
 
     def interpolate(values):
-        return sum(w[:, k, None] * values[corners[:, k]] for k in range(3))
+        return np.einsum("nk,nkc->nc", w, values[corners])
+
+    def face_normal(rows):
+        a, b, c = (mesh.vertices[corners[rows, k]] for k in range(3))
+        n = np.cross(b - a, c - a)
+        return n / np.linalg.norm(n, axis=1, keepdims=True)  # non-zero: the face has area
 
     position = interpolate(mesh.vertices)
-    face_normal = mesh.face_normals()[face]
     if mesh.normals is None:
-        normal = face_normal
+        normal = face_normal(slice(None))
     else:
         normal = interpolate(mesh.normals)
         # Renormalise; where opposite vertex normals cancel, fall back to the face normal.
-        length = np.linalg.norm(normal, axis=1)
-        ok = length > 1e-12 * np.linalg.norm(mesh.normals[corners], axis=2).max(axis=1)
-        normal = np.where(ok[:, None], normal / np.where(ok, length, 1.0)[:, None], face_normal)
+        length = np.linalg.norm(normal, axis=1, keepdims=True)
+        vanish = length[:, 0] <= 1e-12 * np.linalg.norm(mesh.normals[corners], axis=2).max(axis=1)
+        length[vanish] = 1.0
+        normal /= length
+        normal[vanish] = face_normal(vanish)
     if mesh.uvs is None:
         uv = np.stack([w[:, 1] + w[:, 2], w[:, 2]], axis=1)  # pbrt: (0, 0), (1, 0), (1, 1)
     else:
         uv = interpolate(mesh.uvs)
     if camera.projection == "perspective":
-        to_eye = np.asarray(camera.eye) - position
-        view = to_eye / np.linalg.norm(to_eye, axis=1, keepdims=True)
+        view = np.asarray(camera.eye) - position
+        view /= np.linalg.norm(view, axis=1, keepdims=True)
     else:
-        view = np.broadcast_to(camera.basis()[2], position.shape)
-    g.position[covered] = position
-    g.normal[covered] = normal
-    g.uv[covered] = uv
-    g.depth[covered] = depth[covered]
-    g.view[covered] = view
-    g.material_id[covered] = mesh.material
-    g.object_id[covered] = object_id
-    g.mask[covered] = True
+        view = camera.basis()[2]
+    g.position.reshape(-1, 3)[pixel] = position
+    g.normal.reshape(-1, 3)[pixel] = normal
+    g.uv.reshape(-1, 2)[pixel] = uv
+    g.depth.reshape(-1)[pixel] = depth.ravel()[pixel]
+    g.view.reshape(-1, 3)[pixel] = view
+    g.material_id.reshape(-1)[pixel] = mesh.material
+    g.object_id.reshape(-1)[pixel] = object_id
+    g.mask.reshape(-1)[pixel] = True
     return g
 
 
