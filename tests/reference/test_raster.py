@@ -351,7 +351,7 @@ def test_degenerate_triangles_are_skipped_without_nans(backend):
         [[-1, 0, 0], [0, 0.25, 0], [1, 0.5, 0]],  # collinear
         [[0, 0, 0], [0, 0, 0], [0, 0, 0]],  # a point
         [[-1, 0.1, 0], [1, 0.1, 0], [0, 0.1 + 1e-14, 0]],  # a sliver, height 1e-14 of its base
-        [[0.2, -1, 1], [0.2, 1, -1], [0.2, 0, 0]],  # seen edge-on (in the plane x = 0.2 ... )
+        [[0, -1, 1], [0, 1, -1], [0, 0.5, 0.5]],  # seen edge-on: its plane x = 0 holds the eye
     ]
     vertices = np.concatenate([good, *degenerate]).astype(float)
     faces = np.arange(len(vertices)).reshape(-1, 3)
