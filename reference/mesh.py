@@ -125,25 +125,22 @@ class TriangleMesh:
             index = int(faces[first][(faces[first] < 0) | (faces[first] >= V)][0])
             raise SpecrefError(f"{src}: faces: index {index} out of range [0, {V}) in face {first}")
         faces.setflags(write=False)
-        normals = None
+        # Optional per-vertex attributes: one finite row per vertex.
+        for key, columns in (("normals", 3), ("uvs", 2)):
+            values = getattr(self, key)
+            if values is not None:
+                values = _as_float_array(values, f"{src}: {key}", columns, "V")
+                require(
+                    values.shape[0] == V,
+                    f"{src}: {key}: must have one row per vertex ({V}), got {values.shape[0]}",
+                )
+                object.__setattr__(self, key, values)
         if self.normals is not None:
-            normals = _as_float_array(self.normals, f"{src}: normals", 3, "V")
-            require(
-                normals.shape[0] == V,
-                f"{src}: normals: must have one row per vertex ({V}), got {normals.shape[0]}",
-            )
-            zero = np.linalg.norm(normals, axis=1) == 0.0
+            zero = np.linalg.norm(self.normals, axis=1) == 0.0
             require(
                 not zero.any(),
                 f"{src}: normals: must be non-zero, got zero length at vertex "
                 f"{int(np.argmax(zero))}",
-            )
-        uvs = None
-        if self.uvs is not None:
-            uvs = _as_float_array(self.uvs, f"{src}: uvs", 2, "V")
-            require(
-                uvs.shape[0] == V,
-                f"{src}: uvs: must have one row per vertex ({V}), got {uvs.shape[0]}",
             )
         require(
             isinstance(self.material, int | np.integer) and self.material >= 0,
@@ -151,8 +148,6 @@ class TriangleMesh:
         )
         object.__setattr__(self, "vertices", vertices)
         object.__setattr__(self, "faces", faces)
-        object.__setattr__(self, "normals", normals)
-        object.__setattr__(self, "uvs", uvs)
         object.__setattr__(self, "material", int(self.material))
         object.__setattr__(self, "cull_backfaces", bool(self.cull_backfaces))
 
