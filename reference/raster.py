@@ -49,7 +49,8 @@ References
 - J. Pineda, "A parallel algorithm for polygon rasterization", SIGGRAPH 1988, pp. 17-20.
 - P. Heckbert, H. Moreton, "Interpolation for polygon texture mapping and shading", in *State of the
   Art in Computer Graphics*, Springer 1991 (perspective-correct interpolation).
-- Microsoft, *Direct3D 11.3 Functional Specification*, §3.4.2.1 "Top-Left Rule" (2015).
+- Microsoft, "Rasterization rules: triangle rasterization rules (without multisampling)",
+  Direct3D 11 documentation (the top-left rule).
 - M. Pharr, W. Jakob, G. Humphreys, *Physically Based Rendering*, 4th ed., §6.5 (triangle uvs).
 """
 

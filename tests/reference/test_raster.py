@@ -520,3 +520,11 @@ def test_shared_edges_through_a_pixel_centre_up_to_rounding(backend):
             count += triangle >= 0
         assert count[8, 8] == 1, (a, b)
         assert count.max() == 1
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_empty_mesh_draws_nothing(backend):
+    empty = TriangleMesh(np.zeros((0, 3)), np.zeros((0, 3), dtype=int))
+    g = rasterize_mesh(empty, PROJECTIONS["perspective"], 6, 4, backend=backend)
+    assert not g.mask.any()
+    assert np.isinf(g.depth).all()
