@@ -32,7 +32,7 @@ test: $(STAMP)
 ## make bench: run the pytest-benchmark suite and save JSON (specref report turns it into charts)
 bench: $(STAMP)
 	SPECREF_BENCH=1 $(PY) -m pytest -q tests/benchmarks --benchmark-enable \
-		--benchmark-json=bench.json --benchmark-min-rounds=3 -p no:doctest
+		--benchmark-json=bench.json --benchmark-min-rounds=3
 	$(VENV)/bin/specref report --out report --bench bench.json
 
 ## make results: benchmarks, then the full report; regenerates docs/results.md and docs/results/
