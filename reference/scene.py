@@ -473,9 +473,15 @@ def _parse_spectral(reader: SceneReader, data: dict) -> tuple[SpectralGrid, str,
     if explicit:
         if len(explicit) != 3:
             reader.fail(key, "start_nm, end_nm and step_nm go together; give all three")
-        bounds = [reader.number(table[k], f"{key}.{k}") for k in ("start_nm", "end_nm", "step_nm")]
+        start, end = (
+            reader.number(table[k], f"{key}.{k}", 0, 10000, True, True)
+            for k in ("start_nm", "end_nm")
+        )
+        step = reader.number(table["step_nm"], f"{key}.step_nm", 0, exclusive_minimum=True)
+        if (end - start) / step > 4096:
+            reader.fail(key, f"at most 4096 bands, got {(end - start) / step + 1:.0f}")
         with reader.context(key):
-            grid = SpectralGrid(*bounds)
+            grid = SpectralGrid(start, end, step)
     else:
         grid = GRIDS[reader.choice(str(table.get("grid", "41")), f"{key}.grid", GRIDS)]
     observer = reader.choice(table.get("observer", DEFAULT_OBSERVER), f"{key}.observer", OBSERVERS)
@@ -658,6 +664,12 @@ def scene_from_dict(data: dict, file: str = "<string>", base_dir=".", path=None)
         kind = _item_type(reader, table, key, LIGHT_TYPES)
         lights.append(kind.parse(reader, table, key))
     lights = tuple(lights)
+    # Each light's band weights on this grid: computed (and cached) now, so a light the grid cannot
+    # weigh is refused at load time.
+    for i, light in enumerate(lights):
+        if isinstance(getattr(light, "spectrum", None), Spectrum):
+            with reader.context(f"lights[{i}].spectrum", alias=light.spectrum.name):
+                band_weights(grid, light.spectrum, method, observer)
 
     return Scene(
         camera=_parse_camera(reader, data),

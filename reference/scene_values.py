@@ -268,9 +268,13 @@ class SceneReader:
         name = self.string(value, key)
         if "\x00" in name:
             self.fail(key, f"not a valid path, got {_shown(name)}")
-        path = Path(name).expanduser()
+        path = Path(name)
         path = path if path.is_absolute() else self.base_dir / path
-        if not path.is_file():
+        try:
+            found = path.is_file()
+        except (OSError, ValueError) as error:
+            self.fail(key, f"not a usable path ({error.__class__.__name__}): {_shown(name)}")
+        if not found:
             self.fail(key, f"file not found: {path}")
         return path
 
