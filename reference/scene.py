@@ -16,7 +16,8 @@ The loader is driven by registries, so a later issue adds a type without editing
 
 Every value is checked where it is read, with one-line messages naming the file, the dotted key,
 what is allowed and what was given: ``scene.toml: materials.gold.n: must be >= 0, got -3``.
-Relative paths (CSV spectra, meshes, environment maps) are relative to the scene file's folder.
+Relative paths (CSV spectra, OBJ meshes, environment maps) are relative to the scene file's
+folder.
 
 Resolution limits: each image side is at most ``MAX_RESOLUTION`` (16384) pixels, supersampling at
 most :data:`MAX_SUPERSAMPLE` (16) per axis, and the G-buffer at most :data:`MAX_RENDER_SAMPLES`
@@ -34,7 +35,8 @@ from pathlib import Path
 
 import numpy as np
 
-import reference.colorchecker  # noqa: F401  (registers the colorchecker material and shaders)
+import reference.colorchecker  # registers the colorchecker material and its shaders
+import reference.raster  # noqa: F401  (registers the TriangleMesh G-buffer writer)
 from reference.camera import MAX_RESOLUTION, PROJECTIONS, Camera
 from reference.colorimetry import BAND_WEIGHT_METHODS, DEFAULT_OBSERVER, OBSERVERS, band_weights
 from reference.display import ENCODINGS
@@ -43,6 +45,7 @@ from reference.geometry import Plane, Sphere
 from reference.images import channel_wavelengths_nm, read_exr, read_hdr
 from reference.lights import AmbientLight, EnvironmentLight, PointLight
 from reference.materials import MATERIAL_TYPES, MaterialType, make_material
+from reference.mesh import TriangleMesh, mesh_from_obj
 from reference.registry import Registry
 from reference.scene_values import SceneReader
 from reference.shading import ShadingContext
@@ -348,6 +351,24 @@ def _plane_parser(rectangle: bool):
     return parse
 
 
+def _parse_mesh(reader: SceneReader, table: dict, key: str, materials: Mapping) -> TriangleMesh:
+    keys = ("type", "material", "file", "scale", "translate", "cull_backfaces")
+    reader.table(table, key, keys, ("material", "file"))
+    path = reader.file_path(table["file"], f"{key}.file")
+    scale = reader.number(table.get("scale", 1.0), f"{key}.scale", 0, exclusive_minimum=True)
+    translate = np.array(reader.vector(table.get("translate", [0.0, 0.0, 0.0]), f"{key}.translate"))
+    cull = reader.boolean(table.get("cull_backfaces", False), f"{key}.cull_backfaces")
+    material = _material_ref(reader, table, key, materials)
+    with reader.context(f"{key}.file"):
+        mesh = mesh_from_obj(path, material, cull)
+        if scale == 1.0 and not translate.any():
+            return mesh
+        # A uniform scale and a translation keep the shading normals as they are.
+        with np.errstate(over="ignore", invalid="ignore"):
+            vertices = mesh.vertices * scale + translate
+        return dataclasses.replace(mesh, vertices=vertices)
+
+
 def _parse_point_light(reader: SceneReader, table: dict, key: str) -> PointLight:
     keys = ("type", "position", "spectrum", "intensity", "attenuation")
     reader.table(table, key, keys, ("position",))
@@ -428,6 +449,15 @@ OBJECT_TYPES.register(
         _plane_parser(rectangle=True),
         ("material", "point", "normal", "u_axis", "size"),
         "a plane with a required `size`; uv spans [0, 1] over it",
+    )
+)
+
+OBJECT_TYPES.register(
+    SceneItemType(
+        "mesh",
+        _parse_mesh,
+        ("material", "file", "scale", "translate", "cull_backfaces"),
+        "a triangle mesh from a Wavefront OBJ file, rasterized",
     )
 )
 

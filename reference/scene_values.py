@@ -233,6 +233,12 @@ class SceneReader:
             self.fail(key, f"must be a list of {n} numbers, got {_shown(value)}")
         return tuple(self.number(v, f"{key}[{i}]") for i, v in enumerate(value))
 
+    def boolean(self, value, key: str) -> bool:
+        """A TOML boolean (``true`` or ``false``)."""
+        if not isinstance(value, bool):
+            self.fail(key, f"must be true or false, got {_shown(value)}")
+        return value
+
     def string(self, value, key: str) -> str:
         """A non-empty string."""
         if not isinstance(value, str) or not value:

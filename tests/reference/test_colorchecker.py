@@ -106,7 +106,9 @@ def test_scene_material_keys_and_errors():
         loads_scene(chart + "patches = 1", "s.toml")
     with pytest.raises(SpecrefError, match=r"^s\.toml: materials\.chart\.set: unknown value 'X'"):
         loads_scene(chart + 'set = "X"', "s.toml")
-    with pytest.raises(SpecrefError, match=r"^s\.toml: materials\.chart: colorchecker:dark skin: covers 380-730 nm"):
+    with pytest.raises(
+        SpecrefError, match=r"^s\.toml: materials\.chart: colorchecker:dark skin: covers 380-730 nm"
+    ):
         loads_scene(chart + 'set = "BabelColor Average"', "s.toml")
 
 

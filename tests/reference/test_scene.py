@@ -15,6 +15,7 @@ from reference.geometry import Plane, Sphere
 from reference.images import spectral_channel_names, write_exr
 from reference.lights import AmbientLight, EnvironmentLight, PointLight
 from reference.materials import MATERIAL_TYPES, LambertMaterial, MaterialType, PhongMaterial
+from reference.mesh import TriangleMesh
 from reference.scene import (
     LIGHT_TYPES,
     MAX_RENDER_SAMPLES,
@@ -593,3 +594,46 @@ def test_environment_maps_with_bad_values(tmp_path):
         scene_with(env + '"square.exr"', tmp_path)
     with pytest.raises(SpecrefError, match=r"lights\[0\]\.file: .*channels U, V; an environment"):
         scene_with(env + '"other.exr"', tmp_path)
+
+
+# --- meshes ---------------------------------------------------------------------------------------
+
+QUAD_OBJ = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvn 0 0 1\nf 1//1 2//1 3//1 4//1\n"
+
+
+def test_mesh_objects_load_and_place(tmp_path):
+    (tmp_path / "quad.obj").write_text(QUAD_OBJ)
+    scene = scene_with(
+        GREY.replace("sphere", "mesh")
+        + 'file = "quad.obj"\nscale = 0.5\ntranslate = [0, 1, -2]\ncull_backfaces = true',
+        tmp_path,
+    )
+    (mesh,) = scene.objects
+    assert isinstance(mesh, TriangleMesh)
+    assert mesh.material == 0
+    assert mesh.cull_backfaces
+    # Source: the OBJ's vertices, scaled by 0.5 and moved by (0, 1, -2).
+    assert_allclose(mesh.vertices[:, :2], [[-0.5, 0.5], [0.5, 0.5], [0.5, 1.5], [-0.5, 1.5]])
+    assert_allclose(mesh.vertices[:, 2], -2.0)
+    assert_allclose(mesh.normals, np.tile([0.0, 0.0, 1.0], (4, 1)))
+
+
+def test_mesh_with_nan_or_inf_vertices_is_refused(tmp_path):
+    (tmp_path / "nan.obj").write_text("v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    (tmp_path / "inf.obj").write_text("v 0 0 0\nv inf 0 0\nv 0 1 0\nf 1 2 3\n")
+    for name in ("nan.obj", "inf.obj"):
+        with pytest.raises(
+            SpecrefError,
+            match=rf"^scene\.toml: objects\[0\]\.file: .*{name}.*(finite|not a number)",
+        ):
+            scene_with(GREY.replace("sphere", "mesh") + f'file = "{name}"', tmp_path)
+    with raises("scene.toml: objects[0].file: file not found: "):
+        scene_with(GREY.replace("sphere", "mesh") + 'file = "none.obj"', tmp_path)
+    with raises("scene.toml: objects[0]: missing key 'file'"):
+        scene_with(GREY.replace("sphere", "mesh"), tmp_path)
+    with raises("scene.toml: objects[0].scale: must be > 0, got 0"):
+        scene_with(GREY.replace("sphere", "mesh") + 'file = "nan.obj"\nscale = 0', tmp_path)
+    with raises("scene.toml: objects[0].cull_backfaces: must be true or false, got 1"):
+        scene_with(
+            GREY.replace("sphere", "mesh") + 'file = "nan.obj"\ncull_backfaces = 1', tmp_path
+        )

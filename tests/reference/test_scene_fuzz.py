@@ -40,13 +40,14 @@ KEYS = [
     "k_d", "k_s", "n", "k_a", "set", "gap", "gap_width", "material", "center", "radius", "point",
     "normal", "u_axis", "size", "position", "spectrum", "intensity", "attenuation", "file",
     "constant", "illuminant", "light_source", "colorchecker", "csv", "column", "row", "scale",
-    "wavelengths", "values", "extrapolation", "interpolation", "grey",
+    "wavelengths", "values", "extrapolation", "interpolation", "grey", "scale", "translate",
+    "cull_backfaces",
 ]  # fmt: skip
 WORDS = [
     "lambert", "phong", "colorchecker", "sphere", "plane", "rectangle", "point", "ambient",
     "environment", "D65", "A", "FL2", "dark skin", "BabelColor Average", "41", "31", "srgb",
     "sRGB", "Bradford", "none", "orthographic", "perspective", "grey", "constant", "sprague",
-    "r.csv", "rgb.exr", "missing.hdr", "astm_e308", "point",
+    "r.csv", "rgb.exr", "missing.hdr", "astm_e308", "point", "mesh", "quad.obj",
 ]  # fmt: skip
 
 scalars = st.one_of(
@@ -75,10 +76,11 @@ documents = st.dictionaries(keys, values, max_size=8)
 
 @pytest.fixture(scope="module")
 def base_dir(tmp_path_factory) -> Path:
-    """Files that fuzzed scenes may name: a CSV spectrum and an RGB environment map."""
+    """Files that fuzzed scenes may name: a CSV spectrum, an RGB environment map, an OBJ mesh."""
     folder = tmp_path_factory.mktemp("fuzz")
     (folder / "r.csv").write_text("nm,R\n380,0.2\n780,0.6\n")
     write_exr(folder / "rgb.exr", np.full((4, 8, 3), 0.5))
+    (folder / "quad.obj").write_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n")
     return folder
 
 
@@ -112,6 +114,12 @@ material = "a"
 type = "rectangle"
 size = [1, 1]
 material = "b"
+[[objects]]
+type = "mesh"
+file = "quad.obj"
+scale = 2
+translate = [0, 0, -1]
+material = "a"
 [[lights]]
 type = "point"
 position = [0, 2, 2]

@@ -64,6 +64,11 @@ BAD_INPUT = {
         [],
         "scene.toml: materials.m.k_d: wavelengths must increase strictly",
     ),
+    "mesh with NaN vertices": (
+        GOOD.replace('type = "sphere"', 'type = "mesh"\nfile = "nan.obj"').replace("{k_d}", "1"),
+        [],
+        "nan.obj: line 2: v 2: must be finite, got [nan, 0.0, 0.0]",
+    ),
     "zero width": (
         GOOD.replace("{k_d}", "1"),
         ["--width", "0"],
@@ -85,13 +90,20 @@ BAD_INPUT = {
 
 
 #: Cases also run as real processes (each costs a Python start-up and the colour-science import).
-SUBPROCESS_CASES = ("malformed TOML", "NaN spectrum", "absurd supersampling", "width not a number")
+SUBPROCESS_CASES = (
+    "malformed TOML",
+    "NaN spectrum",
+    "mesh with NaN vertices",
+    "absurd supersampling",
+    "width not a number",
+)
 
 
 def _prepare(folder: Path, name: str) -> list[str]:
     """Write the case's files into ``folder``; return the ``specref`` arguments."""
     text, extra, _ = BAD_INPUT[name]
     (folder / "junk.hdr").write_bytes(b"#?RADIANCE\nnot an image\n")
+    (folder / "nan.obj").write_text("v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n")
     if text is not None:
         (folder / "scene.toml").write_text(text, encoding="utf-8")
     output = [] if "-o" in extra else ["-o", "out.png"]
