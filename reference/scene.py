@@ -435,23 +435,18 @@ OBJECT_TYPES = Registry("object type")
 OBJECT_TYPES.register(
     SceneItemType("sphere", _parse_sphere, ("material", "center", "radius"), "an analytic sphere")
 )
-OBJECT_TYPES.register(
-    SceneItemType(
-        "plane",
-        _plane_parser(rectangle=False),
-        ("material", "point", "normal", "u_axis", "size"),
-        "an analytic plane (a rectangle if `size` is given)",
+for _name, _rectangle, _doc in (
+    ("plane", False, "an analytic plane (a rectangle if `size` is given)"),
+    ("rectangle", True, "a plane with a required `size`; uv spans [0, 1] over it"),
+):
+    OBJECT_TYPES.register(
+        SceneItemType(
+            _name,
+            _plane_parser(_rectangle),
+            ("material", "point", "normal", "u_axis", "size"),
+            _doc,
+        )
     )
-)
-OBJECT_TYPES.register(
-    SceneItemType(
-        "rectangle",
-        _plane_parser(rectangle=True),
-        ("material", "point", "normal", "u_axis", "size"),
-        "a plane with a required `size`; uv spans [0, 1] over it",
-    )
-)
-
 OBJECT_TYPES.register(
     SceneItemType(
         "mesh",
