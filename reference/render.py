@@ -392,6 +392,19 @@ def write_render(result: RenderResult, png=None, exr=None) -> list[Path]:
     ------
     SpecrefError
         Wrong suffix, or the file cannot be written (the message names it).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from reference.scene import loads_scene
+    >>> result = render_scene(loads_scene("[render]" + chr(10) + "background = 0.5"), 4, 2)
+    >>> out = pathlib.Path(tempfile.mkdtemp())
+    >>> [p.name for p in write_render(result, png=out / "a.png", exr=out / "a.exr")]
+    ['a.exr', 'a.png']
+    >>> write_render(result, png=out / "a.jpg")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: -o: the output must end in .png, got '.../a.jpg'
     """
     jobs = []
     if exr is not None:
@@ -440,6 +453,19 @@ def render_scene_file(
     ------
     SpecrefError
         Anything wrong with the scene, the sizes or the outputs.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> _ = (folder / "s.toml").write_text("[render]" + chr(10) + "width = 0")
+    >>> render_scene_file(folder / "s.toml", folder / "s.png")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: .../s.toml: render.width: must be an integer in [1, 16384], got 0
+    >>> _ = (folder / "s.toml").write_text(chr(10).join(["[render]", "width = 6", "height = 4"]))
+    >>> render_scene_file(folder / "s.toml", folder / "s.png").encoded.shape
+    (4, 6, 3)
     """
     if png is not None:
         _check_output(png, ".png", "-o")
