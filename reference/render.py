@@ -199,6 +199,13 @@ def background_XYZ(scene: Scene, directions) -> np.ndarray:
     if not env.is_spectral:
         return display_RGB_to_XYZ(values, env.colourspace)
     # A spectral map: linear interpolation onto the grid is a matrix (resample each unit channel).
+    wl, grid = env.wavelengths_nm, scene.grid
+    require(
+        wl.size >= 2 and wl[0] <= grid.start_nm and wl[-1] >= grid.end_nm,
+        f"{scene.file}: render.background: the spectral environment {env.name} covers "
+        f"{wl[0]:g}-{wl[-1]:g} nm but the grid needs {grid.start_nm:g}-{grid.end_nm:g} nm; use a "
+        "constant background",
+    )
     columns = []
     for k in range(env.wavelengths_nm.size):
         unit = np.zeros(env.wavelengths_nm.size)

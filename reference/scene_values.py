@@ -368,7 +368,8 @@ class SceneReader:
             end = math.ceil(max(self.grid.end_nm, min(780.0, wl[-1])))
             fine = SpectralGrid(float(start), float(end), 1.0)
             values = resample_spectrum(spectrum, fine, spec.extrapolation, spec.interpolation)
-            return make_spectrum(fine.wavelengths_nm, np.maximum(values, 0.0), spectrum.name)
+            # Sprague can ring below 0 next to sharp features: make_spectrum refuses that.
+            return make_spectrum(fine.wavelengths_nm, values, spectrum.name)
 
 
 # --- spectrum forms

@@ -368,3 +368,20 @@ def test_rasterized_mesh_quad_matches_the_ray_cast_rectangle(tmp_path):
     assert both.sum() > 0.5 * b.gbuffer.mask.sum()
     # Same surface, same shading: perspective-correct interpolation of a plane is exact.
     assert_allclose(a.XYZ[both], b.XYZ[both], rtol=1e-9, atol=1e-12)
+
+
+def test_environment_background_needs_a_map_that_covers_the_grid(tmp_path):
+    wl = np.array([400.0, 550.0, 700.0])
+    write_exr(tmp_path / "narrow.exr", np.ones((4, 8, 3)), spectral_channel_names(wl))
+    scene = loads_scene(
+        '[render]\nwidth = 2\nheight = 2\nbackground = "environment"\n'
+        '[[lights]]\ntype = "environment"\nfile = "narrow.exr"',
+        "s.toml",
+        tmp_path,
+    )
+    with pytest.raises(
+        SpecrefError,
+        match=r"^s\.toml: render\.background: the spectral environment .*narrow\.exr covers "
+        r"400-700 nm but the grid needs 380-780 nm",
+    ):
+        render_scene(scene)
