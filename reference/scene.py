@@ -541,13 +541,17 @@ def loads_scene(text: str, file: str = "<string>", base_dir=".") -> Scene:
     reference.errors.SpecrefError: scene.toml: malformed TOML: Expected ']' at the end of a table
     declaration (at line 1, column 8)
     """
+    return scene_from_dict(_parse_toml(text, file), file, base_dir)
+
+
+def _parse_toml(text: str, file: str) -> dict:
+    """``tomllib.loads`` with its errors as one-line SpecrefErrors naming the file."""
     if not isinstance(text, str):
         raise SpecrefError(f"{file}: a scene must be TOML text, got {type(text).__name__}")
     try:
-        data = tomllib.loads(text)
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
         raise SpecrefError(f"{file}: malformed TOML: {error}") from None
-    return scene_from_dict(data, file, base_dir)
 
 
 def load_scene(path) -> Scene:
@@ -584,8 +588,4 @@ def load_scene(path) -> Scene:
         raise SpecrefError(f"{file}: not UTF-8 text, so not a TOML scene") from None
     except OSError as error:
         raise SpecrefError(f"{file}: cannot read ({error.__class__.__name__})") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as error:
-        raise SpecrefError(f"{file}: malformed TOML: {error}") from None
-    return scene_from_dict(data, file, path.parent, path)
+    return scene_from_dict(_parse_toml(text, file), file, path.parent, path)
