@@ -175,9 +175,9 @@ def directions_to_theta_phi(directions) -> tuple[np.ndarray, np.ndarray]:
 
     Examples
     --------
-    >>> theta, phi = directions_to_theta_phi([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])
+    >>> theta, phi = directions_to_theta_phi([[0.0, 0.0, -1.0], [1.0, 0.0, 0.0]])
     >>> theta.round(6), phi.round(6)
-    (array([0.      , 1.570796]), array([0.      , 1.570796]))
+    (array([1.570796, 1.570796]), array([0.      , 1.570796]))
     """
     u, v = direction_to_latlong_uv(directions)
     return np.pi * v, 2.0 * np.pi * u
@@ -366,7 +366,7 @@ def legendre_analysis(order: int, theta, w, F_cos, F_sin, method: str = "auto") 
     --------
     >>> H = 4; theta = latlong_ring_angles(H); w = fejer1_weights(H)
     >>> F = np.zeros((2, H, 1)); F[0, :, 0] = 2 * np.pi   # f = 1: ∫ cos(0φ) dφ = 2π
-    >>> legendre_analysis(1, theta, w, F, np.zeros_like(F)).round(6)   # √(4π) Y_00
+    >>> legendre_analysis(1, theta, w, F, np.zeros_like(F)).round(6) + 0.0  # √(4π) Y_00
     array([[3.544908, 0.      , 0.      , 0.      ]])
     """
     L = int(order)
