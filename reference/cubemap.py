@@ -73,7 +73,7 @@ def cubemap_texel_directions(size: int) -> np.ndarray:
     Examples
     --------
     >>> d = cubemap_texel_directions(1)
-    >>> d[:, 0, 0]
+    >>> d[:, 0, 0] + 0.0
     array([[ 1.,  0.,  0.],
            [-1.,  0.,  0.],
            [ 0.,  1.,  0.],
