@@ -157,18 +157,16 @@ def sh_evaluate_kernel(L, x, sin_theta, phi, A, B, coeffs, scaled, out):
 
 
 @numba.njit(cache=False)
-def prefilter_bruteforce_kernel(normals, directions, weights, radiance, cos_grid, kernel_grid, out):
-    """Twin of ``shrm.prefilter.prefilter_bruteforce``: angular convolution, one pass per texel.
+def prefilter_bruteforce_table_kernel(normals, directions, weights, radiance, angles, values, out):
+    """Twin of ``shrm.prefilter.prefilter_bruteforce`` for tabulated lobes K(γ).
 
-    ``out[k, c] = Σ_p radiance[p, c] K(ω_p · n_k) w_p`` with K linearly interpolated from its
-    samples ``kernel_grid`` at the uniform cosines ``cos_grid`` (K = 0 below ``cos_grid[0]``).
+    ``out[k, c] = Σ_p radiance[p, c] K(acos(ω_p · n_k)) w_p``, K linear in γ between the samples
+    and 0 beyond the last angle.
     """
     K = normals.shape[0]
     P = directions.shape[0]
     C = radiance.shape[1]
-    n_grid = cos_grid.shape[0]
-    t0 = cos_grid[0]
-    dt = (cos_grid[n_grid - 1] - t0) / (n_grid - 1)
+    last = angles[angles.shape[0] - 1]
     for k in range(K):
         for p in range(P):
             t = (
@@ -176,14 +174,11 @@ def prefilter_bruteforce_kernel(normals, directions, weights, radiance, cos_grid
                 + normals[k, 1] * directions[p, 1]
                 + normals[k, 2] * directions[p, 2]
             )
-            if t <= t0:
+            gamma = math.acos(min(max(t, -1.0), 1.0))
+            if gamma > last:
                 continue
-            u = (t - t0) / dt
-            i = int(u)
-            if i >= n_grid - 1:
-                i = n_grid - 2
-            f = u - i
-            kern = (kernel_grid[i] * (1.0 - f) + kernel_grid[i + 1] * f) * weights[p]
+            # Eq. (7), Ramamoorthi & Hanrahan 2001, in the angular domain: Σ_p L_p K(γ_p) w_p
+            kern = np.interp(gamma, angles, values) * weights[p]
             for c in range(C):
                 out[k, c] += radiance[p, c] * kern
 
@@ -216,7 +211,7 @@ __all__ = [
     "legendre_analysis_kernel",
     "legendre_synthesis_kernel",
     "legendre_table_kernel",
-    "prefilter_bruteforce_kernel",
     "prefilter_bruteforce_power_kernel",
+    "prefilter_bruteforce_table_kernel",
     "sh_evaluate_kernel",
 ]
