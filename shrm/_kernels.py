@@ -32,7 +32,7 @@ def _sectoral_next(p, e, m, sin_theta, scaled):
 
 @numba.njit(cache=False)
 def _column(m, L, sgn, u, p_mm, e_mm, A, B, t0, scaled, buf):
-    """buf[l - m] = λ_lm(x) for l = m..L, from λ_mm = p_mm · 2^e_mm; x = sgn (1 - u), u = 1 - |x|."""
+    """buf[l - m] = λ_lm(x), l = m..L, from λ_mm = p_mm 2^e_mm; x = sgn (1 - u), u = 1 - |x|."""
     p1 = p_mm
     p2 = 0.0
     e = e_mm

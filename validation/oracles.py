@@ -13,7 +13,7 @@ __all__ = ["converged_mp", "lambert_Lambda_mp", "phong_Lambda_mp", "sh_basis_mp"
 
 
 def _legendre_recurrence_mp(l: int, m: int, x):
-    """Unnormalized Ferrers P_l^m(x) (Condon–Shortley phase) by the textbook recurrence in mpmath."""
+    """Unnormalized Ferrers P_l^m(x) (Condon–Shortley phase) by the textbook recurrence."""
     p_mm = (-1) ** m * mpmath.fac2(2 * m - 1) * mpmath.sqrt(1 - x * x) ** m
     if l == m:
         return p_mm

@@ -17,9 +17,9 @@ from shrm.sh import (
     latlong_ring_angles,
     legendre_recurrence_coefficients,
     legendre_table,
-    ring_cosines,
     project_function,
     project_latlong,
+    ring_cosines,
     sh_basis,
     sh_degrees_orders,
     sh_evaluate,
@@ -46,9 +46,10 @@ def _basis_at(l, m, theta, phi, method):
 def test_sh_basis_matches_mpmath_at_hard_points(l_max, tolerance):
     # Source: mpmath 50 dps, checked at 80 (validation/precompute/sh_basis.py -> sh_basis.json).
     # Points: θ within 1e-12..1e-1 of 0 and π (sin^m θ underflows), sin θ = 1/e, the equator.
-    # The bound is ≤ 5e-13 for l ≤ 100 and ≤ 1e-11 for l ≤ 1000 (absolute / sqrt((2l+1)/4π)).
+    # Bounds: ≤ 5e-13 (l ≤ 200) and ≤ 1e-11 (l ≤ 1000), absolute / sqrt((2l+1)/4π).
     data, points = _points()
-    assert data["dps"] == 50 and data["check_dps"] == 80
+    assert data["dps"] == 50
+    assert data["check_dps"] == 80
     rows = points[(points[:, 0] <= l_max) & (points[:, 0] > (l_max // 5 if l_max > 200 else -1))]
     for l, m, theta, phi, value in rows:
         got = _basis_at(l, m, theta, phi, "auto")
@@ -153,7 +154,7 @@ def test_projection_of_finite_sum_returns_coefficients(rng):
 
 
 def test_solid_angle_weights_leave_round_trip_error(rng):
-    # The pixel solid-angle rule is a midpoint rule: its error (about 5e-4 relative) is why it is not
+    # The pixel solid-angle rule is a midpoint rule: its error (5e-4 relative) is why it is not
     # the default.
     L = 20
     c = rng.normal(size=(1, (L + 1) ** 2))

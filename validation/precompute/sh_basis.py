@@ -35,7 +35,7 @@ OUT = Path(__file__).resolve().parents[2] / "tests" / "data" / "sh_basis.json"
 
 
 def orders_for(l: int) -> list[int]:
-    """m ∈ {0, 1, l/2, l-1, l}, and m = 0.36 l for l >= 1500, with both signs for m > 0.
+    """Orders m ∈ {0, 1, l/2, l-1, l}, and m = 0.36 l for l >= 1500, with both signs for m > 0.
 
     m ≈ l sin θ at sin θ = 1/e is where the plain recurrence's sectoral start underflows while
     Y_lm is O(1).
