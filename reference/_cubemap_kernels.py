@@ -77,19 +77,22 @@ def cubemap_lookup_kernel(cube, directions, out):
 
 @numba.njit(cache=False)
 def gather_bilinear_kernel(image, taps, weights, out):
-    """Twin of ``reference.cubemap.gather_bilinear``: out[n] = Σ_k weights[k, n] image[taps[k, n]].
+    """Twin of ``reference.cubemap.gather_bilinear``: out[n] = Σ_k weights[n, k] image[taps[n, k]].
 
-    ``image``: (P, C) flattened pixels; ``taps``: (4, N) flat pixel indices; ``out``: (N, C).
+    ``image``: (P, C) flattened pixels; ``taps``, ``weights``: (N, 4); ``out``: (N, C). The four
+    rows of a texel are read as contiguous channel vectors.
     """
     N = out.shape[0]
     C = out.shape[1]
     for n in range(N):
-        i0, i1, i2, i3 = taps[0, n], taps[1, n], taps[2, n], taps[3, n]
-        w0, w1, w2, w3 = weights[0, n], weights[1, n], weights[2, n], weights[3, n]
+        r0 = image[taps[n, 0]]
+        r1 = image[taps[n, 1]]
+        r2 = image[taps[n, 2]]
+        r3 = image[taps[n, 3]]
+        w0, w1, w2, w3 = weights[n, 0], weights[n, 1], weights[n, 2], weights[n, 3]
+        o = out[n]
         for c in range(C):
-            out[n, c] = (
-                w0 * image[i0, c] + w1 * image[i1, c] + w2 * image[i2, c] + w3 * image[i3, c]
-            )
+            o[c] = w0 * r0[c] + w1 * r1[c] + w2 * r2[c] + w3 * r3[c]
 
 
 __all__ = ["cubemap_lookup_kernel", "gather_bilinear_kernel"]

@@ -216,11 +216,11 @@ def cubemap_lookup_bilinear(cube, directions, backend: str = "numpy") -> np.ndar
 
 
 @functools.lru_cache(maxsize=8)
-def _latlong_taps(height: int, width: int, size: int) -> tuple[np.ndarray, np.ndarray]:
+def _latlong_taps(height: int, width: int, size: int, dtype: str) -> tuple[np.ndarray, np.ndarray]:
     """Bilinear taps (flat pixel indices) and weights of the texel centres in a lat-long map.
 
     The sampling pattern depends only on the sizes, so it is computed once (``reference.envmap``
-    lookup rules: u wraps, v clamps at the poles).
+    lookup rules: u wraps, v clamps at the poles). Shapes (N, 4); weights in ``dtype``.
     """
     d = cubemap_texel_directions(size).reshape(-1, 3)
     u, v = direction_to_latlong_uv(d)
@@ -231,15 +231,16 @@ def _latlong_taps(height: int, width: int, size: int) -> tuple[np.ndarray, np.nd
     fx, fy = x - x0, y - y0
     x1, y1 = (x0 + 1) % width, np.minimum(y0 + 1, height - 1)
     x0 = x0 % width
-    taps = np.stack([y0 * width + x0, y0 * width + x1, y1 * width + x0, y1 * width + x1])
-    weights = np.stack([(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy])
+    taps = np.stack([y0 * width + x0, y0 * width + x1, y1 * width + x0, y1 * width + x1], -1)
+    weights = np.stack([(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy], -1)
+    weights = weights.astype(dtype)
     for array in (taps, weights):
         array.setflags(write=False)
     return taps, weights
 
 
 def gather_bilinear(image, taps, weights) -> np.ndarray:
-    """Weighted sum of four taps per output: ``out[n] = Σ_k weights[k, n] image[taps[k, n]]``.
+    """Weighted sum of four taps per output: ``out[n] = Σ_k weights[n, k] image[taps[n, k]]``.
 
     The data movement of §7.1, Herbert et al. (bilinear filtering at memory bandwidth), as used by
     :func:`latlong_to_cubemap`; the numba twin streams all channels of a texel together. Eq. (1),
@@ -249,9 +250,9 @@ def gather_bilinear(image, taps, weights) -> np.ndarray:
     ----------
     image : ndarray, shape (P, C)
         Flattened pixels.
-    taps : ndarray of int, shape (4, N)
+    taps : ndarray of int, shape (N, 4)
         Flat pixel indices.
-    weights : ndarray, shape (4, N)
+    weights : ndarray, shape (N, 4)
         Bilinear weights.
 
     Returns
@@ -260,17 +261,16 @@ def gather_bilinear(image, taps, weights) -> np.ndarray:
 
     Examples
     --------
-    >>> gather_bilinear(np.array([[0.0], [2.0]]), np.array([[0], [1], [0], [1]]),
-    ...                 np.full((4, 1), 0.25))
+    >>> gather_bilinear(np.array([[0.0], [2.0]]), np.array([[0, 1, 0, 1]]), np.full((1, 4), 0.25))
     array([[1.]])
     """
-    out = np.zeros((taps.shape[1], image.shape[1]))
+    out = np.zeros((taps.shape[0], image.shape[1]), dtype=np.result_type(image, weights))
     for k in range(4):
-        out += weights[k][:, None] * image[taps[k]]
+        out += weights[:, k, None] * image[taps[:, k]]
     return out.astype(image.dtype)
 
 
-def latlong_to_cubemap(image, size: int = 64, backend: str = "numba") -> np.ndarray:
+def latlong_to_cubemap(image, size: int = 64, backend: str = "numba", out=None) -> np.ndarray:
     """Resample a lat-long map onto a cube map by bilinear lookups at the texel centres.
 
     §7.1, Herbert et al. (fast environment transforms); lat-long convention of
@@ -284,6 +284,8 @@ def latlong_to_cubemap(image, size: int = 64, backend: str = "numba") -> np.ndar
     size : int
         Face size S.
     backend : {"numba", "numpy"}
+    out : ndarray, shape (6, S, S, C), optional
+        Output buffer of the input's dtype (reused across calls; numba backend).
 
     Returns
     -------
@@ -303,14 +305,19 @@ def latlong_to_cubemap(image, size: int = 64, backend: str = "numba") -> np.ndar
     if image.dtype not in (np.float32, np.float64):
         image = image.astype(np.float64)
     H, W, C = image.shape
-    taps, weights = _latlong_taps(H, W, size)
+    taps, weights = _latlong_taps(H, W, size, image.dtype.str)
     flat = np.ascontiguousarray(image).reshape(H * W, C)
     if backend == "numpy":
-        out = gather_bilinear(flat, taps, weights)
-    else:
-        out = np.empty((taps.shape[1], C), dtype=image.dtype)
-        _k.gather_bilinear_kernel(flat, taps, weights.astype(image.dtype), out)
-    return out.reshape(6, size, size, C)
+        return gather_bilinear(flat, taps, weights).reshape(6, size, size, C)
+    if out is None:
+        out = np.empty((6, size, size, C), dtype=image.dtype)
+    require(
+        out.shape == (6, size, size, C) and out.dtype == image.dtype and out.flags.c_contiguous,
+        f"latlong_to_cubemap: out must be a C-contiguous {image.dtype} array (6, {size}, {size}, "
+        f"{C}), got {out.dtype} {out.shape}",
+    )
+    _k.gather_bilinear_kernel(flat, taps, weights, out.reshape(-1, C))
+    return out
 
 
 def cubemap_to_latlong(cube, height: int, backend: str = "numpy") -> np.ndarray:
@@ -336,7 +343,7 @@ CUBEMAP_METHODS.register(
         gather_bilinear,
         _k.gather_bilinear_kernel,
         "Eq. (1), Herbert et al. (§7.1 environment transforms)",
-        lambda rng: (rng.random((50, 3)), rng.integers(0, 50, (4, 20)), rng.random((4, 20))),
+        lambda rng: (rng.random((50, 3)), rng.integers(0, 50, (20, 4)), rng.random((20, 4))),
     )
 )
 CUBEMAP_METHODS.register(

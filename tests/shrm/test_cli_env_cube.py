@@ -9,6 +9,7 @@ from reference.cubemap import (
     cubemap_to_latlong,
     latlong_to_cubemap,
 )
+from reference.errors import SpecrefError
 from reference.gbuffer import render_gbuffer
 from reference.geometry import Sphere
 from reference.images import read_hdr, write_exr
@@ -26,7 +27,7 @@ def test_cube_solid_angles_sum_and_twins(rng):
     for method in CUBEMAP_METHODS.values():
         args = method.example_inputs(rng)
         if method.name == "gather_bilinear":
-            out = np.empty((args[1].shape[1], args[0].shape[1]))
+            out = np.empty((args[1].shape[0], args[0].shape[1]))
             method.kernel(args[0], args[1], args[2], out)
         else:
             out = method.reference(*args, backend="numba")
@@ -133,3 +134,14 @@ def test_cli_bad_input_exit_2(argv, tmp_path, shared_data, capsys):
     err = capsys.readouterr().err
     assert err.startswith("specref: error:")
     assert "Traceback" not in err
+
+
+def test_latlong_to_cubemap_float32_twin_and_out(rng):
+    image = rng.random((16, 32, 41)).astype(np.float32)
+    fast = latlong_to_cubemap(image, 8)
+    assert fast.dtype == np.float32
+    np.testing.assert_allclose(fast, latlong_to_cubemap(image, 8, backend="numpy"), rtol=1e-6)
+    out = np.empty_like(fast)
+    assert latlong_to_cubemap(image, 8, out=out) is out
+    with pytest.raises(SpecrefError, match="out must be"):
+        latlong_to_cubemap(image, 8, out=np.empty((6, 8, 8, 41)))
