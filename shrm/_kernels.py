@@ -51,19 +51,25 @@ def _column(m, L, sgn, u, p_mm, e_mm, A, B, t0, scaled, buf):
 
 
 @numba.njit(cache=False)
-def legendre_table_kernel(L, sgn, u, sin_theta, A, B, scaled, out):
-    """Twin of ``shrm.sh.legendre_table``: out[t(l, m), j] = λ_lm(x_j), m-major layout."""
+def legendre_table_kernel(L, sgn, u, sin_theta, A, B, scaled, keep, out):
+    """Twin of ``shrm.sh.legendre_table``: out[t(l, m), j] = λ_lm(x_j), m-major layout.
+
+    Only the blocks with ``keep[m]`` are written, one after the other.
+    """
     N = u.shape[0]
     buf = np.empty(L + 1)
     for j in range(N):
         p, e = _INV_SQRT_4PI, 0
         t0 = 0
+        row = 0
         for m in range(L + 1):
             if m > 0:
                 p, e = _sectoral_next(p, e, m, sin_theta[j], scaled)
-            _column(m, L, sgn[j], u[j], p, e, A, B, t0, scaled, buf)
-            for i in range(L + 1 - m):
-                out[t0 + i, j] = buf[i]
+            if keep[m]:
+                _column(m, L, sgn[j], u[j], p, e, A, B, t0, scaled, buf)
+                for i in range(L + 1 - m):
+                    out[row + i, j] = buf[i]
+                row += L + 1 - m
             t0 += L + 1 - m
 
 

@@ -198,6 +198,17 @@ def latlong_ring_angles(height: int) -> np.ndarray:
     return (np.arange(height) + 0.5) * np.pi / height
 
 
+@functools.lru_cache(maxsize=16)
+def _fejer1_weights_cached(n: int) -> np.ndarray:
+    theta = latlong_ring_angles(n)
+    k = np.arange(1, n // 2 + 1)
+    # Fejér's first rule: w_j = (2/n)(1 - 2 Σ_k cos(2kθ_j)/(4k²-1))
+    series = np.cos(2.0 * np.outer(theta, k)) / (4.0 * k * k - 1.0)
+    w = (2.0 / n) * (1.0 - 2.0 * series.sum(axis=1))
+    w.setflags(write=False)
+    return w
+
+
 def fejer1_weights(n: int) -> np.ndarray:
     """Weights of Fejér's first quadrature rule on ``x_j = cos θ_j``, θ_j = (j + ½)π/n.
 
@@ -222,13 +233,10 @@ def fejer1_weights(n: int) -> np.ndarray:
     (array([0.264298, 0.735702, 0.735702, 0.264298]), 2.0)
     """
     require(int(n) >= 1, f"fejer1_weights: n must be >= 1, got {n}")
-    theta = latlong_ring_angles(int(n))
-    k = np.arange(1, n // 2 + 1)
-    # Fejér's first rule: w_j = (2/n)(1 - 2 Σ_k cos(2kθ_j)/(4k²-1))
-    series = np.cos(2.0 * np.outer(theta, k)) / (4.0 * k * k - 1.0)
-    return (2.0 / n) * (1.0 - 2.0 * series.sum(axis=1))
+    return _fejer1_weights_cached(int(n)).copy()
 
 
+@functools.lru_cache(maxsize=16)
 def legendre_recurrence_coefficients(order: int) -> tuple[np.ndarray, np.ndarray]:
     """The column-recurrence coefficients a_lm, b_lm in the m-major triangular layout.
 
@@ -246,17 +254,18 @@ def legendre_recurrence_coefficients(order: int) -> tuple[np.ndarray, np.ndarray
     (array([0.    , 1.7321, 0.    ]), array([0., 0., 0.]))
     """
     L = int(order)
-    A, B = [], []
-    for m in range(L + 1):
-        l = np.arange(m, L + 1, dtype=np.float64)
-        a = np.zeros_like(l)
-        b = np.zeros_like(l)
+    m = np.concatenate([np.full(L + 1 - k, k) for k in range(L + 1)]).astype(np.float64)
+    l = np.concatenate([np.arange(k, L + 1) for k in range(L + 1)]).astype(np.float64)
+    A, B = np.zeros_like(l), np.zeros_like(l)
+    with np.errstate(divide="ignore", invalid="ignore"):
         # a_lm = sqrt((4l²-1)/(l²-m²)), b_lm = sqrt(((l-1)²-m²)/(4(l-1)²-1)) (Holmes & Featherstone)
-        a[1:] = np.sqrt((4.0 * l[1:] ** 2 - 1.0) / (l[1:] ** 2 - m * m))
-        b[2:] = np.sqrt(((l[2:] - 1.0) ** 2 - m * m) / (4.0 * (l[2:] - 1.0) ** 2 - 1.0))
-        A.append(a)
-        B.append(b)
-    return np.concatenate(A), np.concatenate(B)
+        a = np.sqrt((4.0 * l**2 - 1.0) / (l**2 - m**2))
+        b = np.sqrt(((l - 1.0) ** 2 - m**2) / (4.0 * (l - 1.0) ** 2 - 1.0))
+    A = np.where(l >= m + 1, a, 0.0)
+    B = np.where(l >= m + 2, b, 0.0)
+    for array in (A, B):
+        array.setflags(write=False)
+    return A, B
 
 
 def ring_cosines(theta) -> tuple[np.ndarray, np.ndarray]:
@@ -283,7 +292,9 @@ def _scaled_for(order: int, method: str) -> bool:
     return method == "scaled" or (method == "auto" and order > PLAIN_ORDER_LIMIT)
 
 
-def legendre_table(order: int, theta, method: str = "auto", orders=None) -> np.ndarray:
+def legendre_table(
+    order: int, theta, method: str = "auto", orders=None, backend: str = "numpy"
+) -> np.ndarray:
     """Normalized associated Legendre functions λ_lm(cos θ) for 0 <= m <= l <= L.
 
     Eq. (3), Ramamoorthi & Hanrahan 2001 (the θ part of the real basis).
@@ -302,6 +313,8 @@ def legendre_table(order: int, theta, method: str = "auto", orders=None) -> np.n
     method : {"auto", "plain", "scaled"}
     orders : sequence of int, optional
         Keep only the blocks of these orders m (default all), for large L.
+    backend : {"numpy", "numba"}
+        ``numba`` runs the twin kernel.
 
     Returns
     -------
@@ -318,13 +331,32 @@ def legendre_table(order: int, theta, method: str = "auto", orders=None) -> np.n
     L = check_order(order)
     scaled = _scaled_for(L, method)
     theta = np.atleast_1d(np.asarray(theta, dtype=np.float64))
+    N = theta.size
+    keep = set(range(L + 1)) if orders is None else {int(m) for m in orders}
+    if backend == "numba":
+        from shrm._kernels import legendre_table_kernel
+
+        A, B = legendre_recurrence_coefficients(L)
+        mask = np.zeros(L + 1, dtype=np.bool_)
+        mask[sorted(keep)] = True
+        out = np.empty((sum(L + 1 - m for m in keep), N))
+        legendre_table_kernel(L, *ring_cosines(theta), np.sin(theta), A, B, scaled, mask, out)
+        return out
+    require_choice(backend, ("numpy", "numba"), "Legendre backend")
+    blocks = [block for _, block in _legendre_blocks(L, theta, scaled, keep)]
+    return np.concatenate(blocks) if blocks else np.empty((0, N))
+
+
+def _legendre_blocks(L: int, theta: np.ndarray, scaled: bool, keep=None):
+    """Yield ``(m, block)`` with block[l - m, j] = λ_lm(θ_j), l = m..L, for the orders in ``keep``.
+
+    Holmes & Featherstone's sectoral and column recurrences, vectorized over θ (see
+    :func:`legendre_table`).
+    """
     sgn, u = ring_cosines(theta)
     sin_theta = np.sin(theta)
     A, B = legendre_recurrence_coefficients(L)
     N = theta.size
-    keep = set(range(L + 1)) if orders is None else {int(m) for m in orders}
-    out = np.empty((sum(L + 1 - m for m in keep), N))
-    row = 0
     p = np.full(N, 1.0 / np.sqrt(4.0 * np.pi))
     e = np.zeros(N, dtype=np.int64)
     t0 = 0
@@ -336,11 +368,12 @@ def legendre_table(order: int, theta, method: str = "auto", orders=None) -> np.n
                 tiny = (p != 0.0) & (np.abs(p) < _SMALL)
                 p = np.where(tiny, p * _BIG, p)
                 e = np.where(tiny, e - _SCALE_BITS, e)
-        if m not in keep:
+        if keep is not None and m not in keep:
             t0 += L + 1 - m
             continue
+        block = np.empty((L + 1 - m, N))
         p1, p2, e_col = p, np.zeros(N), e
-        out[row] = np.ldexp(p1, e_col) if scaled else p1
+        block[0] = np.ldexp(p1, e_col) if scaled else p1
         for l in range(m + 1, L + 1):
             t = t0 + l - m
             # Column recurrence: λ_lm = a_lm (x λ_{l-1,m} - b_lm λ_{l-2,m}), x p = sgn (p - u p)
@@ -351,10 +384,9 @@ def legendre_table(order: int, theta, method: str = "auto", orders=None) -> np.n
                     p1 = np.where(big, p1 * _SMALL, p1)
                     p2 = np.where(big, p2 * _SMALL, p2)
                     e_col = np.where(big, e_col + _SCALE_BITS, e_col)
-            out[row + l - m] = np.ldexp(p1, e_col) if scaled else p1
+            block[l - m] = np.ldexp(p1, e_col) if scaled else p1
         t0 += L + 1 - m
-        row += L + 1 - m
-    return out
+        yield m, block
 
 
 def _table_blocks(order: int, table: np.ndarray) -> list[np.ndarray]:
@@ -577,11 +609,24 @@ def sh_evaluate(coeffs, directions, backend: str = "numpy", method: str = "auto"
     elif backend == "ducc0":
         out = _evaluate_ducc0(c, L, d)
     else:
-        out = np.empty((d.shape[0], C))
-        chunk = max(1, 4_000_000 // n_coefficients(L))
+        out = np.zeros((d.shape[0], C))
+        chunk = max(1, 8_000_000 // (L + 1))
+        scaled = _scaled_for(L, method)
         for start in range(0, d.shape[0], chunk):
-            # Eq. (2), Ramamoorthi & Hanrahan 2001: f(ω) = Σ c_lm Y_lm(ω)
-            out[start : start + chunk] = sh_basis(L, d[start : start + chunk], method) @ c.T
+            theta, phi = directions_to_theta_phi(d[start : start + chunk])
+            acc = out[start : start + chunk]
+            for m, block in _legendre_blocks(L, theta, scaled):
+                l = np.arange(m, L + 1)
+                # Eq. (2), Ramamoorthi & Hanrahan 2001: f(ω) = Σ_m Σ_l c_lm Y_lm(ω), per order m
+                if m == 0:
+                    acc += block.T @ c[:, l * l + l].T
+                else:
+                    acc += (
+                        np.sqrt(2.0) * np.cos(m * phi)[:, None] * (block.T @ c[:, l * l + l + m].T)
+                    )
+                    acc += (
+                        np.sqrt(2.0) * np.sin(m * phi)[:, None] * (block.T @ c[:, l * l + l - m].T)
+                    )
     out = out.reshape(*shape, C)
     return out[..., 0] if single else out
 
@@ -680,9 +725,11 @@ def _project_numba(image, L, w, method):
 
 
 def _project_ducc0(image, L, w, method):
-    """Projection path (ducc0 adjoint synthesis).
+    """Projection path (ducc0: one FFT pass for all channels, a Legendre transform per channel).
 
-    Eq. (4), Ramamoorthi & Hanrahan 2001: ``c_lm = Σ_j w_j ∫ f Y_lm dφ``.
+    Eq. (4), Ramamoorthi & Hanrahan 2001: ``c_lm = Σ_j w_j ∫ f Y_lm dφ``, with the same Fejér-1
+    ring weights ``w_j 2π/W`` as the NumPy path (``ringfactor``), pixel centres at
+    ``φ_i = 2π(i + ½)/W`` (``phi0 = π/W``). The channels are read in place as strided maps.
 
     Examples
     --------
@@ -691,18 +738,21 @@ def _project_ducc0(image, L, w, method):
     """
     import ducc0
 
-    W, C = image.shape[1:]
-    # The same quadrature as the NumPy path: ring weights w_j (2π/W) through the adjoint synthesis.
-    ringfactor = w * (2.0 * np.pi / W)
+    H, W, C = image.shape
+    maps = np.asarray(image, dtype=np.float64).reshape(H * W, C).T  # (C, H·W) strided view
+    leg = ducc0.sht.experimental.map2leg(
+        map=maps,
+        nphi=np.full(H, W, dtype=np.uint64),
+        phi0=np.full(H, np.pi / W),
+        ringstart=(np.arange(H) * W).astype(np.uint64),
+        ringfactor=w * (2.0 * np.pi / W),
+        mmax=L,
+    )
+    theta = latlong_ring_angles(H)
     alm = np.empty((C, (L + 1) * (L + 2) // 2), dtype=np.complex128)
-    for channel in range(C):  # ducc0 transforms one spin-0 map per call
-        alm[channel] = ducc0.sht.experimental.adjoint_synthesis_2d(
-            map=np.ascontiguousarray(image[None, :, :, channel], dtype=np.float64),
-            spin=0,
-            lmax=L,
-            geometry="F1",
-            phi0=np.pi / W,
-            ringfactor=ringfactor,
+    for channel in range(C):  # ducc0's Legendre transform takes one spin-0 component per call
+        alm[channel] = ducc0.sht.experimental.leg2alm(
+            leg=leg[channel : channel + 1], lmax=L, theta=theta
         )[0]
     return _ducc0_to_real(alm, L)
 

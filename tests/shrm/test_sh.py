@@ -177,12 +177,11 @@ def test_numba_twins_equal_numpy(method, rng):
     args = method.example_inputs(rng)
     if method.name == "legendre_table":
         L, theta = args
-        ref = method.reference(L, theta)
-        A, B = legendre_recurrence_coefficients(L)
-        for scaled in (False, True):
-            out = np.empty_like(ref)
-            method.kernel(L, *ring_cosines(theta), np.sin(theta), A, B, scaled, out)
-            np.testing.assert_allclose(out, ref, rtol=1e-12, atol=1e-14)
+        for scaled in ("plain", "scaled"):
+            for orders in (None, [0, 3, L]):
+                ref = method.reference(L, theta, scaled, orders)
+                out = method.reference(L, theta, scaled, orders, backend="numba")
+                np.testing.assert_allclose(out, ref, rtol=1e-12, atol=1e-14)
     elif method.name == "legendre_analysis":
         L, theta, w, F_cos, F_sin = args
         ref = method.reference(L, theta, w, F_cos, F_sin)

@@ -17,7 +17,8 @@ import mpmath
 from reference.images import write_text_atomic
 from validation.oracles import converged_mp, sh_basis_mp
 
-DEGREES = (0, 1, 2, 10, 99, 100, 101, 199, 200, 500, 999, 1000, 1500, 1930, 2000, 2500)
+DEGREES = (0, 1, 2, 10, 99, 100, 101, 199, 200, 500, 999, 1000, 1500, 1930, 2000, 2100, 2200)
+DEGREES += (2300, 2400, 2500)
 THETAS = (
     1e-12,
     1e-6,
