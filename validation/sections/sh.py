@@ -160,6 +160,28 @@ def prefilter_agreement(
     return out
 
 
+def irradiance_images(ctx, path) -> list:
+    """The environment and its irradiance / π (Lambert prefilter, adaptive order), as sRGB images.
+
+    Both at the same exposure (0.25 / the map's mean), so a white Lambertian surface facing direction
+    n shows the irradiance image's colour at n.
+    """
+    from shrm.prefilter import prefilter_environment
+
+    image = read_hdr(path)
+    result = prefilter_environment(image, "lambert", output="latlong", height=64)
+    exposure = 0.25 / float(image.mean())
+    small = image[:: image.shape[0] // 64, :: image.shape[0] // 64]
+    return [
+        ctx.image("environment", linear_to_display(small, "srgb", exposure), f"{path.name}"),
+        ctx.image(
+            "irradiance",
+            linear_to_display(result.values / np.pi, "srgb", exposure),
+            f"Irradiance / π of {path.name}, Lambert prefilter at order {result.order}",
+        ),
+    ]
+
+
 def _basis_chart(ctx, errors):
     import matplotlib.pyplot as plt
 
@@ -357,6 +379,8 @@ def run(ctx: ReportContext) -> SectionResult:
         blocks.append(
             ctx.image(f"window-{window}", encoded, f"L = 100, window {window} (negative: magenta)")
         )
+    # A prefiltered irradiance map of a shared environment (docs/sh.md shows it).
+    blocks += irradiance_images(ctx, SHARED / "environments" / "st_fagans_interior_1k.hdr")
     # Prefiltering: frequency against brute force.
     step = 4
     small = np.ascontiguousarray(image[::step, ::step, :1])
