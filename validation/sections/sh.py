@@ -163,7 +163,7 @@ def prefilter_agreement(
 def irradiance_images(ctx, path) -> list:
     """The environment and its irradiance / π (Lambert prefilter, adaptive order), as sRGB images.
 
-    Both at the same exposure (0.25 / the map's mean), so a white Lambertian surface facing direction
+    Both at the same exposure (0.25 / the mean radiance), so a white Lambertian surface facing
     n shows the irradiance image's colour at n.
     """
     from shrm.prefilter import prefilter_environment
