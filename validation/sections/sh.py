@@ -33,6 +33,7 @@ from shrm.prefilter import (
 from shrm.sh import (
     PLAIN_ORDER_LIMIT,
     legendre_table,
+    order_of,
     project_latlong,
     sh_evaluate,
     synthesize_latlong,
@@ -180,6 +181,37 @@ def irradiance_images(ctx, path) -> list:
             f"Irradiance / π of {path.name}, Lambert prefilter at order {result.order}",
         ),
     ]
+
+
+def gaussian_approximation_errors(coeffs, exponents, size: int = 32) -> dict:
+    """Per-texel error of prefiltering with ``exp(-l²/2s)`` instead of the exact Λ_l.
+
+    Returns
+    -------
+    dict
+        ``{s: {"max_relative", "median_relative", "max_over_peak"}}`` over a cube map's texels.
+
+    Examples
+    --------
+    >>> c = np.zeros((1, 9)); c[0, 0] = 1.0
+    >>> gaussian_approximation_errors(c, [8], 2)[8]["max_relative"]
+    0.0
+    """
+    from reference.cubemap import cubemap_texel_directions
+
+    L = order_of(coeffs.shape[1])
+    d = cubemap_texel_directions(size)
+    out = {}
+    for s in exponents:
+        exact = sh_evaluate(prefilter_coefficients(coeffs, parse_kernel(f"phong:{s}").Lambda(L)), d)
+        approx = sh_evaluate(prefilter_coefficients(coeffs, phong_Lambda_gaussian(s, L)), d)
+        relative = np.abs(approx - exact) / np.abs(exact)
+        out[s] = {
+            "max_relative": float(relative.max()),
+            "median_relative": float(np.median(relative)),
+            "max_over_peak": float(np.abs(approx - exact).max() / np.abs(exact).max()),
+        }
+    return out
 
 
 def _basis_chart(ctx, errors):
@@ -408,6 +440,19 @@ def run(ctx: ReportContext) -> SectionResult:
         ),
         _lambda_chart(ctx, 100),
     ]
+    gauss_errors = gaussian_approximation_errors(coeffs[:1], (32, 256), 16 if ctx.quick else 32)
+    results["gaussian_approximation"] = gauss_errors
+    blocks.append(
+        Table(
+            ["s", "max relative", "median relative", "max / peak"],
+            [
+                [s, v["max_relative"], v["median_relative"], v["max_over_peak"]]
+                for s, v in gauss_errors.items()
+            ],
+            "Phong prefilter of venice_sunset (R, L = 100) with exp(-l²/2s), not the exact Λ_l",
+            "{:.3g}",
+        )
+    )
     # Benchmarks.
     rows, bench_results, bench_checks, by_order = _bench(ctx)
     results["benchmarks"] = bench_results
