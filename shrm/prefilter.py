@@ -12,8 +12,9 @@ Hanrahan 2001, where ``Λ_l = sqrt(4π/(2l+1)) A_l``), with the exact Legendre p
 
 computed here by Gauss–Legendre quadrature, not by the Gaussian approximation ``exp(-l²/2s)`` of a
 Phong lobe (on ``venice_sunset_1k.hdr`` at L = 100 that approximation is off by 10 % at the worst
-texel of a 16²×6 cube for s = 32 and 256, more on finer cubes; the report measures it). The angular-domain convolution is quadratic per texel;
-the frequency-space one is a product per coefficient (§5.4, Herbert et al.).
+texel of a 16²×6 cube for s = 32 and 256, more on finer cubes; the report measures it). The
+angular-domain convolution is quadratic per texel; the frequency-space one is a product per
+coefficient (§5.4, Herbert et al.).
 
 Kernels (:data:`PREFILTER_KERNELS`, spec strings for ``--kernel``):
 
