@@ -315,9 +315,10 @@ def parse_kernel(spec) -> RadialKernel:
     require(param, f"kernel {name!r} needs a parameter: {name}:{entry.extra['param']}")
     if name == "phong":
         try:
-            return entry.reference(float(param))
+            exponent = float(param)
         except ValueError:
             raise SpecrefError(f"kernel {spec!r}: the exponent must be a number") from None
+        return entry.reference(exponent)
     return entry.reference(param)
 
 

@@ -118,17 +118,29 @@ def test_cli_project_and_prefilter(tmp_path, shared_data):
         ["sh", "prefilter", "ENV", "--kernel", "ward", "--out", "x.exr"],
         ["sh", "prefilter", "SQUARE", "--kernel", "lambert", "--out", "x.exr"],
         ["sh", "prefilter", "NEG", "--kernel", "lambert", "--out", "x.exr"],
+        ["sh", "project", "NAN", "--order", "2", "-o", "x.npz"],
+        ["sh", "project", "ENV", "--order", "5000", "-o", "x.npz"],
+        ["sh", "project", "BROKEN", "--order", "2", "-o", "x.npz"],
+        ["sh", "prefilter", "ENV", "--kernel", "table:BADTABLE", "--out", "x.exr"],
+        ["sh", "prefilter", "ENV", "--kernel", "phong:-3", "--out", "x.exr"],
+        ["sh", "prefilter", "ENV", "--kernel", "lambert", "--tol", "2", "--out", "x.exr"],
     ],
 )
 def test_cli_bad_input_exit_2(argv, tmp_path, shared_data, capsys):
     write_exr(tmp_path / "square.exr", np.ones((8, 8, 3)))
     write_exr(tmp_path / "neg.exr", -np.ones((8, 16, 3)))
+    write_exr(tmp_path / "nan.exr", np.full((8, 16, 3), np.nan))
+    (tmp_path / "broken.hdr").write_bytes(b"#?RADIANCE\nnot really\n")
+    (tmp_path / "bad.csv").write_text("angle_rad,value\n0,1\n5,1\n")
     mapping = {
         "ENV": str(shared_data / "environments" / "studio_small_03_1k.hdr"),
         "SQUARE": str(tmp_path / "square.exr"),
         "NEG": str(tmp_path / "neg.exr"),
         "x.npz": str(tmp_path / "x.npz"),
         "x.exr": str(tmp_path / "x.exr"),
+        "NAN": str(tmp_path / "nan.exr"),
+        "BROKEN": str(tmp_path / "broken.hdr"),
+        "table:BADTABLE": f"table:{tmp_path / 'bad.csv'}",
     }
     assert main([mapping.get(a, a) for a in argv]) == 2
     err = capsys.readouterr().err
