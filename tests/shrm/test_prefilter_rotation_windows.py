@@ -113,7 +113,8 @@ def test_kernel_table_bad_input(text, message, tmp_path):
 
 
 @pytest.mark.parametrize(
-    ("spec", "message"), [("ward", "unknown kernel"), ("phong", "needs"), ("phong:x", "number")]
+    ("spec", "message"),
+    [("ward", "unknown kernel"), ("phong", "needs"), ("phong:x", "number"), ("phong:-3", "1e5")],
 )
 def test_parse_kernel_bad(spec, message):
     with pytest.raises(SpecrefError, match=message):
