@@ -17,9 +17,10 @@ environment. With ``ctx.options["environment"] == "bruteforce"`` (``specref rend
 pixel integrates the whole map instead (:func:`shrm.prefilter.prefilter_bruteforce`).
 
 A spectral environment (one channel per band) is resampled linearly onto the scene's grid; an RGB
-one is upsampled with ``reference.upsampling`` (Mallett & Yuksel 2019 by default; option
-``ctx.options["upsampling"]``). XYZ uses the equal-energy band weights: radiance spectra carry no
-light to fold in, and a spectral radiance of 1 in every band has Y = 1.
+one is upsampled with ``reference.upsampling.RGB_to_radiance_spectra`` (Mallett & Yuksel 2019 by
+default, times the colourspace's white illuminant, so a white texel becomes a D65-shaped spectrum
+and renders white; option ``ctx.options["upsampling"]``). XYZ uses the equal-energy band weights:
+radiance spectra carry no light to fold in.
 
 Options read from ``ctx.options``: ``environment`` (``"frequency"`` default, or ``"bruteforce"``),
 ``environment_tol`` (default :data:`shrm.prefilter.DEFAULT_TOL`), ``environment_size`` (cube
@@ -39,7 +40,7 @@ from reference.materials import LambertMaterial, PhongMaterial
 from reference.registry import Method
 from reference.shading import SHADERS, Surface
 from reference.spectra import SpectralGrid
-from reference.upsampling import DEFAULT_UPSAMPLING, RGB_to_spectra
+from reference.upsampling import DEFAULT_UPSAMPLING, RGB_to_radiance_spectra
 from shrm.prefilter import (
     DEFAULT_TOL,
     adaptive_order,
@@ -83,7 +84,7 @@ def environment_spectral_radiance(
         M = np.stack([np.interp(target, wl, np.eye(wl.size)[i]) for i in range(wl.size)])
         spectra = image @ M
     else:
-        spectra = RGB_to_spectra(image, grid, upsampling)
+        spectra = RGB_to_radiance_spectra(image, grid, upsampling, light.colourspace)
     return light.intensity * spectra
 
 
@@ -163,7 +164,8 @@ def shade_lambert_environment(
     >>> s = Surface(np.zeros((1, 3)), np.array([[0.0, 1.0, 0.0]]), np.array([[0.0, 1.0, 0.0]]),
     ...             np.zeros((1, 2)))
     >>> shade_lambert_environment(s, LambertMaterial(np.ones(41)), env, ShadingContext()).round(3)
-    array([[1., 1., 1.]])
+    ... # a white sky of radiance 1: the D65 white
+    array([[0.95, 1.  , 1.09]])
     """
     require(surface.normal.ndim == 2, "environment shading: surface arrays must be (N, 3)")
     # Eq. (2), Herbert et al.: I_d = E_d D, reflected radiance k_d E / π
@@ -186,8 +188,8 @@ def shade_phong_environment(
     >>> s = Surface(np.zeros((1, 3)), np.array([[0.0, 1.0, 0.0]]), np.array([[0.0, 1.0, 0.0]]),
     ...             np.zeros((1, 2)))
     >>> m = PhongMaterial(np.zeros(41), np.ones(41), np.ones(41))
-    >>> shade_phong_environment(s, m, env, ShadingContext()).round(3)   # ∫ cos/π dω = 1
-    array([[1., 1., 1.]])
+    >>> shade_phong_environment(s, m, env, ShadingContext()).round(3)   # D65 white, ∫ cos/π dω = 1
+    array([[0.95, 1.  , 1.09]])
     """
     N, V = surface.normal, surface.view
     # Reflected view vector r = 2 (N·V) N − V

@@ -2,6 +2,7 @@ import numpy as np
 import pytest
 
 from reference.camera import Camera
+from reference.colorimetry import band_weights, spectra_to_RGB_matrix
 from reference.cubemap import (
     CUBEMAP_METHODS,
     cubemap_lookup_bilinear,
@@ -17,7 +18,7 @@ from reference.lights import EnvironmentLight
 from reference.materials import LambertMaterial, PhongMaterial
 from reference.shading import ShadingContext, shade_gbuffer
 from reference.spectra import GRID_41
-from reference.upsampling import RGB_to_spectra
+from reference.upsampling import RGB_to_radiance_spectra, RGB_to_spectra
 from shrm.sh import sh_evaluate, synthesize_latlong
 from validation.cli import main
 
@@ -51,9 +52,18 @@ def test_cube_lookup_second_order_and_round_trip(rng):
     assert np.sqrt(np.mean((back - fine) ** 2)) < 1e-2 * np.abs(fine).max()
 
 
-def test_upsampling_white_is_flat():
+def test_upsampling_white_is_flat_and_renders_white():
+    # Mallett 2019: the basis sums to 1 within 1e-5 (colour-science data), so white is flat.
     S = RGB_to_spectra(np.array([[3.0, 3.0, 3.0]]), GRID_41)
     np.testing.assert_allclose(S, 3.0, rtol=1e-4)
+    # As radiance: times D65/Y(D65), so XYZ (E weights) -> sRGB gives back the white texel.
+    # Source: colour-science D65 and sRGB; tolerance: D65 sampled at 10 nm vs its 5 nm table.
+    M = spectra_to_RGB_matrix(band_weights(GRID_41, None))
+    for method in ("mallett2019", "jakob2019"):
+        R = RGB_to_radiance_spectra(np.array([[3.0, 3.0, 3.0]]), GRID_41, method)
+        np.testing.assert_allclose(R @ M, 3.0, rtol=2e-3)
+    with pytest.raises(SpecrefError, match="finite, >= 0"):
+        RGB_to_spectra(np.array([[-1.0, 0.0, 0.0]]), GRID_41)
 
 
 def test_environment_shaders_frequency_vs_bruteforce(shared_data):
