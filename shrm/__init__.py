@@ -14,16 +14,8 @@ from shrm.prefilter import (
     prefilter_environment,
 )
 from shrm.rotation import rotate_coefficients, rotation_matrix, sh_rotation_blocks
-from shrm.sh import (
-    SH_BACKENDS,
-    SH_MAX_ORDER,
-    project_function,
-    project_latlong,
-    sh_basis,
-    sh_evaluate,
-    sh_index,
-    synthesize_latlong,
-)
+from shrm.sh import SH_MAX_ORDER, sh_basis, sh_evaluate, sh_index
+from shrm.transform import SH_BACKENDS, project_function, project_latlong, synthesize_latlong
 from shrm.windows import WINDOWS, apply_window, ringing_statistics
 
 __all__ = [

@@ -49,7 +49,8 @@ from shrm.prefilter import (
     prefilter_bruteforce,
     prefilter_coefficients,
 )
-from shrm.sh import project_latlong, sh_evaluate
+from shrm.sh import sh_evaluate
+from shrm.transform import project_latlong
 
 __all__ = [
     "environment_spectral_radiance",

@@ -77,7 +77,7 @@ def project_file(path, order: int, out, window=None, bands=None, backend: str = 
     import io
 
     from reference.images import write_bytes_atomic
-    from shrm.sh import project_latlong
+    from shrm.transform import project_latlong
 
     image, names = read_environment(path, bands)
     coeffs = project_latlong(image, order, window=window, backend=backend, where=str(path))

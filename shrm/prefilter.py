@@ -56,11 +56,10 @@ from shrm.sh import (
     check_order,
     fejer1_weights,
     order_of,
-    project_latlong,
     sh_degrees_orders,
     sh_evaluate,
-    synthesize_latlong,
 )
+from shrm.transform import project_latlong, synthesize_latlong
 
 __all__ = [
     "BRUTEFORCE_METHODS",

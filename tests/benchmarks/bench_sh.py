@@ -4,7 +4,7 @@ BLAS runs single-threaded (``threadpoolctl.threadpool_limits(1)``): multithreade
 the shared 2-core machines (docs/dependencies.md). Groups:
 
 - ``sh-project-L100``: one 512×1024 channel of ``venice_sunset_1k.hdr`` to L = 100 by each path of
-  ``shrm.sh.SH_BACKENDS`` (ducc0 is the baseline); targets ducc0 ≤ 5 ms, NumPy ≤ 25 ms.
+  ``shrm.transform.SH_BACKENDS`` (ducc0 is the baseline); targets ducc0 ≤ 5 ms, NumPy ≤ 25 ms.
 - ``sh-project-41band``: the same map upsampled to 41 bands, ducc0 (target ≤ 0.25 s).
 - ``sh-project-order``: projection time against order, per path (the report's chart).
 - ``sh-prefilter-cube64``: a 64²×6 cube map of the map prefiltered with ``phong:32`` at L = 100 from
@@ -26,7 +26,8 @@ from reference.images import read_hdr
 from reference.spectra import GRID_41
 from reference.upsampling import RGB_to_spectra
 from shrm.prefilter import parse_kernel, prefilter_bruteforce, prefilter_coefficients
-from shrm.sh import SH_BACKENDS, project_latlong, sh_evaluate
+from shrm.sh import sh_evaluate
+from shrm.transform import SH_BACKENDS, project_latlong
 
 
 @pytest.fixture(scope="module", autouse=True)

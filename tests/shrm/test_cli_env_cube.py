@@ -19,7 +19,8 @@ from reference.materials import LambertMaterial, PhongMaterial
 from reference.shading import ShadingContext, shade_gbuffer
 from reference.spectra import GRID_41
 from reference.upsampling import RGB_to_radiance_spectra, RGB_to_spectra
-from shrm.sh import sh_evaluate, synthesize_latlong
+from shrm.sh import sh_evaluate
+from shrm.transform import synthesize_latlong
 from validation.cli import main
 
 

@@ -16,7 +16,8 @@ from shrm.prefilter import (
     prefilter_environment,
 )
 from shrm.rotation import rotate_coefficients, rotation_matrix, sh_rotation_blocks
-from shrm.sh import project_latlong, sh_evaluate, synthesize_latlong
+from shrm.sh import sh_evaluate
+from shrm.transform import project_latlong, synthesize_latlong
 from shrm.windows import apply_window, parse_window, ringing_statistics, window_gaussian
 from validation.oracles import lambert_Lambda_mp, phong_Lambda_mp
 

@@ -10,19 +10,21 @@ from reference.errors import SpecrefError
 from reference.images import read_hdr
 from shrm.sh import (
     PLAIN_ORDER_LIMIT,
-    SH_BACKENDS,
-    SH_KERNELS,
     directions_to_theta_phi,
     fejer1_weights,
     latlong_ring_angles,
     legendre_recurrence_coefficients,
     legendre_table,
-    project_function,
-    project_latlong,
     ring_cosines,
     sh_basis,
     sh_degrees_orders,
     sh_evaluate,
+)
+from shrm.transform import (
+    SH_BACKENDS,
+    SH_KERNELS,
+    project_function,
+    project_latlong,
     synthesize_latlong,
 )
 

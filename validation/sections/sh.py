@@ -30,14 +30,8 @@ from shrm.prefilter import (
     prefilter_coefficients,
     truncation_tail,
 )
-from shrm.sh import (
-    PLAIN_ORDER_LIMIT,
-    legendre_table,
-    order_of,
-    project_latlong,
-    sh_evaluate,
-    synthesize_latlong,
-)
+from shrm.sh import PLAIN_ORDER_LIMIT, legendre_table, order_of, sh_evaluate
+from shrm.transform import project_latlong, synthesize_latlong
 from shrm.windows import WINDOWS, apply_window, ringing_statistics
 from validation.report import (
     REPORT_SECTIONS,
