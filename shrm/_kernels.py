@@ -31,23 +31,31 @@ def _sectoral_next(p, e, m, sin_theta, scaled):
 
 
 @numba.njit(cache=False)
-def _column(m, L, sgn, u, p_mm, e_mm, A, B, t0, scaled, buf):
-    """buf[l - m] = λ_lm(x), l = m..L, from λ_mm = p_mm 2^e_mm; x = sgn (1 - u), u = 1 - |x|."""
-    p1 = p_mm
-    p2 = 0.0
-    e = e_mm
-    buf[0] = math.ldexp(p1, e) if scaled else p1
-    for l in range(m + 1, L + 1):
-        # λ_lm = a_lm (x λ_{l-1,m} - b_lm λ_{l-2,m})  (b_{m+1,m} = 0, a_{m+1,m} = sqrt(2m+3))
-        # x p = sgn (p - u p): exact near the poles, where x = cos θ is not representable
-        p = A[t0 + l - m] * (sgn * (p1 - u * p1) - B[t0 + l - m] * p2)
-        p2 = p1
-        p1 = p
-        if scaled and abs(p1) > _BIG:
-            p1 *= _SMALL
-            p2 *= _SMALL
-            e += SCALE_BITS
-        buf[l - m] = math.ldexp(p1, e) if scaled else p1
+def _point_table(L, sgn, u, sin_theta, A, B, scaled, keep, lam):
+    """lam[t(l, m)] = λ_lm(x) for one point, m-major, for the orders with ``keep[m]``.
+
+    x = sgn (1 - u) with u = 1 - |x| (``shrm.sh.ring_cosines``); the other entries are left alone.
+    """
+    p, e = _INV_SQRT_4PI, 0
+    t0 = 0
+    for m in range(L + 1):
+        if m > 0:
+            p, e = _sectoral_next(p, e, m, sin_theta, scaled)
+        if keep[m]:
+            p1 = p
+            p2 = 0.0
+            e_col = e
+            lam[t0] = math.ldexp(p1, e_col) if scaled else p1
+            for l in range(m + 1, L + 1):
+                # λ_lm = a_lm (x λ_{l-1,m} - b_lm λ_{l-2,m})  (b_{m+1,m} = 0, a_{m+1,m} = √(2m+3))
+                # x p = sgn (p - u p): exact near the poles, where x = cos θ is not representable
+                p1, p2 = A[t0 + l - m] * (sgn * (p1 - u * p1) - B[t0 + l - m] * p2), p1
+                if scaled and abs(p1) > _BIG:
+                    p1 *= _SMALL
+                    p2 *= _SMALL
+                    e_col += SCALE_BITS
+                lam[t0 + l - m] = math.ldexp(p1, e_col) if scaled else p1
+        t0 += L + 1 - m
 
 
 @numba.njit(cache=False)
@@ -56,111 +64,97 @@ def legendre_table_kernel(L, sgn, u, sin_theta, A, B, scaled, keep, out):
 
     Only the blocks with ``keep[m]`` are written, one after the other.
     """
-    N = u.shape[0]
-    buf = np.empty(L + 1)
-    for j in range(N):
-        p, e = _INV_SQRT_4PI, 0
+    lam = np.empty((L + 1) * (L + 2) // 2)
+    for j in range(u.shape[0]):
+        _point_table(L, sgn[j], u[j], sin_theta[j], A, B, scaled, keep, lam)
         t0 = 0
         row = 0
         for m in range(L + 1):
-            if m > 0:
-                p, e = _sectoral_next(p, e, m, sin_theta[j], scaled)
             if keep[m]:
-                _column(m, L, sgn[j], u[j], p, e, A, B, t0, scaled, buf)
                 for i in range(L + 1 - m):
-                    out[row + i, j] = buf[i]
+                    out[row + i, j] = lam[t0 + i]
                 row += L + 1 - m
             t0 += L + 1 - m
 
 
 @numba.njit(cache=False)
 def legendre_analysis_kernel(L, sgn, u, sin_theta, w, A, B, F_cos, F_sin, scaled, out):
-    """Twin of ``shrm.sh.legendre_analysis``: c_lm = Σ_j w_j √2 λ_lm(θ_j) F_m(θ_j).
+    """Twin of ``shrm.transform.legendre_analysis``: c_lm = Σ_j w_j √2 λ_lm(θ_j) F_m(θ_j).
 
     ``F_cos, F_sin``: (L+1, H, C) ring integrals of f cos(mφ) and f sin(mφ); out: ((L+1)², C).
     """
-    H = u.shape[0]
     C = F_cos.shape[2]
     sqrt2 = math.sqrt(2.0)
-    buf = np.empty(L + 1)
-    for j in range(H):
-        p, e = _INV_SQRT_4PI, 0
+    keep = np.ones(L + 1, dtype=np.bool_)
+    lam = np.empty((L + 1) * (L + 2) // 2)
+    for j in range(u.shape[0]):
+        _point_table(L, sgn[j], u[j], sin_theta[j], A, B, scaled, keep, lam)
         t0 = 0
         for m in range(L + 1):
-            if m > 0:
-                p, e = _sectoral_next(p, e, m, sin_theta[j], scaled)
-            _column(m, L, sgn[j], u[j], p, e, A, B, t0, scaled, buf)
-            t0 += L + 1 - m
             # Fejér-1 quadrature: c_lm = Σ_j w_j λ_lm(θ_j) ∫ f(θ_j, φ) √2 trig(mφ) dφ
             for l in range(m, L + 1):
                 if m == 0:
-                    q = w[j] * buf[l]
+                    q = w[j] * lam[t0 + l]
                     for c in range(C):
                         out[l * l + l, c] += q * F_cos[0, j, c]
                 else:
-                    q = sqrt2 * w[j] * buf[l - m]
+                    q = sqrt2 * w[j] * lam[t0 + l - m]
                     for c in range(C):
                         out[l * l + l + m, c] += q * F_cos[m, j, c]
                         out[l * l + l - m, c] += q * F_sin[m, j, c]
+            t0 += L + 1 - m
 
 
 @numba.njit(cache=False)
 def legendre_synthesis_kernel(L, sgn, u, sin_theta, A, B, coeffs, scaled, G_cos, G_sin):
-    """Twin of ``shrm.sh.legendre_synthesis``: ring Fourier amplitudes of Σ c_lm Y_lm.
+    """Twin of ``shrm.transform.legendre_synthesis``: ring Fourier amplitudes of Σ c_lm Y_lm.
 
     ``coeffs``: ((L+1)², C); ``G_cos, G_sin``: (L+1, H, C), the cos(mφ) and sin(mφ) amplitudes.
     """
-    H = u.shape[0]
     C = coeffs.shape[1]
     sqrt2 = math.sqrt(2.0)
-    buf = np.empty(L + 1)
-    for j in range(H):
-        p, e = _INV_SQRT_4PI, 0
+    keep = np.ones(L + 1, dtype=np.bool_)
+    lam = np.empty((L + 1) * (L + 2) // 2)
+    for j in range(u.shape[0]):
+        _point_table(L, sgn[j], u[j], sin_theta[j], A, B, scaled, keep, lam)
         t0 = 0
         for m in range(L + 1):
-            if m > 0:
-                p, e = _sectoral_next(p, e, m, sin_theta[j], scaled)
-            _column(m, L, sgn[j], u[j], p, e, A, B, t0, scaled, buf)
-            t0 += L + 1 - m
             for l in range(m, L + 1):
                 if m == 0:
                     for c in range(C):
-                        G_cos[0, j, c] += buf[l] * coeffs[l * l + l, c]
+                        G_cos[0, j, c] += lam[t0 + l] * coeffs[l * l + l, c]
                 else:
-                    q = sqrt2 * buf[l - m]
+                    q = sqrt2 * lam[t0 + l - m]
                     for c in range(C):
                         G_cos[m, j, c] += q * coeffs[l * l + l + m, c]
                         G_sin[m, j, c] += q * coeffs[l * l + l - m, c]
+            t0 += L + 1 - m
 
 
 @numba.njit(cache=False)
 def sh_evaluate_kernel(L, sgn, u, sin_theta, phi, A, B, coeffs, scaled, out):
     """Twin of ``shrm.sh.sh_evaluate``: out[n, c] = Σ_lm c_lm Y_lm(θ_n, φ_n) at any directions."""
-    N = u.shape[0]
     C = coeffs.shape[1]
     sqrt2 = math.sqrt(2.0)
-    buf = np.empty(L + 1)
-    for n in range(N):
-        p, e = _INV_SQRT_4PI, 0
+    keep = np.ones(L + 1, dtype=np.bool_)
+    lam = np.empty((L + 1) * (L + 2) // 2)
+    for n in range(u.shape[0]):
+        _point_table(L, sgn[n], u[n], sin_theta[n], A, B, scaled, keep, lam)
         t0 = 0
         for m in range(L + 1):
-            if m > 0:
-                p, e = _sectoral_next(p, e, m, sin_theta[n], scaled)
-            _column(m, L, sgn[n], u[n], p, e, A, B, t0, scaled, buf)
-            t0 += L + 1 - m
             # Real SH: Y_lm = √2 λ_l|m| cos(mφ) (m > 0), √2 λ_l|m| sin(|m|φ) (m < 0)
             cos_m = sqrt2 * math.cos(m * phi[n])
             sin_m = sqrt2 * math.sin(m * phi[n])
             for l in range(m, L + 1):
-                lam = buf[l - m]
                 if m == 0:
                     for c in range(C):
-                        out[n, c] += lam * coeffs[l * l + l, c]
+                        out[n, c] += lam[t0 + l] * coeffs[l * l + l, c]
                 else:
                     for c in range(C):
-                        out[n, c] += lam * (
+                        out[n, c] += lam[t0 + l - m] * (
                             cos_m * coeffs[l * l + l + m, c] + sin_m * coeffs[l * l + l - m, c]
                         )
+            t0 += L + 1 - m
 
 
 @numba.njit(cache=False)
