@@ -264,12 +264,13 @@ def test_precomputed_sample_regenerates():
 
 
 @pytest.mark.xslow
-def test_order_2000_limit_demo():
-    # The plain recurrence at L = 2000 on random points: the scaled one agrees with it where the
-    # plain one has not underflowed, and differs where it has (xslow: a 2001² table).
+def test_order_2200_limit_demo():
+    # The whole table at L = 2200: at sin θ = 0.84 nothing underflows and the two recurrences agree;
+    # at sin θ = 1/e the plain one's sectoral start underflows (m ≳ 740, l ≳ 2020) and it fails,
+    # which the scaled one does not (xslow: two 2.4M-entry tables in NumPy).
     theta = np.array([0.377, 1.0])
-    plain = legendre_table(2000, theta, "plain")
-    scaled = legendre_table(2000, theta, "scaled")
+    plain = legendre_table(2200, theta, "plain")
+    scaled = legendre_table(2200, theta, "scaled")
     assert np.abs(plain[:, 1] - scaled[:, 1]).max() < 1e-10
     assert np.abs(plain[:, 0] - scaled[:, 0]).max() > 1e-3
     assert os.environ.get("SPECREF_XSLOW")
