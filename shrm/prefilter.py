@@ -11,8 +11,8 @@ Hanrahan 2001, where ``Λ_l = sqrt(4π/(2l+1)) A_l``), with the exact Legendre p
     Λ_l = 2π ∫_{-1}^{1} K(t) P_l(t) dt,
 
 computed here by Gauss–Legendre quadrature, not by the Gaussian approximation ``exp(-l²/2s)`` of a
-Phong lobe (on ``venice_sunset_1k.hdr`` at L = 100 that approximation is off by 10 % at the worst
-texel of a 16²×6 cube for s = 32 and 256, more on finer cubes; the report measures it). The
+Phong lobe (prefiltering the red channel of ``venice_sunset_1k.hdr`` at L = 100 with it is off by
+about 10 % at the worst texel for s = 32 and 256; the report measures it). The
 angular-domain convolution is quadratic per texel; the frequency-space one is a product per
 coefficient (§5.4, Herbert et al.).
 
