@@ -73,12 +73,19 @@ def test_environment_shaders_frequency_vs_bruteforce(shared_data):
     g = render_gbuffer([Sphere()], Camera(eye=(0, 0, 5)), 12, 12)
     k = np.linspace(0.2, 0.8, 41)
     for material in (LambertMaterial(k), PhongMaterial(k, 0.5 * k, np.full(41, 20.0))):
-        fast = shade_gbuffer(g, [material], [env], ShadingContext())
         brute = shade_gbuffer(
             g, [material], [env], ShadingContext(options={"environment": "bruteforce"})
         )
-        # Tolerance: the adaptive order's tail (1e-2 relative L2 of the kernel) plus cube lookups.
-        assert np.abs(fast - brute).max() <= 0.03 * brute.max()
+        errors = []
+        for tol in (1e-2, 1e-3):
+            fast = shade_gbuffer(
+                g, [material], [env], ShadingContext(options={"environment_tol": tol})
+            )
+            errors.append(np.abs(fast - brute).max() / brute.max())
+        # The frequency path converges to the oracle as the adaptive order's tolerance falls; the
+        # kernel's relative L2 tail bounds the error only on average, so allow 3× the tolerance.
+        assert errors[1] < errors[0] / 4
+        assert errors[0] <= 3e-2
 
 
 def test_cli_project_and_prefilter(tmp_path, shared_data):

@@ -39,10 +39,12 @@ def test_phong_Lambda_matches_mpmath(s):
 
 
 def test_gaussian_approximation_is_percent_level_off():
-    # exp(-l²/2s) is the textbook approximation; exact Λ_l differ by a few percent at moderate l.
-    exact = parse_kernel("phong:32").Lambda(30)
-    approx = phong_Lambda_gaussian(32, 30)
-    assert np.abs(approx - exact).max() > 0.01
+    # Source: mpmath Λ_10 of phong:32; exp(-l²/2s) is 11 % too large there (erratum E10).
+    exact = parse_kernel("phong:32").Lambda(10)[10]
+    assert abs(exact - phong_Lambda_mp(10, 32)) <= 1e-12
+    assert phong_Lambda_gaussian(32, 10)[10] / phong_Lambda_mp(10, 32) - 1 == pytest.approx(
+        0.113, abs=5e-4
+    )
 
 
 def test_adaptive_order_lambert_is_cheap():
