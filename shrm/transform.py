@@ -27,10 +27,10 @@ from reference.envmap import check_latlong_shape
 from reference.errors import require, require_choice
 from reference.registry import Method, Registry
 from shrm.sh import (
-    PLAIN_ORDER_LIMIT,
     SH_MAX_ORDER,
     _as_coeffs,
     _ducc0_to_real,
+    _legendre_blocks,
     _real_to_ducc0,
     _scaled_for,
     _table_blocks,
@@ -98,22 +98,16 @@ def legendre_analysis(order: int, theta, w, F_cos, F_sin, method: str = "auto") 
     L = int(order)
     H = len(theta)
     C = F_cos.shape[2]
-    if (
-        method == "auto"
-        and L <= PLAIN_ORDER_LIMIT
-        and (L + 1) * (L + 2) // 2 * H <= _RING_CACHE_VALUES
-    ):
-        same_grid = np.array_equal(theta, latlong_ring_angles(H))
-        blocks = _ring_table(L, H, method) if same_grid else None
-    else:
-        blocks = None
-    if blocks is None:
-        blocks = _table_blocks(L, legendre_table(L, theta, method))
+    small = (L + 1) * (L + 2) // 2 * H <= _RING_CACHE_VALUES
+    if method == "auto" and small and np.array_equal(theta, latlong_ring_angles(H)):
+        blocks = enumerate(_ring_table(L, H, method))
+    else:  # streamed block by block: O(L H) memory at any order
+        blocks = _legendre_blocks(L, np.asarray(theta, dtype=np.float64), _scaled_for(L, method))
     out = np.zeros((C, (L + 1) ** 2))
-    for m in range(L + 1):
+    for m, block in blocks:
         l = np.arange(m, L + 1)
         # Fejér-1 quadrature over the rings: Σ_j w_j λ_lm(θ_j) F_m(θ_j)
-        lam_w = blocks[m] * w
+        lam_w = block * w
         if m == 0:
             out[:, l * l + l] = (lam_w @ F_cos[0]).T
         else:
@@ -151,17 +145,16 @@ def legendre_synthesis(order: int, theta, coeffs, method: str = "auto"):
     theta = np.asarray(theta, dtype=np.float64)
     H = theta.size
     C = coeffs.shape[0]
-    blocks = _table_blocks(L, legendre_table(L, theta, method))
     G_cos = np.zeros((L + 1, H, C))
     G_sin = np.zeros((L + 1, H, C))
-    for m in range(L + 1):
+    for m, block in _legendre_blocks(L, theta, _scaled_for(L, method)):
         l = np.arange(m, L + 1)
         # Eq. (2), Ramamoorthi & Hanrahan 2001: Σ_l c_lm Y_lm, per ring and per m
         if m == 0:
-            G_cos[0] = blocks[0].T @ coeffs[:, l * l + l].T
+            G_cos[0] = block.T @ coeffs[:, l * l + l].T
         else:
-            G_cos[m] = np.sqrt(2.0) * blocks[m].T @ coeffs[:, l * l + l + m].T
-            G_sin[m] = np.sqrt(2.0) * blocks[m].T @ coeffs[:, l * l + l - m].T
+            G_cos[m] = np.sqrt(2.0) * block.T @ coeffs[:, l * l + l + m].T
+            G_sin[m] = np.sqrt(2.0) * block.T @ coeffs[:, l * l + l - m].T
     return G_cos, G_sin
 
 
