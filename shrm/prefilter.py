@@ -44,6 +44,7 @@ References
 from __future__ import annotations
 
 import csv
+import functools
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -174,6 +175,7 @@ class RadialKernel:
         return 8.0 * np.pi**2 * total
 
 
+@functools.lru_cache(maxsize=1)
 def kernel_lambert() -> RadialKernel:
     """The clamped cosine ``K = max(cos γ, 0)``: E is the irradiance.
 
@@ -192,6 +194,7 @@ def kernel_lambert() -> RadialKernel:
     )
 
 
+@functools.lru_cache(maxsize=64)
 def kernel_phong(s: float) -> RadialKernel:
     """The normalized Phong lobe ``(s+1)/(2π) max(cos γ, 0)^s`` (Λ_0 = 1).
 
