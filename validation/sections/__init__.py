@@ -3,8 +3,4 @@
 Each module registers one section. A new section is a new module plus one import line here.
 """
 
-from validation.sections import (  # noqa: F401
-    raster,
-    sh,
-    spectral,
-)
+from validation.sections import raster, sh, spectral  # noqa: F401
