@@ -175,3 +175,58 @@ def test_latlong_to_cubemap_float32_twin_and_out(rng):
     assert latlong_to_cubemap(image, 8, out=out) is out
     with pytest.raises(SpecrefError, match="out must be"):
         latlong_to_cubemap(image, 8, out=np.empty((6, 8, 8, 41)))
+
+
+def test_cli_bands_conversions(tmp_path, rng):
+    # RGB -> 41 bands (Mallett 2019) and a spectral EXR (wavelength channel names) -> RGB.
+    from reference.images import spectral_channel_names
+
+    rgb = tmp_path / "rgb.exr"
+    write_exr(rgb, rng.random((16, 32, 3)))
+    assert (
+        main(
+            [
+                "sh",
+                "project",
+                str(rgb),
+                "--order",
+                "4",
+                "--bands",
+                "spectral",
+                "-o",
+                str(tmp_path / "s.npz"),
+            ]
+        )
+        == 0
+    )
+    data = np.load(tmp_path / "s.npz")
+    assert data["coeffs"].shape == (41, 25)
+    assert str(data["channels"][0]) == "S0.380,000000nm"
+    spectral = tmp_path / "spectral.exr"
+    write_exr(
+        spectral, rng.random((16, 32, 41)), channels=spectral_channel_names(GRID_41.wavelengths_nm)
+    )
+    out = tmp_path / "cube.exr"
+    assert (
+        main(
+            [
+                "sh",
+                "prefilter",
+                str(spectral),
+                "--kernel",
+                "phong:8",
+                "--bands",
+                "rgb",
+                "--size",
+                "4",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
+    from reference.images import read_exr
+
+    image, names = read_exr(out)
+    assert image.shape == (24, 4, 3)
+    assert names == ["R", "G", "B"]
