@@ -51,6 +51,7 @@ def test_adaptive_order_lambert_is_cheap():
     assert adaptive_order("lambert", 1e-2) < 20 < adaptive_order("phong:256", 1e-2) < 100
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("kernel", "bound"), [("phong:32", 1e-11), ("phong:256", 2e-9), ("lambert", 5e-4)]
 )

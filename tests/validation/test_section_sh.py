@@ -1,5 +1,7 @@
 import json
 
+import pytest
+
 from validation.report import run_report
 
 
@@ -12,6 +14,7 @@ def _record(group, name, role, median, **extra):
     }
 
 
+@pytest.mark.slow
 def test_report_sh_section_quick(tmp_path):
     # A pytest-benchmark file with every sh-* group; expected ratios and shares follow from the
     # records below (e.g. brute force 10 s / frequency 5 ms = 2000×; cube map (1.5e8 B / 0.06 s) /
