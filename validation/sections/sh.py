@@ -410,12 +410,19 @@ def run(ctx: ReportContext) -> SectionResult:
     # Prefiltering: frequency against brute force.
     step = 4
     small = np.ascontiguousarray(image[::step, ::step, :1])
+    # A tabulated lobe (the 1-D measured-BRDF case): a Gaussian of 0.15 rad sampled every 0.01 rad.
+    angles = np.arange(0.0, 0.8, 0.01)
+    lobe = ctx.out_dir / "images" / "sh-gaussian-lobe.csv"
+    lobe.parent.mkdir(parents=True, exist_ok=True)
+    rows = "\n".join(f"{a:.2f},{np.exp(-0.5 * (a / 0.15) ** 2):.12g}" for a in angles)
+    lobe.write_text("angle_rad,value\n" + rows + "\n")
     agreement = prefilter_agreement(
         small,
-        ["lambert", "phong:32", "phong:256"],
+        ["lambert", "phong:32", "phong:256", f"table:{lobe}"],
         8 if ctx.quick else 16,
         backend="numpy" if ctx.quick else "numba",
     )
+    agreement = {k.replace(str(lobe.parent) + "/", ""): v for k, v in agreement.items()}
     results["prefilter"] = agreement
     for spec, bound in (("phong:32", 1e-11), ("phong:256", 2e-9), ("lambert", 5e-4)):
         err = agreement[spec]["relative_error"]
@@ -426,7 +433,13 @@ def run(ctx: ReportContext) -> SectionResult:
         Table(
             ["kernel", "relative error", "frequency s", "brute force s", "adaptive L (tol 1e-2)"],
             [
-                [k, v["relative_error"], v["frequency_s"], v["bruteforce_s"], v["adaptive_order"]]
+                [
+                    k,
+                    v["relative_error"],
+                    v["frequency_s"],
+                    v["bruteforce_s"],
+                    v["adaptive_order"],
+                ]
                 for k, v in agreement.items()
             ],
             f"Frequency path vs brute force at L = 100, input {small.shape[1]}×{small.shape[0]}",
