@@ -59,5 +59,12 @@ def test_report_sh_section_quick(tmp_path):
     assert section["ringing"]["none"]["100"]["negative_share"] > 0.01
     html = (tmp_path / "r" / "index.html").read_text()
     assert "<h2>Spherical harmonics</h2>" in html
-    for name in ("basis-error", "ringing", "phong-lambda", "projection-time", "irradiance"):
+    for name in (
+        "basis-error",
+        "ringing",
+        "prefilter",
+        "phong-lambda",
+        "projection-time",
+        "irradiance",
+    ):
         assert (tmp_path / "r" / "images" / f"sh-{name}.png").is_file()
