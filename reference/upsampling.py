@@ -1,0 +1,230 @@
+"""RGB → spectrum upsampling of environment maps (colour-science ``colour.recovery``).
+
+Herbert et al. (§4) expand HDR panoramas to 31-41 bands with a fitted polynomial; specref offers
+two published methods from colour-science, by key (:data:`UPSAMPLING_METHODS`):
+
+- ``mallett2019`` (default): Mallett & Yuksel's spectral primary decomposition for sRGB. A
+  spectrum is the linear combination ``R b_r(λ) + G b_g(λ) + B b_b(λ)`` of three non-negative
+  basis spectra that sum to 1 at every wavelength, so it is linear (HDR values > 1 scale exactly),
+  non-negative for non-negative RGB, and a **white texel (R = G = B = v) becomes the flat spectrum
+  v** in every band (to 1e-5, the precision of the published basis). It is the default because it is
+  exact on white, linear and fast (one matrix product per map).
+- ``jakob2019``: Jakob & Hanika's sigmoid-polynomial model, as used by Mitsuba 3 and pbrt-v4, via
+  colour-science's coefficient table (``LUT3D_Jakob2019``). The model represents reflectances in
+  [0, 1]; HDR texels are scaled by their largest component m, upsampled, and multiplied by m. A
+  white texel becomes a near-flat spectrum (within 1 % of flat: the sigmoid approaches 1 without
+  reaching it). Colours are fitted one by one (0.3 s each, for small maps), or looked up in
+  colour-science's coefficient table, generated once (minutes) and cached in the user cache folder.
+
+The RGB is linear in the map's colourspace (sRGB primaries for both methods). Both methods recover
+*reflectance-like* spectra: R = G = B maps to a flat spectrum, whose colour under the equal-energy
+weights is illuminant E, not the sRGB white. Environment maps hold *radiance*, so
+:func:`RGB_to_radiance_spectra` multiplies the recovered spectrum by the colourspace's white
+illuminant (D65 for sRGB), normalized to Y = 1, as Mitsuba 3 and pbrt-v4 do for RGB emitters: a
+white texel of value v becomes ``v · D65(λ) / Y(D65)``, whose XYZ is v times the D65 white, so it
+displays as sRGB (v, v, v).
+
+References
+----------
+- I. Mallett, C. Yuksel, "Spectral Primary Decomposition for Rendering with sRGB Reflectance",
+  EGSR 2019.
+- W. Jakob, J. Hanika, "A Low-Dimensional Function Space for Efficient Spectral Upsampling",
+  Computer Graphics Forum 38(2), 2019.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from reference.errors import require
+from reference.registry import Method, Registry
+from reference.spectra import SpectralGrid
+
+__all__ = [
+    "DEFAULT_UPSAMPLING",
+    "UPSAMPLING_METHODS",
+    "RGB_to_radiance_spectra",
+    "RGB_to_spectra",
+    "RGB_to_spectra_Jakob2019",
+    "RGB_to_spectra_Mallett2019",
+]
+
+#: The default RGB → spectrum method.
+DEFAULT_UPSAMPLING = "mallett2019"
+
+
+def _mallett_basis(grid: SpectralGrid) -> np.ndarray:
+    import colour
+
+    basis = colour.recovery.MSDS_BASIS_FUNCTIONS_sRGB_MALLETT2019
+    wl = grid.wavelengths_nm
+    return np.stack(
+        [np.interp(wl, basis.wavelengths, basis.values[:, i]) for i in range(3)]
+    )  # (3, n_bands)
+
+
+def RGB_to_spectra_Mallett2019(RGB, grid: SpectralGrid) -> np.ndarray:
+    """Spectra of linear sRGB values by Mallett & Yuksel's primaries: ``S = RGB @ B``.
+
+    Eq. (4), Mallett & Yuksel 2019 (the spectrum as a convex combination of three basis spectra),
+    resampled linearly onto ``grid``.
+
+    Parameters
+    ----------
+    RGB : array_like, shape (..., 3)
+        Linear sRGB, >= 0 (any magnitude).
+    grid : SpectralGrid
+
+    Returns
+    -------
+    ndarray, shape (..., n_bands)
+
+    Examples
+    --------
+    >>> from reference.spectra import GRID_41
+    >>> S = RGB_to_spectra_Mallett2019([[2.0, 2.0, 2.0]], GRID_41)
+    >>> bool(np.allclose(S, 2.0, atol=1e-4))
+    True
+    """
+    RGB = np.asarray(RGB, dtype=np.float64)
+    return RGB @ _mallett_basis(grid)
+
+
+_JAKOB_LUTS: dict = {}
+
+
+def _jakob_lut(size: int):
+    import colour
+    from colour.recovery import LUT3D_Jakob2019
+
+    if size in _JAKOB_LUTS:
+        return _JAKOB_LUTS[size]
+    folder = Path(os.environ.get("SPECREF_CACHE", Path.home() / ".cache" / "specref"))
+    path = folder / f"jakob2019-sRGB-{size}.coeff"
+    lut = LUT3D_Jakob2019()
+    if path.is_file():
+        lut.read(str(path))
+    else:
+        lut.generate(colour.RGB_COLOURSPACES["sRGB"], size=size)
+        folder.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_suffix(".tmp")
+        lut.write(str(tmp))
+        os.replace(tmp, path)
+    _JAKOB_LUTS[size] = lut
+    return lut
+
+
+def RGB_to_spectra_Jakob2019(RGB, grid: SpectralGrid, lut_size: int | None = None) -> np.ndarray:
+    """Spectra of linear sRGB values by Jakob & Hanika's sigmoid polynomials (colour-science).
+
+    Eq. (3), Jakob & Hanika 2019: ``S(λ) = sigmoid(c0 λ² + c1 λ + c2)``. HDR values are scaled by
+    their largest component m, fitted in [0, 1] and multiplied by m (module docstring).
+
+    Parameters
+    ----------
+    RGB : array_like, shape (..., 3)
+        Linear sRGB, >= 0.
+    grid : SpectralGrid
+    lut_size : int, optional
+        None: fit each distinct colour (chromaticity quantized to 1/64 of the largest component)
+        with ``colour.recovery.find_coefficients_Jakob2019`` (about 0.3 s each; for small maps).
+        An int: colour-science's ``lut_size³`` coefficient table, generated once (minutes) and
+        cached in ``$SPECREF_CACHE`` or ``~/.cache/specref``.
+
+    Returns
+    -------
+    ndarray, shape (..., n_bands)
+
+    Examples
+    --------
+    >>> from reference.spectra import GRID_41
+    >>> S = RGB_to_spectra_Jakob2019([[2.0, 2.0, 2.0]], GRID_41)      # white: nearly flat
+    >>> round(float(S.min()), 3), round(float(S.max()), 3)
+    (1.999, 1.999)
+    """
+    import colour
+
+    RGB = np.asarray(RGB, dtype=np.float64)
+    m = RGB.max(axis=-1, keepdims=True)
+    unit = RGB / np.where(m > 0, m, 1.0)
+    if lut_size is not None:
+        coefficients = _jakob_lut(int(lut_size)).RGB_to_coefficients(unit)
+    else:
+        from colour.recovery import find_coefficients_Jakob2019
+
+        quantized = np.round(unit * 64.0) / 64.0
+        flat = quantized.reshape(-1, 3)
+        unique, inverse = np.unique(flat, axis=0, return_inverse=True)
+        space = colour.RGB_COLOURSPACES["sRGB"]
+        fitted = np.stack(
+            [find_coefficients_Jakob2019(colour.RGB_to_XYZ(c, space))[0] for c in unique]
+        )
+        coefficients = fitted[inverse.ravel()].reshape(*RGB.shape[:-1], 3)
+    lam = grid.wavelengths_nm
+    # Eq. (3), Jakob & Hanika 2019: x = c0 λ² + c1 λ + c2, S = ½ + x / (2 sqrt(1 + x²))
+    x = (coefficients[..., 0:1] * lam + coefficients[..., 1:2]) * lam + coefficients[..., 2:3]
+    return (0.5 + x / (2.0 * np.sqrt(1.0 + x * x))) * m
+
+
+#: RGB → spectrum methods by key.
+UPSAMPLING_METHODS = Registry("RGB upsampling")
+UPSAMPLING_METHODS.register(
+    Method("mallett2019", RGB_to_spectra_Mallett2019, None, "Eq. (4), Mallett & Yuksel 2019")
+)
+UPSAMPLING_METHODS.register(
+    Method("jakob2019", RGB_to_spectra_Jakob2019, None, "Eq. (3), Jakob & Hanika 2019")
+)
+
+
+def RGB_to_spectra(RGB, grid: SpectralGrid, method: str = DEFAULT_UPSAMPLING) -> np.ndarray:
+    """Spectra of linear sRGB values by a registered method (default ``mallett2019``).
+
+    Eq. (4), Mallett & Yuksel 2019 by default.
+
+    Raises
+    ------
+    SpecrefError
+        Unknown method, negative or non-finite RGB.
+
+    Examples
+    --------
+    >>> from reference.spectra import GRID_31
+    >>> RGB_to_spectra(np.ones((2, 2, 3)), GRID_31).shape
+    (2, 2, 31)
+    """
+    entry = UPSAMPLING_METHODS.lookup(method)
+    RGB = np.asarray(RGB, dtype=np.float64)
+    require(RGB.shape[-1:] == (3,), f"RGB_to_spectra: expected (..., 3), got {RGB.shape}")
+    require(np.isfinite(RGB).all() and (RGB >= 0).all(), "RGB_to_spectra: RGB must be finite, >= 0")
+    return entry.reference(RGB, grid)
+
+
+def RGB_to_radiance_spectra(
+    RGB, grid: SpectralGrid, method: str = DEFAULT_UPSAMPLING, colourspace: str = "sRGB"
+) -> np.ndarray:
+    """Spectral radiance of linear RGB radiance: the upsampled spectrum times the white illuminant.
+
+    Eq. (4), Mallett & Yuksel 2019 by default, times ``D(λ) / Y(D)`` with D the colourspace's white
+    illuminant (module docstring), so that XYZ (equal-energy weights) reproduces the RGB's XYZ.
+
+    Examples
+    --------
+    >>> from reference.colorimetry import band_weights, spectra_to_RGB_matrix
+    >>> from reference.spectra import GRID_41
+    >>> S = RGB_to_radiance_spectra([[1.0, 1.0, 1.0]], GRID_41)       # a white texel
+    >>> (S @ spectra_to_RGB_matrix(band_weights(GRID_41, None))).round(2)
+    array([[1., 1., 1.]])
+    """
+    import colour
+
+    from reference.colorimetry import band_weights
+    from reference.spectra import resample_spectrum, spectrum_from_dataset
+
+    space = colour.RGB_COLOURSPACES[colourspace]
+    illuminant = spectrum_from_dataset("illuminant", space.whitepoint_name)
+    D = resample_spectrum(illuminant, grid, extrapolation="constant")
+    D = D / (D @ band_weights(grid, None)[:, 1])
+    return RGB_to_spectra(RGB, grid, method) * D

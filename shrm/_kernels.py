@@ -1,0 +1,218 @@
+"""numba twins of the readable NumPy functions of ``shrm.sh`` and ``shrm.prefilter``.
+
+Each kernel keeps the names and equation comments of its NumPy reference, never validates, never
+prints, and writes into an output array that the public entry point allocated. The equality tests
+live in ``tests/shrm``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+# Rescaling step of the extended-exponent recurrence: values are kept in [2^-SCALE, 2^SCALE].
+SCALE_BITS = 200
+_BIG = 2.0**SCALE_BITS
+_SMALL = 2.0**-SCALE_BITS
+_INV_SQRT_4PI = 1.0 / math.sqrt(4.0 * math.pi)
+
+
+@numba.njit(cache=False)
+def _sectoral_next(p, e, m, sin_theta, scaled):
+    """λ_mm from λ_{m-1,m-1}, as (mantissa, binary exponent); the exponent moves only if scaled."""
+    # Sectoral recurrence: λ_mm = -sqrt((2m+1)/(2m)) sin θ λ_{m-1,m-1}
+    p = -math.sqrt((2.0 * m + 1.0) / (2.0 * m)) * sin_theta * p
+    if scaled and p != 0.0 and abs(p) < _SMALL:
+        p *= _BIG
+        e -= SCALE_BITS
+    return p, e
+
+
+@numba.njit(cache=False)
+def _point_table(L, sgn, u, sin_theta, A, B, scaled, keep, lam):
+    """lam[t(l, m)] = λ_lm(x) for one point, m-major, for the orders with ``keep[m]``.
+
+    x = sgn (1 - u) with u = 1 - |x| (``shrm.sh.ring_cosines``); the other entries are left alone.
+    """
+    p, e = _INV_SQRT_4PI, 0
+    t0 = 0
+    for m in range(L + 1):
+        if m > 0:
+            p, e = _sectoral_next(p, e, m, sin_theta, scaled)
+        if keep[m]:
+            p1 = p
+            p2 = 0.0
+            e_col = e
+            lam[t0] = math.ldexp(p1, e_col) if scaled else p1
+            for l in range(m + 1, L + 1):
+                # λ_lm = a_lm (x λ_{l-1,m} - b_lm λ_{l-2,m})  (b_{m+1,m} = 0, a_{m+1,m} = √(2m+3))
+                # x p = sgn (p - u p): exact near the poles, where x = cos θ is not representable
+                p1, p2 = A[t0 + l - m] * (sgn * (p1 - u * p1) - B[t0 + l - m] * p2), p1
+                if scaled and abs(p1) > _BIG:
+                    p1 *= _SMALL
+                    p2 *= _SMALL
+                    e_col += SCALE_BITS
+                lam[t0 + l - m] = math.ldexp(p1, e_col) if scaled else p1
+        t0 += L + 1 - m
+
+
+@numba.njit(cache=False)
+def legendre_table_kernel(L, sgn, u, sin_theta, A, B, scaled, keep, out):
+    """Twin of ``shrm.sh.legendre_table``: out[t(l, m), j] = λ_lm(x_j), m-major layout.
+
+    Only the blocks with ``keep[m]`` are written, one after the other.
+    """
+    lam = np.empty((L + 1) * (L + 2) // 2)
+    for j in range(u.shape[0]):
+        _point_table(L, sgn[j], u[j], sin_theta[j], A, B, scaled, keep, lam)
+        t0 = 0
+        row = 0
+        for m in range(L + 1):
+            if keep[m]:
+                for i in range(L + 1 - m):
+                    out[row + i, j] = lam[t0 + i]
+                row += L + 1 - m
+            t0 += L + 1 - m
+
+
+@numba.njit(cache=False)
+def legendre_analysis_kernel(L, sgn, u, sin_theta, w, A, B, F_cos, F_sin, scaled, out):
+    """Twin of ``shrm.transform.legendre_analysis``: c_lm = Σ_j w_j √2 λ_lm(θ_j) F_m(θ_j).
+
+    ``F_cos, F_sin``: (L+1, H, C) ring integrals of f cos(mφ) and f sin(mφ); out: ((L+1)², C).
+    """
+    C = F_cos.shape[2]
+    sqrt2 = math.sqrt(2.0)
+    keep = np.ones(L + 1, dtype=np.bool_)
+    lam = np.empty((L + 1) * (L + 2) // 2)
+    for j in range(u.shape[0]):
+        _point_table(L, sgn[j], u[j], sin_theta[j], A, B, scaled, keep, lam)
+        t0 = 0
+        for m in range(L + 1):
+            # Fejér-1 quadrature: c_lm = Σ_j w_j λ_lm(θ_j) ∫ f(θ_j, φ) √2 trig(mφ) dφ
+            for l in range(m, L + 1):
+                if m == 0:
+                    q = w[j] * lam[t0 + l]
+                    for c in range(C):
+                        out[l * l + l, c] += q * F_cos[0, j, c]
+                else:
+                    q = sqrt2 * w[j] * lam[t0 + l - m]
+                    for c in range(C):
+                        out[l * l + l + m, c] += q * F_cos[m, j, c]
+                        out[l * l + l - m, c] += q * F_sin[m, j, c]
+            t0 += L + 1 - m
+
+
+@numba.njit(cache=False)
+def legendre_synthesis_kernel(L, sgn, u, sin_theta, A, B, coeffs, scaled, G_cos, G_sin):
+    """Twin of ``shrm.transform.legendre_synthesis``: ring Fourier amplitudes of Σ c_lm Y_lm.
+
+    ``coeffs``: ((L+1)², C); ``G_cos, G_sin``: (L+1, H, C), the cos(mφ) and sin(mφ) amplitudes.
+    """
+    C = coeffs.shape[1]
+    sqrt2 = math.sqrt(2.0)
+    keep = np.ones(L + 1, dtype=np.bool_)
+    lam = np.empty((L + 1) * (L + 2) // 2)
+    for j in range(u.shape[0]):
+        _point_table(L, sgn[j], u[j], sin_theta[j], A, B, scaled, keep, lam)
+        t0 = 0
+        for m in range(L + 1):
+            for l in range(m, L + 1):
+                if m == 0:
+                    for c in range(C):
+                        G_cos[0, j, c] += lam[t0 + l] * coeffs[l * l + l, c]
+                else:
+                    q = sqrt2 * lam[t0 + l - m]
+                    for c in range(C):
+                        G_cos[m, j, c] += q * coeffs[l * l + l + m, c]
+                        G_sin[m, j, c] += q * coeffs[l * l + l - m, c]
+            t0 += L + 1 - m
+
+
+@numba.njit(cache=False)
+def sh_evaluate_kernel(L, sgn, u, sin_theta, phi, A, B, coeffs, scaled, out):
+    """Twin of ``shrm.sh.sh_evaluate``: out[n, c] = Σ_lm c_lm Y_lm(θ_n, φ_n) at any directions."""
+    C = coeffs.shape[1]
+    sqrt2 = math.sqrt(2.0)
+    keep = np.ones(L + 1, dtype=np.bool_)
+    lam = np.empty((L + 1) * (L + 2) // 2)
+    for n in range(u.shape[0]):
+        _point_table(L, sgn[n], u[n], sin_theta[n], A, B, scaled, keep, lam)
+        t0 = 0
+        for m in range(L + 1):
+            # Real SH: Y_lm = √2 λ_l|m| cos(mφ) (m > 0), √2 λ_l|m| sin(|m|φ) (m < 0)
+            cos_m = sqrt2 * math.cos(m * phi[n])
+            sin_m = sqrt2 * math.sin(m * phi[n])
+            for l in range(m, L + 1):
+                if m == 0:
+                    for c in range(C):
+                        out[n, c] += lam[t0 + l] * coeffs[l * l + l, c]
+                else:
+                    for c in range(C):
+                        out[n, c] += lam[t0 + l - m] * (
+                            cos_m * coeffs[l * l + l + m, c] + sin_m * coeffs[l * l + l - m, c]
+                        )
+            t0 += L + 1 - m
+
+
+@numba.njit(cache=False)
+def prefilter_bruteforce_table_kernel(normals, directions, weights, radiance, angles, values, out):
+    """Twin of ``shrm.prefilter.prefilter_bruteforce`` for tabulated lobes K(γ).
+
+    ``out[k, c] = Σ_p radiance[p, c] K(acos(ω_p · n_k)) w_p``, K linear in γ between the samples
+    and 0 beyond the last angle.
+    """
+    K = normals.shape[0]
+    P = directions.shape[0]
+    C = radiance.shape[1]
+    last = angles[angles.shape[0] - 1]
+    for k in range(K):
+        for p in range(P):
+            t = (
+                normals[k, 0] * directions[p, 0]
+                + normals[k, 1] * directions[p, 1]
+                + normals[k, 2] * directions[p, 2]
+            )
+            gamma = math.acos(min(max(t, -1.0), 1.0))
+            if gamma > last:
+                continue
+            # Eq. (7), Ramamoorthi & Hanrahan 2001, in the angular domain: Σ_p L_p K(γ_p) w_p
+            kern = np.interp(gamma, angles, values) * weights[p]
+            for c in range(C):
+                out[k, c] += radiance[p, c] * kern
+
+
+@numba.njit(cache=False)
+def prefilter_bruteforce_power_kernel(normals, directions, weights, radiance, s, scale, out):
+    """Twin of ``shrm.prefilter.prefilter_bruteforce`` for the power lobes K(t) = scale·max(t, 0)^s.
+
+    Lambert is s = 1, scale = 1; normalized Phong is scale = (s + 1)/(2π).
+    """
+    K = normals.shape[0]
+    P = directions.shape[0]
+    C = radiance.shape[1]
+    for k in range(K):
+        for p in range(P):
+            t = (
+                normals[k, 0] * directions[p, 0]
+                + normals[k, 1] * directions[p, 1]
+                + normals[k, 2] * directions[p, 2]
+            )
+            if t <= 0.0:
+                continue
+            # Eq. (7), Ramamoorthi & Hanrahan 2001, in the angular domain: Σ_p L_p K(ω_p · n) w_p
+            kern = scale * t**s * weights[p]
+            for c in range(C):
+                out[k, c] += radiance[p, c] * kern
+
+
+__all__ = [
+    "legendre_analysis_kernel",
+    "legendre_synthesis_kernel",
+    "legendre_table_kernel",
+    "prefilter_bruteforce_power_kernel",
+    "prefilter_bruteforce_table_kernel",
+    "sh_evaluate_kernel",
+]
