@@ -124,7 +124,8 @@ def check_ward_duer_params(rho_d, rho_s, alpha, where: str = "ward_duer", energy
     >>> check_ward_duer_params(0.5, 0.6, 0.2)
     Traceback (most recent call last):
     ...
-    reference.errors.SpecrefError: ward_duer: rho_d + rho_s: must be <= 1 (energy conservation), got 1.1
+    reference.errors.SpecrefError: ward_duer: rho_d + rho_s: must be <= 1 (energy conservation),
+    got 1.1
     """
     rho_d = require_nonnegative(rho_d, f"{where}: rho_d")
     rho_s = require_nonnegative(rho_s, f"{where}: rho_s")

@@ -198,7 +198,8 @@ def chi2_test(
     >>> def uniform_hemisphere(u):
     ...     z = u[:, 0]
     ...     r = np.sqrt(1 - z * z)
-    ...     return np.stack([r * np.cos(2 * np.pi * u[:, 1]), r * np.sin(2 * np.pi * u[:, 1]), z], -1)
+    ...     phi = 2 * np.pi * u[:, 1]
+    ...     return np.stack([r * np.cos(phi), r * np.sin(phi), z], -1)
     >>> result = chi2_test(uniform_hemisphere, lambda d: np.full(len(d), 1 / (2 * np.pi)),
     ...                    "hemisphere", 20000, 9, seed=1)
     >>> result.passed, result.dof
@@ -227,7 +228,8 @@ def chi2_test(
     cos_theta = np.clip(d[:, 2] / np.linalg.norm(d, axis=-1), -1.0, 1.0)
     if (cos_theta < lo - 1e-9).any():
         worst = float(cos_theta.min())
-        return fail(f"{int((cos_theta < lo - 1e-9).sum())} samples outside the {domain} (cos θ = {worst:.3g})")
+        count = int((cos_theta < lo - 1e-9).sum())
+        return fail(f"{count} samples outside the {domain} (cos θ = {worst:.3g})")
     phi = np.mod(np.arctan2(d[:, 1], d[:, 0]), 2.0 * np.pi)
     observed, _, _ = np.histogram2d(cos_theta, phi, bins=[cos_edges, phi_edges])
 
@@ -283,4 +285,6 @@ def chi2_test(
     if not passed and out_dir is not None:
         files = _save_diagnostics(out_dir, name, observed, expected)
         message += "; saved " + ", ".join(str(f) for f in files)
-    return Chi2Result(passed, message, p_value, statistic, alpha_test, dof, observed, expected, files)
+    return Chi2Result(
+        passed, message, p_value, statistic, alpha_test, dof, observed, expected, files
+    )

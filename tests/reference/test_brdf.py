@@ -45,7 +45,7 @@ def test_brdf_ward_duer_specular_values_closed_form():
     assert brdf_ward_duer_specular(wi, wo, Z, alpha) == pytest.approx(expected, rel=1e-13)
     # Off-specular: wi at 0°, wo at 40°: θ_h = 20°, exp(−tan²20°/α²)/(4πα² cos 40°).
     wo = _direction(np.radians(40))
-    expected = np.exp(-np.tan(np.radians(20)) ** 2 / alpha**2) / (
+    expected = np.exp(-(np.tan(np.radians(20)) ** 2) / alpha**2) / (
         4 * np.pi * alpha**2 * np.cos(np.radians(40))
     )
     assert brdf_ward_duer_specular(Z, wo, Z, alpha) == pytest.approx(expected, rel=1e-12)
@@ -128,7 +128,9 @@ def _albedo_quadrature(f, wi, pole, order):
     phi = 2 * np.pi * np.arange(n_phi) / n_phi
     t, b = frame_from_normal(pole)
     s = np.sqrt(1 - mu**2)
-    local = np.stack(np.broadcast_arrays(s[:, None] * np.cos(phi), s[:, None] * np.sin(phi), mu[:, None]), -1)
+    local = np.stack(
+        np.broadcast_arrays(s[:, None] * np.cos(phi), s[:, None] * np.sin(phi), mu[:, None]), -1
+    )
     wo = local[..., 0:1] * t + local[..., 1:2] * b + local[..., 2:3] * pole
     integrand = f(wi, wo)[..., 0] * np.maximum(wo[..., 2], 0.0)
     return float((integrand * wmu[:, None]).sum() * 2 * np.pi / n_phi)

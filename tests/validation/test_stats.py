@@ -54,23 +54,31 @@ def test_chi2_rejects_wrong_pdf(tmp_path):
     )
     assert not result.passed
     assert result.p_value < 1e-10
-    assert (tmp_path / "chi2_wrong.npz").exists() and (tmp_path / "chi2_wrong.png").exists()
+    assert (tmp_path / "chi2_wrong.npz").exists()
+    assert (tmp_path / "chi2_wrong.png").exists()
     assert "chi2_wrong.png" in result.message
 
 
 def test_chi2_rejects_samples_outside_domain():
-    result = chi2_test(_uniform_sphere, lambda d: np.full(len(d), 1 / (2 * np.pi)), "hemisphere", 2000, 5, seed=1)
-    assert not result.passed and "outside the hemisphere" in result.message
+    result = chi2_test(
+        _uniform_sphere, lambda d: np.full(len(d), 1 / (2 * np.pi)), "hemisphere", 2000, 5, seed=1
+    )
+    assert not result.passed
+    assert "outside the hemisphere" in result.message
 
 
 def test_chi2_rejects_negative_pdf():
     result = chi2_test(_cosine_hemisphere, lambda d: d[:, 0], "hemisphere", 2000, 5, seed=1)
-    assert not result.passed and "negative" in result.message
+    assert not result.passed
+    assert "negative" in result.message
 
 
 def test_chi2_rejects_pdf_mass_above_one():
-    result = chi2_test(_cosine_hemisphere, lambda d: 1.01 * _cosine_pdf(d), "hemisphere", 2000, 5, seed=1)
-    assert not result.passed and "integrates to 1.01" in result.message
+    result = chi2_test(
+        _cosine_hemisphere, lambda d: 1.01 * _cosine_pdf(d), "hemisphere", 2000, 5, seed=1
+    )
+    assert not result.passed
+    assert "integrates to 1.01" in result.message
 
 
 @pytest.mark.parametrize(
