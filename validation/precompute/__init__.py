@@ -1,0 +1,1 @@
+"""Scripts that precompute expensive references and package data (run with ``python -m``)."""
