@@ -38,6 +38,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from reference._specular_lighting_kernels import (
+    specular_brute_force_kernel,
+    specular_fis_kernel,
+    specular_point_lights_kernel,
+)
 from reference.arealights import PlaneLight, PointLights, light_plane_uv
 from reference.brdf import brdf_ward_duer_specular, frame_from_normal, pdf_ward_duer_lobe
 from reference.errors import require, require_choice, require_nonnegative, require_positive_int
@@ -210,8 +215,6 @@ def specular_point_lights(
         )
     out = np.zeros((P.shape[0], lights.L.shape[1]))
     if backend == "numba":
-        from reference._specular_lighting_kernels import specular_point_lights_kernel
-
         for c in range(lights.L.shape[1]):
             column = np.zeros(P.shape[0])
             specular_point_lights_kernel(
@@ -283,8 +286,6 @@ def specular_fis(
     for c, image in enumerate(_channels(light.image)):
         levels = mip_pyramid(image)
         if backend == "numba":
-            from reference._specular_lighting_kernels import specular_fis_kernel
-
             flat = np.concatenate([level.ravel() for level in levels])
             sizes = np.array([level.size for level in levels])
             offsets = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
@@ -371,8 +372,6 @@ def specular_brute_force(
     s = supersample
     for c, image in enumerate(_channels(light.image)):
         if backend == "numba":
-            from reference._specular_lighting_kernels import specular_brute_force_kernel
-
             column = np.zeros(P.shape[0])
             specular_brute_force_kernel(
                 P, N, V, a, image, o, A, B, light.l_A, light.l_B, light.n_light, s, column
@@ -544,16 +543,6 @@ def _example_scene(rng):
     return points, normals, views, alpha, plane, lights
 
 
-def _kernel(name):
-    def load(*args, **kwargs):
-        import reference._specular_lighting_kernels as kernels
-
-        return getattr(kernels, name)(*args, **kwargs)
-
-    load.__name__ = name
-    return load
-
-
 #: Specular lighting methods; ``reference`` is the NumPy function (``backend`` selects the numba
 #: twin named by ``kernel``); ``example_inputs(rng)`` returns ``(points, normals, views, alpha,
 #: plane, lights)``; ``extra["call"](method_fn, inputs, backend)`` runs it on those inputs.
@@ -562,7 +551,7 @@ SPECULAR_METHODS.register(
     Method(
         "point_lights",
         specular_point_lights,
-        _kernel("specular_point_lights_kernel"),
+        specular_point_lights_kernel,
         "Eq. (2), Ferwerda",
         _example_scene,
         extra={"call": lambda x, backend: specular_point_lights(*x[:4], x[5], backend=backend)},
@@ -572,7 +561,7 @@ SPECULAR_METHODS.register(
     Method(
         "fis",
         specular_fis,
-        _kernel("specular_fis_kernel"),
+        specular_fis_kernel,
         "Eq. (8), Ferwerda",
         _example_scene,
         extra={"call": lambda x, backend: specular_fis(*x[:5], 16, backend=backend)},
@@ -592,7 +581,7 @@ SPECULAR_METHODS.register(
     Method(
         "brute_force",
         specular_brute_force,
-        _kernel("specular_brute_force_kernel"),
+        specular_brute_force_kernel,
         "Eq. (4), Ferwerda",
         _example_scene,
         extra={"call": lambda x, backend: specular_brute_force(*x[:5], 2, backend=backend)},
