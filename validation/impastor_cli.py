@@ -1,4 +1,4 @@
-"""Library side of ``specref impastor``: checked inputs and formatted tables (the CLI dispatches)."""
+"""Library side of ``specref impastor``: checked inputs and formatted tables."""
 
 from __future__ import annotations
 
