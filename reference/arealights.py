@@ -463,6 +463,8 @@ class PointLights:
     spread : ndarray, shape (N,)
         Energy-weighted spatial variance of each region about its light, ``Σ E |x − c|² / Σ E``
         (m² for plane lights, sr for lat-long lights): how far a point light misplaces energy.
+    method : str
+        The partition that made them (a key of :data:`LIGHT_SAMPLING_METHODS`).
     """
 
     position: np.ndarray
@@ -472,6 +474,7 @@ class PointLights:
     n_light: np.ndarray
     pixel_area: float
     spread: np.ndarray
+    method: str = "median_cut"
 
 
 def point_lights_from_plane(light: PlaneLight, method: str = "median_cut", n_lights: int = 32):
@@ -530,6 +533,7 @@ def point_lights_from_plane(light: PlaneLight, method: str = "median_cut", n_lig
         light.n_light,
         light.pixel_area,
         np.array(spread),
+        method,
     )
 
 
@@ -596,6 +600,7 @@ def point_lights_from_latlong(image, method: str = "median_cut", n_lights: int =
         np.full(3, np.nan),
         1.0,
         np.array(spread),
+        method,
     )
 
 
@@ -720,7 +725,8 @@ def light_plane_uv(light: PlaneLight, points, directions):
     # Only the emitting side counts: the ray must travel against n_light (denom < 0).
     d = np.where((denom < -1e-15) & (d > 0), d, np.inf)
     # Eq. (6), Ferwerda: p_light = d i_world + p_surf
-    p_light = np.where(np.isfinite(d)[..., None], d[..., None] * i + p, np.nan)
+    hit = np.isfinite(d)[..., None]
+    p_light = np.where(hit, np.where(hit, d[..., None], 0.0) * i + p, np.nan)
     # Eq. (7), Ferwerda: p_relative = p_light − o_TL
     p_relative = p_light - o
     # Eq. (8), Ferwerda: (a, b) = pinv([l_A A  l_B B]) p_relative

@@ -398,26 +398,53 @@ def specular_brute_force(
 # --- the hybrid ----------------------------------------------------------------------------------
 
 
+def _lobe_scales(P, N, V, a, light: PlaneLight, lights: PointLights):
+    """Per pixel: ``x_pl = σ²/s²`` and ``x_fis = Ω_lobe/Ω_texel`` (see hybrid_error_estimates)."""
+    H, W = light.shape
+    to_light = lights.position[None] - P[:, None]
+    d2 = np.einsum("pni,pni->pn", to_light, to_light)
+    cos_l = np.maximum(-(to_light @ light.n_light) / np.sqrt(d2), 0.0)
+    spread = lights.spread * cos_l / d2  # sr
+    cos_o = np.clip(np.einsum("pi,pi->p", N, V), 1e-6, 1.0)
+    mirror = 2.0 * cos_o[:, None] * N - V
+    a_uv, b_uv, d = light_plane_uv(light, P, mirror)
+    on = np.isfinite(d) & (a_uv >= 0) & (a_uv < 1) & (b_uv >= 0) & (b_uv < 1)
+    col = np.clip(np.floor(np.where(on, a_uv, 0) * W), 0, W - 1).astype(int)
+    row = np.clip(np.floor(np.where(on, b_uv, 0) * H), 0, H - 1).astype(int)
+    owner = np.full((H, W), -1)
+    for k, (y0, y1, x0, x1) in enumerate(lights.regions):
+        owner[y0:y1, x0:x1] = k
+    s2 = np.where(on, spread[np.arange(P.shape[0]), owner[row, col]], spread.mean(axis=1))
+    sigma2 = 2.0 * a**2
+    x_pl = sigma2 / np.maximum(s2, 1e-300)
+    safe_d = np.where(on, d, 1.0)
+    omega_texel = light.pixel_area * np.where(on, -(mirror @ light.n_light), 1.0) / safe_d**2
+    omega_lobe = 4.0 * np.pi * a**2 * cos_o
+    x_fis = omega_lobe / omega_texel
+    return x_pl, x_fis, on, mirror, a_uv, b_uv, d, cos_o
+
+
 def hybrid_error_estimates(points, normals, views, alpha, light: PlaneLight, lights, n_samples):
-    """Predicted relative errors of point lights and FIS at each pixel (specref's metric).
+    """Predicted relative errors of point lights and FIS at each pixel (specref's hybrid metric).
 
     The paper's "custom error minimization metric" is not given (§3.5.2, Ferwerda). specref
-    predicts each method's relative error from the lobe's width, the light's layout and K:
+    predicts each method's error from the lobe's width, the light's layout and the sample count:
 
-    - **Point lights** replace each region by its energy at one point, the energy centroid. For a
-      lobe of angular variance ``σ² = 2α²`` per axis (Ward's ``exp(−tan²θ_h/α²)`` with
-      ``θ_i ≈ 2θ_h``) the one-point rule is off by its second-moment term,
-      ``e_pl = min(1, Ω_var / (2σ²)) = min(1, Ω_var / (4α²))``, where ``Ω_var`` is the region's
-      energy spread (``PointLights.spread``, m²) seen from the pixel (× cos θ_l / d²), for the
-      region the mirror direction hits (the mean region where it misses the light).
-    - **FIS** integrates the lobe with K stratified (Hammersley) samples: its error falls as the
-      quasi-Monte Carlo rate ``K^(−3/4)``; the part of the lobe that misses the light adds the
-      binomial noise of the hits, ``sqrt((1 − q)/(K q))``, with ``q = min(1, Ω_light/(4 Ω_lobe))``
-      the covered fraction, ``Ω_lobe = 4π α² cos θ_o`` (one over the lobe pdf's peak) and
-      ``Ω_light`` the light's solid angle.
+    - **Point lights** put each region's energy at its centroid. For a lobe of angular variance
+      ``σ² = 2α²`` (Ward's ``exp(−tan²θ_h/α²)`` with ``θ_i ≈ 2θ_h``; both axes) the one-point rule
+      errs by its second-moment term, ``(s²/4)|∇²g|/g = s²/(2σ²)`` at the lobe's peak, with ``s²``
+      the energy spread (``PointLights.spread`` × cos θ_l / d², sr) of the median-cut region that
+      the mirror direction meets (the mean region's where it misses the light):
+      ``e_pl = min(1, s² / (4α²))``.
+    - **FIS** draws K samples in proportion to the lobe, so its weights are nearly constant and
+      its error is that of K samples of the light itself, ``CV / sqrt(K)``, with CV the light's
+      coefficient of variation over the lobe's footprint, read from mip pyramids of L and L² at
+      the level whose texel covers ``Ω_lobe = 4π α² cos θ_o`` (one over the lobe pdf's peak)
+      around the mirror direction. The part of the lobe that misses the light adds the binomial
+      noise ``sqrt((1 − q)/(K q))``, ``q = min(1, Ω_light / (4 Ω_lobe))``.
 
-    The hybrid takes FIS where ``e_fis < e_pl``. Every constant comes from the models above;
-    none is fitted to a scene.
+    Every constant comes from these models; none is fitted to a scene. :func:`specular_hybrid`
+    combines the two estimates with inverse-variance weights.
 
     Parameters
     ----------
@@ -425,7 +452,7 @@ def hybrid_error_estimates(points, normals, views, alpha, light: PlaneLight, lig
     alpha : array_like, shape (...,)
     light : PlaneLight
     lights : PointLights
-        The point lights the hybrid would use (their regions and spreads).
+        The point lights the hybrid uses (their regions and spreads).
     n_samples : int
         K of FIS.
 
@@ -440,38 +467,36 @@ def hybrid_error_estimates(points, normals, views, alpha, light: PlaneLight, lig
     ...                    (0, 0, 1), 1.2, 0.8)
     >>> lights = point_lights_from_plane(plane, "median_cut", 32)
     >>> view = np.array([0.0, 0.6, 0.8])
-    >>> e_pl, e_fis = hybrid_error_estimates(np.zeros((2, 3)), [0, 1, 0], view, [0.02, 0.4],
+    >>> e_pl, e_fis = hybrid_error_estimates(np.zeros((2, 3)), [0, 1, 0], view, [0.01, 0.4],
     ...                                      plane, lights, 32)
     >>> bool(e_fis[0] < e_pl[0]), bool(e_fis[1] > e_pl[1])
     (True, True)
     """
     P, N, V, a, shape = _flat(points, normals, views, alpha)
-    H, W = light.shape
-    # Each region's area and energy spread, seen from each pixel (× cos θ_l / d²).
-    area = np.array([(y1 - y0) * (x1 - x0) for y0, y1, x0, x1 in lights.regions]) * light.pixel_area
+    K = require_positive_int(n_samples, "hybrid: n_samples", 1 << 20)
+    x_pl, _, on, mirror, a_uv, b_uv, d, cos_o = _lobe_scales(P, N, V, a, light, lights)
+    # Point lights: the one-point rule's second-moment error at the lobe's peak, s²/(2σ²).
+    e_point_lights = np.minimum(1.0, 1.0 / (2.0 * x_pl))
+    # FIS: K lobe-proportional samples of the light: CV/√K over the lobe's footprint.
+    omega_lobe = 4.0 * np.pi * a**2 * cos_o
+    luminance = light.image.mean(axis=-1)
+    mean_levels, square_levels = mip_pyramid(luminance), mip_pyramid(luminance**2)
+    safe_d = np.where(on, d, 1.0)
+    omega_texel = light.pixel_area * np.where(on, -(mirror @ light.n_light), 1.0) / safe_d**2
+    level = np.maximum(0.5 * np.log2(omega_lobe / omega_texel), 0.0)
+    a_on, b_on = np.where(on, a_uv, 0.5), np.where(on, b_uv, 0.5)
+    mean = mip_lookup(mean_levels, a_on, b_on, level)
+    square = mip_lookup(square_levels, a_on, b_on, level)
+    safe_mean = np.where(mean > 0, mean, 1.0)
+    cv = np.where(on & (mean > 0), np.sqrt(np.maximum(square - mean**2, 0.0)) / safe_mean, 1.0)
+    # The part of the lobe that misses the light: binomial noise of the hits.
+    area = np.array([(y1 - y0) * (x1 - x0) for y0, y1, x0, x1 in lights.regions])
     to_light = lights.position[None] - P[:, None]
     d2 = np.einsum("pni,pni->pn", to_light, to_light)
     cos_l = np.maximum(-(to_light @ light.n_light) / np.sqrt(d2), 0.0)
-    omega_light = (area * cos_l / d2).sum(axis=1)
-    omega_var = lights.spread * cos_l / d2
-    # The region the mirror direction hits.
-    cos_o = np.clip(np.einsum("pi,pi->p", N, V), 1e-6, 1.0)
-    mirror = 2.0 * cos_o[:, None] * N - V
-    a_uv, b_uv, d = light_plane_uv(light, P, mirror)
-    on = np.isfinite(d) & (a_uv >= 0) & (a_uv < 1) & (b_uv >= 0) & (b_uv < 1)
-    col = np.clip(np.floor(np.where(on, a_uv, 0) * W), 0, W - 1).astype(int)
-    row = np.clip(np.floor(np.where(on, b_uv, 0) * H), 0, H - 1).astype(int)
-    owner = np.full((H, W), -1)
-    for k, (y0, y1, x0, x1) in enumerate(lights.regions):
-        owner[y0:y1, x0:x1] = k
-    region = owner[row, col]
-    spread = np.where(on, omega_var[np.arange(P.shape[0]), region], omega_var.mean(axis=1))
-    # Point lights: the one-point rule's second-moment error for a lobe of variance 2α².
-    e_point_lights = np.minimum(1.0, spread / (4.0 * a**2))
-    # FIS: quasi-Monte Carlo rate K^(−3/4), plus binomial noise of the samples that hit the light.
-    omega_lobe = 4.0 * np.pi * a**2 * cos_o
+    omega_light = (area * light.pixel_area * cos_l / d2).sum(axis=1)
     q = np.clip(omega_light / (4.0 * omega_lobe), 1e-12, 1.0)
-    e_fis = n_samples**-0.75 + np.sqrt((1.0 - q) / (n_samples * q))
+    e_fis = cv / np.sqrt(K) + np.sqrt((1.0 - q) / (K * q))
     return e_point_lights.reshape(shape), e_fis.reshape(shape)
 
 
@@ -488,9 +513,15 @@ def specular_hybrid(
 ) -> np.ndarray:
     """Per-pixel hybrid of point lights and FIS (§3.5.2, Ferwerda).
 
-    The method is picked per pixel by :func:`hybrid_error_estimates`.
+    Eq. (4), Ferwerda, estimated at each pixel by both methods and combined with the weights that
+    minimise the variance of the combination, given the errors :func:`hybrid_error_estimates`
+    predicts: ``I = (e_fis² I_pl + e_pl² I_fis) / (e_pl² + e_fis²)``. Where one prediction is far
+    below the other this is a switch; near the crossover it averages the two.
 
-    Eq. (4), Ferwerda, through the method with the smaller predicted error at each pixel.
+    Parameters
+    ----------
+    points, normals, views, alpha, light, lights, n_samples, visibility, backend
+        As in :func:`specular_point_lights` and :func:`specular_fis`.
 
     Returns
     -------
@@ -507,22 +538,24 @@ def specular_hybrid(
     """
     P, N, V, a, shape = _flat(points, normals, views, alpha)
     e_pl, e_fis = hybrid_error_estimates(P, N, V, a, light, lights, n_samples)
-    use_fis = e_fis < e_pl
-    out = np.zeros((P.shape[0], light.image.shape[-1]))
     vis = None
     if visibility is not None:
         vis = np.broadcast_to(np.asarray(visibility, float), (*shape, len(lights.regions)))
         vis = vis.reshape(P.shape[0], -1)
-    if use_fis.any():
-        out[use_fis] = specular_fis(
-            P[use_fis], N[use_fis], V[use_fis], a[use_fis], light, n_samples, backend=backend
+    w_pl = (e_fis**2 / np.maximum(e_pl**2 + e_fis**2, 1e-300))[:, None]
+    out = np.zeros((P.shape[0], light.image.shape[-1]))
+    # Evaluate each method only where its weight matters (> 1e-6).
+    need_pl, need_fis = w_pl[:, 0] > 1e-6, w_pl[:, 0] < 1.0 - 1e-6
+    if need_pl.any():
+        k = need_pl
+        out[k] += w_pl[k] * specular_point_lights(
+            P[k], N[k], V[k], a[k], lights, None if vis is None else vis[k], backend=backend
         )
-    if (~use_fis).any():
-        keep = ~use_fis
-        out[keep] = specular_point_lights(
-            P[keep], N[keep], V[keep], a[keep], lights,
-            None if vis is None else vis[keep], backend=backend,
-        )  # fmt: skip
+    if need_fis.any():
+        k = need_fis
+        out[k] += (1.0 - w_pl[k]) * specular_fis(
+            P[k], N[k], V[k], a[k], light, n_samples, backend=backend
+        )
     return out.reshape((*shape, -1))
 
 

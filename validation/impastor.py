@@ -648,7 +648,7 @@ def specular_error_vs_alpha(
     -------
     dict
         ``alpha`` and, per method, the relative RMS errors; ``reference_error``; ``fis_share`` (the
-        fraction of points where the hybrid chose FIS).
+        mean weight the hybrid gives FIS).
 
     Examples
     --------
@@ -676,7 +676,7 @@ def specular_error_vs_alpha(
         out["fis"].append(_relative_rms(fis, reference))
         out["hybrid"].append(_relative_rms(hybrid, reference))
         out["reference_error"].append(_relative_rms(coarse, reference))
-        out["fis_share"].append(float((e_fis < e_pl).mean()))
+        out["fis_share"].append(float((e_pl**2 / (e_pl**2 + e_fis**2)).mean()))
     return out
 
 
