@@ -149,7 +149,7 @@ def test_light_plane_uv_round_trip(rng):
 
 def test_light_plane_misses_and_back_side():
     plane = _ceiling(np.ones((4, 4)))
-    a, b, d = light_plane_uv(plane, [0.0, 0.0, 0.0], [0.0, -1.0, 0.0])
+    _a, _b, d = light_plane_uv(plane, [0.0, 0.0, 0.0], [0.0, -1.0, 0.0])
     assert np.isinf(d)
     above = light_plane_lookup(plane, [[0.0, 1.0, -0.5]], [[0.0, -1.0, 0.0]])
     assert above[0, 0] == 0.0  # from behind the emitting side

@@ -119,7 +119,7 @@ def test_load_display_measurements(tmp_path):
         (lambda d: d["ramps"]["R"]["Y"].__setitem__(10, 0.0), "ramps.R.Y: must increase"),
         (lambda d: d.pop("black_XYZ"), "missing key 'black_XYZ'"),
         (lambda d: d["ramps"]["B"].__setitem__("counts", [0, 5, 100]), "same length"),
-        (lambda d: d["primaries_XYZ"].__setitem__("G", d["primaries_XYZ"]["R"]), "linearly dep"),
+        (lambda d: d["primaries_XYZ"].__setitem__("G", d["primaries_XYZ"]["R"]), "dependent"),
         (lambda d: d["front_surface"].__setitem__("diffuse", -1), "front_surface.diffuse"),
         (lambda d: d.__setitem__("bits", 40), "bits: must be 1..16"),
     ],
@@ -131,7 +131,7 @@ def test_display_measurements_bad_input(edit, match, tmp_path):
         display_from_measurements(doc, "display.json")
     path = tmp_path / "bad.json"
     path.write_text(json.dumps(doc))
-    with pytest.raises(SpecrefError, match="bad.json"):
+    with pytest.raises(SpecrefError, match=r"bad\.json"):
         load_display_measurements(path)
 
 

@@ -58,7 +58,7 @@ def _albedo_normal_incidence(alpha, order=200):
     theta = (x + 1) * np.pi / 4
     weights = w * np.pi / 4
     theta_h = theta / 2
-    f = np.exp(-np.tan(theta_h) ** 2 / alpha**2) / (4 * np.pi * alpha**2 * np.cos(theta))
+    f = np.exp(-(np.tan(theta_h) ** 2) / alpha**2) / (4 * np.pi * alpha**2 * np.cos(theta))
     return float(np.sum(f * np.cos(theta) * np.sin(theta) * 2 * np.pi * weights))
 
 
