@@ -3,7 +3,4 @@
 Each module registers one section. A new section is a new module plus one import line here.
 """
 
-from validation.sections import (
-    impastor,  # noqa: F401
-    spectral,  # noqa: F401
-)
+from validation.sections import impastor, raster, spectral  # noqa: F401
