@@ -24,6 +24,20 @@ def _ward_lobe(wi, wo, n, alpha):
 
 
 @numba.njit(cache=False)
+def _lobe_geometry(x0, x1, x2, P_p, N_p, V_p, n_light, alpha, wi):
+    """Eq. (2), Ferwerda, weighted by the lobe: f_s (N·I)(−N_light·I) / d² for a light point x."""
+    d0, d1, d2 = x0 - P_p[0], x1 - P_p[1], x2 - P_p[2]
+    dist2 = d0 * d0 + d1 * d1 + d2 * d2
+    dist = math.sqrt(dist2)
+    wi[0], wi[1], wi[2] = d0 / dist, d1 / dist, d2 / dist
+    cos_s = wi[0] * N_p[0] + wi[1] * N_p[1] + wi[2] * N_p[2]
+    cos_l = -(wi[0] * n_light[0] + wi[1] * n_light[1] + wi[2] * n_light[2])
+    if cos_s <= 0.0 or cos_l <= 0.0:
+        return 0.0
+    return _ward_lobe(wi, V_p, N_p, alpha) * cos_s * cos_l / dist2
+
+
+@numba.njit(cache=False)
 def specular_point_lights_kernel(P, N, V, alpha, light_pos, light_L, n_light, pixel_area, vis, out):
     """Twin of ``specular_point_lights``: Σ_n f_s(I_n, V) L_n (N·I_n)(−N_light·I_n) A/P / d_n²."""
     wi = np.empty(3)
@@ -32,19 +46,10 @@ def specular_point_lights_kernel(P, N, V, alpha, light_pos, light_L, n_light, pi
         for k in range(light_pos.shape[0]):
             if vis[p, k] == 0.0:
                 continue
-            d0 = light_pos[k, 0] - P[p, 0]
-            d1 = light_pos[k, 1] - P[p, 1]
-            d2 = light_pos[k, 2] - P[p, 2]
-            dist2 = d0 * d0 + d1 * d1 + d2 * d2
-            dist = math.sqrt(dist2)
-            wi[0], wi[1], wi[2] = d0 / dist, d1 / dist, d2 / dist
-            cos_s = wi[0] * N[p, 0] + wi[1] * N[p, 1] + wi[2] * N[p, 2]
-            cos_l = -(wi[0] * n_light[0] + wi[1] * n_light[1] + wi[2] * n_light[2])
-            if cos_s <= 0.0 or cos_l <= 0.0:
-                continue
+            x = light_pos[k]
             # Eq. (2), Ferwerda, with the lobe of Eq. (4), Ferwerda, as the weight
-            f = _ward_lobe(wi, V[p], N[p], alpha[p])
-            acc += f * light_L[k] * vis[p, k] * cos_s * cos_l * pixel_area / dist2
+            g = _lobe_geometry(x[0], x[1], x[2], P[p], N[p], V[p], n_light, alpha[p], wi)
+            acc += g * light_L[k] * vis[p, k] * pixel_area
         out[p] = acc
 
 
@@ -161,16 +166,9 @@ def specular_brute_force_kernel(
                     b = (j + (sj + 0.5) / s) / H
                     for si in range(s):
                         a = (i + (si + 0.5) / s) / W
-                        d0 = origin[0] + a * l_A * A[0] + b * l_B * B[0] - P[p, 0]
-                        d1 = origin[1] + a * l_A * A[1] + b * l_B * B[1] - P[p, 1]
-                        d2 = origin[2] + a * l_A * A[2] + b * l_B * B[2] - P[p, 2]
-                        dist2 = d0 * d0 + d1 * d1 + d2 * d2
-                        dist = math.sqrt(dist2)
-                        wi[0], wi[1], wi[2] = d0 / dist, d1 / dist, d2 / dist
-                        cos_s = wi[0] * N[p, 0] + wi[1] * N[p, 1] + wi[2] * N[p, 2]
-                        cos_l = -(wi[0] * n_light[0] + wi[1] * n_light[1] + wi[2] * n_light[2])
-                        if cos_s <= 0.0 or cos_l <= 0.0:
-                            continue
-                        f = _ward_lobe(wi, V[p], N[p], alpha[p])
-                        acc += f * L * cos_s * cos_l * sub_area / dist2
+                        x0 = origin[0] + a * l_A * A[0] + b * l_B * B[0]
+                        x1 = origin[1] + a * l_A * A[1] + b * l_B * B[1]
+                        x2 = origin[2] + a * l_A * A[2] + b * l_B * B[2]
+                        g = _lobe_geometry(x0, x1, x2, P[p], N[p], V[p], n_light, alpha[p], wi)
+                        acc += g * L * sub_area
         out[p] = acc

@@ -355,6 +355,8 @@ def median_cut(
 ):
     """Debevec's median cut: split regions in two across their longer side at the energy median.
 
+    Eq. (2), Ferwerda (the 32 "median cut lights" it sums over).
+
     Regions are split level by level (all regions per level, 2^k in all); when ``n_lights`` is
     not a power of two, the last level splits only the regions of highest energy.
 
@@ -395,6 +397,8 @@ def variance_minimization(
     energy, n_lights: int = 32, pixel_width: float = 1.0, pixel_height: float = 1.0, row_scale=None
 ):
     """Viriyothai & Debevec's variance minimization: the cut minimising the halves' variance.
+
+    Eq. (2), Ferwerda (an alternative to its median-cut lights).
 
     Both axes and every cut position are tried with summed-area tables of ``E``, ``E x``, ``E y``,
     ``E x²`` and ``E y²``, so each candidate costs O(1). Levels and arguments as in
