@@ -27,8 +27,8 @@ def _horizon_along(h, pixel_size, j, i, phi, max_steps):
     for t in range(1, max_steps + 1):
         rise = _sample_periodic(h, j + t * dy, i + t * dx) - h[j, i]
         # Sloan & Cohen 2000: the horizon is the largest elevation angle seen along the ray
-        best = max(best, math.atan2(rise, t * pixel_size))
-    return best
+        best = max(best, rise / (t * pixel_size))
+    return math.atan(best)
 
 
 @numba.njit(cache=False)

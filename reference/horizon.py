@@ -81,8 +81,8 @@ def _horizon_along(h, pixel_size, phi, max_steps):
     for t in range(1, max_steps + 1):
         rise = _sample_periodic(h, rows + t * dy, cols + t * dx) - h
         # Sloan & Cohen 2000: the horizon is the largest elevation angle seen along the ray
-        best = np.maximum(best, np.arctan2(rise, t * pixel_size))
-    return best
+        best = np.maximum(best, rise / (t * pixel_size))
+    return np.arctan(best)
 
 
 def horizon_map(

@@ -20,6 +20,7 @@ here, from the library in ``reference/``:
 
 from __future__ import annotations
 
+import functools
 import time
 from pathlib import Path
 
@@ -61,7 +62,8 @@ from reference.specular_lighting import (
     specular_hybrid,
     specular_point_lights,
 )
-from validation.metrics import colorchecker_truth, delta_E_stats
+from validation.metrics import colorchecker_truth as _colorchecker_truth_uncached
+from validation.metrics import delta_E_stats
 
 __all__ = [
     "EXTRA_LIGHTS",
@@ -70,6 +72,7 @@ __all__ = [
     "PAINT_SPECTRA",
     "booth_plane_light",
     "channel_count_errors",
+    "colorchecker_truth",
     "design_delta_E",
     "gloss_validation",
     "impasto_painting",
@@ -104,6 +107,18 @@ PAINT_SPECTRA = (
 )
 #: The booth: the viewer's eye and the ceiling light (§3.2, Fig. 7), metres, y up.
 EYE = (0.0, 0.45, 0.6)
+
+
+@functools.lru_cache(maxsize=32)
+def colorchecker_truth(light: str):
+    """:func:`validation.metrics.colorchecker_truth`, cached per light (do not modify the result).
+
+    Examples
+    --------
+    >>> colorchecker_truth("A") is colorchecker_truth("A")
+    True
+    """
+    return _colorchecker_truth_uncached(light)
 
 
 def _lab_delta_E(XYZ, XYZ_true, white) -> np.ndarray:
