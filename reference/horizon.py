@@ -173,14 +173,15 @@ def horizon_lookup(hmap, phi, beta) -> np.ndarray:
 
     Parameters
     ----------
-    hmap : ndarray, shape (H, W, S)
-    phi, beta : array_like, broadcastable to (H, W)
-        Light azimuth and elevation, radians.
+    hmap : ndarray, shape (..., S)
+        Horizon angles per pixel (for example ``(H, W, S)``, or ``(P, 1, S)`` for P pixels).
+    phi, beta : array_like
+        Light azimuth and elevation, radians, broadcast against ``hmap.shape[:-1]``.
 
     Returns
     -------
-    ndarray of bool, shape (H, W)
-        True where the light reaches the pixel.
+    ndarray of bool
+        True where the light reaches the pixel, in the broadcast shape.
 
     Examples
     --------
@@ -190,9 +191,10 @@ def horizon_lookup(hmap, phi, beta) -> np.ndarray:
     """
     hmap = np.asarray(hmap, dtype=np.float64)
     S = hmap.shape[-1]
-    phi, beta = np.broadcast_arrays(np.asarray(phi, float), np.asarray(beta, float))
-    phi = np.broadcast_to(phi, hmap.shape[:-1])
-    beta = np.broadcast_to(beta, hmap.shape[:-1])
+    phi, beta = np.asarray(phi, float), np.asarray(beta, float)
+    shape = np.broadcast_shapes(hmap.shape[:-1], phi.shape, beta.shape)
+    hmap = np.broadcast_to(hmap, (*shape, S))
+    phi, beta = np.broadcast_to(phi, shape), np.broadcast_to(beta, shape)
     sector = np.floor(np.mod(phi, 2.0 * np.pi) / (2.0 * np.pi / S)).astype(np.int64) % S
     critical = np.take_along_axis(hmap, sector[..., None], axis=-1)[..., 0]
     # §3.5.3, Ferwerda: the source counts only above the critical elevation

@@ -309,13 +309,16 @@ def table1(
 # --- metamers (Fig. 4) ----------------------------------------------------------------------------
 
 
-def metamer_pair(match: str = "A", differ: str = "D65", base: float = 0.45) -> tuple:
+def metamer_pair(
+    match: str = "A", differ: str = "D65", base: float = 0.45, delta_E_differ: float = 4.0
+) -> tuple:
     """Two reflectances that match under ``match`` and differ under ``differ`` (Fig. 4, Ferwerda).
 
-    The second is the first plus a *metameric black* for the ``match`` light: the part of a smooth
-    spectral difference (the ``differ`` light's colour-matching weights minus the ``match``
-    light's) that lies in the null space of the ``match`` light's band weights, so its XYZ there
-    is exactly zero. It is scaled as far as reflectances in [0.02, 0.98] allow.
+    The second is a flat gray plus a smooth *metameric black* for the ``match`` light: a
+    combination of the cosines ``cos(kπx)``, k = 1 … 6, over 380-780 nm that lies in the null space
+    of the ``match`` light's band weights (its XYZ there is exactly zero) and, among those, changes
+    the colour under ``differ`` the most per unit size. It is scaled so that the true difference
+    under ``differ`` is ``delta_E_differ`` ΔE00.
 
     Returns
     -------
@@ -327,22 +330,34 @@ def metamer_pair(match: str = "A", differ: str = "D65", base: float = 0.45) -> t
     >>> from reference.colorimetry import band_weights
     >>> R1, R2 = metamer_pair()
     >>> W_A = band_weights(MS_GRID, spectrum_from_dataset("illuminant", "A"))
-    >>> bool(np.allclose(R1 @ W_A, R2 @ W_A, atol=1e-12))
-    True
+    >>> bool(np.allclose(R1 @ W_A, R2 @ W_A, atol=1e-12)), bool(R2.min() > 0)
+    (True, True)
     """
+    from scipy.optimize import brentq
+
     from reference.colorimetry import band_weights
 
     W_match = band_weights(MS_GRID, spectrum_from_dataset("illuminant", match))
     W_differ = band_weights(MS_GRID, spectrum_from_dataset("illuminant", differ))
-    # A smooth direction that moves the colour under `differ`: its z̄-weighted minus x̄-weighted
-    # weights (blue against red), made orthogonal to the three columns of W_match.
-    direction = (W_differ[:, 2] - W_differ[:, 0]) / np.abs(W_differ).max()
-    Q, _ = np.linalg.qr(W_match)
-    black = direction - Q @ (Q.T @ direction)
+    x = np.linspace(0.0, 1.0, MS_GRID.n_bands)
+    basis = np.stack([np.cos(k * np.pi * x) for k in range(1, 7)], axis=-1)
+    # The null space of W_match within the basis: metameric blacks for the `match` light.
+    _, _, vt = np.linalg.svd(W_match.T @ basis)
+    null = vt[3:].T
+    # Among them, the one that moves the `differ` colour most.
+    _, _, vt = np.linalg.svd(W_differ.T @ basis @ null)
+    black = basis @ (null @ vt[0])
     black /= np.abs(black).max()
     R1 = np.full(MS_GRID.n_bands, base)
-    room = np.min(np.where(black > 0, (0.98 - R1) / black, (0.02 - R1) / black))
-    return R1, R1 + room * black
+    white = W_differ.sum(axis=0)
+
+    def excess(k):
+        return (
+            float(_lab_delta_E(R1 @ W_differ, (R1 + k * black) @ W_differ, white)) - delta_E_differ
+        )
+
+    k = brentq(excess, 1e-6, min(base, 1.0 - base))
+    return R1, R1 + k * black
 
 
 def metamer_delta_E(design: str = "optimized", n_channels: int = 6, lights=("A", "D65")) -> dict:

@@ -39,7 +39,7 @@ def format_table1(result: dict) -> str:
     ...        "screen": dict(mean=0.5, std=0.2, p90=0.8, max=1.0)}
     >>> print(format_table1({"design": "optimized", "n_channels": 6, "rows": [row],
     ...                      "lights": {"D65": {"out_of_gamut": []}}}).splitlines()[3])
-    D65 (24)     0.20  0.10  0.40  0.30 |  0.50  0.20  0.80  1.00
+    D65 (24)    0.20  0.10  0.30  0.40 |  0.50  0.20  0.80  1.00
     """
     lines = [
         f"Table 1 (Ferwerda 2015): CIEDE2000 against the 5 nm spectral truth, "
