@@ -261,13 +261,13 @@ def run(ctx: ReportContext) -> SectionResult:
             backend=backend,
         )
         shadows = imp.shadow_agreement(
-            (6, 18), size=32, n_azimuths=2, elevations_deg=(20.0,), max_steps=8, backend=backend
+            (6, 18), size=64, n_azimuths=4, elevations_deg=(15.0,), max_steps=16, backend=backend
         )
         gloss = imp.gloss_validation(
             gloss=((0.06, 0.02), (0.06, 0.15)), angles_deg=[6, 7.5, 10, 20], backend=backend
         )
     else:
-        alpha = imp.specular_error_vs_alpha(backend=backend)
+        alpha = imp.specular_error_vs_alpha(supersample=4, backend=backend)
         shadows = imp.shadow_agreement(backend=backend)
         gloss = imp.gloss_validation(backend=backend)
     alpha_blocks, alpha_summary = _alpha_blocks(ctx, alpha)
