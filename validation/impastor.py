@@ -457,7 +457,7 @@ def impasto_painting(size: int = 256, seed: int = 1, width_m: float = 0.3, n_str
     width_m : float
         Physical width, m (a 30 cm canvas by default).
     n_strokes : int, optional
-        Default ``120 · (width_m / 0.3)²``.
+        Default ``400 · (width_m / 0.3)²``.
 
     Returns
     -------
@@ -474,7 +474,7 @@ def impasto_painting(size: int = 256, seed: int = 1, width_m: float = 0.3, n_str
     size = require_positive_int(size, "painting: size", 8192)
     rng = np.random.default_rng(seed)
     pixel = width_m / size
-    n = n_strokes or int(120 * (width_m / 0.3) ** 2)
+    n = n_strokes or int(400 * (width_m / 0.3) ** 2)
     y, x = np.meshgrid(np.arange(size) * pixel, np.arange(size) * pixel, indexing="ij")
     # Canvas weave: two crossed sinusoids, 1 mm period, 20 µm deep.
     height = 2e-5 * (np.sin(2 * np.pi * x / 1e-3) * np.sin(2 * np.pi * y / 1e-3))
