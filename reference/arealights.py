@@ -273,8 +273,11 @@ def _split_levels(n_lights: int):
     return levels
 
 
-def _partition(energy, n_lights, geometry, choose_cut, priority):
+def _partition(energy, n_lights, sizes, choose_cut, priority, where):
     """Shared driver: split regions level by level with a cut chooser; see :func:`median_cut`."""
+    energy = _check_image(energy, f"{where}: energy")[..., 0]
+    n_lights = require_positive_int(n_lights, f"{where}: n_lights", energy.size)
+    geometry = _geometry(energy, *sizes)
     H, W = energy.shape
     X, Y = _coordinates(energy.shape, *geometry)
     tables = {
@@ -382,15 +385,9 @@ def median_cut(
     >>> median_cut(image, 2)
     [(0, 4, 0, 6), (0, 4, 6, 8)]
     """
-    energy = _check_image(energy, "median cut: energy")[..., 0]
-    n_lights = require_positive_int(n_lights, "median cut: n_lights", energy.size)
-    return _partition(
-        energy,
-        n_lights,
-        _geometry(energy, pixel_width, pixel_height, row_scale),
-        _median_cut_split,
-        lambda tables, region: _box(tables["E"], *region),
-    )
+    sizes = (pixel_width, pixel_height, row_scale)
+    energy_of = lambda tables, region: _box(tables["E"], *region)  # noqa: E731
+    return _partition(energy, n_lights, sizes, _median_cut_split, energy_of, "median cut")
 
 
 def variance_minimization(
@@ -411,15 +408,8 @@ def variance_minimization(
     >>> variance_minimization(image, 2)
     [(0, 4, 0, 2), (0, 4, 2, 8)]
     """
-    energy = _check_image(energy, "variance minimization: energy")[..., 0]
-    n_lights = require_positive_int(n_lights, "variance minimization: n_lights", energy.size)
-    return _partition(
-        energy,
-        n_lights,
-        _geometry(energy, pixel_width, pixel_height, row_scale),
-        _variance_split,
-        _variance,
-    )
+    sizes = (pixel_width, pixel_height, row_scale)
+    return _partition(energy, n_lights, sizes, _variance_split, _variance, "variance minimization")
 
 
 #: Partitions of a light image into N regions; ``reference(energy, n_lights, pixel_width,
