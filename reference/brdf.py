@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from reference.errors import SpecrefWarning, require, require_nonnegative
+from reference.errors import SpecrefError, SpecrefWarning, require, require_nonnegative
 from reference.registry import Method, Registry
 
 __all__ = [
@@ -134,6 +134,13 @@ def check_ward_duer_params(rho_d, rho_s, alpha, where: str = "ward_duer", energy
         bool((alpha > 0).all()),
         f"{where}: alpha: must be > 0 (the lobe width), got {float(alpha.min()):g}",
     )
+    try:
+        np.broadcast_shapes(rho_d.shape, rho_s.shape, alpha.shape)
+    except ValueError:
+        raise SpecrefError(
+            f"{where}: the rho_d, rho_s and alpha maps must have matching sizes, got "
+            f"{rho_d.shape}, {rho_s.shape} and {alpha.shape}"
+        ) from None
     total = rho_d + rho_s
     if energy != "ignore" and (total > 1.0 + 1e-12).any():
         worst = float(total.max())
@@ -245,6 +252,13 @@ def brdf_ward_duer(wi, wo, normal, rho_d, rho_s, alpha, energy: str = "error") -
     """
     rho_d, rho_s, alpha = check_ward_duer_params(rho_d, rho_s, alpha, energy=energy)
     cos_i, cos_o = _dot(wi, normal), _dot(wo, normal)
+    try:
+        np.broadcast_shapes((*cos_i.shape, 1), rho_d.shape, rho_s.shape, alpha.shape)
+    except ValueError:
+        raise SpecrefError(
+            f"ward_duer: parameter maps {rho_d.shape}, {rho_s.shape}, {alpha.shape} do not match "
+            f"the {cos_i.shape} directions (maps are (..., C) per pixel)"
+        ) from None
     above = ((cos_i > 0.0) & (cos_o > 0.0))[..., None]
     # Eq. (4), Ferwerda: ρ_d/π + ρ_s · lobe
     lobe = brdf_ward_duer_specular(

@@ -89,6 +89,14 @@ def test_brdf_ward_duer_bad_input(kwargs, match):
         brdf_ward_duer(Z, Z, Z, **kwargs)
 
 
+def test_brdf_ward_duer_maps_of_mismatched_size():
+    with pytest.raises(SpecrefError, match="maps must have matching sizes"):
+        brdf_ward_duer(Z, Z, Z, np.full((4, 4, 6), 0.2), np.full((3, 3, 6), 0.1), 0.1)
+    wi = np.tile(Z, (4, 4, 1))
+    with pytest.raises(SpecrefError, match="do not match the"):
+        brdf_ward_duer(wi, wi, Z, np.full((3, 3, 6), 0.2), 0.1, 0.1)
+
+
 def test_check_ward_duer_params_warn_mode():
     with pytest.warns(SpecrefWarning, match="energy conservation"):
         check_ward_duer_params(0.7, 0.4, 0.1, energy="warn")
