@@ -16,7 +16,7 @@ from reference.colorimetry import XYZ_to_Lab, band_weights, delta_E_00, spectra_
 from reference.errors import require
 from reference.spectra import SpectralGrid, make_spectrum, resample_spectrum, spectrum_from_dataset
 
-__all__ = ["COLORCHECKER", "colorchecker_delta_E", "delta_E_stats"]
+__all__ = ["COLORCHECKER", "colorchecker_delta_E", "colorchecker_truth", "delta_E_stats"]
 
 #: The ColorChecker measurement set used for accuracy figures (5 nm, 380-780 nm).
 COLORCHECKER = "ColorChecker N Ohta"
@@ -50,6 +50,41 @@ def delta_E_stats(delta_E) -> dict:
     }
 
 
+def colorchecker_truth(illuminant: str) -> tuple[dict, np.ndarray, np.ndarray]:
+    """The 5 nm truth on the ColorChecker: colour-science's ``sd_to_XYZ`` (CIE 1931 2°), Y = 1.
+
+    Parameters
+    ----------
+    illuminant : str
+        A colour-science illuminant key.
+
+    Returns
+    -------
+    patches : dict
+        Patch name to colour-science ``SpectralDistribution`` (5 nm, 380-780 nm).
+    XYZ : ndarray, shape (24, 3)
+        Truth per patch.
+    white : ndarray, shape (3,)
+        The perfect white diffuser under the light (Y = 1).
+
+    Examples
+    --------
+    >>> _, XYZ, white = colorchecker_truth("D65")
+    >>> XYZ.shape, white.round(4)
+    ((24, 3), array([0.9505, 1.    , 1.089 ]))
+    """
+    import colour
+
+    sd_light = spectrum_from_dataset("illuminant", illuminant).meta["colour_sd"]
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
+    patches = colour.SDS_COLOURCHECKERS[COLORCHECKER]
+    first = next(iter(patches.values()))
+    unit = colour.SpectralDistribution(np.ones(first.values.size), first.wavelengths)
+    white = colour.sd_to_XYZ(unit, cmfs, sd_light) / 100.0
+    XYZ = np.array([colour.sd_to_XYZ(sd, cmfs, sd_light) / 100.0 for sd in patches.values()])
+    return dict(patches), XYZ, white
+
+
 def colorchecker_delta_E(
     grid: SpectralGrid, illuminant: str, method: str = "astm_e308"
 ) -> np.ndarray:
@@ -80,26 +115,12 @@ def colorchecker_delta_E(
     >>> float(colorchecker_delta_E(GRID_41, "D65").mean()) < 0.03
     True
     """
-    import colour
-
     light = spectrum_from_dataset("illuminant", illuminant)
-    sd_light = light.meta["colour_sd"]
-    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
     W = band_weights(grid, light, method)
-    patches = colour.SDS_COLOURCHECKERS[COLORCHECKER]
-    first = next(iter(patches.values()))
-    white = (
-        colour.sd_to_XYZ(
-            colour.SpectralDistribution(np.ones(first.values.size), first.wavelengths),
-            cmfs,
-            sd_light,
-        )
-        / 100.0
-    )
+    patches, truth, white = colorchecker_truth(illuminant)
     out = []
-    for name, sd in patches.items():
-        truth = colour.sd_to_XYZ(sd, cmfs, sd_light) / 100.0
+    for (name, sd), XYZ_true in zip(patches.items(), truth, strict=True):
         R = resample_spectrum(make_spectrum(sd.wavelengths, sd.values, name), grid)
         XYZ = spectra_to_XYZ(R, W)
-        out.append(float(delta_E_00(XYZ_to_Lab(XYZ, white), XYZ_to_Lab(truth, white))))
+        out.append(float(delta_E_00(XYZ_to_Lab(XYZ, white), XYZ_to_Lab(XYZ_true, white))))
     return np.asarray(out)

@@ -1,1 +1,1 @@
-"""Scripts that precompute expensive oracle values into ``tests/data/*.json``."""
+"""Scripts that precompute expensive references and package data (run with ``python -m``)."""

@@ -1,0 +1,80 @@
+"""ImpastoR benchmarks (``make bench``): lighting methods, horizon maps and full frames.
+
+Each group measures its own baseline in the same run, so the report shows ratios:
+
+- ``impastor-specular``: every registered specular method on the same 4096 surface points, with
+  the brute-force sum over the light (on 256 of them) as the baseline;
+- ``impastor-horizon``: the NumPy twin of each horizon method (baseline) against its numba kernel;
+- ``impastor-frame-512``: a 512×512 frame of the demo painting per lighting method (numba, warm).
+"""
+
+from __future__ import annotations
+
+from operator import attrgetter
+
+import numpy as np
+import pytest
+
+from reference.horizon import HORIZON_METHODS
+from reference.specular_lighting import SPECULAR_METHODS
+from validation import impastor as imp
+
+
+@pytest.fixture(scope="module")
+def specular_scene():
+    rng = np.random.default_rng(7)
+    painting = imp.impasto_painting(128, seed=2)
+    P, N, V = imp._painting_samples(64, painting)
+    alpha = rng.uniform(0.02, 0.3, len(P))
+    plane = imp.booth_plane_light("fluorescent", 64, 32)
+    lights = imp.point_lights_from_plane(plane, "median_cut", 32)
+    return P, N, V, alpha, plane, lights
+
+
+@pytest.mark.parametrize("method", SPECULAR_METHODS.values(), ids=attrgetter("name"))
+def test_bench_specular(benchmark, method, specular_scene):
+    benchmark.group = "impastor-specular"
+    inputs = (
+        specular_scene
+        if method.name != "brute_force"
+        else tuple(x[:256] if isinstance(x, np.ndarray) else x for x in specular_scene)
+    )
+    calls = {
+        "point_lights": lambda x: method.reference(*x[:4], x[5], backend="numba"),
+        "fis": lambda x: method.reference(*x[:5], 32, backend="numba"),
+        "hybrid": lambda x: method.reference(*x[:6], 32, backend="numba"),
+        "brute_force": lambda x: method.reference(*x[:5], 1, backend="numba"),
+    }
+    call = calls[method.name]
+    call(inputs)  # JIT warm-up outside the timing
+    benchmark.extra_info["points"] = len(inputs[0])
+    benchmark(call, inputs)
+
+
+@pytest.mark.parametrize("method", HORIZON_METHODS.values(), ids=attrgetter("name"))
+@pytest.mark.parametrize("backend", ["numpy", "numba"])
+def test_bench_horizon(benchmark, method, backend):
+    benchmark.group = f"impastor-horizon-{method.name}"
+    painting = imp.impasto_painting(256, seed=4)
+    h, pixel = painting["height"], painting["pixel_size"]
+    if method.name == "horizon_map":
+        args = (h, pixel, 18, 32)
+    else:
+        args = (h, pixel, 0.7, np.radians(20.0), 32)
+    method.reference(*args, backend=backend)
+    benchmark(method.reference, *args, backend=backend)
+
+
+@pytest.mark.parametrize("method", imp.LIGHTING_METHODS)
+def test_bench_frame_512(benchmark, method):
+    benchmark.group = "impastor-frame-512"
+    painting = imp.impasto_painting(512, seed=1)
+    spectra = imp.load_paint_spectra()
+    imp.render_painting("D65", 64, method, imp.impasto_painting(64), spectra=spectra)  # warm-up
+    benchmark.pedantic(
+        imp.render_painting,
+        args=("D65", 512, method, painting),
+        kwargs={"spectra": spectra},
+        rounds=3,
+        iterations=1,
+    )

@@ -1,0 +1,88 @@
+"""Library side of ``specref impastor``: checked inputs and formatted tables."""
+
+from __future__ import annotations
+
+from reference.errors import require
+from reference.multispectral import MIN_CHANNELS, MULTISPECTRAL_DESIGNS
+
+__all__ = ["format_table1", "render_for_cli", "table1_for_cli"]
+
+
+def table1_for_cli(design: str, n_channels: int, white_luminance: float, display_file=None):
+    """Validate the CLI's arguments and compute :func:`validation.impastor.table1`.
+
+    Examples
+    --------
+    >>> table1_for_cli("optimized", 2, 200.0)
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: --channels: channel count must be >= 3, got 2
+    """
+    from reference.display_model import load_display_measurements, virtual_display
+    from validation.impastor import table1
+
+    MULTISPECTRAL_DESIGNS.lookup(design)
+    require(
+        n_channels >= MIN_CHANNELS,
+        f"--channels: channel count must be >= {MIN_CHANNELS}, got {n_channels}",
+    )
+    display = load_display_measurements(display_file) if display_file else virtual_display()
+    return table1(design, n_channels, white_luminance, display)
+
+
+def format_table1(result: dict) -> str:
+    """Table 1 as text: six-channel simulation and screen output, ΔE00 statistics per row.
+
+    Examples
+    --------
+    >>> row = {"label": "D65 (24)", "simulation": dict(mean=0.2, std=0.1, p90=0.3, max=0.4),
+    ...        "screen": dict(mean=0.5, std=0.2, p90=0.8, max=1.0)}
+    >>> print(format_table1({"design": "optimized", "n_channels": 6, "rows": [row],
+    ...                      "lights": {"D65": {"out_of_gamut": []}}}).splitlines()[3])
+    D65 (24)    0.20  0.10  0.30  0.40 |  0.50  0.20  0.80  1.00
+    """
+    lines = [
+        f"Table 1 (Ferwerda 2015): CIEDE2000 against the 5 nm spectral truth, "
+        f"{result['n_channels']}-channel {result['design']} design",
+        f"{'':10} {'six-channel simulation':^24} | {'screen output':^24}",
+        f"{'':10} {'mean':>5} {'std':>5} {'90th':>5} {'max':>5} | "
+        f"{'mean':>5} {'std':>5} {'90th':>5} {'max':>5}",
+    ]
+    for row in result["rows"]:
+        sim, scr = row["simulation"], row["screen"]
+        left = f"{sim['mean']:5.2f} {sim['std']:5.2f} {sim['p90']:5.2f} {sim['max']:5.2f}"
+        right = (
+            f"{scr['mean']:5.2f} {scr['std']:5.2f} {scr['p90']:5.2f} {scr['max']:5.2f}"
+            if scr
+            else "  —"
+        )
+        lines.append(f"{row['label']:10} {left} | {right}")
+    for light, info in result["lights"].items():
+        names = ", ".join(info["out_of_gamut"]) or "none"
+        lines.append(f"out of gamut under {light}: {len(info['out_of_gamut'])} ({names})")
+    return "\n".join(lines)
+
+
+def render_for_cli(light: str, size: int, method: str, out) -> str:
+    """Render the demo painting and write it as a PNG; return a one-line summary.
+
+    Examples
+    --------
+    >>> render_for_cli("D65", 16, "nearest", "x.png")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: unknown lighting method 'nearest'; allowed: fis, hybrid,
+    median_cut, variance_min
+    """
+    from reference.errors import require_choice, require_positive_int
+    from reference.images import write_png
+    from reference.spectra import spectrum_from_dataset
+    from validation.impastor import LIGHTING_METHODS, render_painting
+
+    require_choice(method, LIGHTING_METHODS, "lighting method")
+    size = require_positive_int(size, "--size", 4096)
+    spectrum_from_dataset("illuminant", light)
+    result = render_painting(light, size, method)
+    write_png(out, result["sRGB"])
+    seconds = sum(result["seconds"].values())
+    return f"wrote {out} ({size}×{size}, {light}, {method}, shading {seconds:.2f} s)"
