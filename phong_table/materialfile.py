@@ -1,8 +1,8 @@
 """Material files for ``specref phong --material FILE.toml``: a spectral Phong material, its light.
 
 The format is documented in ``docs/phong-tables.md`` ("Material files"). A file holds a
-``[material]`` table (``k_d``, ``k_s``, ``n`` and optionally ``k_a``, each a spectrum) and an optional ``[light]``
-table (``spectrum``, ``position``, ``intensity``, ``attenuation``); the sphere, the camera and the
+``[material]`` table (``k_d``, ``k_s``, ``n`` and optionally ``k_a``, each a spectrum) and an
+optional ``[light]`` table (``spectrum``, ``position``, ``intensity``, ``attenuation``); the sphere, the camera and the
 views are those of the reconstructed scenes (``phong_table.scenes``). A spectrum is one of:
 
 - a number: constant over the grid (``n = 50``);
