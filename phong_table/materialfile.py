@@ -3,7 +3,7 @@
 The format is documented in ``docs/phong-tables.md`` ("Material files"). A file holds a
 ``[material]`` table (``k_d``, ``k_s``, ``n`` and optionally ``k_a``, each a spectrum) and an
 optional ``[light]`` table (``spectrum``, ``position``, ``intensity``, ``attenuation``); the
-sphere, the camera and the views are those of the reconstructed scenes (``phong_table.scenes``). A spectrum is one of:
+sphere, the camera and the views are those of the scenes (``phong_table.scenes``). A spectrum is:
 
 - a number: constant over the grid (``n = 50``);
 - a list of ``n_bands`` numbers on the grid (380-780 nm in 10 nm steps by default);
