@@ -69,44 +69,31 @@ def light_geometry_kernel(position, normal, view, light_position, attenuation, o
 
 
 @numba.njit(cache=False, inline="always")
-def _interval(nodes, guide, uniform, t):
-    """Index i of the interval ``[t_i, t_{i+1}]`` holding ``t`` (``searchsorted`` − 1, clipped)."""
+def _interval(nodes, guide, steps, uniform, t):
+    """Index i of the interval ``[t_i, t_{i+1}]`` holding ``t`` (``searchsorted`` − 1, clipped).
+
+    Branch-free, so that the pixel loop compiles to conditional moves.
+    """
     m = nodes.size - 1
     if uniform:
-        # O(1): uniform nodes t_i = i/m
-        i = min(max(int(t * m), 0), m - 1)
-    else:
-        # inverse-map index: cell c of K uniform cells holds intervals guide[c] .. guide[c+1]
-        K = guide.size - 1
-        c = min(max(int(t * K), 0), K - 1)
-        lo = guide[c]
-        hi = guide[c + 1]
-        while lo < hi:
-            mid = (lo + hi + 1) >> 1
-            if nodes[mid] <= t:
-                lo = mid
-            else:
-                hi = mid - 1
-        i = lo
-    # rounding of t·m or t·K can land one interval off; step to the exact interval
-    while i > 0 and nodes[i] > t:
-        i -= 1
-    while i < m - 1 and nodes[i + 1] <= t:
-        i += 1
-    return i
-
-
-@numba.njit(cache=False, inline="always")
-def _parabola(x0, x1, x2, x, values, j):
-    """3-point Lagrange parabola through (x_k, values[j − 1 + k]), k = 0, 1, 2, at x."""
-    l0 = (x - x1) * (x - x2) / ((x0 - x1) * (x0 - x2))
-    l1 = (x - x0) * (x - x2) / ((x1 - x0) * (x1 - x2))
-    l2 = (x - x0) * (x - x1) / ((x2 - x0) * (x2 - x1))
-    return (
-        l0 * values[j - 1, 0] + l1 * values[j, 0] + l2 * values[j + 1, 0],
-        l0 * values[j - 1, 1] + l1 * values[j, 1] + l2 * values[j + 1, 1],
-        l0 * values[j - 1, 2] + l1 * values[j, 2] + l2 * values[j + 1, 2],
-    )
+        # O(1): uniform nodes t_i = i/m; rounding of t·m can land one interval off
+        i = min(int(t * m), m - 1)
+        i -= np.int64(nodes[i] > t)
+        i += np.int64(nodes[min(i + 1, m)] <= t) * np.int64(i < m - 1)
+        return i
+    # inverse-map index: cell c of K uniform cells holds intervals guide[c] .. guide[c+1]; one
+    # more on each side covers the rounding of t·K; ``steps`` halvings of the cell's widest range
+    # find the largest t_i <= t
+    K = guide.size - 1
+    c = min(int(t * K), K - 1)
+    lo = max(guide[c] - 1, 0)
+    hi = min(guide[c + 1] + 1, m - 1)
+    for _ in range(steps):
+        mid = min((lo + hi + 1) >> 1, hi)
+        below = nodes[mid] <= t
+        lo = mid if below else lo
+        hi = hi if below else mid - 1
+    return lo
 
 
 @numba.njit(cache=False, inline="always")
@@ -219,6 +206,53 @@ def shade_exact_kernel(cos_theta, t, f_att, diffuse_RGB, C, n, ambient_RGB, out)
     return out
 
 
+@numba.njit(cache=False, inline="always")
+def _shade_table_loop(
+    cos_theta,
+    t,
+    f_att,
+    diffuse_RGB,
+    ambient_RGB,
+    nodes,
+    values,
+    inv_width,
+    cubic,
+    guide,
+    steps,
+    uniform,
+    code,
+    a,
+    out,
+):
+    """The pixel loop of :func:`shade_table_kernel` for one lookup and one interpolation."""
+    # at t = 0 every interpolation returns the first tabulated value exactly (unlit pixels)
+    if code == LINEAR:
+        for p in range(t.size):
+            if t[p] == 0.0:
+                r, g, b = values[0, 0], values[0, 1], values[0, 2]
+            else:
+                i = _interval(nodes, guide, steps, uniform, t[p])
+                r, g, b = _linear(nodes, values, inv_width, i, t[p])
+            _write(out, p, ambient_RGB, diffuse_RGB, f_att[p], cos_theta[p], r, g, b)
+    elif code == MONOTONE:
+        for p in range(t.size):
+            if t[p] == 0.0:
+                r, g, b = values[0, 0], values[0, 1], values[0, 2]
+            else:
+                i = _interval(nodes, guide, steps, uniform, t[p])
+                r, g, b = _monotone(nodes, values, inv_width, cubic, i, t[p])
+            _write(out, p, ambient_RGB, diffuse_RGB, f_att[p], cos_theta[p], r, g, b)
+    else:
+        in_w = code == PARABOLIC_W
+        for p in range(t.size):
+            if t[p] == 0.0:
+                r, g, b = values[0, 0], values[0, 1], values[0, 2]
+            else:
+                i = _interval(nodes, guide, steps, uniform, t[p])
+                r, g, b = _parabolic(nodes, values, in_w, a, i, t[p])
+            _write(out, p, ambient_RGB, diffuse_RGB, f_att[p], cos_theta[p], r, g, b)
+
+
 @numba.njit(cache=False)
 def shade_table_kernel(
     cos_theta,
@@ -231,6 +265,7 @@ def shade_table_kernel(
     inv_width,
     cubic,
     guide,
+    steps,
     uniform,
     code,
     a,
@@ -241,33 +276,43 @@ def shade_table_kernel(
     Twin of ``phong_table.render.shade_table`` (Eq. (7) and Eq. (11), Wang et al.; the table
     holds ``f_sp`` without ``f_att``, Erratum E8); writes ``out`` (N, 3).
     """
-    # one loop per interpolation, so that each compiles without a branch per pixel; at t = 0 every
-    # interpolation returns the first tabulated value exactly (unlit and back-facing pixels)
-    if code == LINEAR:
-        for p in range(t.size):
-            if t[p] == 0.0:
-                r, g, b = values[0, 0], values[0, 1], values[0, 2]
-            else:
-                i = _interval(nodes, guide, uniform, t[p])
-                r, g, b = _linear(nodes, values, inv_width, i, t[p])
-            _write(out, p, ambient_RGB, diffuse_RGB, f_att[p], cos_theta[p], r, g, b)
-    elif code == MONOTONE:
-        for p in range(t.size):
-            if t[p] == 0.0:
-                r, g, b = values[0, 0], values[0, 1], values[0, 2]
-            else:
-                i = _interval(nodes, guide, uniform, t[p])
-                r, g, b = _monotone(nodes, values, inv_width, cubic, i, t[p])
-            _write(out, p, ambient_RGB, diffuse_RGB, f_att[p], cos_theta[p], r, g, b)
+    # one loop per lookup and interpolation, so that each compiles without a branch per pixel
+    if uniform:
+        _shade_table_loop(
+            cos_theta,
+            t,
+            f_att,
+            diffuse_RGB,
+            ambient_RGB,
+            nodes,
+            values,
+            inv_width,
+            cubic,
+            guide,
+            steps,
+            True,
+            code,
+            a,
+            out,
+        )
     else:
-        in_w = code == PARABOLIC_W
-        for p in range(t.size):
-            if t[p] == 0.0:
-                r, g, b = values[0, 0], values[0, 1], values[0, 2]
-            else:
-                i = _interval(nodes, guide, uniform, t[p])
-                r, g, b = _parabolic(nodes, values, in_w, a, i, t[p])
-            _write(out, p, ambient_RGB, diffuse_RGB, f_att[p], cos_theta[p], r, g, b)
+        _shade_table_loop(
+            cos_theta,
+            t,
+            f_att,
+            diffuse_RGB,
+            ambient_RGB,
+            nodes,
+            values,
+            inv_width,
+            cubic,
+            guide,
+            steps,
+            False,
+            code,
+            a,
+            out,
+        )
     return out
 
 
@@ -284,7 +329,7 @@ def _pchip_end_slope(h0, h1, m0, m1):
 
 @numba.njit(cache=False)
 def tabulate_kernel(nodes, C, n, cells_per_entry):
-    """Values, monotone slopes, inverse widths, Horner cubics and inverse-map index of a table.
+    """Values, slopes, inverse widths, Horner cubics, inverse-map index and bisection steps.
 
     Twin of ``phong_table.table.tabulate`` (Eq. (11), Wang et al. at the nodes).
     """
@@ -354,7 +399,14 @@ def tabulate_kernel(nodes, C, n, cells_per_entry):
         while i < m - 1 and nodes[i + 1] <= edge:
             i += 1
         guide[c] = i
-    return values, slopes, inv_width, cubic, guide
+    # bisection steps for the widest cell (with the one-interval margins of _interval)
+    widest = 1
+    for c in range(K):
+        widest = max(widest, min(guide[c + 1] + 1, m - 1) - max(guide[c] - 1, 0) + 1)
+    steps = 0
+    while (1 << steps) < widest:
+        steps += 1
+    return values, slopes, inv_width, cubic, guide, steps
 
 
 @numba.njit(cache=False)

@@ -41,6 +41,7 @@ __all__ = [
     "SHADING_PATHS",
     "ShadingBuffer",
     "SphereGeometry",
+    "compiled_shader",
     "light_geometry",
     "render_sphere",
     "render_sphere_gbuffer",
@@ -262,24 +263,34 @@ def shade_table(
     return model.ambient_RGB + f_att[:, None] * (cos_theta[:, None] * model.diffuse_RGB + specular)
 
 
-def _exact_compiled(buffer: ShadingBuffer, model: SpectralPhong, out):
-    return _kernels.shade_exact_kernel(
-        buffer.cos_theta,
-        buffer.t,
-        buffer.f_att,
-        model.diffuse_RGB,
-        model.specular_weights,
-        model.n,
-        model.ambient_RGB,
-        out,
-    )
+def compiled_shader(
+    model: SpectralPhong, table: SpecularTable | None = None, interpolation: str = "monotone"
+):
+    """A function ``shade(buffer, out)`` that calls the exact or the table kernel directly.
 
+    Everything but the pixels is bound once, as a renderer does between frames; the timings of
+    ``specref phong`` call it per tile.
 
-def _table_compiled(buffer: ShadingBuffer, model, table: SpecularTable, interpolation: str, out):
-    return _kernels.shade_table_kernel(
-        buffer.cos_theta,
-        buffer.t,
-        buffer.f_att,
+    Examples
+    --------
+    >>> from phong_table.scenes import constant_material
+    >>> model = constant_material(5.0)
+    >>> buffer = shading_buffer(sphere_gbuffer("far", 8), model)
+    >>> shade = compiled_shader(model)
+    >>> shade(buffer, np.empty((buffer.t.size, 3))).shape
+    (32, 3)
+    """
+    if table is None:
+        bound = (model.diffuse_RGB, model.specular_weights, model.n, model.ambient_RGB)
+
+        def shade(buffer: ShadingBuffer, out):
+            return _kernels.shade_exact_kernel(
+                buffer.cos_theta, buffer.t, buffer.f_att, *bound, out
+            )
+
+        return shade
+    check_interpolation(interpolation, table.entries)
+    bound = (
         model.diffuse_RGB,
         model.ambient_RGB,
         table.nodes,
@@ -287,11 +298,24 @@ def _table_compiled(buffer: ShadingBuffer, model, table: SpecularTable, interpol
         table.inv_width,
         table.cubic,
         table.guide,
+        table.steps,
         table.uniform,
         INTERPOLATION_METHODS.lookup(interpolation).extra["code"],
         table.an + 1.0,
-        out,
     )
+
+    def shade(buffer: ShadingBuffer, out):
+        return _kernels.shade_table_kernel(buffer.cos_theta, buffer.t, buffer.f_att, *bound, out)
+
+    return shade
+
+
+def _exact_compiled(buffer: ShadingBuffer, model: SpectralPhong, out):
+    return compiled_shader(model)(buffer, out)
+
+
+def _table_compiled(buffer: ShadingBuffer, model, table: SpecularTable, interpolation: str, out):
+    return compiled_shader(model, table, interpolation)(buffer, out)
 
 
 #: The shading paths and the per-pixel geometry, each a NumPy reference with its numba twin;

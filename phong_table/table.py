@@ -73,6 +73,8 @@ class SpecularTable:
         + s c3))`` with ``s = (t − t_i)/(t_{i+1} − t_i)`` (what the kernel evaluates).
     guide : ndarray of int64, shape (16 m + 1,)
         Inverse-map index (``phong_table.interpolation.guide_index``).
+    steps : int
+        Bisection steps inside the widest cell of ``guide``.
     uniform : bool
         True when the nodes are ``q/m`` (O(1) lookup).
     an : float
@@ -96,6 +98,7 @@ class SpecularTable:
     inv_width: np.ndarray
     cubic: np.ndarray
     guide: np.ndarray
+    steps: int
     uniform: bool
     an: float
     placement: str
@@ -184,10 +187,12 @@ def tabulate(nodes, C, n, cells_per_entry: int = GUIDE_CELLS_PER_ENTRY) -> tuple
     cubic : ndarray, shape (m, 3, 3)
         ``[c1, c2, c3]`` with ``f = v_i + s (c1 + s (c2 + s c3))`` on interval i.
     guide : ndarray of int64, shape (cells_per_entry · m + 1,)
+    steps : int
+        Bisection steps that resolve the widest cell of ``guide``.
 
     Examples
     --------
-    >>> values, slopes, inv_width, cubic, guide = tabulate(
+    >>> values, slopes, inv_width, cubic, guide, steps = tabulate(
     ...     np.array([0.0, 0.5, 1.0]), np.ones((1, 3)), np.array([2.0]), 1)
     >>> values[:, 0], cubic[1, 0]
     (array([0.  , 0.25, 1.  ]), array([ 0.375,  0.5  , -0.125]))
@@ -201,7 +206,11 @@ def tabulate(nodes, C, n, cells_per_entry: int = GUIDE_CELLS_PER_ENTRY) -> tuple
     # h00 = 2s³ − 3s² + 1, h10 = s³ − 2s² + s, h01 = −2s³ + 3s², h11 = s³ − s², collected by power
     cubic = np.stack([hd0, 3.0 * delta - 2.0 * hd0 - hd1, hd0 + hd1 - 2.0 * delta], axis=-1)
     guide = guide_index(nodes, cells_per_entry)
-    return values, slopes, 1.0 / np.diff(nodes), np.ascontiguousarray(cubic), guide
+    # bisection steps for the widest cell, with the one-interval margins of the kernel's lookup
+    m = nodes.size - 1
+    widest = (np.minimum(guide[1:] + 1, m - 1) - np.maximum(guide[:-1] - 1, 0) + 1).max()
+    steps = int(np.ceil(np.log2(max(int(widest), 1))))
+    return values, slopes, 1.0 / np.diff(nodes), np.ascontiguousarray(cubic), guide, steps
 
 
 def build_table(
@@ -270,7 +279,7 @@ def build_table(
         "entries",
     )
     make = _kernels.tabulate_kernel if compiled else tabulate
-    values, slopes, inv_width, cubic, guide = make(
+    values, slopes, inv_width, cubic, guide, steps = make(
         nodes, material.specular_weights, material.n, GUIDE_CELLS_PER_ENTRY
     )
     return SpecularTable(
@@ -280,6 +289,7 @@ def build_table(
         inv_width=inv_width,
         cubic=cubic,
         guide=guide,
+        steps=int(steps),
         uniform=placement == "uniform" or (placement == "importance" and p == 1),
         an=material.an,
         placement=placement,

@@ -35,6 +35,7 @@ import numpy as np
 from phong_table.model import SpectralPhong
 from phong_table.render import (
     SphereGeometry,
+    compiled_shader,
     render_sphere_gbuffer,
     shade_pixels,
     shading_buffer,
@@ -215,6 +216,9 @@ def _tiles(buffer, size: int = TILE_PIXELS):
 def time_shading(state: ViewState, table=None, interpolation: str = "monotone", repeats=9):
     """Shading time of a path on the view's buffer: per tile, minimum of ``repeats``, summed.
 
+    The compiled path calls the kernel directly (``phong_table.render.compiled_shader``); the
+    NumPy path (``state.compiled`` False) calls the reference.
+
     Examples
     --------
     >>> from phong_table.scenes import constant_material
@@ -223,15 +227,17 @@ def time_shading(state: ViewState, table=None, interpolation: str = "monotone", 
     True
     """
     method = "exact" if table is None else "table"
+    if state.compiled:
+        shade = compiled_shader(state.model, table, interpolation)
+    else:
+
+        def shade(tile, out):
+            return shade_pixels(tile, state.model, method, table, interpolation, False, out)
+
     total = 0.0
     for tile in _tiles(state.buffer):
         out = np.empty((tile.t.size, 3))
-        total += _minimum_time(
-            lambda tile=tile, out=out: shade_pixels(
-                tile, state.model, method, table, interpolation, state.compiled, out
-            ),
-            repeats,
-        )
+        total += _minimum_time(lambda tile=tile, out=out: shade(tile, out), repeats)
     return total
 
 
