@@ -41,7 +41,7 @@ from phong_table.render import (
     shading_buffer,
     sphere_gbuffer,
 )
-from phong_table.scenes import SCENES, spectral_phong_unit_peak
+from phong_table.scenes import SCENES, VIEWS, spectral_phong_unit_peak
 from phong_table.table import build_table, check_interpolation
 from reference.display import linear_to_display
 from reference.errors import require
@@ -57,8 +57,11 @@ __all__ = [
     "ViewState",
     "bimodal_material",
     "format_rows",
+    "format_targets",
+    "format_tolerance",
     "material_rows",
     "rms_8bit",
+    "run_material",
     "run_table1",
     "scene_state",
     "shared_frame_time",
@@ -684,3 +687,96 @@ def format_rows(rows: list[dict]) -> str:
             f"{1e3 * r['frame_s']:7.1f} {r['frame_speedup']:7.2f}x"
         )
     return "\n".join(lines)
+
+
+def run_material(
+    path,
+    view: str = "far",
+    entries: int = TABLE1_ENTRIES,
+    placement: str = "error",
+    interpolation: str = "monotone",
+    segments: int | None = None,
+    tolerance: float | None = None,
+    resolution: int = 512,
+    repeats: int = 9,
+) -> dict:
+    """``specref phong --material FILE.toml``: one table of a material against the exact render.
+
+    Returns
+    -------
+    dict
+        ``rows`` (the exact baseline and the table, keys as Table 1) and ``tolerance`` (the result
+        of :func:`tolerance_search`, or None).
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> text = "[material]" + chr(10) + "k_d = 0.2" + chr(10) + "k_s = 0.5" + chr(10) + "n = 40"
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     p = os.path.join(d, "m.toml")
+    ...     _ = open(p, "w").write(text + chr(10))
+    ...     result = run_material(p, "near", 32, resolution=16, repeats=1)
+    >>> [r["placement"] for r in result["rows"]], result["rows"][1]["rms"] < 0.05
+    (['exact', 'error'], True)
+    """
+    from phong_table.materialfile import load_material_file
+    from phong_table.placement import PLACEMENT_METHODS, check_entries
+    from reference.errors import require_choice
+
+    model = load_material_file(path)
+    require_choice(view, VIEWS, "view")
+    PLACEMENT_METHODS.lookup(placement)
+    check_entries(entries, segments, f"{placement} table")
+    check_interpolation(interpolation, entries)
+    rows, state = material_rows(
+        model, view, [(placement, interpolation, entries, segments)], resolution, repeats
+    )
+    result = {"material": str(path), "resolution": resolution, "rows": rows, "tolerance": None}
+    if tolerance is not None:
+        result["tolerance"] = tolerance_search(state, tolerance, interpolation)
+    return result
+
+
+def format_tolerance(result: dict) -> str:
+    """A tolerance search as text.
+
+    Examples
+    --------
+    >>> r = {"tolerance": 0.05, "interpolation": "monotone", "placement": "error", "entries": 20,
+    ...      "rms": 0.04, "verified_rms": 0.04, "verified": True,
+    ...      "candidates": {"error": {"entries": 20, "rms": 0.04}}}
+    >>> print(format_tolerance(r).splitlines()[-1])
+    pick: error with 20 entries, RMS 0.04 on the rendered image (verified)
+    """
+    lines = [f"--tolerance {result['tolerance']:g} ({result['interpolation']} interpolation):"]
+    for placement, c in result["candidates"].items():
+        reached = f"{c['entries']} entries" if c["entries"] else "not reached"
+        lines.append(f"  {placement:10} {reached:>14}  RMS {c['rms']:.3g}")
+    if result["placement"] is None:
+        lines.append("pick: none meets the tolerance")
+    else:
+        state = "verified" if result["verified"] else "NOT verified"
+        lines.append(
+            f"pick: {result['placement']} with {result['entries']} entries, RMS "
+            f"{result['verified_rms']:.3g} on the rendered image ({state})"
+        )
+    return "\n".join(lines)
+
+
+def format_targets(checks: list[dict]) -> str:
+    """The target checks as text, one per line with PASS or FAIL.
+
+    Examples
+    --------
+    >>> print(format_targets([{"target": "x", "value": 2.0, "limit": 1.0, "pass": False}]))
+    FAIL  x: 2 (limit 1)
+    """
+
+    def show(x):
+        return "none" if x is None else f"{x:.3g}"
+
+    return "\n".join(
+        f"{'PASS' if c['pass'] else 'FAIL'}  {c['target']}: {show(c['value'])} (limit "
+        f"{show(c['limit'])})"
+        for c in checks
+    )
