@@ -11,8 +11,11 @@ method).
 - :mod:`phong_table.table`: ``build_table`` and ``SpecularTable``.
 - :mod:`phong_table.render`: the exact and table shading paths and ``render_sphere``.
 - :mod:`phong_table.scenes`: the reconstructed scenes R1-R3, the failure cases and the views.
+- :mod:`phong_table.shader`: the ``"table"`` Phong shader for scenes (``options["phong"]``).
+- :mod:`phong_table.materialfile`: TOML material files for ``specref phong --material``.
 """
 
+from phong_table import shader  # noqa: F401  (registers the table shader)
 from phong_table.interpolation import INTERPOLATION_METHODS
 from phong_table.model import SpectralPhong
 from phong_table.placement import PLACEMENT_METHODS

@@ -210,9 +210,12 @@ class SpectralPhong:
     grid : SpectralGrid
         The material's grid; default 380-780 nm in 10 nm steps.
     colourspace : str
-        Display colourspace of the linear RGB (default sRGB).
+        Display colourspace of the linear RGB (default sRGB), or ``"XYZ"`` for tristimulus values
+        (the spectra-to-XYZ matrix is then the band weights themselves).
     observer : str
         Colour-matching functions.
+    weights_method : str
+        Band-weight method (``"astm_e308"`` or ``"point"``).
 
     Attributes
     ----------
@@ -246,6 +249,7 @@ class SpectralPhong:
     grid: SpectralGrid = DEFAULT_GRID
     colourspace: str = "sRGB"
     observer: str = DEFAULT_OBSERVER
+    weights_method: str = "astm_e308"
     spectra_to_RGB: np.ndarray = field(init=False, repr=False)
     diffuse_RGB: np.ndarray = field(init=False, repr=False)
     specular_weights: np.ndarray = field(init=False, repr=False)
@@ -267,13 +271,11 @@ class SpectralPhong:
             f"{self.grid.n_bands}; lengths must match",
         )
         # Eq. (9), Wang et al.: band weights (light folded in) times XYZ-to-RGB
-        W = band_weights(self.grid, self.light.spectrum, observer=self.observer)
-        M = spectra_to_RGB_matrix(W, self.colourspace)
+        M = self._spectra_to_RGB(self.light.spectrum)
         ambient = np.zeros(3)
         if self.ambient is not None:
-            W_a = band_weights(self.grid, self.ambient.spectrum, observer=self.observer)
             # Eq. (1), Wang et al.: ambient term I_a k_a
-            M_a = spectra_to_RGB_matrix(W_a, self.colourspace)
+            M_a = self._spectra_to_RGB(self.ambient.spectrum)
             ambient = self.ambient.intensity * (m.k_a @ M_a)
         values = {
             "spectra_to_RGB": M,
@@ -285,6 +287,10 @@ class SpectralPhong:
             value = np.ascontiguousarray(value, dtype=np.float64)
             value.setflags(write=False)
             object.__setattr__(self, key, value)
+
+    def _spectra_to_RGB(self, spectrum) -> np.ndarray:
+        W = band_weights(self.grid, spectrum, self.weights_method, self.observer)
+        return W if self.colourspace == "XYZ" else spectra_to_RGB_matrix(W, self.colourspace)
 
     @property
     def n(self) -> np.ndarray:
