@@ -28,6 +28,7 @@ __all__ = [
     "decode_srgb",
     "display_to_linear",
     "encode_gamma",
+    "encode_linear",
     "encode_lstar_Herbert",
     "encode_srgb",
     "linear_to_display",
@@ -141,35 +142,35 @@ def encode_lstar_Herbert(linear):
     return np.clip((116.0 * np.cbrt(Y) - 16.0) / 100.0, 0.0, 1.0)
 
 
-def _identity(values):
+def encode_linear(values):
+    """No encoding: linear values clipped to [0, 1] (also its own inverse).
+
+    Examples
+    --------
+    >>> encode_linear([-0.5, 0.25, 2.0])
+    array([0.  , 0.25, 1.  ])
+    """
     return np.clip(np.asarray(values, dtype=np.float64), 0.0, 1.0)
 
 
-#: Display encodings by the keys used in scene files (``display.encoding``) and the CLI.
-#: ``reference`` encodes linear to display values; ``extra["decode"]`` goes back.
+#: Display encodings by the keys of scene files (``display.encoding``) and the CLI. Each entry's
+#: ``reference`` encodes linear values, ``extra["decode"]`` goes back, and ``extra["kwargs"]`` are
+#: passed to both.
 ENCODINGS = Registry("encoding")
 ENCODINGS.register(
     Method("srgb", encode_srgb, None, "IEC 61966-2-1", extra={"decode": decode_srgb})
 )
-ENCODINGS.register(Method("linear", _identity, None, "none", extra={"decode": _identity}))
-ENCODINGS.register(
-    Method(
-        "gamma_1.8",
-        lambda x: encode_gamma(x, 1.8),
-        None,
-        "Eq. (6), Herbert et al.",
-        extra={"decode": lambda x: decode_gamma(x, 1.8)},
+ENCODINGS.register(Method("linear", encode_linear, None, "none", extra={"decode": encode_linear}))
+for _gamma in (1.8, 2.2):
+    ENCODINGS.register(
+        Method(
+            f"gamma_{_gamma}",
+            encode_gamma,
+            None,
+            "Eq. (6), Herbert et al.",
+            extra={"decode": decode_gamma, "kwargs": {"gamma": _gamma}},
+        )
     )
-)
-ENCODINGS.register(
-    Method(
-        "gamma_2.2",
-        lambda x: encode_gamma(x, 2.2),
-        None,
-        "Eq. (6), Herbert et al.",
-        extra={"decode": lambda x: decode_gamma(x, 2.2)},
-    )
-)
 ENCODINGS.register(
     Method(
         "lstar",
@@ -204,7 +205,9 @@ def linear_to_display(linear, encoding: str = "srgb", exposure: float = 1.0) -> 
     array([[0.    , 0.4614, 1.    ]])
     """
     entry = ENCODINGS.lookup(encoding)
-    return entry.reference(np.asarray(linear, dtype=np.float64) * exposure)
+    return entry.reference(
+        np.asarray(linear, dtype=np.float64) * exposure, **entry.extra.get("kwargs", {})
+    )
 
 
 def display_to_linear(encoded, encoding: str = "srgb") -> np.ndarray:
@@ -215,7 +218,8 @@ def display_to_linear(encoded, encoding: str = "srgb") -> np.ndarray:
     >>> display_to_linear(linear_to_display([0.5], "gamma_2.2"), "gamma_2.2").round(12)
     array([0.5])
     """
-    return ENCODINGS.lookup(encoding).extra["decode"](encoded)
+    entry = ENCODINGS.lookup(encoding)
+    return entry.extra["decode"](encoded, **entry.extra.get("kwargs", {}))
 
 
 def to_8bit(encoded) -> np.ndarray:

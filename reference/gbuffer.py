@@ -9,7 +9,7 @@ Each primitive type registers a function in :data:`PRIMITIVES` that returns the 
 own surface; :func:`render_gbuffer` keeps, per pixel, the nearest over all objects (a z-buffer on
 camera depth).
 Analytic spheres and planes are ray cast exactly; triangle meshes are rasterized
-(``reference.raster`` registers ``"mesh"``).
+(``reference.raster`` registers ``"TriangleMesh"``).
 
 Supersampling renders the G-buffer at ``factor × factor`` the resolution; shade it, then resolve
 with ``reference.camera.downsample_box``.
@@ -119,6 +119,15 @@ def gbuffer_from_hit(
     Returns
     -------
     GBuffer
+
+    Examples
+    --------
+    >>> from reference.geometry import intersect_sphere, Sphere
+    >>> cam = Camera(eye=(0, 0, 5))
+    >>> origins, directions = cam.rays(4, 4)
+    >>> g = gbuffer_from_hit(intersect_sphere(Sphere(), origins, directions), cam, directions, 0, 0)
+    >>> int(g.mask.sum()), float(g.depth[g.mask].min()).__round__(3)
+    (4, 4.213)
     """
     H, W = hit.t.shape
     g = empty_gbuffer(H, W)

@@ -166,7 +166,7 @@ def read_png(path) -> np.ndarray:
     path = Path(path)
     require(path.is_file(), f"{path}: file not found")
     try:
-        image = iio.imread(path)
+        image = iio.imread(path, plugin="pillow")
     except Exception as error:  # imageio raises many kinds; all mean "not a readable image"
         raise SpecrefError(f"{path}: cannot read image ({error.__class__.__name__})") from None
     image = np.asarray(image)

@@ -66,8 +66,9 @@ class ShadingContext:
     weights_method : str
         Band-weight method (``"astm_e308"`` or ``"point"``).
     options : mapping
-        Per-render switches that registered shaders read, e.g. ``{"environment": "bruteforce"}`` for the
-        environment-light oracle; each shader documents the keys it reads and ignores the others.
+        Per-render switches that registered shaders read, e.g. ``{"environment": "bruteforce"}`` for
+        the environment-light oracle; each shader documents the keys it reads and ignores the
+        others.
 
     Examples
     --------

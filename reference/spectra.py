@@ -254,8 +254,7 @@ def spectrum_constant(value: float, name: str = "constant") -> Spectrum:
     return Spectrum(spectrum.wavelengths_nm, spectrum.values, name, constant=True)
 
 
-# --- colour-science datasets
-# -------------------------------------------------------------------------
+# --- colour-science datasets ---------------------------------------------------------
 
 
 def _colorchecker(set_name: str = "ColorChecker N Ohta"):
@@ -350,14 +349,13 @@ def spectrum_to_colour_sd(spectrum: Spectrum):
     )
 
 
-# --- CSV files
-# ----------------------------------------------------------------------------------------
+# --- CSV files -----------------------------------------------------------------------
 
 _WAVELENGTH_HEADER = re.compile(r"^\s*[A-Za-z]{0,3}\s*(\d+(?:\.\d+)?)\s*(?:nm)?\s*$")
 
 
-def _read_rows(path: Path) -> list[list[str]]:
-    """Rows of a delimited text file; the delimiter is sniffed (``sep=`` lines are honoured)."""
+def _read_rows(path: Path) -> tuple[list[list[str]], list[int]]:
+    """Rows of a delimited text file and their 1-based line numbers; the delimiter is sniffed."""
     try:
         text = path.read_text(encoding="utf-8-sig")
     except FileNotFoundError:
@@ -366,24 +364,29 @@ def _read_rows(path: Path) -> list[list[str]]:
         raise SpecrefError(
             f"{path}: cannot read spectrum file ({error.__class__.__name__})"
         ) from None
-    lines = [
-        line for line in text.splitlines() if line.strip() and not line.lstrip().startswith("#")
+    numbered = [
+        (n, line)
+        for n, line in enumerate(text.splitlines(), start=1)
+        if line.strip() and not line.lstrip().startswith("#")
     ]
-    require(lines, f"{path}: empty spectrum file")
+    require(numbered, f"{path}: empty spectrum file")
     delimiter = None
-    if lines[0].lower().startswith("sep="):
-        delimiter = lines[0][4:5] or ","
-        lines = lines[1:]
+    if numbered[0][1].lower().startswith("sep="):
+        delimiter = numbered[0][1][4:5] or ","
+        numbered = numbered[1:]
+    numbers = [n for n, _ in numbered]
+    lines = [line for _, line in numbered]
     if delimiter is None:
         sample = "\n".join(lines[:20])
         counts = {d: sample.count(d) for d in (";", ",", "\t")}
         best = max(counts, key=counts.get)
         delimiter = best if counts[best] else None
     if delimiter is None:
-        return [line.split() for line in lines]
-    return [
+        return [line.split() for line in lines], numbers
+    rows = [
         [cell.strip().strip('"') for cell in row] for row in csv.reader(lines, delimiter=delimiter)
     ]
+    return rows, numbers
 
 
 def _as_float(cell: str) -> float | None:
@@ -444,7 +447,7 @@ def spectrum_from_csv(
     """
     path = Path(path)
     label = name or str(path)
-    rows = _read_rows(path)
+    rows, line_numbers = _read_rows(path)
     # Wide layout: the first row with at least three increasing wavelength-like cells (200-2500 nm).
     for r, cells in enumerate(rows):
         wl_cols = [
@@ -472,7 +475,7 @@ def spectrum_from_csv(
     # Long layout.
     header = None
     if rows and _as_float(rows[0][0]) is None:
-        header, rows = rows[0], rows[1:]
+        header, rows, line_numbers = rows[0], rows[1:], line_numbers[1:]
     if column is None:
         index = 1
     elif isinstance(column, int) and not isinstance(column, bool):
@@ -485,25 +488,24 @@ def spectrum_from_csv(
         )
         index = header.index(column)
     wavelengths, values = [], []
-    for n, cells in enumerate(rows):
-        require(
-            len(cells) > index,
-            f"{label}: line {n + 1 + (header is not None)}: expected at least {index + 1} columns",
-        )
+    for n, cells in zip(line_numbers, rows, strict=True):
+        require(len(cells) > index, f"{label}: line {n}: expected at least {index + 1} columns")
         wl, value = _as_float(cells[0]), _as_float(cells[index])
         require(
             wl is not None and value is not None,
-            f"{label}: line {n + 1 + (header is not None)}: expected numbers, got {cells[0]!r}, "
-            f"{cells[index]!r}",
+            f"{label}: line {n}: expected numbers, got {cells[0]!r}, {cells[index]!r}",
         )
         wavelengths.append(wl)
         values.append(value)
-    require(len(wavelengths) >= 2, f"{label}: no spectrum found (need a long or wide layout)")
+    require(
+        len(wavelengths) >= 2,
+        f"{label}: needs at least 2 samples (a wavelength and a value per line, or a header row "
+        f"of wavelengths), got {len(wavelengths)}",
+    )
     return make_spectrum(wavelengths, np.asarray(values) * scale, label)
 
 
-# --- resampling
-# ---------------------------------------------------------------------------------------
+# --- resampling ----------------------------------------------------------------------
 
 
 def resample_spectrum(

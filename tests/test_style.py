@@ -1,0 +1,152 @@
+"""STYLE.md's checkable rules, as tests (§11 "Style checked as tests")."""
+
+import ast
+import importlib
+import inspect
+import pkgutil
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from reference.registry import Method, Registry
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGES = ("reference", "phong_table", "shrm", "validation")
+
+
+def _modules():
+    for package in PACKAGES:
+        module = importlib.import_module(package)
+        yield module
+        for info in pkgutil.walk_packages(module.__path__, prefix=f"{package}."):
+            yield importlib.import_module(info.name)
+
+
+MODULES = list(_modules())
+SOURCES = [p for package in PACKAGES for p in (ROOT / package).rglob("*.py")]
+
+
+def _registries():
+    seen = {}
+    for module in MODULES:
+        for name, value in vars(module).items():
+            if isinstance(value, Registry):
+                seen[id(value)] = (f"{module.__name__}.{name}", value)
+    return list(seen.values())
+
+
+REGISTRIES = _registries()
+METHODS = [
+    (f"{where}:{key}", entry)
+    for where, registry in REGISTRIES
+    for key, entry in registry.items()
+    if isinstance(entry, Method)
+]
+
+
+@pytest.mark.parametrize(("where", "method"), METHODS, ids=[w for w, _ in METHODS])
+def test_registered_references_cite_their_equation_and_have_examples(where, method):
+    doc = inspect.getdoc(method.reference) or ""
+    assert "Examples" in doc, f"{where}: the reference's docstring has no Examples section"
+    assert ">>>" in doc, f"{where}: the reference's docstring has no doctest"
+    if "Eq. (" in method.cites:
+        number = re.search(r"Eq\. \((\d+)\)", method.cites).group(1)
+        assert f"Eq. ({number})" in doc, f"{where}: the docstring does not cite {method.cites}"
+
+
+def _njit_functions():
+    found = []
+    for path in SOURCES:
+        if not path.name.endswith("_kernels.py"):
+            continue
+        tree = ast.parse(path.read_text())
+        for node in ast.walk(tree):
+            if isinstance(node, ast.FunctionDef):
+                for deco in node.decorator_list:
+                    text = ast.unparse(deco)
+                    if "njit" in text or "numba.jit" in text:
+                        found.append((path.relative_to(ROOT).as_posix(), node.name, text))
+    return found
+
+
+def test_every_njit_kernel_is_registered_exactly_once():
+    kernels = {}
+    for _, registry in REGISTRIES:
+        for entry in registry.values():
+            kernel = getattr(entry, "kernel", None)
+            if kernel is not None:
+                name = getattr(getattr(kernel, "py_func", kernel), "__name__", repr(kernel))
+                kernels[name] = kernels.get(name, 0) + 1
+    problems = [
+        f"{path}:{name} is the kernel of {kernels.get(name, 0)} registry entries"
+        for path, name, _ in _njit_functions()
+        if kernels.get(name, 0) != 1 and not name.startswith("_")
+    ]
+    assert not problems, "; ".join(problems)
+
+
+def test_no_kernel_sets_fastmath():
+    offenders = [f"{p}:{n}" for p, n, text in _njit_functions() if "fastmath" in text]
+    offenders += [
+        str(p.relative_to(ROOT))
+        for p in SOURCES
+        if re.search(r"fastmath\s*=\s*True", p.read_text())
+    ]
+    assert not offenders
+
+
+def test_print_only_in_cli_and_examples():
+    offenders = []
+    for path in SOURCES:
+        if path.name == "cli.py":
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Call) and getattr(node.func, "id", None) == "print":
+                offenders.append(f"{path.relative_to(ROOT)}:{node.lineno}")
+    assert not offenders
+
+
+def _public_functions():
+    for module in MODULES:
+        for name in getattr(module, "__all__", []):
+            obj = getattr(module, name, None)
+            if inspect.isfunction(obj) and obj.__module__ == module.__name__:
+                yield f"{module.__name__}.{name}", obj
+
+
+PUBLIC = list(_public_functions())
+
+
+@pytest.mark.parametrize(("name", "function"), PUBLIC, ids=[n for n, _ in PUBLIC])
+def test_public_functions_have_doctests(name, function):
+    doc = inspect.getdoc(function) or ""
+    assert ">>>" in doc, f"{name} has no doctest"
+
+
+def test_citations_use_the_fixed_format():
+    # One grep finds each equation: "Eq. (11), Wang et al." -- never "Eq 11", "Equation (11)" or
+    # "eq. (11)".
+    pattern = re.compile(r"\b(Eq \(|Eqn\.? ?\(|Equation \(|eq\. \()")
+    offenders = [
+        f"{p.relative_to(ROOT)}:{i}"
+        for p in SOURCES
+        for i, line in enumerate(p.read_text().splitlines(), 1)
+        if pattern.search(line)
+    ]
+    assert not offenders
+
+
+def test_ruff_lint_and_format():
+    ruff = Path(sys.executable).with_name("ruff")
+    command = [str(ruff)] if ruff.exists() else [sys.executable, "-m", "ruff"]
+    lint = subprocess.run(
+        [*command, "check", "--no-cache", str(ROOT)], capture_output=True, text=True
+    )
+    assert lint.returncode == 0, lint.stdout[-3000:]
+    fmt = subprocess.run(
+        [*command, "format", "--check", "--no-cache", str(ROOT)], capture_output=True, text=True
+    )
+    assert fmt.returncode == 0, fmt.stdout[-3000:]

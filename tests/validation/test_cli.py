@@ -1,0 +1,40 @@
+import subprocess
+import sys
+
+from validation.cli import build_parser, main
+
+
+def _run(*args):
+    return subprocess.run(
+        [sys.executable, "-m", "validation.cli", *args], capture_output=True, text=True, timeout=300
+    )
+
+
+def test_help_lists_subcommands():
+    result = _run("--help")
+    assert result.returncode == 0
+    assert "report" in result.stdout
+
+
+def test_bad_input_exits_2_with_one_line_and_no_traceback(tmp_path):
+    result = _run("report", "--only", "nonexistent", "--out", str(tmp_path))
+    assert result.returncode == 2
+    assert "Traceback" not in result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1
+    assert lines[0].startswith("specref: error: unknown report section 'nonexistent'; allowed:")
+
+
+def test_usage_errors_exit_2_on_one_line():
+    result = _run("report", "--no-such-flag")
+    assert result.returncode == 2
+    assert len(result.stderr.strip().splitlines()) == 1
+    assert "unrecognized arguments: --no-such-flag" in result.stderr
+    assert _run().returncode == 2
+
+
+def test_report_via_main(tmp_path, capsys):
+    assert main(["report", "--quick", "--only", "spectral-core", "--out", str(tmp_path)]) == 0
+    assert (tmp_path / "index.html").is_file()
+    assert "index.html" in capsys.readouterr().out
+    assert build_parser().parse_args(["report"]).out == "report"

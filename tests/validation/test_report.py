@@ -1,0 +1,89 @@
+import json
+
+import numpy as np
+import pytest
+
+from reference.errors import SpecrefError
+from validation.report import (
+    REPORT_SECTIONS,
+    Check,
+    ReportContext,
+    ReportSection,
+    SectionResult,
+    Table,
+    Text,
+    run_report,
+    to_jsonable,
+)
+
+
+def test_report_spectral_section_quick(tmp_path):
+    md = tmp_path / "results.md"
+    results = run_report(
+        tmp_path / "r", quick=True, only=["spectral-core"], markdown=md, progress=False
+    )
+    stored = json.loads((tmp_path / "r" / "results.json").read_text())
+    assert stored == json.loads(json.dumps(results))
+    section = stored["sections"]["spectral-core"]
+    # The published figures are the ones the tests check (tests/reference/test_colorimetry.py).
+    assert section["380-780/10 FL2 astm_e308"]["mean"] < 0.06
+    assert section["380-780/10 FL2 point"]["mean"] > 3.0
+    html = (tmp_path / "r" / "index.html").read_text()
+    assert "<h2>Spectral core</h2>" in html
+    assert "ColorChecker accuracy" in html
+    image = tmp_path / "r" / "images" / "spectral-core-fl2-patches.png"
+    assert image.stat().st_size > 1000
+    text = md.read_text()
+    assert text.startswith("# specref results")
+    assert "| grid | light | weights |" in text
+
+
+def test_report_refuses_unknown_section_and_bad_bench(tmp_path):
+    with pytest.raises(SpecrefError, match="unknown report section 'spectra'"):
+        run_report(tmp_path, only=["spectra"], progress=False)
+    with pytest.raises(SpecrefError, match=r"missing\.json: file not found"):
+        run_report(tmp_path, only=["spectral-core"], bench_json=tmp_path / "missing.json")
+    bad = tmp_path / "bad.json"
+    bad.write_text("{not json")
+    with pytest.raises(SpecrefError, match="not a pytest-benchmark JSON file"):
+        run_report(tmp_path, only=["spectral-core"], bench_json=bad, progress=False)
+
+
+def test_registered_section_renders_blocks(tmp_path):
+    def run(ctx):
+        assert ctx.quick
+        rows = [["a", 1.23456, float("nan")]]
+        blocks = [
+            Text("hello `code`"),
+            Table(["x", "y", "z"], rows, "T"),
+            ctx.image("img", np.ones((2, 2, 3))),
+        ]
+        checks = [Check("a", "<= 1", 0.5, True), Check("b", "<= 1", 2.0, False)]
+        return SectionResult(blocks, {"value": np.float64(2.5), "arr": np.arange(2)}, checks)
+
+    REPORT_SECTIONS.register(ReportSection("test-only", "Test only", 999, run))
+    try:
+        results = run_report(tmp_path, quick=True, only=["test-only"], progress=False)
+    finally:
+        REPORT_SECTIONS._entries.pop("test-only")
+    section = results["sections"]["test-only"]
+    assert section["value"] == 2.5
+    assert section["arr"] == [0, 1]
+    html = (tmp_path / "index.html").read_text()
+    assert "<code>code</code>" in html
+    assert "<td>1.235</td>" in html
+    assert "<td>—</td>" in html
+    assert (tmp_path / "images" / "test-only-img.png").is_file()
+    assert "1 of 2 targets hold; <b>1 do not</b>" in html
+    assert [c["passed"] for c in results["checks"]] == [True, False]
+
+
+def test_bench_groups_filters_by_prefix():
+    ctx = ReportContext(out_dir=".", bench={"benchmarks": [{"group": "raster-a"}, {"group": "sh"}]})
+    assert list(ctx.bench_groups("raster")) == ["raster-a"]
+    assert ReportContext(out_dir=".").bench_groups("x") == {}
+
+
+def test_to_jsonable():
+    value = {"a": (np.int32(1), np.bool_(True)), 2: [np.inf, np.float32(0.5)]}
+    assert to_jsonable(value) == {"a": [1, True], "2": [None, 0.5]}
