@@ -28,7 +28,7 @@ from phong_table import _kernels
 from phong_table.interpolation import INTERPOLATION_METHODS
 from phong_table.model import SpectralPhong
 from phong_table.scenes import SPHERE, view_camera
-from phong_table.table import SpecularTable, build_table, check_interpolation
+from phong_table.table import SpecularTable, build_table, check_interpolation, tabulate
 from reference.camera import MAX_RESOLUTION
 from reference.errors import require, require_choice
 from reference.gbuffer import GBuffer, render_gbuffer
@@ -318,9 +318,9 @@ def _table_compiled(buffer: ShadingBuffer, model, table: SpecularTable, interpol
     return compiled_shader(model, table, interpolation)(buffer, out)
 
 
-#: The shading paths and the per-pixel geometry, each a NumPy reference with its numba twin;
-#: ``extra["compiled"]`` calls the kernel on a :class:`ShadingBuffer` (``"exact"``, ``"table"``)
-#: or on G-buffer arrays (``"geometry"``).
+#: The kernels of the render path, each a NumPy reference with its numba twin: the two shading
+#: paths (``extra["compiled"]`` calls the kernel on a :class:`ShadingBuffer`), the per-pixel
+#: geometry and the tabulation of a table's values, slopes and index.
 RENDER_METHODS = Registry("shading path")
 RENDER_METHODS.register(
     Method(
@@ -347,6 +347,15 @@ RENDER_METHODS.register(
         _kernels.light_geometry_kernel,
         "Eq. (1), Wang et al.",
         extra={"compiled": _kernels.light_geometry_kernel},
+    )
+)
+RENDER_METHODS.register(
+    Method(
+        "tabulate",
+        tabulate,
+        _kernels.tabulate_kernel,
+        "Eq. (11), Wang et al.",
+        extra={"compiled": _kernels.tabulate_kernel},
     )
 )
 #: The keys of :data:`RENDER_METHODS` that shade (``render_sphere``'s ``method``).
