@@ -203,7 +203,7 @@ def interpolate_parabolic_w(nodes, values, t, an: float = 0.0) -> np.ndarray:
 
     def rescaled(x, log_top):
         # Eq. (14), Wang et al.: w = x^(an+1), divided by the top node's w
-        with np.errstate(divide="ignore"):
+        with np.errstate(divide="ignore", over="ignore"):
             return np.where(x > 0.0, np.exp(a * (np.log(np.where(x > 0, x, 1.0)) - log_top)), 0.0)
 
     log_top = np.log(nodes[i + 1])
@@ -257,7 +257,7 @@ def pchip_slopes(nodes, values) -> np.ndarray:
     w1 = 2.0 * h[1:] + h[:-1]
     w2 = h[1:] + 2.0 * h[:-1]
     agree = (np.sign(delta[1:]) == np.sign(delta[:-1])) & (delta[1:] != 0) & (delta[:-1] != 0)
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         harmonic = (w1 + w2) / (w1 / delta[:-1] + w2 / delta[1:])
     d[1:-1] = np.where(agree, harmonic, 0.0)
     # ends: one-sided three-point estimate, kept shape-preserving
