@@ -804,7 +804,6 @@ def format_targets(checks: list[dict]) -> str:
 
     status = {True: "PASS", False: "FAIL", None: "INFO"}
     return "\n".join(
-        f"{status[c['pass']]}  {c['target']}: {show(c['value'])} (limit "
-        f"{show(c['limit'])})"
+        f"{status[c['pass']]}  {c['target']}: {show(c['value'])} (limit {show(c['limit'])})"
         for c in checks
     )
