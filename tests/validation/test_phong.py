@@ -5,7 +5,7 @@ from phong_table.scenes import SCENES, spectral_phong_unit_peak
 from reference.errors import SpecrefError
 from reference.spectra import DEFAULT_GRID, resample_spectrum, spectrum_from_csv
 from validation.cli import main
-from validation.phong import table_error_row, tolerance_search, view_state
+from validation.phong import run_material, table_error_row, tolerance_search, view_state
 
 MATERIALS = ("brick", "lemon", "orange", "porcelain", "toothpaste", "chocolate")
 
@@ -119,8 +119,6 @@ def test_bad_material_input_exits_2(tmp_path, capsys, text, args, match):
     assert match in err
     assert len(err.strip().splitlines()) == 1
     with pytest.raises(SpecrefError):
-        from validation.phong import run_material
-
         run_material(path, resolution=8, repeats=1, **_kwargs(args))
 
 
