@@ -41,6 +41,7 @@ from reference.registry import Method, Registry
 from reference.spectra import DEFAULT_GRID, SpectralGrid, Spectrum
 
 __all__ = [
+    "PHONG_POINT_METHODS",
     "SHADERS",
     "ShadingContext",
     "Surface",
@@ -193,7 +194,7 @@ def _point_geometry(surface: Surface, light: PointLight):
     return cos_theta, t, f_att
 
 
-def shade_phong_point(
+def shade_phong_point_exact(
     surface: Surface, material: PhongMaterial, light: PointLight, ctx
 ) -> np.ndarray:
     """XYZ of a Phong material under a point light, exact spectral evaluation (the speed baseline).
@@ -205,12 +206,40 @@ def shade_phong_point(
     >>> m = PhongMaterial(np.ones(41), np.zeros(41), np.ones(41))
     >>> s = Surface(np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]), np.array([[0.0, 0.0, 1.0]]),
     ...             np.zeros((1, 2)))
-    >>> shade_phong_point(s, m, PointLight((0.0, 0.0, 3.0)), ShadingContext()).round(4)
+    >>> shade_phong_point_exact(s, m, PointLight((0.0, 0.0, 3.0)), ShadingContext()).round(4)
     array([[0.9505, 1.    , 1.0888]])
     """
     cos_theta, t, f_att = _point_geometry(surface, light)
     spectra = phong_spectral_exact(cos_theta, t, material.k_d, material.k_s, material.n, f_att)
     return light.intensity * (spectra @ ctx.weights(light.spectrum))
+
+
+#: Methods for a Phong material under a point light, chosen by ``ctx.options["phong"]["method"]``
+#: (default ``"exact"``); ``phong_table`` registers ``"table"``. Each ``reference`` is a shader.
+PHONG_POINT_METHODS = Registry("Phong point-light method")
+PHONG_POINT_METHODS.register(Method("exact", shade_phong_point_exact, None, "Eq. (2), Wang et al."))
+
+
+def shade_phong_point(
+    surface: Surface, material: PhongMaterial, light: PointLight, ctx
+) -> np.ndarray:
+    """XYZ of a Phong material under a point light, by the method ``ctx.options["phong"]`` names.
+
+    Eq. (2), Wang et al. Without ``options["phong"]`` (or with ``{"method": "exact"}``) this is
+    :func:`shade_phong_point_exact`; other methods are registered in :data:`PHONG_POINT_METHODS`
+    (``phong_table`` adds ``"table"``, which documents its keys).
+
+    Examples
+    --------
+    >>> m = PhongMaterial(np.ones(41), np.zeros(41), np.ones(41))
+    >>> s = Surface(np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]), np.array([[0.0, 0.0, 1.0]]),
+    ...             np.zeros((1, 2)))
+    >>> shade_phong_point(s, m, PointLight((0.0, 0.0, 3.0)), ShadingContext()).round(4)
+    array([[0.9505, 1.    , 1.0888]])
+    """
+    options = ctx.options.get("phong", {}) if isinstance(ctx, ShadingContext) else {}
+    method = options.get("method", "exact") if isinstance(options, Mapping) else "exact"
+    return PHONG_POINT_METHODS.lookup(method).reference(surface, material, light, ctx)
 
 
 def shade_lambert_point(surface: Surface, material: LambertMaterial, light: PointLight, ctx):

@@ -170,6 +170,72 @@ def _add_impastor_parser(sub) -> None:
     r.set_defaults(func=_cmd_impastor_render)
 
 
+def _write_json(path, result) -> None:
+    import json
+
+    from reference.images import write_text_atomic
+    from validation.report import to_jsonable
+
+    write_text_atomic(path, json.dumps(to_jsonable(result), indent=1))
+    print(f"wrote {path}")
+
+
+def _cmd_phong(args) -> int:
+    from reference.errors import SpecrefError
+    from validation import phong
+
+    if args.action == "table1":
+        result = phong.run_table1(args.resolution, args.entries, args.repeats, progress=True)
+        print(f"Table 1 (Wang et al.), {args.resolution}x{args.resolution}, {args.entries} entries")
+        print(phong.format_rows(result["rows"]))
+        print("\nTargets")
+        print(phong.format_targets(result["targets"]))
+    else:
+        if args.material is None:
+            raise SpecrefError("specref phong: give table1 or --material FILE.toml")
+        result = phong.run_material(
+            args.material,
+            args.view,
+            args.entries,
+            args.placement,
+            args.interp,
+            args.segments,
+            args.tolerance,
+            args.resolution,
+            args.repeats,
+        )
+        print(phong.format_rows(result["rows"]))
+        if result["tolerance"] is not None:
+            print(phong.format_tolerance(result["tolerance"]))
+    if args.json:
+        _write_json(args.json, result)
+    return 0
+
+
+def _add_phong_parser(sub) -> None:
+    p = sub.add_parser(
+        "phong",
+        help="spectral Phong tables: Table 1 of Wang et al., or one material file",
+        description="specref phong table1 [--json FILE] | specref phong --material FILE.toml "
+        "--view far|near --entries M --placement P --interp I [--segments S] [--tolerance T] "
+        "[--json FILE]",
+    )
+    p.add_argument("action", nargs="?", choices=["table1"], help="reproduce Table 1")
+    p.add_argument("--material", metavar="FILE.toml", help="a material file (docs/phong-tables.md)")
+    p.add_argument("--view", default="far", help="far (whole sphere) or near (the highlight)")
+    p.add_argument("--entries", type=int, default=200, help="table entries m (default 200)")
+    p.add_argument("--placement", default="error", help="uniform, importance or error")
+    p.add_argument(
+        "--interp", default="monotone", help="linear, parabolic, parabolic_w or monotone"
+    )
+    p.add_argument("--segments", type=int, help="importance segments p (must divide m)")
+    p.add_argument("--tolerance", type=float, help="pick the smallest table with RMS <= T")
+    p.add_argument("--resolution", type=int, default=512, help="image size (default 512)")
+    p.add_argument("--repeats", type=int, default=9, help="timing repetitions (minimum kept)")
+    p.add_argument("--json", metavar="FILE", help="write the records as JSON")
+    p.set_defaults(func=_cmd_phong)
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser for all subcommands.
 
@@ -200,6 +266,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_render_parser(sub)
     _add_sh_parser(sub)
     _add_impastor_parser(sub)
+    _add_phong_parser(sub)
     return parser
 
 

@@ -1,0 +1,479 @@
+"""numba twins of the readable NumPy functions in ``phong_table`` (same names plus ``_kernel``).
+
+Each kernel is the compiled twin of a NumPy reference, and ``tests/phong_table/test_kernels.py``
+shows that the two agree to ~1e-12:
+
+- :func:`shade_exact_kernel` ↔ ``phong_table.render.shade_exact``: the exact spectral shading, one
+  ``ln t`` per pixel and one ``exp`` per band (the speed baseline);
+- :func:`shade_table_kernel` ↔ ``phong_table.render.shade_table``: the same pixels through a table
+  of Eq. (11), Wang et al. with any registered interpolation;
+- :func:`table_error_kernel` ↔ ``phong_table.placement.table_error``: the node density of the
+  error-equidistributing placement;
+- :func:`tabulate_kernel` ↔ ``phong_table.table.tabulate``: the table's values, slopes and index;
+- :func:`light_geometry_kernel` ↔ ``phong_table.render.light_geometry``: ``cos θ``, ``t`` and
+  ``f_att`` per pixel from the G-buffer (``phong_cosines``, ``attenuation_Wang``).
+
+The private helpers (``_interval``, ``_linear``, ``_monotone``, ``_parabolic``, ``_write``) are
+inlined into the render kernels. No kernel sets ``fastmath``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+#: ``exp(x)`` is below the smallest normal double for ``x`` under this; such terms are skipped,
+#: since a subnormal result takes the C library's slow path and the term is below 2.2e-308 anyway.
+LOG_SMALLEST_NORMAL = -708.39
+
+#: Interpolation codes the table kernel understands; ``INTERPOLATION_METHODS`` stores them.
+LINEAR, PARABOLIC, PARABOLIC_W, MONOTONE = 0, 1, 2, 3
+#: Smallest node spacing of a stencil in the rescaled w = ir(t) (its span is 1) for which the
+#: parabola is taken in w; below it w cannot resolve the nodes (t^(an+1) has underflowed or the
+#: nodes crowd at w = 0) and the parabola is taken in t
+#: (``phong_table.interpolation.interpolate_parabolic_w``).
+W_RESOLUTION = 1e-6
+
+
+@numba.njit(cache=False)
+def light_geometry_kernel(position, normal, view, light_position, attenuation, out):
+    """``cos θ``, ``t`` and ``f_att`` per pixel, into ``out`` (3, N).
+
+    Twin of ``phong_table.render.light_geometry`` (``phong_cosines`` and ``attenuation_Wang``).
+    """
+    for p in range(position.shape[0]):
+        Lx = light_position[0] - position[p, 0]
+        Ly = light_position[1] - position[p, 1]
+        Lz = light_position[2] - position[p, 2]
+        d = math.sqrt(Lx * Lx + Ly * Ly + Lz * Lz)
+        Lx, Ly, Lz = Lx / d, Ly / d, Lz / d
+        # Eq. (1), Wang et al. (Erratum E2: min, not max): f_att = min(1/(c1 + c2 d + c3 d²), 1)
+        denominator = attenuation[0] + attenuation[1] * d + attenuation[2] * d * d
+        out[2, p] = 1.0 if denominator <= 1.0 else 1.0 / denominator
+        Nx, Ny, Nz = normal[p, 0], normal[p, 1], normal[p, 2]
+        N_dot_L = Nx * Lx + Ny * Ly + Nz * Lz
+        if N_dot_L <= 0.0:
+            out[0, p] = 0.0
+            out[1, p] = 0.0
+            continue
+        # Eq. (1), Wang et al., Figure 1: R = 2 (N·L) N − L and t = cos α = R·V
+        Rx = 2.0 * N_dot_L * Nx - Lx
+        Ry = 2.0 * N_dot_L * Ny - Ly
+        Rz = 2.0 * N_dot_L * Nz - Lz
+        t = Rx * view[p, 0] + Ry * view[p, 1] + Rz * view[p, 2]
+        out[0, p] = N_dot_L
+        out[1, p] = min(max(t, 0.0), 1.0)
+    return out
+
+
+@numba.njit(cache=False, inline="always")
+def _interval(nodes, guide, steps, uniform, t):
+    """Index i of the interval ``[t_i, t_{i+1}]`` holding ``t`` (``searchsorted`` − 1, clipped).
+
+    Branch-free, so that the pixel loop compiles to conditional moves.
+    """
+    m = nodes.size - 1
+    if uniform:
+        # O(1): uniform nodes t_i = i/m; rounding of t·m can land one interval off
+        i = min(int(t * m), m - 1)
+        i -= np.int64(nodes[i] > t)
+        i += np.int64(nodes[min(i + 1, m)] <= t) * np.int64(i < m - 1)
+        return i
+    # inverse-map index: cell c of K uniform cells holds intervals guide[c] .. guide[c+1]; one
+    # more on each side covers the rounding of t·K; ``steps`` halvings of the cell's widest range
+    # find the largest t_i <= t
+    K = guide.size - 1
+    c = min(int(t * K), K - 1)
+    lo = max(guide[c] - 1, 0)
+    hi = min(guide[c + 1] + 1, m - 1)
+    for _ in range(steps):
+        mid = min((lo + hi + 1) >> 1, hi)
+        below = nodes[mid] <= t
+        lo = mid if below else lo
+        hi = hi if below else mid - 1
+    return lo
+
+
+@numba.njit(cache=False, inline="always")
+def _linear(nodes, values, inv_width, i, t):
+    """The chord of interval ``i`` at ``t`` (3 channels)."""
+    s = (t - nodes[i]) * inv_width[i]
+    return (
+        values[i, 0] + s * (values[i + 1, 0] - values[i, 0]),
+        values[i, 1] + s * (values[i + 1, 1] - values[i, 1]),
+        values[i, 2] + s * (values[i + 1, 2] - values[i, 2]),
+    )
+
+
+@numba.njit(cache=False, inline="always")
+def _monotone_channel(values, cubic, i, c, s):
+    """The Hermite cubic of interval ``i``, channel ``c``: ``v_i + s (c1 + s (c2 + s c3))``."""
+    v0 = values[i, c]
+    v1 = values[i + 1, c]
+    f = v0 + s * (cubic[i, c, 0] + s * (cubic[i, c, 1] + s * cubic[i, c, 2]))
+    # never outside the interval's two values (PCHIP is monotone there; this catches rounding)
+    return min(max(f, min(v0, v1)), max(v0, v1))
+
+
+@numba.njit(cache=False, inline="always")
+def _monotone(nodes, values, inv_width, cubic, i, t):
+    """The monotone cubic of interval ``i`` at ``t`` (3 channels)."""
+    s = (t - nodes[i]) * inv_width[i]
+    return (
+        _monotone_channel(values, cubic, i, 0, s),
+        _monotone_channel(values, cubic, i, 1, s),
+        _monotone_channel(values, cubic, i, 2, s),
+    )
+
+
+@numba.njit(cache=False, inline="always")
+def _parabolic(nodes, values, in_w, a, i, t):
+    """3-point Lagrange parabola through the nearest node and its neighbours, in t or in w."""
+    m = nodes.size - 1
+    t0 = nodes[i]
+    t1 = nodes[i + 1]
+    # the nearest node j (in w for the w reading), kept in [1, m − 1]
+    if in_w:
+        log_top = math.log(t1)
+        w = math.exp(a * (math.log(t) - log_top)) if t > 0.0 else 0.0
+        w0 = math.exp(a * (math.log(t0) - log_top)) if t0 > 0.0 else 0.0
+        j = i if w - w0 <= 1.0 - w else i + 1
+    else:
+        j = i if t - t0 <= t1 - t else i + 1
+    j = min(max(j, 1), m - 1)
+    x0, x1, x2, x = nodes[j - 1], nodes[j], nodes[j + 1], t
+    if in_w:
+        # Lagrange weights are unchanged by scaling w, so w is taken relative to the top node
+        log_top = math.log(x2)
+        y0 = math.exp(a * (math.log(x0) - log_top)) if x0 > 0.0 else 0.0
+        y1 = math.exp(a * (math.log(x1) - log_top))
+        if min(y1 - y0, 1.0 - y1) >= W_RESOLUTION:
+            y = math.exp(a * (math.log(t) - log_top)) if t > 0.0 else 0.0
+            x0, x1, x2, x = y0, y1, 1.0, y
+    l0 = (x - x1) * (x - x2) / ((x0 - x1) * (x0 - x2))
+    l1 = (x - x0) * (x - x2) / ((x1 - x0) * (x1 - x2))
+    l2 = (x - x0) * (x - x1) / ((x2 - x0) * (x2 - x1))
+    return (
+        l0 * values[j - 1, 0] + l1 * values[j, 0] + l2 * values[j + 1, 0],
+        l0 * values[j - 1, 1] + l1 * values[j, 1] + l2 * values[j + 1, 1],
+        l0 * values[j - 1, 2] + l1 * values[j, 2] + l2 * values[j + 1, 2],
+    )
+
+
+@numba.njit(cache=False, inline="always")
+def _write(out, p, ambient_RGB, diffuse_RGB, f_att, cos_theta, r, g, b):
+    """Eq. (7), Wang et al.: ambient + f_att (cos θ · diffuse RGB + specular RGB), pixel ``p``."""
+    out[p, 0] = ambient_RGB[0] + f_att * (cos_theta * diffuse_RGB[0] + r)
+    out[p, 1] = ambient_RGB[1] + f_att * (cos_theta * diffuse_RGB[1] + g)
+    out[p, 2] = ambient_RGB[2] + f_att * (cos_theta * diffuse_RGB[2] + b)
+
+
+@numba.njit(cache=False)
+def shade_exact_kernel(cos_theta, t, f_att, diffuse_RGB, C, n, ambient_RGB, out):
+    """Exact spectral Phong shading to linear RGB: one ``ln t`` per pixel, one ``exp`` per band.
+
+    Twin of ``phong_table.render.shade_exact`` (Eq. (2), Wang et al., through Eq. (7) and
+    Eq. (11), Wang et al.); writes ``out`` (N, 3).
+    """
+    n_bands = n.size
+    for p in range(t.size):
+        r = 0.0
+        g = 0.0
+        b = 0.0
+        t_p = t[p]
+        if t_p > 0.0:
+            log_t = math.log(t_p)
+            # Eq. (11), Wang et al.: Σ_λ C(λ) t^{n(λ)}, t^n = exp(n ln t)
+            for k in range(n_bands):
+                x = n[k] * log_t
+                if x < LOG_SMALLEST_NORMAL:
+                    continue
+                power = math.exp(x)
+                r += C[k, 0] * power
+                g += C[k, 1] * power
+                b += C[k, 2] * power
+        else:
+            # t = 0: t^n is 0, except 0^0 = 1
+            for k in range(n_bands):
+                if n[k] == 0.0:
+                    r += C[k, 0]
+                    g += C[k, 1]
+                    b += C[k, 2]
+        # Eq. (7), Wang et al.: ambient + f_att (cos θ · diffuse RGB + specular RGB)
+        _write(out, p, ambient_RGB, diffuse_RGB, f_att[p], cos_theta[p], r, g, b)
+    return out
+
+
+@numba.njit(cache=False, inline="always")
+def _shade_table_loop(
+    cos_theta,
+    t,
+    f_att,
+    diffuse_RGB,
+    ambient_RGB,
+    nodes,
+    values,
+    inv_width,
+    cubic,
+    guide,
+    steps,
+    uniform,
+    code,
+    a,
+    out,
+):
+    """The pixel loop of :func:`shade_table_kernel` for one lookup and one interpolation."""
+    # at t = 0 every interpolation returns the first tabulated value exactly (unlit pixels)
+    if code == LINEAR:
+        for p in range(t.size):
+            if t[p] == 0.0:
+                r, g, b = values[0, 0], values[0, 1], values[0, 2]
+            else:
+                i = _interval(nodes, guide, steps, uniform, t[p])
+                r, g, b = _linear(nodes, values, inv_width, i, t[p])
+            _write(out, p, ambient_RGB, diffuse_RGB, f_att[p], cos_theta[p], r, g, b)
+    elif code == MONOTONE:
+        for p in range(t.size):
+            if t[p] == 0.0:
+                r, g, b = values[0, 0], values[0, 1], values[0, 2]
+            else:
+                i = _interval(nodes, guide, steps, uniform, t[p])
+                r, g, b = _monotone(nodes, values, inv_width, cubic, i, t[p])
+            _write(out, p, ambient_RGB, diffuse_RGB, f_att[p], cos_theta[p], r, g, b)
+    else:
+        in_w = code == PARABOLIC_W
+        for p in range(t.size):
+            if t[p] == 0.0:
+                r, g, b = values[0, 0], values[0, 1], values[0, 2]
+            else:
+                i = _interval(nodes, guide, steps, uniform, t[p])
+                r, g, b = _parabolic(nodes, values, in_w, a, i, t[p])
+            _write(out, p, ambient_RGB, diffuse_RGB, f_att[p], cos_theta[p], r, g, b)
+
+
+@numba.njit(cache=False)
+def shade_table_kernel(
+    cos_theta,
+    t,
+    f_att,
+    diffuse_RGB,
+    ambient_RGB,
+    nodes,
+    values,
+    inv_width,
+    cubic,
+    guide,
+    steps,
+    uniform,
+    code,
+    a,
+    out,
+):
+    """Table-based spectral Phong shading to linear RGB: one lookup per pixel, no ``exp``.
+
+    Twin of ``phong_table.render.shade_table`` (Eq. (7) and Eq. (11), Wang et al.; the table
+    holds ``f_sp`` without ``f_att``, Erratum E18); writes ``out`` (N, 3).
+    """
+    # one loop per lookup and interpolation, so that each compiles without a branch per pixel
+    if uniform:
+        _shade_table_loop(
+            cos_theta,
+            t,
+            f_att,
+            diffuse_RGB,
+            ambient_RGB,
+            nodes,
+            values,
+            inv_width,
+            cubic,
+            guide,
+            steps,
+            True,
+            code,
+            a,
+            out,
+        )
+    else:
+        _shade_table_loop(
+            cos_theta,
+            t,
+            f_att,
+            diffuse_RGB,
+            ambient_RGB,
+            nodes,
+            values,
+            inv_width,
+            cubic,
+            guide,
+            steps,
+            False,
+            code,
+            a,
+            out,
+        )
+    return out
+
+
+@numba.njit(cache=False, inline="always")
+def _pchip_end_slope(h0, h1, m0, m1):
+    """One-sided three-point end slope, kept shape-preserving (as SciPy's PCHIP)."""
+    d = ((2.0 * h0 + h1) * m0 - h0 * m1) / (h0 + h1)
+    if np.sign(d) != np.sign(m0):
+        return 0.0
+    if np.sign(m0) != np.sign(m1) and abs(d) > abs(3.0 * m0):
+        return 3.0 * m0
+    return d
+
+
+@numba.njit(cache=False)
+def tabulate_kernel(nodes, C, n, cells_per_entry):
+    """Values, slopes, inverse widths, Horner cubics, inverse-map index and bisection steps.
+
+    Twin of ``phong_table.table.tabulate`` (Eq. (11), Wang et al. at the nodes).
+    """
+    m = nodes.size - 1
+    n_bands = n.size
+    values = np.zeros((m + 1, 3))
+    # Eq. (11), Wang et al.: f_sp(t_q) = Σ_λ C(λ) t_q^{n(λ)} (0^0 = 1)
+    for q in range(m + 1):
+        t = nodes[q]
+        log_t = math.log(t) if t > 0.0 else -np.inf
+        for k in range(n_bands):
+            if t > 0.0:
+                x = n[k] * log_t
+                if x < LOG_SMALLEST_NORMAL:
+                    continue
+                power = math.exp(x)
+            else:
+                power = 1.0 if n[k] == 0.0 else 0.0
+            for c in range(3):
+                values[q, c] += C[k, c] * power
+    # PCHIP slopes: weighted harmonic mean inside, shape-preserving three-point ends
+    slopes = np.zeros((m + 1, 3))
+    inv_width = np.empty(m)
+    for i in range(m):
+        inv_width[i] = 1.0 / (nodes[i + 1] - nodes[i])
+    for c in range(3):
+        if m == 1:
+            slopes[0, c] = (values[1, c] - values[0, c]) / (nodes[1] - nodes[0])
+            slopes[1, c] = slopes[0, c]
+            continue
+        for i in range(1, m):
+            h0 = nodes[i] - nodes[i - 1]
+            h1 = nodes[i + 1] - nodes[i]
+            d0 = (values[i, c] - values[i - 1, c]) / h0
+            d1 = (values[i + 1, c] - values[i, c]) / h1
+            if np.sign(d0) == np.sign(d1) and d0 != 0.0 and d1 != 0.0:
+                w1 = 2.0 * h1 + h0
+                w2 = h1 + 2.0 * h0
+                slopes[i, c] = (w1 + w2) / (w1 / d0 + w2 / d1)
+        h0 = nodes[1] - nodes[0]
+        h1 = nodes[2] - nodes[1]
+        d0 = (values[1, c] - values[0, c]) / h0
+        d1 = (values[2, c] - values[1, c]) / h1
+        slopes[0, c] = _pchip_end_slope(h0, h1, d0, d1)
+        h0 = nodes[m] - nodes[m - 1]
+        h1 = nodes[m - 1] - nodes[m - 2]
+        d0 = (values[m, c] - values[m - 1, c]) / h0
+        d1 = (values[m - 1, c] - values[m - 2, c]) / h1
+        slopes[m, c] = _pchip_end_slope(h0, h1, d0, d1)
+    # the Hermite cubic of each interval by powers of s: h00, h10, h01, h11 collected
+    cubic = np.empty((m, 3, 3))
+    for i in range(m):
+        h = nodes[i + 1] - nodes[i]
+        for c in range(3):
+            delta = values[i + 1, c] - values[i, c]
+            hd0 = h * slopes[i, c]
+            hd1 = h * slopes[i + 1, c]
+            cubic[i, c, 0] = hd0
+            cubic[i, c, 1] = 3.0 * delta - 2.0 * hd0 - hd1
+            cubic[i, c, 2] = hd0 + hd1 - 2.0 * delta
+    # inverse-map index: the interval holding c/K for each of the K + 1 cell edges
+    K = cells_per_entry * m
+    guide = np.empty(K + 1, dtype=np.int64)
+    i = 0
+    for c in range(K + 1):
+        edge = c / K
+        while i < m - 1 and nodes[i + 1] <= edge:
+            i += 1
+        guide[c] = i
+    # bisection steps for the widest cell (with the one-interval margins of _interval)
+    widest = 1
+    for c in range(K):
+        widest = max(widest, min(guide[c + 1] + 1, m - 1) - max(guide[c] - 1, 0) + 1)
+    steps = 0
+    while (1 << steps) < widest:
+        steps += 1
+    return values, slopes, inv_width, cubic, guide, steps
+
+
+@numba.njit(cache=False)
+def table_error_kernel(t_fine, C, n, entries, floor):
+    """Nodes that equidistribute the interpolation error of the true ``f_sp``.
+
+    Twin of ``phong_table.placement.table_error``; one ``exp`` per band and fine point gives both
+    ``t^{n−3}`` and ``t^{n−2} = t · t^{n−3}`` (Eq. (11), Wang et al., differentiated).
+    """
+    F = t_fine.size
+    n_bands = n.size
+    rho2 = np.zeros(F - 1)
+    rho3 = np.zeros(F - 1)
+    for q in range(F - 1):
+        t = 0.5 * (t_fine[q] + t_fine[q + 1])
+        log_t = math.log(t)
+        d2r, d2g, d2b, d3r, d3g, d3b = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        for k in range(n_bands):
+            nk = n[k]
+            f2 = nk * (nk - 1.0)
+            if f2 == 0.0:
+                continue
+            x = (nk - 3.0) * log_t
+            if x < LOG_SMALLEST_NORMAL:
+                continue
+            f3 = f2 * (nk - 2.0)
+            power = math.exp(x)
+            # Eq. (11), Wang et al., differentiated: C n(n−1) t^(n−2) and C n(n−1)(n−2) t^(n−3)
+            a2 = f2 * power * t
+            a3 = f3 * power
+            d2r += C[k, 0] * a2
+            d2g += C[k, 1] * a2
+            d2b += C[k, 2] * a2
+            d3r += C[k, 0] * a3
+            d3g += C[k, 1] * a3
+            d3b += C[k, 2] * a3
+        rho2[q] = math.sqrt(max(abs(d2r), abs(d2g), abs(d2b)))
+        rho3[q] = np.cbrt(max(abs(d3r), abs(d3g), abs(d3b)))
+    # normalise each density, take the larger, add the floor, integrate (Notes of table_error)
+    mass2 = 0.0
+    mass3 = 0.0
+    for q in range(F - 1):
+        h = t_fine[q + 1] - t_fine[q]
+        mass2 += rho2[q] * h
+        mass3 += rho3[q] * h
+    rho = np.zeros(F - 1)
+    mass = 0.0
+    for q in range(F - 1):
+        r2 = rho2[q] / mass2 if mass2 > 0.0 else 0.0
+        r3 = rho3[q] / mass3 if mass3 > 0.0 else 0.0
+        rho[q] = max(r2, r3)
+        mass += rho[q] * (t_fine[q + 1] - t_fine[q])
+    cdf = np.zeros(F)
+    for q in range(F - 1):
+        r = (rho[q] / mass if mass > 0.0 else 0.0) + floor
+        cdf[q + 1] = cdf[q] + r * (t_fine[q + 1] - t_fine[q])
+    # invert the cumulative density at q/m by linear interpolation (np.interp)
+    nodes = np.empty(entries + 1)
+    total = cdf[F - 1]
+    q = 0
+    for k in range(entries + 1):
+        target = total * k / entries
+        while q < F - 2 and cdf[q + 1] < target:
+            q += 1
+        width = cdf[q + 1] - cdf[q]
+        s = (target - cdf[q]) / width
+        nodes[k] = t_fine[q] + min(max(s, 0.0), 1.0) * (t_fine[q + 1] - t_fine[q])
+    nodes[0] = 0.0
+    nodes[entries] = 1.0
+    return nodes

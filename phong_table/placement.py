@@ -1,0 +1,343 @@
+"""Where to put the nodes of a table of ``f_sp(t)``: uniform, Wang's importance, and error-driven.
+
+A table of ``m`` entries has ``m + 1`` nodes ``0 = t_0 < t_1 < ... < t_m = 1`` (the ``m`` intervals
+of Eq. (16), Wang et al.). Every placement returns the nodes, strictly increasing, from 0 to 1; the
+registry :data:`PLACEMENT_METHODS` maps the keys users type (``--placement``) to them.
+
+- ``uniform``: ``t_q = q/m``.
+- ``importance`` (:func:`table_importance_Wang`): Eqs. (12)-(16), Wang et al. The importance ratio
+  ``ir(t) = t^{an+1}`` of the proxy ``t^{an}`` (``an`` the average exponent, Erratum E1) is split
+  into ``p`` segments of equal weight, ``S_i = iir(i/p)``, and each segment into ``m/p`` equal
+  intervals (Erratum E3).
+- ``error`` (:func:`table_error`, ours): nodes that equidistribute the interpolation error of the
+  *true* ``f_sp`` (all bands, all three channels), with a density floor.
+
+The importance proxy ignores ``k_s``, the light and the spread of ``n(λ)``, and its first interval
+``[0, S_1]`` has ``ir = 1/p`` of the weight whatever ``m`` is: with ``p = m`` and a bimodal ``n(λ)``
+that interval never shrinks, so the table stops converging (see ``docs/phong-tables.md``).
+
+References
+----------
+- C.-M. Wang, J.-R. Chern, J. Lee, "An Efficient Spectral Rendering Technique for Phong Illumination
+  Model".
+- C. de Boor, *A Practical Guide to Splines*, rev. ed., 2001, ch. XII (equidistributing the error by
+  node density ∝ |f^(k)|^(1/k)).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from phong_table import _kernels
+from phong_table.model import SpectralPhong, average_exponent_Wang
+from reference.errors import require
+from reference.registry import Method, Registry
+
+__all__ = [
+    "ERROR_DENSITY_FLOOR",
+    "MAX_ENTRIES",
+    "PLACEMENT_METHODS",
+    "check_entries",
+    "fine_grid",
+    "importance_ratio_Wang",
+    "inverse_importance_ratio_Wang",
+    "table_error",
+    "table_importance_Wang",
+    "table_uniform",
+]
+
+#: Largest table size accepted (a million entries is already far past any error budget).
+MAX_ENTRIES = 1_000_000
+#: Uniform share added to the normalised error density of :func:`table_error`: at least
+#: ``floor/(1 + floor)`` of the nodes are spread uniformly, so no interval exceeds
+#: ``(1 + floor)/(floor · m)``.
+ERROR_DENSITY_FLOOR = 0.1
+
+
+def check_entries(entries, segments=None, where: str = "table") -> tuple[int, int | None]:
+    """Validate a table size ``m`` and a segment count ``p`` (``p`` divides ``m``).
+
+    Examples
+    --------
+    >>> check_entries(200, 20)
+    (200, 20)
+    >>> check_entries(200, 30)
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: table: segments: must divide entries = 200, got 30
+    """
+    ok = isinstance(entries, int | np.integer) and not isinstance(entries, bool)
+    require(
+        ok and 1 <= entries <= MAX_ENTRIES,
+        f"{where}: entries: must be an integer in [1, {MAX_ENTRIES}], got {entries!r}",
+    )
+    if segments is None:
+        return int(entries), None
+    ok = isinstance(segments, int | np.integer) and not isinstance(segments, bool)
+    require(
+        ok and 1 <= segments <= entries,
+        f"{where}: segments: must be an integer in [1, entries = {entries}], got {segments!r}",
+    )
+    require(
+        entries % segments == 0,
+        f"{where}: segments: must divide entries = {entries}, got {segments}",
+    )
+    return int(entries), int(segments)
+
+
+def table_uniform(model: SpectralPhong | None, entries: int, segments=None) -> np.ndarray:
+    """Uniform nodes ``t_q = q/m``: the paper's baseline.
+
+    Eq. (16), Wang et al., with ``p = 1`` (one segment spanning [0, 1]).
+
+    Parameters
+    ----------
+    model : SpectralPhong or None
+        Unused (the uniform table does not look at the material).
+    entries : int
+        ``m``, the number of intervals, >= 1.
+    segments : None
+        Not used by this placement.
+
+    Returns
+    -------
+    ndarray, shape (m + 1,)
+
+    Examples
+    --------
+    >>> table_uniform(None, 4)
+    array([0.  , 0.25, 0.5 , 0.75, 1.  ])
+    """
+    m, _ = check_entries(entries, None)
+    # Eq. (16), Wang et al. with p = 1: S_0 = 0, S_1 = 1, t_j = j/m
+    return np.arange(m + 1, dtype=np.float64) / m
+
+
+def importance_ratio_Wang(t, an: float) -> np.ndarray:
+    """The importance ratio of the proxy ``t^{an}``: ``ir(t) = t^{an+1}``.
+
+    Eq. (14), Wang et al. (the closed form of Eq. (12) for ``f^app = t^{an}`` of Eq. (13)).
+
+    Parameters
+    ----------
+    t : array_like
+        Points in [0, 1].
+    an : float
+        The average exponent (Erratum E1), >= 0.
+
+    Returns
+    -------
+    ndarray
+        ``w`` in [0, 1]; it underflows to 0 for ``t^{an+1} < 1e-308`` (t < 0.7 at an = 2000).
+
+    Examples
+    --------
+    >>> importance_ratio_Wang([0.0, 0.5, 1.0], 1.0)
+    array([0.  , 0.25, 1.  ])
+    """
+    # Eq. (14), Wang et al.: ir(t) = ∫_0^t x^an dx / ∫_0^1 x^an dx = t^(an+1)
+    return np.asarray(t, dtype=np.float64) ** (an + 1.0)
+
+
+def inverse_importance_ratio_Wang(w, an: float) -> np.ndarray:
+    """The inverse importance ratio ``iir(w) = w^{1/(an+1)}``.
+
+    Eq. (15), Wang et al., with Erratum E4 (the paper prints ``a + 1`` for ``an + 1``).
+
+    Examples
+    --------
+    >>> inverse_importance_ratio_Wang([0.0, 0.25, 1.0], 1.0)
+    array([0. , 0.5, 1. ])
+    """
+    # Eq. (15), Wang et al. (Erratum E4): t = (an+1)-th root of w
+    return np.asarray(w, dtype=np.float64) ** (1.0 / (an + 1.0))
+
+
+def table_importance_Wang(model: SpectralPhong, entries: int, segments=None) -> np.ndarray:
+    """Wang et al.'s importance-driven nodes: ``p`` equal-weight segments of ``m/p`` intervals.
+
+    Eq. (16), Wang et al. (with Eqs. (12)-(15)), with Errata E1, E3 and E4.
+
+    Parameters
+    ----------
+    model : SpectralPhong
+        The material; only its average exponent ``an`` is used (Eq. (13), Wang et al.).
+    entries : int
+        ``m``, the number of intervals.
+    segments : int, optional
+        ``p``, which must divide ``m``; default ``m`` (one interval per segment).
+
+    Returns
+    -------
+    ndarray, shape (m + 1,)
+        Strictly increasing nodes from 0 to 1.
+
+    Notes
+    -----
+    With ``p = 1`` the nodes are exactly the uniform ones; with ``p = m`` and a constant exponent
+    ``n`` they are ``t_q = (q/m)^{1/(n+1)}``.
+
+    Examples
+    --------
+    >>> from phong_table.scenes import constant_material
+    >>> table_importance_Wang(constant_material(1.0), 4).round(4)
+    array([0.    , 0.5   , 0.7071, 0.866 , 1.    ])
+    >>> table_importance_Wang(constant_material(1.0), 4, segments=2).round(4)
+    array([0.    , 0.3536, 0.7071, 0.8536, 1.    ])
+    """
+    m, p = check_entries(entries, segments, "importance table")
+    p = m if p is None else p
+    an = average_exponent_Wang(model.n)
+    # Eq. (15), Wang et al. (Erratum E4): segment ends S_i = iir(i/p), so W(S_i) = i/p
+    S = inverse_importance_ratio_Wang(np.arange(p + 1) / p, an)
+    # Eq. (16), Wang et al. (Erratum E3): t_{i·(m/p)+j} = S_i + j·(p/m)·(S_{i+1} − S_i)
+    j = np.arange(m // p)
+    t = S[:-1, None] + (j * p / m)[None, :] * (S[1:] - S[:-1])[:, None]
+    return np.append(t.ravel(), 1.0)
+
+
+def fine_grid(size: int = 256) -> np.ndarray:
+    """The fine grid on which :func:`table_error` integrates its node density.
+
+    ``size`` uniform points on [0, 1] and ``size`` points with ``1 − t`` geometric from 1e-9 to 1,
+    merged: it resolves the lobe of ``t^n`` (width ~1/n near t = 1) for exponents up to ~1e8.
+
+    Examples
+    --------
+    >>> g = fine_grid(8)
+    >>> float(g[0]), float(g[-1]), bool((np.diff(g) > 0).all())
+    (0.0, 1.0, True)
+    """
+    u = np.logspace(-9.0, 0.0, size)
+    t = np.concatenate([np.linspace(0.0, 1.0, size), 1.0 - u, [0.0, 1.0]])
+    return np.unique(np.clip(t, 0.0, 1.0))
+
+
+_FINE_GRID = fine_grid()
+_FINE_GRID.setflags(write=False)
+
+
+def table_error(
+    model: SpectralPhong, entries: int, segments=None, floor: float = ERROR_DENSITY_FLOOR
+) -> np.ndarray:
+    """Nodes that equidistribute the interpolation error of the true specular functions (ours).
+
+    Eq. (11), Wang et al. gives ``f_sp``; this placement replaces the proxy of Eqs. (12)-(13),
+    Wang et al. by the derivatives of ``f_sp`` itself.
+
+    Parameters
+    ----------
+    model : SpectralPhong
+        The material and light: ``f_sp(t) = Σ_λ C(λ) t^{n(λ)}``.
+    entries : int
+        ``m``, the number of intervals.
+    segments : None
+        Not used by this placement.
+    floor : float
+        Uniform share of the density, > 0 (:data:`ERROR_DENSITY_FLOOR`).
+
+    Returns
+    -------
+    ndarray, shape (m + 1,)
+        Strictly increasing nodes from 0 to 1, one node set for the three channels.
+
+    Notes
+    -----
+    **Derivation.** Interpolating with a piecewise polynomial of order ``k`` (``k = 2`` for linear,
+    ``k = 3`` for the parabola and for the monotone cubic, whose slopes are second-order accurate)
+    leaves on an interval of width ``h`` around ``t`` an error ``e ≈ c_k h^k |f^(k)(t)|``. A node
+    density ``ρ`` (nodes per unit ``t``, ``∫ρ = m``) gives ``h = 1/ρ``, so ``e(t) ≈ c_k
+    |f^(k)(t)| / ρ(t)^k``. The largest error over [0, 1] is smallest when it is the same
+    everywhere (equidistribution), i.e. when ``ρ ∝ |f^(k)|^{1/k}``, and then
+
+    ``max e ≈ c_k (∫_0^1 |f^(k)|^{1/k} dt)^k / m^k``.
+
+    For ``f = t^n`` the integral ``∫ (n(n−1)···)^{1/k} t^{(n−k)/k} dt ≈ k n^{1/k} · n^{(k−1)/k}/n``
+    stays bounded as ``n`` grows (``≈ k``), so the error no longer depends on the exponent: this is
+    why the placement converges where the uniform table (error ∝ ``n^k``) and the importance table
+    (whose first interval does not shrink) do not.
+
+    One node set serves the three channels and every interpolation: the density is the larger of
+    the normalised ``max_c |f_c''|^{1/2}`` and ``max_c |f_c'''|^{1/3}`` (``c`` over R, G, B; each
+    channel's error is in the same display units), which costs each interpolation at most half its
+    own optimal nodes. A floor keeps intervals bounded where the derivative vanishes (zero crossings
+    of ``f^(k)``, ``n(λ) ≤ 1``): ``ρ = ρ_error/∫ρ_error + floor``.
+
+    The derivatives are evaluated at the midpoints of :func:`fine_grid`, the density integrated
+    there, and the cumulative density inverted at ``q/m`` by linear interpolation. The compiled twin
+    is ``phong_table._kernels.table_error_kernel``.
+
+    Examples
+    --------
+    >>> from phong_table.scenes import constant_material
+    >>> nodes = table_error(constant_material(500.0), 8)
+    >>> nodes.round(3)
+    array([0.   , 0.982, 0.99 , 0.994, 0.996, 0.997, 0.998, 0.999, 1.   ])
+    """
+    m, _ = check_entries(entries, None, "error table")
+    require(np.isfinite(floor) and floor > 0, f"error table: floor: must be > 0, got {floor}")
+    t_fine = _FINE_GRID
+    h = np.diff(t_fine)
+    t_mid = 0.5 * (t_fine[1:] + t_fine[:-1])
+    rho = np.zeros_like(t_mid)
+    for k in (2, 3):
+        # e ≈ c_k h^k |f^(k)| is equidistributed by the density |f^(k)|^(1/k) (Notes)
+        rho_k = np.abs(model.specular_derivative(t_mid, k)).max(axis=-1) ** (1.0 / k)
+        mass = (rho_k * h).sum()
+        if mass > 0:
+            rho = np.maximum(rho, rho_k / mass)
+    mass = (rho * h).sum()
+    rho = (rho / mass if mass > 0 else rho) + floor
+    cdf = np.concatenate([[0.0], np.cumsum(rho * h)])
+    nodes = np.interp(cdf[-1] * np.arange(m + 1) / m, cdf, t_fine)
+    nodes[0], nodes[-1] = 0.0, 1.0
+    return nodes
+
+
+def _table_error_compiled(model: SpectralPhong, entries: int, segments=None) -> np.ndarray:
+    m, _ = check_entries(entries, None, "error table")
+    return _kernels.table_error_kernel(
+        _FINE_GRID, model.specular_weights, model.n, m, ERROR_DENSITY_FLOOR
+    )
+
+
+def _example_inputs(rng):
+    from phong_table.scenes import constant_material
+
+    return constant_material(float(rng.uniform(1.0, 100.0))), 16, None
+
+
+#: Placements by the keys of ``--placement``. ``reference(model, entries, segments) -> nodes``;
+#: ``kernel`` (if any) is the numba twin of its density computation and ``extra["compiled"]`` calls
+#: it with the reference's signature; ``extra["segments"]`` says whether ``segments`` applies.
+PLACEMENT_METHODS = Registry("placement")
+PLACEMENT_METHODS.register(
+    Method(
+        "uniform",
+        table_uniform,
+        None,
+        "Eq. (16), Wang et al.",
+        _example_inputs,
+        {"segments": False, "source": "Wang et al. (baseline)"},
+    )
+)
+PLACEMENT_METHODS.register(
+    Method(
+        "importance",
+        table_importance_Wang,
+        None,
+        "Eq. (16), Wang et al.",
+        _example_inputs,
+        {"segments": True, "source": "Wang et al."},
+    )
+)
+PLACEMENT_METHODS.register(
+    Method(
+        "error",
+        table_error,
+        _kernels.table_error_kernel,
+        "Eq. (11), Wang et al.",
+        _example_inputs,
+        {"segments": False, "source": "ours", "compiled": _table_error_compiled},
+    )
+)

@@ -1,0 +1,96 @@
+"""The table shader: scenes render Phong materials through a table by ``options["phong"]``.
+
+``reference.shading.shade_phong_point`` dispatches on ``ctx.options["phong"]["method"]``; this
+module registers ``"table"`` in ``reference.shading.PHONG_POINT_METHODS``. The exact shader stays
+the default. Keys of ``options["phong"]`` read here:
+
+- ``method``: ``"table"`` (``"exact"``, the default, is the exact spectral shader);
+- ``placement``: a key of ``PLACEMENT_METHODS`` (default ``"error"``);
+- ``interpolation``: a key of ``INTERPOLATION_METHODS`` (default ``"monotone"``);
+- ``entries``: the table size m (default 200);
+- ``segments``: importance segments p (default None, i.e. p = m).
+
+The table is built in XYZ (the band weights of the scene's grid, light folded in, take the place of
+the spectra-to-RGB matrix of Eq. (9), Wang et al.), so the result adds up with other shaders.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from phong_table import _kernels
+from phong_table.model import SpectralPhong
+from phong_table.render import ShadingBuffer, compiled_shader
+from phong_table.table import build_table, check_interpolation
+from reference.errors import require
+from reference.registry import Method
+from reference.shading import PHONG_POINT_METHODS
+
+__all__ = ["OPTION_KEYS", "shade_phong_point_table"]
+
+#: The keys of ``options["phong"]`` and their defaults.
+OPTION_KEYS = {
+    "method": "table",
+    "placement": "error",
+    "interpolation": "monotone",
+    "entries": 200,
+    "segments": None,
+}
+
+
+def shade_phong_point_table(surface, material, light, ctx) -> np.ndarray:
+    """XYZ of a Phong material under a point light through a table of Eq. (11), Wang et al.
+
+    Eq. (11), Wang et al. tabulated in XYZ; ``f_att`` and ``cos θ`` per pixel (Eq. (7), Wang et
+    al.). The table's settings come from ``ctx.options["phong"]`` (module docstring).
+
+    Examples
+    --------
+    >>> from reference.lights import PointLight
+    >>> from reference.materials import PhongMaterial
+    >>> from reference.shading import ShadingContext, Surface, shade_phong_point
+    >>> m = PhongMaterial(np.full(41, 0.3), np.full(41, 0.5), np.full(41, 40.0))
+    >>> z = np.array([[0.0, 0.0, 1.0]])
+    >>> s = Surface(np.zeros((1, 3)), z, z, np.zeros((1, 2)))
+    >>> ctx = ShadingContext(options={"phong": {"method": "table", "entries": 64}})
+    >>> table = shade_phong_point(s, m, PointLight((0.0, 0.0, 3.0)), ctx)
+    >>> exact = shade_phong_point(s, m, PointLight((0.0, 0.0, 3.0)), ShadingContext())
+    >>> bool(np.allclose(table, exact, atol=1e-9))
+    True
+    """
+    options = dict(ctx.options.get("phong", {}))
+    for key in options:
+        require(
+            key in OPTION_KEYS,
+            f"options.phong: unknown key {key!r}; allowed: {', '.join(sorted(OPTION_KEYS))}",
+        )
+    settings = {**OPTION_KEYS, **options}
+    model = SpectralPhong(
+        material,
+        light,
+        grid=ctx.grid,
+        colourspace="XYZ",
+        observer=ctx.observer,
+        weights_method=ctx.weights_method,
+    )
+    table = build_table(
+        model, settings["entries"], settings["placement"], settings["segments"], compiled=True
+    )
+    check_interpolation(settings["interpolation"], table.entries)
+    position = np.ascontiguousarray(surface.position, dtype=np.float64)
+    rows = _kernels.light_geometry_kernel(
+        position,
+        np.ascontiguousarray(surface.normal, dtype=np.float64),
+        np.ascontiguousarray(surface.view, dtype=np.float64),
+        np.asarray(light.position, dtype=np.float64),
+        np.asarray(light.attenuation, dtype=np.float64),
+        np.empty((3, position.shape[0])),
+    )
+    buffer = ShadingBuffer(None, *(np.ascontiguousarray(r) for r in rows))
+    shade = compiled_shader(model, table, settings["interpolation"])
+    return shade(buffer, np.empty((position.shape[0], 3)))
+
+
+PHONG_POINT_METHODS.register(
+    Method("table", shade_phong_point_table, None, "Eq. (11), Wang et al.", extra=OPTION_KEYS)
+)

@@ -1,0 +1,53 @@
+"""Benchmarks of the Phong tables: shading (build included) against the exact shading, same run."""
+
+import numpy as np
+import pytest
+
+from phong_table import INTERPOLATION_METHODS, PLACEMENT_METHODS, SCENES, build_table
+from phong_table.interpolation import interval_index
+from phong_table.render import compiled_shader, shading_buffer, sphere_gbuffer
+
+CASES = [(s, v) for s in ("R1", "R2", "R3") for v in ("far", "near")]
+
+
+def _setup(scene, view):
+    model = SCENES.lookup(scene).build()
+    buffer = shading_buffer(sphere_gbuffer(view, 512), model)
+    return model, buffer, np.empty((buffer.t.size, 3))
+
+
+@pytest.mark.parametrize(("scene", "view"), CASES)
+def test_exact(benchmark, scene, view):
+    model, buffer, out = _setup(scene, view)
+    benchmark.group = f"phong {scene} {view}"
+    shade = compiled_shader(model)
+    benchmark(shade, buffer, out)
+
+
+@pytest.mark.parametrize("interpolation", INTERPOLATION_METHODS.names())
+@pytest.mark.parametrize("placement", PLACEMENT_METHODS.names())
+@pytest.mark.parametrize(("scene", "view"), CASES)
+def test_table(benchmark, scene, view, placement, interpolation):
+    model, buffer, out = _setup(scene, view)
+    benchmark.group = f"phong {scene} {view}"
+
+    def run():
+        table = build_table(model, 200, placement, compiled=True)
+        return compiled_shader(model, table, interpolation)(buffer, out)
+
+    run()
+    benchmark(run)
+
+
+@pytest.mark.parametrize("method", ["binary search", "inverse-map index"])
+def test_lookup_index(benchmark, method):
+    # the index method for non-uniform tables: np.searchsorted against the kernel's guide index
+    model, buffer, out = _setup("R1", "near")
+    table = build_table(model, 200, "error", compiled=True)
+    benchmark.group = "phong lookup R1 near"
+    if method == "binary search":
+        benchmark(interval_index, table.nodes, buffer.t)
+    else:
+        shade = compiled_shader(model, table, "linear")
+        shade(buffer, out)
+        benchmark(shade, buffer, out)

@@ -1,0 +1,71 @@
+import numpy as np
+import pytest
+
+from phong_table import INTERPOLATION_METHODS, PLACEMENT_METHODS, RENDER_METHODS, build_table
+from phong_table.render import shade_pixels, shading_buffer, sphere_gbuffer
+from phong_table.scenes import SCENES
+from phong_table.table import tabulate
+
+
+def _close(a, b):
+    # twins agree to ~1e-12 of the image's peak
+    np.testing.assert_allclose(a, b, rtol=0, atol=1e-12 * max(1.0, np.abs(b).max()))
+
+
+@pytest.mark.parametrize("scene", ["R1", "R2", "R3", "bimodal"])
+@pytest.mark.parametrize("view", ["far", "near"])
+def test_geometry_and_exact_kernels_equal_numpy(scene, view):
+    model = SCENES.lookup(scene).build()
+    geometry = sphere_gbuffer(view, 24)
+    compiled, reference = (
+        shading_buffer(geometry, model, True),
+        shading_buffer(geometry, model, False),
+    )
+    for key in ("cos_theta", "t", "f_att"):
+        _close(getattr(compiled, key), getattr(reference, key))
+    _close(
+        shade_pixels(compiled, model, "exact"),
+        shade_pixels(reference, model, "exact", compiled=False),
+    )
+
+
+@pytest.mark.parametrize("placement", PLACEMENT_METHODS.names())
+@pytest.mark.parametrize("interpolation", INTERPOLATION_METHODS.names())
+@pytest.mark.parametrize("scene", ["R2", "R3", "n2000"])
+def test_table_kernel_equals_numpy(placement, interpolation, scene):
+    model = SCENES.lookup(scene).build()
+    buffer = shading_buffer(sphere_gbuffer("near", 24), model, False)
+    for entries in (3, 64):
+        table = build_table(model, entries, placement, compiled=True)
+        compiled = shade_pixels(buffer, model, "table", table, interpolation)
+        reference = shade_pixels(buffer, model, "table", table, interpolation, compiled=False)
+        _close(compiled, reference)
+
+
+def test_table_kernel_on_exact_node_hits():
+    # pixels exactly on nodes and at 0 and 1 find the same interval as searchsorted
+    model = SCENES.lookup("R1").build()
+    table = build_table(model, 50, "error")
+    t = np.concatenate([table.nodes, [0.0, 1.0, np.nextafter(1.0, 0.0)]])
+    from phong_table.render import ShadingBuffer
+
+    buffer = ShadingBuffer(None, np.full(t.size, 0.5), t, np.ones(t.size))
+    for interpolation in INTERPOLATION_METHODS.names():
+        _close(
+            shade_pixels(buffer, model, "table", table, interpolation),
+            shade_pixels(buffer, model, "table", table, interpolation, compiled=False),
+        )
+
+
+def test_tabulate_kernel_equals_numpy():
+    entry = RENDER_METHODS.lookup("tabulate")
+    for scene in SCENES.names():
+        model = SCENES.lookup(scene).build()
+        nodes = build_table(model, 100, "error").nodes
+        a = entry.reference(nodes, model.specular_weights, model.n, 16)
+        b = entry.kernel(nodes, model.specular_weights, model.n, 16)
+        for x, y in zip(a[:4], b[:4], strict=True):
+            np.testing.assert_allclose(y, x, rtol=1e-9, atol=1e-12 * max(1.0, np.abs(x).max()))
+        assert a[5] == b[5]
+        assert np.abs(a[4] - b[4]).max() <= 1  # the index may differ at a cell edge by rounding
+    assert tabulate is entry.reference

@@ -1,0 +1,87 @@
+import numpy as np
+import pytest
+
+from phong_table import PLACEMENT_METHODS, build_table
+from phong_table.placement import (
+    importance_ratio_Wang,
+    inverse_importance_ratio_Wang,
+    table_error,
+    table_importance_Wang,
+    table_uniform,
+)
+from phong_table.scenes import SCENES, constant_material
+from reference.errors import SpecrefError
+
+
+def test_ir_of_iir_is_identity(rng):
+    # closed form: ir(iir(w)) = w (Eqs. (14)-(15), Wang et al.)
+    w = rng.uniform(0.0, 1.0, 50)
+    for an in (0.0, 1.0, 37.5, 2000.0):
+        np.testing.assert_allclose(
+            importance_ratio_Wang(inverse_importance_ratio_Wang(w, an), an),
+            w,
+            rtol=1e-12,
+            atol=1e-15,
+        )
+
+
+@pytest.mark.parametrize("placement", PLACEMENT_METHODS.names())
+@pytest.mark.parametrize("scene", SCENES.names())
+@pytest.mark.parametrize("entries", [1, 3, 25, 200, 800])
+def test_nodes_are_monotone_from_0_to_1(placement, scene, entries):
+    nodes = build_table(SCENES.lookup(scene).build(), entries, placement).nodes
+    assert nodes.shape == (entries + 1,)
+    assert nodes[0] == 0.0
+    assert nodes[-1] == 1.0
+    assert (np.diff(nodes) > 0).all()
+
+
+@pytest.mark.parametrize("n", [0.0, 1.0, 10.0, 500.0, 2000.0])
+def test_importance_nodes_constant_exponent_closed_form(n):
+    # closed form: t_q = (q/m)^(1/(n+1)) for p = m
+    m = 40
+    nodes = table_importance_Wang(constant_material(n), m)
+    np.testing.assert_allclose(nodes, (np.arange(m + 1) / m) ** (1.0 / (n + 1.0)), rtol=1e-14)
+
+
+def test_importance_one_segment_is_exactly_uniform():
+    model = SCENES.lookup("R2").build()
+    for m in (7, 25, 200):
+        assert np.array_equal(table_importance_Wang(model, m, segments=1), table_uniform(None, m))
+
+
+@pytest.mark.parametrize("placement", PLACEMENT_METHODS.names())
+@pytest.mark.parametrize("n", [1.0, 7.0, 350.0])
+def test_table_reproduces_t_to_the_n_at_the_nodes(placement, n):
+    # with a constant n, f_sp(t) = f_sp(1) t^n (closed form); the tabulated values match it
+    model = constant_material(n)
+    table = build_table(model, 50, placement)
+    expected = model.specular(1.0)[None, :] * np.power(table.nodes, n)[:, None]
+    np.testing.assert_allclose(table.values, expected, rtol=1e-13, atol=1e-16)
+
+
+def test_error_placement_kernel_equals_numpy():
+    for scene in SCENES.names():
+        model = SCENES.lookup(scene).build()
+        compiled = PLACEMENT_METHODS.lookup("error").extra["compiled"](model, 200)
+        np.testing.assert_allclose(compiled, table_error(model, 200), rtol=0, atol=1e-12)
+
+
+def test_error_placement_has_a_density_floor():
+    # the floor keeps a uniform share: no interval exceeds (1 + floor)/(floor m)
+    nodes = table_error(constant_material(5000.0), 50)
+    assert np.diff(nodes).max() <= (1 + 0.1) / (0.1 * 50) + 1e-12
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"entries": 10, "placement": "importance", "segments": 3}, "must divide entries = 10"),
+        ({"entries": 0, "placement": "uniform"}, r"entries: must be an integer in \[1,"),
+        ({"entries": 10, "placement": "best"}, "unknown placement 'best'"),
+        ({"entries": 10, "placement": "error", "segments": 2}, "only the importance placement"),
+    ],
+)
+def test_bad_table_arguments(kwargs, match):
+    with pytest.raises(SpecrefError, match=match):
+        build_table(constant_material(10.0), **kwargs)

@@ -1,0 +1,69 @@
+import colour
+import numpy as np
+import pytest
+
+from phong_table import SCENES, SpectralPhong, render_sphere
+from phong_table.render import light_geometry, sphere_gbuffer
+from phong_table.scenes import constant_material, highlight_point, spectral_phong_unit_peak
+from reference.camera import Camera
+from reference.gbuffer import render_gbuffer
+from reference.geometry import Sphere
+from reference.lights import PointLight
+from reference.materials import PhongMaterial
+from reference.shading import ShadingContext, shade_gbuffer
+from reference.spectra import DEFAULT_GRID, spectrum_from_dataset
+
+
+@pytest.mark.parametrize("scene", ["R1", "R3"])
+def test_exact_render_matches_colour_sd_to_XYZ_per_pixel(scene):
+    # independent oracle: colour.sd_to_XYZ (ASTM E308) of the per-pixel spectrum of Eq. (2), then
+    # colour-science's sRGB matrix, on a few pixels
+    model = SCENES.lookup(scene).build()
+    image = render_sphere(model, "near", "exact", resolution=16)
+    geometry = sphere_gbuffer("near", 16)
+    ct, t, f_att = light_geometry(
+        geometry.position,
+        geometry.normal,
+        geometry.view,
+        model.light.position,
+        model.light.attenuation,
+    )
+    m = model.material
+    light = model.light.spectrum.meta["colour_sd"]
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
+    M = colour.RGB_COLOURSPACES["sRGB"].matrix_XYZ_to_RGB
+    pixels = np.flatnonzero(geometry.gbuffer.mask.ravel())
+    for k in (0, 57, 130, 200, pixels.size - 1):
+        spectrum = f_att[k] * (m.k_d * ct[k] + m.k_s * t[k] ** m.n)
+        sd = colour.SpectralDistribution(spectrum, DEFAULT_GRID.wavelengths_nm)
+        XYZ = colour.sd_to_XYZ(sd, cmfs, light, method="ASTM E308") / 100.0
+        expected = model.light.intensity * (M @ XYZ)
+        got = image.reshape(-1, 3)[pixels[k]]
+        np.testing.assert_allclose(got, expected, rtol=1e-9, atol=1e-12)
+
+
+def test_table_shader_through_scene_options_matches_exact():
+    material = PhongMaterial(np.full(41, 0.3), np.full(41, 0.4), np.linspace(10.0, 300.0, 41))
+    light = PointLight((2.0, 3.0, 4.0), spectrum_from_dataset("illuminant", "D65"))
+    g = render_gbuffer([Sphere()], Camera(eye=(0, 0, 4)), 24, 24)
+    exact = shade_gbuffer(g, [material], [light])
+    ctx = ShadingContext(options={"phong": {"method": "table", "entries": 200}})
+    table = shade_gbuffer(g, [material], [light], ctx)
+    assert np.abs(table - exact).max() < 1e-6
+    # the default stays the exact shader
+    assert np.array_equal(shade_gbuffer(g, [material], [light], ShadingContext()), exact)
+
+
+def test_highlight_point_has_t_equal_1():
+    p = highlight_point()
+    light, eye = np.array([2.5, 3.0, 4.0]), np.array([0.0, 0.0, 4.5])
+    _, t, _ = light_geometry(
+        p[None], p[None], ((eye - p) / np.linalg.norm(eye - p))[None], light, [1, 0, 0]
+    )
+    assert t[0] == pytest.approx(1.0, abs=1e-12)
+
+
+def test_unit_peak_normalisation():
+    model = spectral_phong_unit_peak(np.full(41, 0.2), np.full(41, 0.5), np.full(41, 50.0), "A")
+    assert float((model.diffuse_RGB + model.specular(1.0)).max()) == pytest.approx(1.0, rel=1e-12)
+    assert isinstance(constant_material(3.0), SpectralPhong)
