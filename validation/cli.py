@@ -37,6 +37,35 @@ def _cmd_report(args) -> int:
     return 0
 
 
+def _cmd_cache(args) -> int:
+    from shrm.cache import Cache
+
+    cache = Cache(args.cache_dir)
+    if args.action == "clear":
+        count = cache.clear()
+        print(f"deleted {count} entries from {cache.directory}")
+        return 0
+    info = cache.info()
+    print(f"location: {info.directory}")
+    size, limit = info.total_bytes / 1e6, info.max_bytes / 1e6
+    print(f"entries: {info.entries} ({size:.1f} MB of {limit:.0f} MB)")
+    if info.foreign:
+        print(f"foreign files (ignored, never deleted): {', '.join(info.foreign)}")
+    return 0
+
+
+def _add_cache_parser(sub) -> None:
+    p = sub.add_parser("cache", help="inspect or empty the persistent map cache")
+    p.add_argument("action", choices=["info", "clear"], help="show the cache or delete its entries")
+    p.add_argument(
+        "--cache-dir",
+        metavar="DIR",
+        help="cache folder (default: $SPECREF_CACHE_DIR, else $XDG_CACHE_HOME/specref, else "
+        "~/.cache/specref)",
+    )
+    p.set_defaults(func=_cmd_cache)
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser for all subcommands.
 
@@ -64,6 +93,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="path from the Markdown file to the report folder",
     )
     p.set_defaults(func=_cmd_report)
+    _add_cache_parser(sub)
     return parser
 
 
