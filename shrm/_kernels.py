@@ -1,0 +1,217 @@
+"""numba twins of the readable NumPy functions of ``shrm.sh`` and ``shrm.prefilter``.
+
+Each kernel keeps the names and equation comments of its NumPy reference, never validates, never
+prints, and writes into an output array that the public entry point allocated. The equality tests
+live in ``tests/shrm``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+# Rescaling step of the extended-exponent recurrence: values are kept in [2^-SCALE, 2^SCALE].
+SCALE_BITS = 200
+_BIG = 2.0**SCALE_BITS
+_SMALL = 2.0**-SCALE_BITS
+_INV_SQRT_4PI = 1.0 / math.sqrt(4.0 * math.pi)
+
+
+@numba.njit(cache=False)
+def _sectoral_next(p, e, m, sin_theta, scaled):
+    """λ_mm from λ_{m-1,m-1}, as (mantissa, binary exponent); the exponent moves only if scaled."""
+    # Sectoral recurrence: λ_mm = -sqrt((2m+1)/(2m)) sin θ λ_{m-1,m-1}
+    p = -math.sqrt((2.0 * m + 1.0) / (2.0 * m)) * sin_theta * p
+    if scaled and p != 0.0 and abs(p) < _SMALL:
+        p *= _BIG
+        e -= SCALE_BITS
+    return p, e
+
+
+@numba.njit(cache=False)
+def _column(m, L, x, p_mm, e_mm, A, B, t0, scaled, buf):
+    """buf[l - m] = λ_lm(x) for l = m..L, from λ_mm = p_mm · 2^e_mm (column recurrence)."""
+    p1 = p_mm
+    p2 = 0.0
+    e = e_mm
+    buf[0] = math.ldexp(p1, e) if scaled else p1
+    for l in range(m + 1, L + 1):
+        # λ_lm = a_lm (x λ_{l-1,m} - b_lm λ_{l-2,m})  (b_{m+1,m} = 0, a_{m+1,m} = sqrt(2m+3))
+        p = A[t0 + l - m] * (x * p1 - B[t0 + l - m] * p2)
+        p2 = p1
+        p1 = p
+        if scaled and abs(p1) > _BIG:
+            p1 *= _SMALL
+            p2 *= _SMALL
+            e += SCALE_BITS
+        buf[l - m] = math.ldexp(p1, e) if scaled else p1
+
+
+@numba.njit(cache=False)
+def legendre_table_kernel(L, x, sin_theta, A, B, scaled, out):
+    """Twin of ``shrm.sh.legendre_table``: out[t(l, m), j] = λ_lm(x_j), m-major layout."""
+    N = x.shape[0]
+    buf = np.empty(L + 1)
+    for j in range(N):
+        p, e = _INV_SQRT_4PI, 0
+        t0 = 0
+        for m in range(L + 1):
+            if m > 0:
+                p, e = _sectoral_next(p, e, m, sin_theta[j], scaled)
+            _column(m, L, x[j], p, e, A, B, t0, scaled, buf)
+            for i in range(L + 1 - m):
+                out[t0 + i, j] = buf[i]
+            t0 += L + 1 - m
+
+
+@numba.njit(cache=False)
+def legendre_analysis_kernel(L, x, sin_theta, w, A, B, F_cos, F_sin, scaled, out):
+    """Twin of ``shrm.sh.legendre_analysis``: c_lm = Σ_j w_j √2 λ_lm(θ_j) F_m(θ_j).
+
+    ``F_cos, F_sin``: (L+1, H, C) ring integrals of f cos(mφ) and f sin(mφ); out: ((L+1)², C).
+    """
+    H = x.shape[0]
+    C = F_cos.shape[2]
+    sqrt2 = math.sqrt(2.0)
+    buf = np.empty(L + 1)
+    for j in range(H):
+        p, e = _INV_SQRT_4PI, 0
+        t0 = 0
+        for m in range(L + 1):
+            if m > 0:
+                p, e = _sectoral_next(p, e, m, sin_theta[j], scaled)
+            _column(m, L, x[j], p, e, A, B, t0, scaled, buf)
+            t0 += L + 1 - m
+            # Fejér-1 quadrature: c_lm = Σ_j w_j λ_lm(θ_j) ∫ f(θ_j, φ) √2 trig(mφ) dφ
+            for l in range(m, L + 1):
+                if m == 0:
+                    q = w[j] * buf[l]
+                    for c in range(C):
+                        out[l * l + l, c] += q * F_cos[0, j, c]
+                else:
+                    q = sqrt2 * w[j] * buf[l - m]
+                    for c in range(C):
+                        out[l * l + l + m, c] += q * F_cos[m, j, c]
+                        out[l * l + l - m, c] += q * F_sin[m, j, c]
+
+
+@numba.njit(cache=False)
+def legendre_synthesis_kernel(L, x, sin_theta, A, B, coeffs, scaled, G_cos, G_sin):
+    """Twin of ``shrm.sh.legendre_synthesis``: ring Fourier amplitudes of Σ c_lm Y_lm.
+
+    ``coeffs``: ((L+1)², C); ``G_cos, G_sin``: (L+1, H, C), the cos(mφ) and sin(mφ) amplitudes.
+    """
+    H = x.shape[0]
+    C = coeffs.shape[1]
+    sqrt2 = math.sqrt(2.0)
+    buf = np.empty(L + 1)
+    for j in range(H):
+        p, e = _INV_SQRT_4PI, 0
+        t0 = 0
+        for m in range(L + 1):
+            if m > 0:
+                p, e = _sectoral_next(p, e, m, sin_theta[j], scaled)
+            _column(m, L, x[j], p, e, A, B, t0, scaled, buf)
+            t0 += L + 1 - m
+            for l in range(m, L + 1):
+                if m == 0:
+                    for c in range(C):
+                        G_cos[0, j, c] += buf[l] * coeffs[l * l + l, c]
+                else:
+                    q = sqrt2 * buf[l - m]
+                    for c in range(C):
+                        G_cos[m, j, c] += q * coeffs[l * l + l + m, c]
+                        G_sin[m, j, c] += q * coeffs[l * l + l - m, c]
+
+
+@numba.njit(cache=False)
+def sh_evaluate_kernel(L, x, sin_theta, phi, A, B, coeffs, scaled, out):
+    """Twin of ``shrm.sh.sh_evaluate``: out[n, c] = Σ_lm c_lm Y_lm(θ_n, φ_n) at any directions."""
+    N = x.shape[0]
+    C = coeffs.shape[1]
+    sqrt2 = math.sqrt(2.0)
+    buf = np.empty(L + 1)
+    for n in range(N):
+        p, e = _INV_SQRT_4PI, 0
+        t0 = 0
+        for m in range(L + 1):
+            if m > 0:
+                p, e = _sectoral_next(p, e, m, sin_theta[n], scaled)
+            _column(m, L, x[n], p, e, A, B, t0, scaled, buf)
+            t0 += L + 1 - m
+            # Real SH: Y_lm = √2 λ_l|m| cos(mφ) (m > 0), √2 λ_l|m| sin(|m|φ) (m < 0)
+            cos_m = sqrt2 * math.cos(m * phi[n])
+            sin_m = sqrt2 * math.sin(m * phi[n])
+            for l in range(m, L + 1):
+                lam = buf[l - m]
+                if m == 0:
+                    for c in range(C):
+                        out[n, c] += lam * coeffs[l * l + l, c]
+                else:
+                    for c in range(C):
+                        out[n, c] += lam * (
+                            cos_m * coeffs[l * l + l + m, c] + sin_m * coeffs[l * l + l - m, c]
+                        )
+
+
+@numba.njit(cache=False)
+def prefilter_bruteforce_table_kernel(normals, directions, weights, radiance, angles, values, out):
+    """Twin of ``shrm.prefilter.prefilter_bruteforce`` for tabulated lobes K(γ).
+
+    ``out[k, c] = Σ_p radiance[p, c] K(acos(ω_p · n_k)) w_p``, K linear in γ between the samples
+    and 0 beyond the last angle.
+    """
+    K = normals.shape[0]
+    P = directions.shape[0]
+    C = radiance.shape[1]
+    last = angles[angles.shape[0] - 1]
+    for k in range(K):
+        for p in range(P):
+            t = (
+                normals[k, 0] * directions[p, 0]
+                + normals[k, 1] * directions[p, 1]
+                + normals[k, 2] * directions[p, 2]
+            )
+            gamma = math.acos(min(max(t, -1.0), 1.0))
+            if gamma > last:
+                continue
+            # Eq. (7), Ramamoorthi & Hanrahan 2001, in the angular domain: Σ_p L_p K(γ_p) w_p
+            kern = np.interp(gamma, angles, values) * weights[p]
+            for c in range(C):
+                out[k, c] += radiance[p, c] * kern
+
+
+@numba.njit(cache=False)
+def prefilter_bruteforce_power_kernel(normals, directions, weights, radiance, s, scale, out):
+    """Twin of ``shrm.prefilter.prefilter_bruteforce`` for the power lobes K(t) = scale·max(t, 0)^s.
+
+    Lambert is s = 1, scale = 1; normalized Phong is scale = (s + 1)/(2π).
+    """
+    K = normals.shape[0]
+    P = directions.shape[0]
+    C = radiance.shape[1]
+    for k in range(K):
+        for p in range(P):
+            t = (
+                normals[k, 0] * directions[p, 0]
+                + normals[k, 1] * directions[p, 1]
+                + normals[k, 2] * directions[p, 2]
+            )
+            if t <= 0.0:
+                continue
+            # Eq. (7), Ramamoorthi & Hanrahan 2001, in the angular domain: Σ_p L_p K(ω_p · n) w_p
+            kern = scale * t**s * weights[p]
+            for c in range(C):
+                out[k, c] += radiance[p, c] * kern
+
+
+__all__ = [
+    "legendre_analysis_kernel",
+    "legendre_synthesis_kernel",
+    "legendre_table_kernel",
+    "prefilter_bruteforce_power_kernel",
+    "prefilter_bruteforce_table_kernel",
+    "sh_evaluate_kernel",
+]
