@@ -423,6 +423,8 @@ def shrm_create(
     C, F1, P1, _ = rho.shape
     F, P = F1 - 1, P1 - 1
     L = np.atleast_2d(np.asarray(env_coeffs, dtype=np.float64))
+    if C == 1 and L.shape[0] > 1:  # a grey BRDF under a coloured environment
+        rho, C = np.broadcast_to(rho, (L.shape[0], *rho.shape[1:])), L.shape[0]
     require(L.shape[0] == C, f"SHRM: lighting has {L.shape[0]} channels but the BRDF has {C}")
     require(L.shape[1] >= F1 * F1, f"SHRM: lighting order is below F = {F}")
     L = L[:, : F1 * F1]

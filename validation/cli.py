@@ -10,6 +10,8 @@ from __future__ import annotations
 import argparse
 import sys
 
+import numpy as np
+
 from reference.errors import SpecrefError
 
 __all__ = ["build_parser", "main"]
@@ -101,6 +103,46 @@ def _add_brdf_parser(sub) -> None:
     c.set_defaults(func=_cmd_brdf_check)
 
 
+def _cmd_shrm_orbit(args) -> int:
+    from shrm.cache import Cache
+    from shrm.session import RenderSession, demo_state, render_orbit
+
+    if args.scene is not None:
+        try:
+            from reference.scene import load_scene  # noqa: F401  (branch 'scenes')
+        except ImportError:
+            raise SpecrefError(
+                f"{args.scene}: scene files need reference.scene, which this build does not have "
+                "yet; omit SCENE to orbit the built-in scene"
+            ) from None
+        raise SpecrefError(f"{args.scene}: SHRM orbits of scene files are not supported yet")
+    quick = {"env_height": 16, "size": 8, "resolution": 48, "F_max": 12, "P_max": 6}
+    state = demo_state(args.env, brdf=args.brdf, **(quick if args.quick else {}))
+    session = RenderSession(state, cache=Cache(args.cache_dir, enabled=not args.no_cache))
+    rows = render_orbit(session, args.frames, args.out)
+    total = [sum(r.values()) for r in rows]
+    print(
+        f"wrote {args.frames} frames and timings.csv to {args.out}; first frame "
+        f"{total[0]:.3f} s, later frames {np.mean(total[1:]) if len(total) > 1 else 0:.3f} s"
+    )
+    return 0
+
+
+def _add_shrm_parser(sub) -> None:
+    p = sub.add_parser("shrm", help="SH reflection maps (Herbert et al. §5.5-5.6)")
+    shrm = p.add_subparsers(dest="shrm_command", required=True, parser_class=_Parser)
+    o = shrm.add_parser("orbit", help="render a camera orbit; PNG frames and per-stage timings")
+    o.add_argument("scene", nargs="?", metavar="SCENE.toml", help="scene file (default: built-in)")
+    o.add_argument("--frames", type=int, default=8, help="frames of a full turn (default 8)")
+    o.add_argument("-o", "--out", required=True, help="output folder")
+    o.add_argument("--brdf", default="effect_pigment", help="isotropic BRDF of the sphere")
+    o.add_argument("--env", help="lat-long environment (.hdr/.exr); default venice_sunset_1k")
+    o.add_argument("--quick", action="store_true", help="small maps and images")
+    o.add_argument("--cache-dir", metavar="DIR", help="persistent cache folder")
+    o.add_argument("--no-cache", action="store_true", help="do not use the persistent cache")
+    o.set_defaults(func=_cmd_shrm_orbit)
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser for all subcommands.
 
@@ -130,6 +172,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_report)
     _add_cache_parser(sub)
     _add_brdf_parser(sub)
+    _add_shrm_parser(sub)
     return parser
 
 
