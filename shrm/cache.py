@@ -404,7 +404,7 @@ class Cache:
         header = json.dumps(
             {
                 "key": key,
-                "created": time.time(),
+                "created_ms": int(time.time() * 1000),
                 "payload_bytes": len(payload),
                 "meta": dict(meta or {}),
             },
