@@ -255,6 +255,8 @@ def _config(state) -> dict:
         "frame": "reflection",
         "F_max": 32,
         "P_max": 10,
+        "F": None,
+        "P": None,
         "light_order": 32,
         "width": 96,
         "height": 96,
@@ -316,12 +318,12 @@ def _brdf_call(state):
 
 
 def _stage_brdf_coeffs(state, inputs):
-    from shrm.shrm import brdf_sh_coefficients, choose_orders
+    from shrm.shrm import brdf_sh_coefficients, shrm_orders
 
     c = _config(state)
     brdf, params = _brdf_call(state)
     rho = brdf_sh_coefficients(brdf, params, c["F_max"], c["P_max"], c["frame"])
-    F, P = choose_orders(rho, c["tol"])
+    F, P = shrm_orders(rho, c["tol"], c.get("F"), c.get("P"))
     return {"rho": rho[:, : F + 1, : P + 1, : min(F, P) + 1]}
 
 

@@ -92,6 +92,7 @@ __all__ = [
     "shrm_create",
     "shrm_create_angular",
     "shrm_extract",
+    "shrm_orders",
     "transfer_function",
 ]
 
@@ -292,6 +293,51 @@ def choose_orders(rho: np.ndarray, tol: float) -> tuple[int, int]:
         )
         orders.append(int(below[0]))
     return orders[0], max(orders[1], P_RANGE[0])
+
+
+def shrm_orders(rho: np.ndarray, tol: float, F: int | None = None, P: int | None = None):
+    """Orders (F, P) for a tolerance, or a check that requested orders meet it.
+
+    Eq. (9), R&H 2002 (the coefficient tails of :func:`choose_orders`). P must lie in
+    :data:`P_RANGE` (§5.5, Herbert et al.: "between 2 and 10") and neither order may be below what
+    ``tol`` requires or above what ``rho`` holds.
+
+    Parameters
+    ----------
+    rho : ndarray, shape (C, F_max+1, P_max+1, M+1)
+    tol : float
+    F, P : int, optional
+        Requested orders; default the smallest that meet ``tol``.
+
+    Returns
+    -------
+    F, P : int
+
+    Raises
+    ------
+    SpecrefError
+        A requested order outside what the tolerance allows.
+
+    Examples
+    --------
+    >>> rho = np.zeros((1, 5, 4, 4)); rho[0, :, 0, 0] = [1.0, 0.5, 0.1, 0.001, 0.0]
+    >>> shrm_orders(rho, 0.01, P=3)
+    (2, 3)
+    >>> shrm_orders(rho, 0.01, F=1)
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: SHRM: F = 1 is outside what tol 0.01 allows: [2, 4]
+    """
+    F_min, P_min = choose_orders(rho, tol)
+    F_max, P_max = rho.shape[1] - 1, min(rho.shape[2] - 1, P_RANGE[1])
+    for name, value, low, high in (("F", F, F_min, F_max), ("P", P, P_min, P_max)):
+        if value is not None:
+            require(
+                isinstance(value, int | np.integer) and low <= value <= high,
+                f"SHRM: {name} = {value} is outside what tol {tol:g} allows: [{low}, {high}]",
+            )
+    require(P_min <= P_max, f"SHRM: tol {tol:g} needs P = {P_min} > {P_max} (§5.5 allows 2-10)")
+    return (F_min if F is None else int(F)), (P_min if P is None else int(P))
 
 
 def polar_rotate(coeffs, angles) -> np.ndarray:

@@ -117,7 +117,8 @@ def _cmd_shrm_orbit(args) -> int:
             ) from None
         raise SpecrefError(f"{args.scene}: SHRM orbits of scene files are not supported yet")
     quick = {"env_height": 16, "size": 8, "resolution": 48, "F_max": 12, "P_max": 6}
-    state = demo_state(args.env, brdf=args.brdf, **(quick if args.quick else {}))
+    orders = {"tol": args.tol, "F": args.F, "P": args.P}
+    state = demo_state(args.env, brdf=args.brdf, **(quick if args.quick else {}), **orders)
     session = RenderSession(state, cache=Cache(args.cache_dir, enabled=not args.no_cache))
     rows = render_orbit(session, args.frames, args.out)
     total = [sum(r.values()) for r in rows]
@@ -138,6 +139,9 @@ def _add_shrm_parser(sub) -> None:
     o.add_argument("--brdf", default="effect_pigment", help="isotropic BRDF of the sphere")
     o.add_argument("--env", help="lat-long environment (.hdr/.exr); default venice_sunset_1k")
     o.add_argument("--quick", action="store_true", help="small maps and images")
+    o.add_argument("--tol", type=float, default=0.01, help="order tolerance (default 0.01)")
+    o.add_argument("--F", type=int, help="lighting order (default: from --tol)")
+    o.add_argument("--P", type=int, help="view order, 2-10 (default: from --tol)")
     o.add_argument("--cache-dir", metavar="DIR", help="persistent cache folder")
     o.add_argument("--no-cache", action="store_true", help="do not use the persistent cache")
     o.set_defaults(func=_cmd_shrm_orbit)
