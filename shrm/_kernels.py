@@ -31,15 +31,16 @@ def _sectoral_next(p, e, m, sin_theta, scaled):
 
 
 @numba.njit(cache=False)
-def _column(m, L, x, p_mm, e_mm, A, B, t0, scaled, buf):
-    """buf[l - m] = λ_lm(x) for l = m..L, from λ_mm = p_mm · 2^e_mm (column recurrence)."""
+def _column(m, L, sgn, u, p_mm, e_mm, A, B, t0, scaled, buf):
+    """buf[l - m] = λ_lm(x), l = m..L, from λ_mm = p_mm 2^e_mm; x = sgn (1 - u), u = 1 - |x|."""
     p1 = p_mm
     p2 = 0.0
     e = e_mm
     buf[0] = math.ldexp(p1, e) if scaled else p1
     for l in range(m + 1, L + 1):
         # λ_lm = a_lm (x λ_{l-1,m} - b_lm λ_{l-2,m})  (b_{m+1,m} = 0, a_{m+1,m} = sqrt(2m+3))
-        p = A[t0 + l - m] * (x * p1 - B[t0 + l - m] * p2)
+        # x p = sgn (p - u p): exact near the poles, where x = cos θ is not representable
+        p = A[t0 + l - m] * (sgn * (p1 - u * p1) - B[t0 + l - m] * p2)
         p2 = p1
         p1 = p
         if scaled and abs(p1) > _BIG:
@@ -50,9 +51,9 @@ def _column(m, L, x, p_mm, e_mm, A, B, t0, scaled, buf):
 
 
 @numba.njit(cache=False)
-def legendre_table_kernel(L, x, sin_theta, A, B, scaled, out):
+def legendre_table_kernel(L, sgn, u, sin_theta, A, B, scaled, out):
     """Twin of ``shrm.sh.legendre_table``: out[t(l, m), j] = λ_lm(x_j), m-major layout."""
-    N = x.shape[0]
+    N = u.shape[0]
     buf = np.empty(L + 1)
     for j in range(N):
         p, e = _INV_SQRT_4PI, 0
@@ -60,19 +61,19 @@ def legendre_table_kernel(L, x, sin_theta, A, B, scaled, out):
         for m in range(L + 1):
             if m > 0:
                 p, e = _sectoral_next(p, e, m, sin_theta[j], scaled)
-            _column(m, L, x[j], p, e, A, B, t0, scaled, buf)
+            _column(m, L, sgn[j], u[j], p, e, A, B, t0, scaled, buf)
             for i in range(L + 1 - m):
                 out[t0 + i, j] = buf[i]
             t0 += L + 1 - m
 
 
 @numba.njit(cache=False)
-def legendre_analysis_kernel(L, x, sin_theta, w, A, B, F_cos, F_sin, scaled, out):
+def legendre_analysis_kernel(L, sgn, u, sin_theta, w, A, B, F_cos, F_sin, scaled, out):
     """Twin of ``shrm.sh.legendre_analysis``: c_lm = Σ_j w_j √2 λ_lm(θ_j) F_m(θ_j).
 
     ``F_cos, F_sin``: (L+1, H, C) ring integrals of f cos(mφ) and f sin(mφ); out: ((L+1)², C).
     """
-    H = x.shape[0]
+    H = u.shape[0]
     C = F_cos.shape[2]
     sqrt2 = math.sqrt(2.0)
     buf = np.empty(L + 1)
@@ -82,7 +83,7 @@ def legendre_analysis_kernel(L, x, sin_theta, w, A, B, F_cos, F_sin, scaled, out
         for m in range(L + 1):
             if m > 0:
                 p, e = _sectoral_next(p, e, m, sin_theta[j], scaled)
-            _column(m, L, x[j], p, e, A, B, t0, scaled, buf)
+            _column(m, L, sgn[j], u[j], p, e, A, B, t0, scaled, buf)
             t0 += L + 1 - m
             # Fejér-1 quadrature: c_lm = Σ_j w_j λ_lm(θ_j) ∫ f(θ_j, φ) √2 trig(mφ) dφ
             for l in range(m, L + 1):
@@ -98,12 +99,12 @@ def legendre_analysis_kernel(L, x, sin_theta, w, A, B, F_cos, F_sin, scaled, out
 
 
 @numba.njit(cache=False)
-def legendre_synthesis_kernel(L, x, sin_theta, A, B, coeffs, scaled, G_cos, G_sin):
+def legendre_synthesis_kernel(L, sgn, u, sin_theta, A, B, coeffs, scaled, G_cos, G_sin):
     """Twin of ``shrm.sh.legendre_synthesis``: ring Fourier amplitudes of Σ c_lm Y_lm.
 
     ``coeffs``: ((L+1)², C); ``G_cos, G_sin``: (L+1, H, C), the cos(mφ) and sin(mφ) amplitudes.
     """
-    H = x.shape[0]
+    H = u.shape[0]
     C = coeffs.shape[1]
     sqrt2 = math.sqrt(2.0)
     buf = np.empty(L + 1)
@@ -113,7 +114,7 @@ def legendre_synthesis_kernel(L, x, sin_theta, A, B, coeffs, scaled, G_cos, G_si
         for m in range(L + 1):
             if m > 0:
                 p, e = _sectoral_next(p, e, m, sin_theta[j], scaled)
-            _column(m, L, x[j], p, e, A, B, t0, scaled, buf)
+            _column(m, L, sgn[j], u[j], p, e, A, B, t0, scaled, buf)
             t0 += L + 1 - m
             for l in range(m, L + 1):
                 if m == 0:
@@ -127,9 +128,9 @@ def legendre_synthesis_kernel(L, x, sin_theta, A, B, coeffs, scaled, G_cos, G_si
 
 
 @numba.njit(cache=False)
-def sh_evaluate_kernel(L, x, sin_theta, phi, A, B, coeffs, scaled, out):
+def sh_evaluate_kernel(L, sgn, u, sin_theta, phi, A, B, coeffs, scaled, out):
     """Twin of ``shrm.sh.sh_evaluate``: out[n, c] = Σ_lm c_lm Y_lm(θ_n, φ_n) at any directions."""
-    N = x.shape[0]
+    N = u.shape[0]
     C = coeffs.shape[1]
     sqrt2 = math.sqrt(2.0)
     buf = np.empty(L + 1)
@@ -139,7 +140,7 @@ def sh_evaluate_kernel(L, x, sin_theta, phi, A, B, coeffs, scaled, out):
         for m in range(L + 1):
             if m > 0:
                 p, e = _sectoral_next(p, e, m, sin_theta[n], scaled)
-            _column(m, L, x[n], p, e, A, B, t0, scaled, buf)
+            _column(m, L, sgn[n], u[n], p, e, A, B, t0, scaled, buf)
             t0 += L + 1 - m
             # Real SH: Y_lm = √2 λ_l|m| cos(mφ) (m > 0), √2 λ_l|m| sin(|m|φ) (m < 0)
             cos_m = sqrt2 * math.cos(m * phi[n])

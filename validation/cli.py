@@ -89,6 +89,26 @@ def _cmd_brdf_check(args) -> int:
     return 0
 
 
+def _cmd_sh_project(args) -> int:
+    from shrm.files import project_file
+
+    info = project_file(args.env, args.order, args.out, args.window, args.bands, args.backend)
+    print(f"wrote {info['out']}: {info['channels']} channels to order {info['order']}")
+    return 0
+
+
+def _cmd_sh_prefilter(args) -> int:
+    from shrm.files import prefilter_file
+
+    info = prefilter_file(
+        args.env, args.kernel, args.out, args.tol, args.format, args.size, args.bands
+    )
+    print(
+        f"wrote {info['out']}: {info['kernel']} at order {info['order']} (tail {info['tail']:.2g})"
+    )
+    return 0
+
+
 def _add_brdf_parser(sub) -> None:
     p = sub.add_parser("brdf", help="tabulate isotropic BRDFs and check BRDF table files")
     brdf = p.add_subparsers(dest="brdf_command", required=True, parser_class=_Parser)
@@ -147,6 +167,28 @@ def _add_shrm_parser(sub) -> None:
     o.set_defaults(func=_cmd_shrm_orbit)
 
 
+def _add_sh_parser(sub) -> None:
+    p = sub.add_parser("sh", help="spherical harmonics: project and prefilter environment maps")
+    sh = p.add_subparsers(dest="sh_command", required=True, parser_class=_Parser)
+    q = sh.add_parser("project", help="SH coefficients of a lat-long map (.npz)")
+    q.add_argument("env", help="lat-long map, .hdr or .exr (RGB or spectral)")
+    q.add_argument("--order", type=int, required=True, help="SH order L")
+    q.add_argument("--window", default=None, help="none, hanning, lanczos, gaussian[:SIGMA]")
+    q.add_argument("--bands", choices=("spectral", "rgb"), default=None, help="convert first")
+    q.add_argument("--backend", default="ducc0", help="numpy, numba or ducc0")
+    q.add_argument("-o", "--out", required=True, help="output .npz")
+    q.set_defaults(func=_cmd_sh_project)
+    r = sh.add_parser("prefilter", help="frequency-space prefiltered cube or lat-long map (.exr)")
+    r.add_argument("env", help="lat-long map, .hdr or .exr")
+    r.add_argument("--kernel", required=True, help="lambert, phong:S or table:FILE")
+    r.add_argument("--out", required=True, help="output .exr")
+    r.add_argument("--tol", type=float, default=1e-2, help="adaptive-order tolerance")
+    r.add_argument("--format", choices=("cube", "latlong"), default="cube")
+    r.add_argument("--size", type=int, default=64, help="cube face size")
+    r.add_argument("--bands", choices=("spectral", "rgb"), default=None, help="convert first")
+    r.set_defaults(func=_cmd_sh_prefilter)
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser for all subcommands.
 
@@ -177,6 +219,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_cache_parser(sub)
     _add_brdf_parser(sub)
     _add_shrm_parser(sub)
+    _add_sh_parser(sub)
     return parser
 
 
@@ -188,6 +231,8 @@ def main(argv: list[str] | None = None) -> int:
     >>> main(["report", "--only", "no-such-section", "--out", "/tmp/specref-doctest"])
     2
     """
+    import shrm  # noqa: F401  (registers the environment-light shaders before any rendering)
+
     parser = build_parser()
     args = parser.parse_args(argv)
     try:

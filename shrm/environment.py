@@ -1,0 +1,232 @@
+"""Shading with environment light: prefiltered maps looked up per pixel (Herbert et al. §5.4).
+
+Importing ``shrm`` registers two shaders in ``reference.shading.SHADERS``:
+
+- ``LambertMaterial/EnvironmentLight``: reflected radiance ``k_d(λ) E(n, λ) / π`` with E the
+  prefiltered irradiance map (kernel ``lambert``), looked up by the normal.
+- ``PhongMaterial/EnvironmentLight``: the diffuse term above plus ``k_s(λ) S_n(λ)(r)``, the
+  prefiltered Phong map of the band's exponent n(λ) looked up by the reflected view vector
+  ``r = 2 (N·V) N − V``. The lobe is ``max(r·ω, 0)^n / π``, so that a small light of solid angle
+  Ω and radiance L_s gives exactly the highlight of a point light of intensity ``L_s Ω / π`` in the
+  point-light model (Eq. (2), Wang et al.), as the diffuse term does; in frequency space this is the
+  normalized Phong kernel times ``2 / (n + 1)``.
+
+The maps are computed in frequency space (project, scale by Λ_l, synthesize a 64×64×6 cube map per
+band), at the order :func:`shrm.prefilter.adaptive_order` picks for the tolerance, and cached per
+environment. With ``ctx.options["environment"] == "bruteforce"`` (``specref render --oracle``) each
+pixel integrates the whole map instead (:func:`shrm.prefilter.prefilter_bruteforce`).
+
+A spectral environment (one channel per band) is resampled linearly onto the scene's grid; an RGB
+one is upsampled with ``reference.upsampling`` (Mallett & Yuksel 2019 by default; option
+``ctx.options["upsampling"]``). XYZ uses the equal-energy band weights: radiance spectra carry no
+light to fold in, and a spectral radiance of 1 in every band has Y = 1.
+
+Options read from ``ctx.options``: ``environment`` (``"frequency"`` default, or ``"bruteforce"``),
+``environment_tol`` (default :data:`shrm.prefilter.DEFAULT_TOL`), ``environment_size`` (cube
+face, default 64), ``upsampling``.
+"""
+
+from __future__ import annotations
+
+import weakref
+
+import numpy as np
+
+from reference.cubemap import cubemap_lookup_bilinear, cubemap_texel_directions
+from reference.errors import require
+from reference.lights import EnvironmentLight
+from reference.materials import LambertMaterial, PhongMaterial
+from reference.registry import Method
+from reference.shading import SHADERS, Surface
+from reference.spectra import SpectralGrid
+from reference.upsampling import DEFAULT_UPSAMPLING, RGB_to_spectra
+from shrm.prefilter import (
+    DEFAULT_TOL,
+    adaptive_order,
+    kernel_phong,
+    parse_kernel,
+    prefilter_bruteforce,
+    prefilter_coefficients,
+)
+from shrm.sh import project_latlong, sh_evaluate
+
+__all__ = [
+    "environment_spectral_radiance",
+    "phong_environment_Lambda",
+    "shade_lambert_environment",
+    "shade_phong_environment",
+]
+
+_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def environment_spectral_radiance(
+    light: EnvironmentLight, grid: SpectralGrid, upsampling: str = DEFAULT_UPSAMPLING
+) -> np.ndarray:
+    """The environment's spectral radiance on ``grid``: ``(H, W, n_bands)``, times its intensity.
+
+    Spectral maps are interpolated linearly between their wavelengths (constant beyond them); RGB
+    maps are upsampled (Eq. (4), Mallett & Yuksel 2019 by default).
+
+    Examples
+    --------
+    >>> from reference.spectra import GRID_31
+    >>> env = EnvironmentLight(np.full((2, 4, 3), 0.5))
+    >>> environment_spectral_radiance(env, GRID_31).shape
+    (2, 4, 31)
+    """
+    image = light.image
+    if light.is_spectral:
+        wl = light.wavelengths_nm
+        target = grid.wavelengths_nm
+        # Linear interpolation matrix from the map's bands to the grid's bands
+        M = np.stack([np.interp(target, wl, np.eye(wl.size)[i]) for i in range(wl.size)])
+        spectra = image @ M
+    else:
+        spectra = RGB_to_spectra(image, grid, upsampling)
+    return light.intensity * spectra
+
+
+def _state(light: EnvironmentLight, ctx) -> dict:
+    key = (ctx.grid, ctx.options.get("upsampling", DEFAULT_UPSAMPLING))
+    per_light = _CACHE.setdefault(light, {})
+    if key not in per_light:
+        per_light.clear()
+        per_light[key] = {"radiance": environment_spectral_radiance(light, ctx.grid, key[1])}
+    return per_light[key]
+
+
+def phong_environment_Lambda(n, order: int) -> np.ndarray:
+    """Λ_l of the lobe ``max(t, 0)^n / π`` per band: the normalized Phong Λ_l times ``2/(n+1)``.
+
+    Eq. (7), Ramamoorthi & Hanrahan 2001 with the kernel of the module docstring.
+
+    Parameters
+    ----------
+    n : array_like, shape (n_bands,)
+        Phong exponent per band.
+    order : int
+
+    Returns
+    -------
+    ndarray, shape (n_bands, order+1)
+
+    Examples
+    --------
+    >>> phong_environment_Lambda([1.0], 1).round(6)       # ∫ max(t,0)/π dω = 1
+    array([[1.      , 0.666667]])
+    """
+    n = np.asarray(n, dtype=np.float64)
+    unique = {float(v): (2.0 / (v + 1.0)) * kernel_phong(v).Lambda(order) for v in np.unique(n)}
+    return np.stack([unique[float(v)] for v in n])
+
+
+def _frequency_map(light, ctx, name: str, kernel_order: int, Lambda) -> np.ndarray:
+    """Cached cube map (6, S, S, n_bands) of the environment prefiltered with Λ (per band)."""
+    state = _state(light, ctx)
+    size = int(ctx.options.get("environment_size", 64))
+    key = (name, kernel_order, size)
+    if key not in state:
+        coeffs = project_latlong(state["radiance"], kernel_order, backend="ducc0", where=light.name)
+        filtered = prefilter_coefficients(coeffs, Lambda)
+        state[key] = sh_evaluate(filtered, cubemap_texel_directions(size), backend="ducc0")
+    return state[key]
+
+
+def _order(light, ctx, kernel) -> int:
+    tol = float(ctx.options.get("environment_tol", DEFAULT_TOL))
+    return min(adaptive_order(kernel, tol), light.image.shape[1] // 2 - 1)
+
+
+def _irradiance(surface: Surface, light, ctx) -> np.ndarray:
+    """E(n, λ) at the surface normals, (N, n_bands)."""
+    if ctx.options.get("environment") == "bruteforce":
+        radiance = _state(light, ctx)["radiance"]
+        return prefilter_bruteforce(radiance, "lambert", surface.normal)
+    L = _order(light, ctx, "lambert")
+    cube = _frequency_map(light, ctx, "lambert", L, parse_kernel("lambert").Lambda(L))
+    return cubemap_lookup_bilinear(cube, surface.normal, backend="numba")
+
+
+def shade_lambert_environment(
+    surface: Surface, material: LambertMaterial, light: EnvironmentLight, ctx
+) -> np.ndarray:
+    """XYZ of a Lambertian material under an environment: ``k_d E(n) / π``.
+
+    Eq. (2), Herbert et al. (``I_d = E_d D``, with E_d the prefiltered Lambertian map) and Eq. (8),
+    Ramamoorthi & Hanrahan 2001 for the irradiance.
+
+    Examples
+    --------
+    >>> from reference.shading import ShadingContext
+    >>> env = EnvironmentLight(np.ones((16, 32, 3)))
+    >>> s = Surface(np.zeros((1, 3)), np.array([[0.0, 1.0, 0.0]]), np.array([[0.0, 1.0, 0.0]]),
+    ...             np.zeros((1, 2)))
+    >>> shade_lambert_environment(s, LambertMaterial(np.ones(41)), env, ShadingContext()).round(3)
+    array([[1., 1., 1.]])
+    """
+    require(surface.normal.ndim == 2, "environment shading: surface arrays must be (N, 3)")
+    # Eq. (2), Herbert et al.: I_d = E_d D, reflected radiance k_d E / π
+    spectra = material.k_d * _irradiance(surface, light, ctx) / np.pi
+    return spectra @ ctx.weights(None)
+
+
+def shade_phong_environment(
+    surface: Surface, material: PhongMaterial, light: EnvironmentLight, ctx
+) -> np.ndarray:
+    """XYZ of a spectral Phong material under an environment: diffuse map plus Phong map.
+
+    Eq. (2), Wang et al. with the light replaced by prefiltered maps: ``k_d E(N)/π + k_s S_n(r)``
+    (module docstring); Eq. (5), Herbert et al. (``I_s = E_s ...``, the specular map).
+
+    Examples
+    --------
+    >>> from reference.shading import ShadingContext
+    >>> env = EnvironmentLight(np.ones((16, 32, 3)))
+    >>> s = Surface(np.zeros((1, 3)), np.array([[0.0, 1.0, 0.0]]), np.array([[0.0, 1.0, 0.0]]),
+    ...             np.zeros((1, 2)))
+    >>> m = PhongMaterial(np.zeros(41), np.ones(41), np.ones(41))
+    >>> shade_phong_environment(s, m, env, ShadingContext()).round(3)   # ∫ cos/π dω = 1
+    array([[1., 1., 1.]])
+    """
+    N, V = surface.normal, surface.view
+    # Reflected view vector r = 2 (N·V) N − V
+    r = 2.0 * np.einsum("ij,ij->i", N, V)[:, None] * N - V
+    diffuse = material.k_d * _irradiance(surface, light, ctx) / np.pi
+    if ctx.options.get("environment") == "bruteforce":
+        radiance = _state(light, ctx)["radiance"]
+        specular = np.zeros_like(diffuse)
+        for value in np.unique(material.n):
+            bands = material.n == value
+            kernel = kernel_phong(value)
+            # The lobe max(t,0)^n/π is the normalized Phong lobe times 2/(n+1)
+            specular[:, bands] = (2.0 / (value + 1.0)) * prefilter_bruteforce(
+                radiance[..., bands], kernel, r
+            )
+    else:
+        L = max(_order(light, ctx, kernel_phong(v)) for v in np.unique(material.n))
+        Lam = phong_environment_Lambda(material.n, L)
+        name = "phong:" + ",".join(f"{v:g}" for v in material.n)
+        cube = _frequency_map(light, ctx, name, L, Lam)
+        specular = cubemap_lookup_bilinear(cube, r, backend="numba")
+    # Eq. (2), Wang et al., environment form: k_d E/π + k_s S_n(r)
+    spectra = diffuse + material.k_s * specular
+    return spectra @ ctx.weights(None)
+
+
+SHADERS.register(
+    Method(
+        "LambertMaterial/EnvironmentLight",
+        shade_lambert_environment,
+        None,
+        "Eq. (2), Herbert et al.",
+    )
+)
+SHADERS.register(
+    Method(
+        "PhongMaterial/EnvironmentLight",
+        shade_phong_environment,
+        None,
+        "Eq. (2), Wang et al.",
+    )
+)

@@ -1,0 +1,123 @@
+"""File-level SH jobs behind ``specref sh project`` and ``specref sh prefilter``.
+
+Maps are read with ``reference.images`` (``.hdr`` RGBE, ``.exr`` RGB or spectral with one channel
+per band). ``bands="spectral"`` turns an RGB map into spectra on the 41-band grid
+(``reference.upsampling``, Mallett & Yuksel 2019); ``bands="rgb"`` turns a spectral map into linear
+sRGB (equal-energy band weights); the default keeps the map as it is.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from reference.colorimetry import band_weights, spectra_to_RGB_matrix
+from reference.errors import require, require_choice
+from reference.images import read_exr, read_hdr, spectral_channel_names, write_exr
+from reference.spectra import DEFAULT_GRID
+from reference.upsampling import RGB_to_spectra
+
+__all__ = ["prefilter_file", "project_file", "read_environment"]
+
+
+def read_environment(path, bands: str | None = None) -> tuple[np.ndarray, list[str]]:
+    """Read a lat-long map and its channel names, converted to ``bands`` if given.
+
+    Raises
+    ------
+    SpecrefError
+        Unreadable file, not 2:1, NaN/inf or negative radiance, unknown ``bands``.
+
+    Examples
+    --------
+    >>> read_environment("/nonexistent.hdr")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: /nonexistent.hdr: file not found
+    """
+    from reference.envmap import check_latlong_shape
+
+    path = Path(path)
+    if path.suffix.lower() == ".exr":
+        image, names = read_exr(path)
+    else:
+        image, names = read_hdr(path), ["R", "G", "B"]
+    check_latlong_shape(image.shape, str(path))
+    require(np.isfinite(image).all(), f"{path}: radiance must be finite, found NaN or inf")
+    require((image >= 0).all(), f"{path}: radiance must be >= 0, found {image.min():g}")
+    spectral = len(names) > 3 or not set(names) <= {"R", "G", "B", "A", "Y"}
+    if bands is not None:
+        require_choice(bands, ("spectral", "rgb"), "--bands")
+    if bands == "spectral" and not spectral:
+        image = RGB_to_spectra(image[..., :3], DEFAULT_GRID)
+        names = spectral_channel_names(DEFAULT_GRID.wavelengths_nm)
+    elif bands == "rgb" and spectral:
+        require(
+            image.shape[2] == DEFAULT_GRID.n_bands,
+            f"{path}: --bands rgb needs a {DEFAULT_GRID.n_bands}-band map, got {image.shape[2]}",
+        )
+        image = image @ spectra_to_RGB_matrix(band_weights(DEFAULT_GRID, None))
+        names = ["R", "G", "B"]
+    return image, names
+
+
+def project_file(path, order: int, out, window=None, bands=None, backend: str = "ducc0") -> dict:
+    """Project a map file onto SH and save ``coeffs (C, (L+1)²)`` and metadata as ``.npz``.
+
+    §5.3, Herbert et al.; Eq. (4), Ramamoorthi & Hanrahan 2001.
+
+    Examples
+    --------
+    >>> project_file("/nonexistent.exr", 4, "/tmp/x.npz")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: /nonexistent.exr: file not found
+    """
+    import io
+
+    from reference.images import write_bytes_atomic
+    from shrm.sh import project_latlong
+
+    image, names = read_environment(path, bands)
+    coeffs = project_latlong(image, order, window=window, backend=backend, where=str(path))
+    buffer = io.BytesIO()
+    np.savez(
+        buffer,
+        coeffs=coeffs,
+        order=order,
+        channels=np.array(names),
+        window=str(window or "none"),
+        source=str(path),
+        layout="real SH, Condon-Shortley phase, index l*l+l+m (docs/conventions.md)",
+    )
+    write_bytes_atomic(out, buffer.getvalue())
+    return {"order": order, "channels": len(names), "out": str(out)}
+
+
+def prefilter_file(
+    path, kernel: str, out, tol: float = 1e-2, output: str = "cube", size: int = 64, bands=None
+) -> dict:
+    """Prefilter a map file and write the result as EXR (cube: faces stacked vertically).
+
+    §5.4, Herbert et al. The cube layout is ``(6·S, S)``: faces +x, −x, +y, −y, +z, −z from top to
+    bottom, each in the orientation of ``reference.cubemap``.
+
+    Examples
+    --------
+    >>> prefilter_file("/nonexistent.hdr", "lambert", "/tmp/x.exr")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: /nonexistent.hdr: file not found
+    """
+    from shrm.prefilter import prefilter_environment
+
+    image, names = read_environment(path, bands)
+    result = prefilter_environment(
+        image, kernel, tol=tol, output=output, size=size, where=str(path)
+    )
+    values = result.values
+    if output == "cube":
+        values = values.reshape(6 * size, size, -1)
+    write_exr(out, values, channels=names if len(names) != 3 else None)
+    return {"order": result.order, "tail": result.tail, "kernel": result.kernel, "out": str(out)}

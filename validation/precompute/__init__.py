@@ -1,0 +1,1 @@
+"""Scripts that precompute expensive oracle values into ``tests/data/*.json``."""
