@@ -11,7 +11,7 @@ export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 export MPLBACKEND ?= Agg
 
-.PHONY: install demo test bench coverage lint clean
+.PHONY: install demo test bench results coverage lint clean
 
 $(STAMP): setup.cfg pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -32,8 +32,13 @@ test: $(STAMP)
 ## make bench: run the pytest-benchmark suite and save JSON (specref report turns it into charts)
 bench: $(STAMP)
 	SPECREF_BENCH=1 $(PY) -m pytest -q tests/benchmarks --benchmark-enable \
-		--benchmark-json=bench.json --benchmark-min-rounds=3 -p no:doctest
+		--benchmark-json=bench.json --benchmark-min-rounds=3
 	$(VENV)/bin/specref report --out report --bench bench.json
+
+## make results: benchmarks, then the full report; regenerates docs/results.md and docs/results/
+results: bench
+	$(VENV)/bin/specref report --out docs/results --bench bench.json \
+		--markdown docs/results.md --markdown-image-prefix results/
 
 ## make coverage: the suite once with the JIT off, so kernel bodies count as Python
 coverage: $(STAMP)

@@ -10,6 +10,15 @@ import matplotlib
 import numpy as np
 import pytest
 
+# Import the packages (and with them every registry) once, under their package names: pytest's
+# importlib mode then finds them in sys.modules instead of executing a module a second time when a
+# test run names its file directly, which would register its methods twice.
+import phong_table  # noqa: F401
+import reference  # noqa: F401
+import shrm  # noqa: F401
+import validation.cli
+import validation.sections  # noqa: F401
+
 matplotlib.use("Agg")
 np.set_printoptions(legacy=False)
 

@@ -53,6 +53,8 @@ from reference.lights import (
     point_light_vectors,
 )
 from reference.materials import MATERIAL_TYPES, LambertMaterial, PhongMaterial, make_material
+from reference.mesh import TriangleMesh, grid_mesh, mesh_from_obj, mesh_to_obj, uv_sphere_mesh
+from reference.raster import RASTER_METHODS, pixel_coverage, rasterize_mesh
 from reference.registry import Method, Registry
 from reference.shading import (
     SHADERS,
@@ -89,6 +91,7 @@ __all__ = [
     "OBSERVERS",
     "PRIMITIVES",
     "PROJECTIONS",
+    "RASTER_METHODS",
     "SHADERS",
     "AmbientLight",
     "Camera",
@@ -107,6 +110,7 @@ __all__ = [
     "Spectrum",
     "Sphere",
     "Surface",
+    "TriangleMesh",
     "XYZ_to_Lab",
     "XYZ_to_RGB_matrix",
     "XYZ_to_display_RGB",
@@ -122,6 +126,7 @@ __all__ = [
     "display_to_linear",
     "downsample_box",
     "empty_gbuffer",
+    "grid_mesh",
     "intersect_plane",
     "intersect_sphere",
     "latlong_lookup_bilinear",
@@ -131,9 +136,13 @@ __all__ = [
     "linear_to_display",
     "make_material",
     "make_spectrum",
+    "mesh_from_obj",
+    "mesh_to_obj",
     "phong_cosines",
     "phong_spectral_exact",
+    "pixel_coverage",
     "point_light_vectors",
+    "rasterize_mesh",
     "read_exr",
     "read_hdr",
     "read_image",
@@ -148,6 +157,7 @@ __all__ = [
     "spectrum_from_csv",
     "spectrum_from_dataset",
     "to_8bit",
+    "uv_sphere_mesh",
     "white_XYZ",
     "write_exr",
     "write_png",

@@ -163,6 +163,8 @@ def _fetch(cube: np.ndarray, face, i, j):
 def cubemap_lookup_bilinear(cube, directions, backend: str = "numpy") -> np.ndarray:
     """Seamless bilinear lookup of a cube map in directions ``d``.
 
+    Eq. (1), Herbert et al. shades with such lookups of the prefiltered maps (E_x).
+
     Texels are point samples at their centres; a tap beyond a face edge is taken from the
     neighbouring face (re-projected), so lookups are continuous across edges.
 

@@ -9,7 +9,7 @@ Each primitive type registers a function in :data:`PRIMITIVES` that returns the 
 own surface; :func:`render_gbuffer` keeps, per pixel, the nearest over all objects (a z-buffer on
 camera depth).
 Analytic spheres and planes are ray cast exactly; triangle meshes are rasterized
-(``reference.raster`` registers ``"mesh"``).
+(``reference.raster`` registers ``"TriangleMesh"``).
 
 Supersampling renders the G-buffer at ``factor × factor`` the resolution; shade it, then resolve
 with ``reference.camera.downsample_box``.

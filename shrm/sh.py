@@ -286,6 +286,8 @@ def _scaled_for(order: int, method: str) -> bool:
 def legendre_table(order: int, theta, method: str = "auto", orders=None) -> np.ndarray:
     """Normalized associated Legendre functions λ_lm(cos θ) for 0 <= m <= l <= L.
 
+    Eq. (3), Ramamoorthi & Hanrahan 2001 (the θ part of the real basis).
+
     Holmes & Featherstone's sectoral and column recurrences (module docstring); the readable NumPy
     oracle, vectorized over θ. ``method="scaled"`` carries a binary exponent beside each running
     value so that ``sin^m θ`` never underflows (extended-exponent arithmetic); ``"plain"`` is the
@@ -642,11 +644,29 @@ def _ring_fourier(image: np.ndarray, L: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _project_numpy(image, L, w, method):
+    """Projection path (NumPy rFFT and Legendre sum).
+
+    Eq. (4), Ramamoorthi & Hanrahan 2001: ``c_lm = Σ_j w_j ∫ f Y_lm dφ``.
+
+    Examples
+    --------
+    >>> _project_numpy(np.ones((4, 8, 1)), 1, fejer1_weights(4), "auto")[0, 0].round(6)
+    np.float64(3.544908)
+    """
     F_cos, F_sin = _ring_fourier(image, L)
     return legendre_analysis(L, latlong_ring_angles(image.shape[0]), w, F_cos, F_sin, method)
 
 
 def _project_numba(image, L, w, method):
+    """Projection path (numba kernel).
+
+    Eq. (4), Ramamoorthi & Hanrahan 2001: ``c_lm = Σ_j w_j ∫ f Y_lm dφ``.
+
+    Examples
+    --------
+    >>> _project_numba(np.ones((4, 8, 1)), 1, fejer1_weights(4), "auto")[0, 0].round(6)
+    np.float64(3.544908)
+    """
     from shrm._kernels import legendre_analysis_kernel
 
     F_cos, F_sin = _ring_fourier(image, L)
@@ -660,6 +680,15 @@ def _project_numba(image, L, w, method):
 
 
 def _project_ducc0(image, L, w, method):
+    """Projection path (ducc0 adjoint synthesis).
+
+    Eq. (4), Ramamoorthi & Hanrahan 2001: ``c_lm = Σ_j w_j ∫ f Y_lm dφ``.
+
+    Examples
+    --------
+    >>> _project_ducc0(np.ones((4, 8, 1)), 1, fejer1_weights(4), "auto")[0, 0].round(6)
+    np.float64(3.544908)
+    """
     import ducc0
 
     W, C = image.shape[1:]

@@ -36,6 +36,7 @@ from reference.registry import Registry
 
 __all__ = [
     "REPORT_SECTIONS",
+    "Check",
     "Image",
     "ReportContext",
     "ReportSection",
@@ -72,12 +73,35 @@ class Image:
     caption: str = ""
 
 
+@dataclass(frozen=True)
+class Check:
+    """A target and the measured value that meets it or not, shown in the report's summary.
+
+    Parameters
+    ----------
+    name : str
+        What is checked, e.g. ``"FL2 mean ΔE00, 41 bands"``.
+    target : str
+        The target as text, e.g. ``"<= 0.06"`` (from the issue or the paper).
+    measured : float or str
+        The measured value.
+    passed : bool
+        Whether the target holds.
+    """
+
+    name: str
+    target: str
+    measured: float | str
+    passed: bool
+
+
 @dataclass
 class SectionResult:
-    """What a section returns: blocks to show and results to store in ``results.json``."""
+    """What a section returns: blocks to show, results for ``results.json`` and target checks."""
 
     blocks: list = field(default_factory=list)
     results: dict = field(default_factory=dict)
+    checks: list = field(default_factory=list)
 
 
 @dataclass(frozen=True)
@@ -217,6 +241,22 @@ def _render_html(
     for section, _ in sections:
         parts.append(f"<li><a href='#{esc(section.name)}'>{esc(section.title)}</a></li>")
     parts.append("</ul></nav>")
+    checks = [(s, c) for s, r in sections for c in r.checks]
+    if checks:
+        failed = sum(not c.passed for _, c in checks)
+        parts.append(
+            f"<h2>Targets</h2><p>{len(checks) - failed} of {len(checks)} targets hold"
+            + (f"; <b>{failed} do not</b>." if failed else ".")
+            + "</p><table><tr><th>section</th><th>check</th><th>target</th><th>measured</th>"
+            "<th>holds</th></tr>"
+        )
+        for section, c in checks:
+            mark = "yes" if c.passed else "<b>NO</b>"
+            parts.append(
+                f"<tr><td>{esc(section.title)}</td><td>{esc(c.name)}</td><td>{esc(c.target)}</td>"
+                f"<td>{esc(_cell(c.measured, '{:.4g}'))}</td><td>{mark}</td></tr>"
+            )
+        parts.append("</table>")
     for section, result in sections:
         parts.append(f"<section id='{esc(section.name)}'><h2>{esc(section.title)}</h2>")
         for block in result.blocks:
@@ -254,6 +294,16 @@ def _render_markdown(title: str, meta: dict, sections, image_prefix: str) -> str
         ", ".join(f"{k}: {v}" for k, v in meta.items()),
         "",
     ]
+    checks = [(s, c) for s, r in sections for c in r.checks]
+    if checks:
+        failed = sum(not c.passed for _, c in checks)
+        lines += ["## Targets", "", f"{len(checks) - failed} of {len(checks)} targets hold.", ""]
+        lines += ["| section | check | target | measured | holds |", "|---|---|---|---|---|"]
+        for section, c in checks:
+            measured = _cell(c.measured, "{:.4g}")
+            holds = "yes" if c.passed else "**NO**"
+            lines.append(f"| {section.title} | {c.name} | {c.target} | {measured} | {holds} |")
+        lines.append("")
     for section, result in sections:
         lines += [f"## {section.title}", ""]
         for block in result.blocks:
@@ -347,7 +397,7 @@ def run_report(
         "benchmarks": str(bench_json) if bench_json else "none (run make bench)",
     }
     done: list[tuple[ReportSection, SectionResult]] = []
-    results: dict = {"meta": meta, "sections": {}}
+    results: dict = {"meta": meta, "checks": [], "sections": {}}
     bar = tqdm(
         sections, desc="specref report", unit="section", file=sys.stderr, disable=not progress
     )
@@ -359,6 +409,8 @@ def run_report(
         result.results.setdefault("section_seconds", time.perf_counter() - start)
         done.append((section, result))
         results["sections"][section.name] = to_jsonable(result.results)
+        for c in result.checks:
+            results["checks"].append(to_jsonable({"section": section.name, **c.__dict__}))
     title = "specref report"
     write_text_atomic(out_dir / "index.html", _render_html(title, meta, done))
     write_text_atomic(out_dir / "results.json", json.dumps(results, indent=1, sort_keys=False))

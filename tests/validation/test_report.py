@@ -6,6 +6,7 @@ import pytest
 from reference.errors import SpecrefError
 from validation.report import (
     REPORT_SECTIONS,
+    Check,
     ReportContext,
     ReportSection,
     SectionResult,
@@ -57,7 +58,8 @@ def test_registered_section_renders_blocks(tmp_path):
             Table(["x", "y", "z"], rows, "T"),
             ctx.image("img", np.ones((2, 2, 3))),
         ]
-        return SectionResult(blocks, {"value": np.float64(2.5), "arr": np.arange(2)})
+        checks = [Check("a", "<= 1", 0.5, True), Check("b", "<= 1", 2.0, False)]
+        return SectionResult(blocks, {"value": np.float64(2.5), "arr": np.arange(2)}, checks)
 
     REPORT_SECTIONS.register(ReportSection("test-only", "Test only", 999, run))
     try:
@@ -72,6 +74,8 @@ def test_registered_section_renders_blocks(tmp_path):
     assert "<td>1.235</td>" in html
     assert "<td>—</td>" in html
     assert (tmp_path / "images" / "test-only-img.png").is_file()
+    assert "1 of 2 targets hold; <b>1 do not</b>" in html
+    assert [c["passed"] for c in results["checks"]] == [True, False]
 
 
 def test_bench_groups_filters_by_prefix():
