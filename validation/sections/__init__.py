@@ -3,4 +3,4 @@
 Each module registers one section. A new section is a new module plus one import line here.
 """
 
-from validation.sections import raster, spectral  # noqa: F401
+from validation.sections import raster, shrm, spectral  # noqa: F401

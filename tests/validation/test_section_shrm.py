@@ -1,0 +1,26 @@
+import json
+
+from validation.report import run_report
+from validation.sections.shrm import SUITE
+
+
+def test_shrm_section_quick(tmp_path):
+    results = run_report(tmp_path, quick=True, only=["shrm"], progress=False)["sections"]["shrm"]
+    for name in SUITE:
+        entry = results[name]
+        assert 0 <= entry["max_error"] < 1
+        assert entry["frame"] in ("normal", "reflection")
+        assert 2 <= entry["P"] <= 10
+    creation = results["creation"]
+    assert creation["angular_seconds"] > 0
+    assert creation["ratio"] == creation["angular_seconds"] / creation["frequency_seconds"]
+    assert results["extraction"]["ratio"] > 0
+    orbit = results["orbit"]["seconds"]
+    # The first frame creates the maps; later frames run only gbuffer, extract and shade.
+    names = results["orbit"]["stages"]
+    later = {names[k] for row in orbit[1:] for k, t in enumerate(row[:-1]) if t > 0}
+    assert later <= {"gbuffer", "extract", "shade"}
+    html = (tmp_path / "index.html").read_text()
+    assert "SHRMs" in html
+    assert (tmp_path / "images" / "shrm-error-vs-P.png").is_file()
+    json.dumps(results)
