@@ -1,5 +1,7 @@
 import json
 
+import pytest
+
 from validation.report import run_report
 from validation.sections.shrm import SUITE
 
@@ -24,3 +26,33 @@ def test_shrm_section_quick(tmp_path):
     assert "SHRMs" in html
     assert (tmp_path / "images" / "shrm-error-vs-P.png").is_file()
     json.dumps(results)
+
+
+@pytest.fixture(scope="module")
+def full_study(tmp_path_factory):
+    # The full study of the report (64×128 environment, 48² image; F, P, size and frame swept).
+    folder = tmp_path_factory.mktemp("shrm-full")
+    return run_report(folder, quick=False, only=["shrm"], progress=False)["sections"]["shrm"]
+
+
+@pytest.mark.xslow
+@pytest.mark.parametrize(
+    "name",
+    [
+        pytest.param(
+            name,
+            marks=pytest.mark.xfail(
+                strict=True,
+                reason="P <= 10 (§5.5) leaves 1.1-2.2 % at grazing pixels for this lobe; see the "
+                "limits in docs/shrm.md",
+            ),
+        )
+        if name != "lafortune"
+        else name
+        for name in SUITE
+    ],
+)
+def test_cheapest_setting_meets_one_percent_of_peak(full_study, name):
+    # The target: some setting renders within 1 % of the per-pixel brute-force render's peak.
+    entry = full_study[name]
+    assert entry["cheapest_under_tolerance"], entry["max_error"]
