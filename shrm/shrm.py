@@ -10,10 +10,10 @@ Environment Map Rendering"), with one change of bookkeeping noted below.
 **Reflected radiance.** A texel holds the radiance ``B(n, v)`` leaving a surface whose *index
 direction* is ``n`` towards the viewer ``v``:
 
-    B(n, v) = ∫ L(ω) ρ̃(R_nᵀ ω, R_nᵀ v) dω,                                       (Eq. (1), R&H 2002)
+    B(n, v) = ∫ L(ω) ρ̃(R_nᵀ ω, R_nᵀ v) dω        (the reflection equation, R&H 2002)
 
 where ``R_n`` rotates the local polar axis (+y) to ``n`` and ``ρ̃`` is the *transfer function*, the
-BRDF times the cosine. Two frames (R&H 2002, §3.2, "reparameterization"):
+BRDF times the cosine. Two frames (R&H 2002, "reparameterization"):
 
 - ``frame="normal"``: ``n`` is the surface normal; ``ρ̃(ω_i, ω_o) = f(ω_i, ω_o; y) max(0, ω_i·y)``.
 - ``frame="reflection"``: ``n`` is the reflection vector ``r = 2(N·v)N − v`` of the surface normal
@@ -30,14 +30,14 @@ expansion ``ρ̃ = Σ ρ_{lm,pq} Y_lm(ω_i) Y_pq(ω_o)`` has ``ρ_{lm,pq} = δ_m
 
     ρ_{lpm} = 2π ∫∫∫ ρ̃(θ_i, θ_o, Δφ) cos(mΔφ) λ_lm(cos θ_i) λ_pm(cos θ_o) dcos θ_i dcos θ_o dΔφ
 
-(Eq. (9), R&H 2002, in specref's real basis; ``λ_lm`` are the normalized Legendre functions of
-``shrm.sh``). :func:`brdf_sh_coefficients` computes it by composite Gauss–Legendre quadrature in
+(R&H 2002, the isotropic BRDF coefficients, in specref's real basis; ``λ_lm`` are the normalized
+Legendre functions of ``shrm.sh``). :func:`brdf_sh_coefficients` computes it by composite Gauss–Legendre quadrature in
 ``cos θ_i`` and ``cos θ_o`` and the trapezoid rule in Δφ. The orders F (lighting) and P (view) come
 from a tolerance on the coefficients' tails (:func:`choose_orders`).
 
 **Frequency-space creation** (:func:`shrm_create`). With the lighting ``L_lm`` rotated into the
-texel's frame, ``B^loc_pq(n) = Σ_l ρ_{lp|q|} [D(R_nᵀ) L]_lq`` (Eq. (12), R&H 2002). specref then
-rotates the view expansion back to world axes, ``B_pq(n) = [D(R_n) B^loc(n)]_pq``: the texel's
+texel's frame, ``B^loc_pq(n) = Σ_l ρ_{lp|q|} [D(R_nᵀ) L]_lq`` (R&H 2002, the SHRM coefficients).
+specref then rotates the view expansion back to world axes, ``B_pq(n) = [D(R_n) B^loc(n)]_pq``: the texel's
 own frame (whose twist about ``n`` is arbitrary) drops out, so neighbouring texels can be filtered
 bilinearly and extraction needs one set of ``Y_pq(v)`` for the whole map. ``B_pq(n)`` is a
 band-limited function of ``n`` (degree ≤ F + P), so specref evaluates it on a Fejér-1 lat-long
@@ -112,7 +112,7 @@ def _dot(a, b):
 def transfer_function(brdf, params: dict, wi, wo, frame: str = "reflection") -> np.ndarray:
     """The transfer function ρ̃ = BRDF × cosine in a texel's local frame (polar axis +y).
 
-    Eq. (1), R&H 2002 (the integrand of the reflection equation), in the frame of the module
+    The integrand of the reflection equation (R&H 2002), in the frame of the module
     docstring; views below the horizon are mirrored above it.
 
     Parameters
@@ -176,7 +176,8 @@ def brdf_sh_coefficients(
 ) -> np.ndarray:
     """The isotropic BRDF's double SH coefficients ``ρ_{lpm}`` (lighting l ≤ F, view p ≤ P).
 
-    Eq. (9), R&H 2002: ``ρ_{lpm} = 2π ∫∫∫ ρ̃ cos(mΔφ) λ_lm(cos θ_i) λ_pm(cos θ_o)`` over
+    R&H 2002, the isotropic BRDF coefficients:
+    ``ρ_{lpm} = 2π ∫∫∫ ρ̃ cos(mΔφ) λ_lm(cos θ_i) λ_pm(cos θ_o)`` over
     ``cos θ_i, cos θ_o ∈ [−1, 1]`` and ``Δφ ∈ [0, 2π)``.
 
     Parameters
@@ -239,7 +240,7 @@ def brdf_sh_coefficients(
         values = transfer_function(brdf, params, wi_dir, np.broadcast_to(wo_a, wi_dir.shape), frame)
         if rho is None:
             rho = np.zeros((values.shape[-1], F + 1, P + 1, M + 1))
-        # Eq. (9), R&H 2002: the Δφ moments, then the θ_i and θ_o sums
+        # R&H 2002, the isotropic BRDF coefficients: the Δφ moments, then the θ_i and θ_o sums
         moments = np.einsum("ijc,mj->mic", values, cos_m_phi) * w_i[None, :, None]
         for m in range(M + 1):
             # 2π ∫ λ_lm(θ_i) λ_pm(θ_o) · moment
@@ -251,7 +252,8 @@ def brdf_sh_coefficients(
 def choose_orders(rho: np.ndarray, tol: float) -> tuple[int, int]:
     """The smallest orders (F, P) whose coefficient tails are below ``tol`` (relative, L2).
 
-    Eq. (9), R&H 2002 (the coefficients). ``tail_F = sqrt(Σ_{l>F} |ρ_l|² / Σ |ρ|²)`` with
+    R&H 2002, the isotropic BRDF coefficients.
+    ``tail_F = sqrt(Σ_{l>F} |ρ_l|² / Σ |ρ|²)`` with
     ``|ρ_l|²`` summed over p, m (twice for m > 0, which stands for ±m) and bands; likewise for P.
     P is at least 2 and both at most what ``rho`` holds.
 
@@ -298,7 +300,7 @@ def choose_orders(rho: np.ndarray, tol: float) -> tuple[int, int]:
 def shrm_orders(rho: np.ndarray, tol: float, F: int | None = None, P: int | None = None):
     """Orders (F, P) for a tolerance, or a check that requested orders meet it.
 
-    Eq. (9), R&H 2002 (the coefficient tails of :func:`choose_orders`). P must lie in
+    R&H 2002, the isotropic BRDF coefficients (their tails, :func:`choose_orders`). P must lie in
     :data:`P_RANGE` (§5.5, Herbert et al.: "between 2 and 10") and neither order may be below what
     ``tol`` requires or above what ``rho`` holds.
 
@@ -435,7 +437,8 @@ def shrm_create(
 ) -> SHRM:
     """Create a SHRM in frequency space from lighting and BRDF coefficients.
 
-    Eq. (12), R&H 2002: ``B^loc_pq(n) = Σ_l ρ_{lp|q|} [D(R_nᵀ) L]_lq``, rotated to world axes,
+    R&H 2002, the SHRM coefficients: ``B^loc_pq(n) = Σ_l ρ_{lp|q|} [D(R_nᵀ) L]_lq``, rotated to
+    world axes,
     evaluated on a Fejér-1 grid (an FFT over φ per row), projected onto SH of degree F + P and
     synthesized at the cube-map texels (module docstring).
 
@@ -512,7 +515,7 @@ def shrm_create(
                 rows[:, None, :, l + mp] * c_l[None, :, None, l - mp]
                 - rows[:, None, :, l - mp] * c_l[None, :, None, l + mp]
             )
-        # Eq. (12), R&H 2002: Σ_l ρ_{lp|q|} (D(R_nᵀ) L)_lq
+        # R&H 2002, the SHRM coefficients: Σ_l ρ_{lp|q|} (D(R_nᵀ) L)_lq
         r = rho[:, l][:, :, np.abs(qs)]  # (C, P+1, nq)
         A_cos[:, :, :, qs + qmax, : l + 1] += r[None, ..., None] * u[:, :, None]
         A_sin[:, :, :, qs + qmax, : l + 1] += r[None, ..., None] * v[:, :, None]
@@ -541,7 +544,7 @@ def shrm_create(
 def shrm_extract(shrm: SHRM, view) -> np.ndarray:
     """A reflection map for one (distant) viewpoint: ``E_v(n) = Σ_pq B_pq(n) Y_pq(v)``.
 
-    §5.6, Herbert et al.; Eq. (13), R&H 2002.
+    §5.6, Herbert et al.; R&H 2002, SHRM evaluation.
 
     Parameters
     ----------
@@ -571,7 +574,7 @@ def _index_directions(frame: str, normal, view) -> np.ndarray:
     """The texel direction a pixel reads: its normal, or the reflection of the view about it."""
     if frame == "normal":
         return normal
-    # R&H 2002 §3.2: r = 2 (N·v) N − v
+    # R&H 2002, reparameterization: r = 2 (N·v) N − v
     return 2.0 * _dot(normal, view)[..., None] * normal - view
 
 
@@ -652,7 +655,8 @@ def _reflected_bruteforce(brdf, params, frame, index, views, env, chunk=4096):
 def shrm_create_angular(image, brdf, params: dict, P: int, frame: str = "reflection", size=8):
     """The oracle: SHRM texels by brute-force angular integration, projected onto ``Y_pq``.
 
-    Eq. (1), R&H 2002 at every texel n and every view v of a Fejér-1 grid of ``2P + 2`` rows:
+    The reflection equation (R&H 2002) at every texel n and every view v of a Fejér-1 grid of
+    ``2P + 2`` rows:
     ``B(n, v) = Σ_pixels L(ω) ρ̃ w`` (the environment's own quadrature weights), then
     ``B_pq(n) = ∫ B(n, v) Y_pq(v) dv`` (``shrm.sh.project_latlong``). Quadratic per texel.
 
@@ -699,7 +703,7 @@ def shrm_create_angular(image, brdf, params: dict, P: int, frame: str = "reflect
 def render_bruteforce(gbuffer, image, brdf, params: dict, view, material_id: int = 0):
     """The per-pixel oracle: every pixel integrates BRDF × environment over all map pixels.
 
-    The reflection equation, Eq. (1), R&H 2002, with a distant viewer ``v`` and the environment's
+    The reflection equation (R&H 2002), with a distant viewer ``v`` and the environment's
     Fejér-1 × uniform-φ quadrature.
 
     Parameters
