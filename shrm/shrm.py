@@ -31,20 +31,20 @@ expansion ``ρ̃ = Σ ρ_{lm,pq} Y_lm(ω_i) Y_pq(ω_o)`` has ``ρ_{lm,pq} = δ_m
     ρ_{lpm} = 2π ∫∫∫ ρ̃(θ_i, θ_o, Δφ) cos(mΔφ) λ_lm(cos θ_i) λ_pm(cos θ_o) dcos θ_i dcos θ_o dΔφ
 
 (R&H 2002, the isotropic BRDF coefficients, in specref's real basis; ``λ_lm`` are the normalized
-Legendre functions of ``shrm.sh``). :func:`brdf_sh_coefficients` computes it by composite Gauss–Legendre quadrature in
-``cos θ_i`` and ``cos θ_o`` and the trapezoid rule in Δφ. The orders F (lighting) and P (view) come
-from a tolerance on the coefficients' tails (:func:`choose_orders`).
+Legendre functions of ``shrm.sh``). :func:`brdf_sh_coefficients` computes it by composite
+Gauss–Legendre quadrature in ``cos θ_i`` and ``cos θ_o`` and the trapezoid rule in Δφ. The orders F
+(lighting) and P (view) come from a tolerance on the coefficients' tails (:func:`choose_orders`).
 
 **Frequency-space creation** (:func:`shrm_create`). With the lighting ``L_lm`` rotated into the
 texel's frame, ``B^loc_pq(n) = Σ_l ρ_{lp|q|} [D(R_nᵀ) L]_lq`` (R&H 2002, the SHRM coefficients).
-specref then rotates the view expansion back to world axes, ``B_pq(n) = [D(R_n) B^loc(n)]_pq``: the texel's
-own frame (whose twist about ``n`` is arbitrary) drops out, so neighbouring texels can be filtered
-bilinearly and extraction needs one set of ``Y_pq(v)`` for the whole map. ``B_pq(n)`` is a
-band-limited function of ``n`` (degree ≤ F + P), so specref evaluates it on a Fejér-1 lat-long
-grid, where ``R_n = R_y(−φ) R_x(−θ)`` factors into a rotation per row and a rotation about the
-pole per column (an FFT over φ), projects it onto SH exactly and synthesizes it at the cube-map
-texels (ducc0). Rotations use the Wigner-D blocks of ``shrm.rotation`` through the identity
-``R_x(θ) = Qᵀ R_y(θ) Q`` (Q a fixed quarter turn), so only rotations about the pole vary per row.
+specref then rotates the view expansion back to world axes, ``B_pq(n) = [D(R_n) B^loc(n)]_pq``: the
+texel's own frame (whose twist about ``n`` is arbitrary) drops out, so neighbouring texels can be
+filtered bilinearly and extraction needs one set of ``Y_pq(v)`` for the whole map. ``B_pq(n)`` is a
+band-limited function of ``n`` (degree ≤ F + P), so specref evaluates it on a Fejér-1 lat-long grid,
+where ``R_n = R_y(−φ) R_x(−θ)`` factors into a rotation per row and a rotation about the pole per
+column (an FFT over φ), projects it onto SH exactly and synthesizes it at the cube-map texels
+(ducc0). Rotations use the Wigner-D blocks of ``shrm.rotation`` through the identity ``R_x(θ) = Qᵀ
+R_y(θ) Q`` (Q a fixed quarter turn), so only rotations about the pole vary per row.
 
 **Extraction** (:func:`shrm_extract`, §5.6, Herbert et al.): ``E_v(n) = Σ_pq B_pq(n) Y_pq(v)``,
 one dot product per texel. **Rendering** (:func:`render_shrm`): each G-buffer pixel looks up
