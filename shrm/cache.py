@@ -7,9 +7,10 @@ map reuse." specref's scheme:
   name and code version, and every input (arrays by dtype, shape and bytes; parameters by
   canonical JSON). A change to any input misses; nothing else does.
 - **Entries.** One file ``<key>.specref`` per entry: the magic ``SPECREF-CACHE`` and a newline,
-  a format version, the header length, a BLAKE2b-256 checksum of everything after it, a JSON
-  header (key, step, code version, payload size) and the payload (an ``.npz`` of named arrays, read
-  without pickle).
+  a format version, the header length, a SHA-256 checksum of everything after it, a JSON
+  header (key, metadata, and the name, dtype, shape and offset of each array) and the payload: the
+  arrays' raw bytes, 64-byte aligned. A hit maps them without copies (read-only arrays) and no
+  pickle is ever involved.
 - **Atomic writes.** An entry is written to a temporary file in the cache folder, synced and renamed
   into place (:func:`reference.images.atomic_write`). A writer killed at any point leaves either no
   entry or a whole one. Two processes writing the same key both succeed; the last rename wins and
@@ -35,7 +36,6 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
-import io
 import json
 import os
 import struct
@@ -63,11 +63,11 @@ __all__ = [
 #: The first bytes of every entry; a file without them is not ours and is never deleted.
 CACHE_MAGIC = b"SPECREF-CACHE\n"
 #: Entry layout version (bumped when the layout changes; older entries are then rebuilt).
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 #: Default size limit of the cache folder, bytes (overridden by ``SPECREF_CACHE_MAX_BYTES``).
 DEFAULT_MAX_BYTES = 2 * 1024**3
 _SUFFIX = ".specref"
-_PREFIX = struct.Struct("<II32s")  # format version, header length, BLAKE2b-256 of the rest
+_PREFIX = struct.Struct("<II32s")  # format version, header length, SHA-256 of the rest
 _HEAD = len(CACHE_MAGIC) + _PREFIX.size
 #: A leftover temporary file older than this (s) belongs to a writer that died; ``clear`` and
 #: eviction remove it if it carries our magic.
@@ -217,10 +217,22 @@ class CacheInfo:
     foreign: list
 
 
-def _encode_payload(arrays: Mapping[str, np.ndarray]) -> bytes:
-    buffer = io.BytesIO()
-    np.savez(buffer, **{str(k): np.asarray(v) for k, v in arrays.items()})
-    return buffer.getvalue()
+def _encode_payload(arrays: Mapping[str, np.ndarray]) -> tuple[list, bytes]:
+    """The arrays' manifest (name, dtype, shape, offset) and their raw bytes, 64-byte aligned."""
+    manifest, chunks, offset = [], [], 0
+    for name, value in arrays.items():
+        array = np.ascontiguousarray(value)
+        require(
+            array.dtype.kind in "biufc",
+            f"cache entry: array {name!r}: must be numeric, got dtype {array.dtype}",
+        )
+        pad = -offset % 64
+        chunks.append(b"\0" * pad)
+        offset += pad
+        manifest.append([str(name), array.dtype.str, list(array.shape), offset])
+        chunks.append(array.tobytes())
+        offset += array.nbytes
+    return manifest, b"".join(chunks)
 
 
 class _CorruptError(Exception):
@@ -320,18 +332,25 @@ class Cache:
         if len(data) < _HEAD:
             raise _CorruptError(f"truncated entry ({len(data)} bytes)")
         version, header_len, digest = _PREFIX.unpack_from(data, len(CACHE_MAGIC))
-        rest = data[_HEAD:]
-        if hashlib.blake2b(rest, digest_size=32).digest() != digest:
+        rest = memoryview(data)[_HEAD:]
+        if hashlib.sha256(rest).digest() != digest:
             raise _CorruptError("checksum mismatch (corrupted or truncated entry)")
         if version != FORMAT_VERSION:
             raise _CorruptError(f"entry format version {version}, expected {FORMAT_VERSION}")
         try:
-            header = json.loads(rest[:header_len].decode("utf-8"))
-            payload = rest[header_len:]
-            if len(payload) != header["payload_bytes"]:
+            header = json.loads(bytes(rest[:header_len]).decode("utf-8"))
+            start = _HEAD + header_len
+            if len(data) - start != header["payload_bytes"]:
                 raise _CorruptError("payload size does not match the header")
-            with np.load(io.BytesIO(payload), allow_pickle=False) as npz:
-                arrays = {name: npz[name] for name in npz.files}
+            arrays = {}
+            for name, dtype, shape, offset in header["arrays"]:
+                dtype = np.dtype(dtype)
+                if dtype.kind not in "biufc":
+                    raise _CorruptError(f"array {name!r} has dtype {dtype}")
+                count = int(np.prod(shape, dtype=np.int64))
+                # A read-only view of the file's bytes: no copy.
+                array = np.frombuffer(data, dtype, count, start + offset).reshape(shape)
+                arrays[name] = array
         except _CorruptError:
             raise
         except Exception as error:  # any decoding failure means a bad entry
@@ -339,7 +358,7 @@ class Cache:
         return header, arrays
 
     def get(self, key: str) -> dict | None:
-        """The arrays stored under ``key``, or None (a miss).
+        """The arrays stored under ``key`` (read-only views), or None (a miss).
 
         A corrupted entry is reported once, deleted and reported as a miss; a foreign or unreadable
         file is reported once and left alone.
@@ -400,18 +419,19 @@ class Cache:
                 return False
             except (_CorruptError, FileNotFoundError):
                 pass
-        payload = _encode_payload(arrays)
+        manifest, payload = _encode_payload(arrays)
         header = json.dumps(
             {
                 "key": key,
                 "created_ms": int(time.time() * 1000),
                 "payload_bytes": len(payload),
+                "arrays": manifest,
                 "meta": dict(meta or {}),
             },
             sort_keys=True,
             default=str,
         ).encode("utf-8")
-        rest_digest = hashlib.blake2b(header + payload, digest_size=32).digest()
+        rest_digest = hashlib.sha256(header + payload).digest()
         prefix = CACHE_MAGIC + _PREFIX.pack(FORMAT_VERSION, len(header), rest_digest)
         with atomic_write(path, "wb") as handle:
             handle.write(prefix + header)

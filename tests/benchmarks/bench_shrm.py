@@ -3,7 +3,7 @@
 Groups:
 
 - ``shrm-create-<brdf>``: SHRM creation in frequency space against the angular oracle (baseline),
-  same environment (64×128 RGB), same texels (2²×6), same P; the error of each against per-pixel
+  same environment (32×64 RGB), same texels (4²×6), same P; the error of each against per-pixel
   brute force at those texels is recorded in ``extra_info`` (target: frequency ≥ 100× faster at
   equal or smaller error);
 - ``shrm-extract``: extraction of a reflection map for a new viewpoint against creation of the
@@ -33,14 +33,14 @@ from shrm.shrm import (
 from validation.sections.shrm import SUITE
 
 ROOT = Path(__file__).resolve().parents[2]
-P, F, SMALL = 6, 24, 2
+P, F, SMALL = 6, 24, 4
 VIEW = np.array([0.3, 0.4, 0.866]) / np.linalg.norm([0.3, 0.4, 0.866])
 
 
 @pytest.fixture(scope="module")
 def env():
     image = read_image(ROOT.parent / "shared/data/environments/venice_sunset_1k.hdr")
-    return downsample_box(image, image.shape[0] // 64)
+    return downsample_box(image, image.shape[0] // 32)
 
 
 def _params(name):
