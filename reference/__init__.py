@@ -4,6 +4,9 @@ Users write ``reference.band_weights``, ``reference.Camera``; the modules hold t
 their citations. ``reference`` imports none of ``phong_table``, ``shrm`` or ``validation``.
 """
 
+import reference.brdf_isotropic
+import reference.brdf_table
+import reference.thinfilm  # noqa: F401  (registers the effect pigment)
 from reference.camera import MAX_RESOLUTION, PROJECTIONS, Camera, downsample_box
 from reference.colorchecker import ColorCheckerMaterial, colorchecker_material
 from reference.colorimetry import (

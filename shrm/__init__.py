@@ -5,6 +5,7 @@ Importing ``shrm`` registers the environment-light shaders in ``reference.shadin
 """
 
 from shrm import environment  # noqa: F401  (registers the environment-light shaders)
+from shrm.cache import Cache, cache_key, default_cache_dir
 from shrm.prefilter import (
     PREFILTER_KERNELS,
     adaptive_order,
@@ -14,23 +15,44 @@ from shrm.prefilter import (
     prefilter_environment,
 )
 from shrm.rotation import rotate_coefficients, rotation_matrix, sh_rotation_blocks
+from shrm.session import HERBERT_STAGES, RenderSession, render_orbit
 from shrm.sh import SH_MAX_ORDER, sh_basis, sh_evaluate, sh_index
+from shrm.shrm import (
+    SHRM,
+    brdf_sh_coefficients,
+    render_bruteforce,
+    render_shrm,
+    shrm_create,
+    shrm_create_angular,
+    shrm_extract,
+    shrm_orders,
+)
 from shrm.transform import SH_BACKENDS, project_function, project_latlong, synthesize_latlong
 from shrm.windows import WINDOWS, apply_window, ringing_statistics
 
 __all__ = [
+    "HERBERT_STAGES",
     "PREFILTER_KERNELS",
+    "SHRM",
     "SH_BACKENDS",
     "SH_MAX_ORDER",
     "WINDOWS",
+    "Cache",
+    "RenderSession",
     "adaptive_order",
     "apply_window",
+    "brdf_sh_coefficients",
+    "cache_key",
+    "default_cache_dir",
     "parse_kernel",
     "prefilter_bruteforce",
     "prefilter_coefficients",
     "prefilter_environment",
     "project_function",
     "project_latlong",
+    "render_bruteforce",
+    "render_orbit",
+    "render_shrm",
     "ringing_statistics",
     "rotate_coefficients",
     "rotation_matrix",
@@ -38,5 +60,9 @@ __all__ = [
     "sh_evaluate",
     "sh_index",
     "sh_rotation_blocks",
+    "shrm_create",
+    "shrm_create_angular",
+    "shrm_extract",
+    "shrm_orders",
     "synthesize_latlong",
 ]

@@ -10,6 +10,8 @@ from __future__ import annotations
 import argparse
 import sys
 
+import numpy as np
+
 from reference.errors import SpecrefError
 
 __all__ = ["build_parser", "main"]
@@ -60,6 +62,56 @@ def _cmd_render(args) -> int:
     return 0
 
 
+def _cmd_cache(args) -> int:
+    from shrm.cache import Cache
+
+    cache = Cache(args.cache_dir)
+    if args.action == "clear":
+        count = cache.clear()
+        print(f"deleted {count} entries from {cache.directory}")
+        return 0
+    info = cache.info()
+    print(f"location: {info.directory}")
+    size, limit = info.total_bytes / 1e6, info.max_bytes / 1e6
+    print(f"entries: {info.entries} ({size:.1f} MB of {limit:.0f} MB)")
+    if info.foreign:
+        print(f"foreign files (ignored, never deleted): {', '.join(info.foreign)}")
+    return 0
+
+
+def _add_cache_parser(sub) -> None:
+    p = sub.add_parser("cache", help="inspect or empty the persistent map cache")
+    p.add_argument("action", choices=["info", "clear"], help="show the cache or delete its entries")
+    p.add_argument(
+        "--cache-dir",
+        metavar="DIR",
+        help="cache folder (default: $SPECREF_CACHE_DIR, else $XDG_CACHE_HOME/specref, else "
+        "~/.cache/specref)",
+    )
+    p.set_defaults(func=_cmd_cache)
+
+
+def _cmd_brdf_tabulate(args) -> int:
+    from reference.brdf_table import tabulate_registered_brdf, write_brdf_table
+
+    table = tabulate_registered_brdf(args.model, args.theta_step, args.phi_step)
+    write_brdf_table(args.out, table, {"source": f"specref brdf tabulate {args.model}"})
+    print(f"wrote {args.out}: {table.values.shape[:3]} angles x {table.n_bands} bands")
+    return 0
+
+
+def _cmd_brdf_check(args) -> int:
+    from reference.brdf_table import read_brdf_table
+
+    t = read_brdf_table(args.file)
+    print(
+        f"{args.file}: {t.theta_i_deg.size} theta_i x {t.theta_o_deg.size} theta_s x "
+        f"{t.phi_d_deg.size} phi_s, {t.n_bands} wavelengths "
+        f"({t.wavelengths_nm[0]:g}-{t.wavelengths_nm[-1]:g} nm), BRDF max {t.values.max():.4g} 1/sr"
+    )
+    return 0
+
+
 def _cmd_sh_project(args) -> int:
     from shrm.files import project_file
 
@@ -104,6 +156,64 @@ def _add_render_parser(sub) -> None:
         '"bruteforce"), the reference the SH engine is checked against; slow',
     )
     p.set_defaults(func=_cmd_render)
+
+
+def _add_brdf_parser(sub) -> None:
+    p = sub.add_parser("brdf", help="tabulate isotropic BRDFs and check BRDF table files")
+    brdf = p.add_subparsers(dest="brdf_command", required=True, parser_class=_Parser)
+    t = brdf.add_parser("tabulate", help="tabulate a registered BRDF (docs/brdf-format.md)")
+    t.add_argument("model", help="a key of reference.brdf.BRDF_METHODS, e.g. ggx")
+    t.add_argument("-o", "--out", required=True, help="output text file")
+    t.add_argument("--theta-step", type=float, default=5.0, help="polar step, degrees")
+    t.add_argument("--phi-step", type=float, default=15.0, help="azimuth step, degrees")
+    t.set_defaults(func=_cmd_brdf_tabulate)
+    c = brdf.add_parser("check", help="read a BRDF table file and summarize it")
+    c.add_argument("file")
+    c.set_defaults(func=_cmd_brdf_check)
+
+
+def _cmd_shrm_orbit(args) -> int:
+    from shrm.cache import Cache
+    from shrm.session import RenderSession, demo_state, render_orbit
+
+    if args.scene is not None:
+        try:
+            from reference.scene import load_scene  # noqa: F401  (branch 'scenes')
+        except ImportError:
+            raise SpecrefError(
+                f"{args.scene}: scene files need reference.scene, which this build does not have "
+                "yet; omit SCENE to orbit the built-in scene"
+            ) from None
+        raise SpecrefError(f"{args.scene}: SHRM orbits of scene files are not supported yet")
+    quick = {"env_height": 16, "size": 8, "resolution": 48, "F_max": 12, "P_max": 6}
+    orders = {"tol": args.tol, "F": args.F, "P": args.P}
+    state = demo_state(args.env, brdf=args.brdf, **(quick if args.quick else {}), **orders)
+    session = RenderSession(state, cache=Cache(args.cache_dir, enabled=not args.no_cache))
+    rows = render_orbit(session, args.frames, args.out)
+    total = [sum(r.values()) for r in rows]
+    print(
+        f"wrote {args.frames} frames and timings.csv to {args.out}; first frame "
+        f"{total[0]:.3f} s, later frames {np.mean(total[1:]) if len(total) > 1 else 0:.3f} s"
+    )
+    return 0
+
+
+def _add_shrm_parser(sub) -> None:
+    p = sub.add_parser("shrm", help="SH reflection maps (Herbert et al. §5.5-5.6)")
+    shrm = p.add_subparsers(dest="shrm_command", required=True, parser_class=_Parser)
+    o = shrm.add_parser("orbit", help="render a camera orbit; PNG frames and per-stage timings")
+    o.add_argument("scene", nargs="?", metavar="SCENE.toml", help="scene file (default: built-in)")
+    o.add_argument("--frames", type=int, default=8, help="frames of a full turn (default 8)")
+    o.add_argument("-o", "--out", required=True, help="output folder")
+    o.add_argument("--brdf", default="effect_pigment", help="isotropic BRDF of the sphere")
+    o.add_argument("--env", help="lat-long environment (.hdr/.exr); default venice_sunset_1k")
+    o.add_argument("--quick", action="store_true", help="small maps and images")
+    o.add_argument("--tol", type=float, default=0.01, help="order tolerance (default 0.01)")
+    o.add_argument("--F", type=int, help="lighting order (default: from --tol)")
+    o.add_argument("--P", type=int, help="view order, 2-10 (default: from --tol)")
+    o.add_argument("--cache-dir", metavar="DIR", help="persistent cache folder")
+    o.add_argument("--no-cache", action="store_true", help="do not use the persistent cache")
+    o.set_defaults(func=_cmd_shrm_orbit)
 
 
 def _add_sh_parser(sub) -> None:
@@ -264,6 +374,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.set_defaults(func=_cmd_report)
     _add_render_parser(sub)
+    _add_cache_parser(sub)
+    _add_brdf_parser(sub)
+    _add_shrm_parser(sub)
     _add_sh_parser(sub)
     _add_impastor_parser(sub)
     _add_phong_parser(sub)

@@ -3,4 +3,4 @@
 Each module registers one section. A new section is a new module plus one import line here.
 """
 
-from validation.sections import examples, impastor, phong, raster, sh, spectral  # noqa: F401
+from validation.sections import examples, impastor, phong, raster, sh, shrm, spectral  # noqa: F401

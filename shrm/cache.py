@@ -1,0 +1,567 @@
+"""A crash-safe, content-addressed persistent cache for maps: SH coefficients, SHRMs, prefilters.
+
+§5.2, Herbert et al.: "A persistent caching scheme, which is tied into this algorithm [...] realizes
+map reuse." specref's scheme:
+
+- **Content-addressed.** :func:`cache_key` hashes everything a map depends on: the producing step's
+  name and code version, and every input (arrays by dtype, shape and bytes; parameters by
+  canonical JSON). A change to any input misses; nothing else does.
+- **Entries.** One file ``<key>.specref`` per entry: the magic ``SPECREF-CACHE`` and a newline,
+  a format version, the header length, a SHA-256 checksum of everything after it, a JSON
+  header (key, metadata, and the name, dtype, shape and offset of each array) and the payload: the
+  arrays' raw bytes, 64-byte aligned. A hit maps them without copies (read-only arrays) and no
+  pickle is ever involved.
+- **Atomic writes.** An entry is written to a temporary file in the cache folder, synced and renamed
+  into place (:func:`reference.images.atomic_write`). A writer killed at any point leaves either no
+  entry or a whole one. Two processes writing the same key both succeed; the last rename wins and
+  leaves one valid entry.
+- **Corruption.** A truncated or corrupted entry (bad checksum, short file, bad header) is reported
+  once as a :class:`~reference.errors.SpecrefWarning`, deleted and rebuilt.
+- **Foreign files.** A file in the cache folder that does not start with our magic, or that cannot
+  be read, is ignored with a warning and never deleted or overwritten.
+- **Size limit.** After each write the least-recently-used entries are deleted until the folder's
+  entries fit in ``max_bytes``; a hit refreshes the entry's modification time, which is the LRU
+  clock.
+- **Location.** :func:`default_cache_dir`: ``$SPECREF_CACHE_DIR`` if set, else
+  ``$XDG_CACHE_HOME/specref``, else ``~/.cache/specref``; the CLI's ``--cache-dir`` overrides both.
+  ``specref cache info`` and ``specref cache clear`` inspect and empty it.
+
+References
+----------
+- F. Herbert, J. Kirkenaer, O. Unter Ecker, "Achieving a Multi-spectral Virtual Reality", 2004.
+- XDG Base Directory Specification 0.8 (``XDG_CACHE_HOME``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import os
+import struct
+import time
+import warnings
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from reference.errors import SpecrefError, SpecrefWarning, require
+from reference.images import atomic_write
+
+__all__ = [
+    "CACHE_MAGIC",
+    "DEFAULT_MAX_BYTES",
+    "Cache",
+    "CacheInfo",
+    "cache_key",
+    "default_cache_dir",
+    "hash_inputs",
+]
+
+#: The first bytes of every entry; a file without them is not ours and is never deleted.
+CACHE_MAGIC = b"SPECREF-CACHE\n"
+#: Entry layout version (bumped when the layout changes; older entries are then rebuilt).
+FORMAT_VERSION = 2
+#: Default size limit of the cache folder, bytes (overridden by ``SPECREF_CACHE_MAX_BYTES``).
+DEFAULT_MAX_BYTES = 2 * 1024**3
+_SUFFIX = ".specref"
+_PREFIX = struct.Struct("<II32s")  # format version, header length, SHA-256 of the rest
+_HEAD = len(CACHE_MAGIC) + _PREFIX.size
+#: A leftover temporary file older than this (s) belongs to a writer that died; ``clear`` and
+#: eviction remove it if it carries our magic.
+STALE_TEMP_SECONDS = 3600.0
+
+
+def default_cache_dir() -> Path:
+    """The cache folder: ``$SPECREF_CACHE_DIR``, ``$XDG_CACHE_HOME/specref``, ``~/.cache/specref``.
+
+    Returns
+    -------
+    Path
+        The folder (not created here).
+
+    Examples
+    --------
+    >>> import os
+    >>> os.environ["SPECREF_CACHE_DIR"] = "/tmp/specref-doc-cache"
+    >>> str(default_cache_dir())
+    '/tmp/specref-doc-cache'
+    >>> del os.environ["SPECREF_CACHE_DIR"]
+    """
+    explicit = os.environ.get("SPECREF_CACHE_DIR")
+    if explicit:
+        return Path(explicit).expanduser()
+    xdg = os.environ.get("XDG_CACHE_HOME")
+    base = Path(xdg).expanduser() if xdg and Path(xdg).is_absolute() else Path.home() / ".cache"
+    return base / "specref"
+
+
+def _feed(h, value, where: str) -> None:
+    """Feed one input to the hash: arrays by dtype, shape and bytes; the rest by canonical JSON."""
+    if isinstance(value, np.ndarray | np.generic):
+        array = np.ascontiguousarray(value)
+        require(
+            array.dtype.kind in "biufc",
+            f"cache key: {where}: arrays must be numeric, got dtype {array.dtype}",
+        )
+        h.update(b"A" + array.dtype.str.encode() + repr(array.shape).encode())
+        h.update(array.tobytes())
+        return
+    if isinstance(value, Mapping):
+        h.update(b"{")
+        for key in sorted(value, key=str):
+            h.update(json.dumps(str(key)).encode() + b":")
+            _feed(h, value[key], f"{where}.{key}")
+        h.update(b"}")
+        return
+    if isinstance(value, list | tuple):
+        h.update(b"[")
+        for i, item in enumerate(value):
+            _feed(h, item, f"{where}[{i}]")
+        h.update(b"]")
+        return
+    try:
+        text = json.dumps(value, sort_keys=True, separators=(",", ":"), allow_nan=True)
+    except TypeError:
+        raise SpecrefError(
+            f"cache key: {where}: must be an array, a number, a string, a bool, None, a list or "
+            f"a dict, got {type(value).__name__}"
+        ) from None
+    h.update(b"J" + text.encode())
+
+
+def hash_inputs(inputs: Mapping) -> str:
+    """SHA-256 of named inputs: arrays by dtype, shape and bytes; parameters by canonical JSON.
+
+    Parameters
+    ----------
+    inputs : mapping of str to array, number, str, bool, None, list or dict
+        Everything a result depends on. Key order does not matter.
+
+    Returns
+    -------
+    str
+        64 hexadecimal digits.
+
+    Raises
+    ------
+    SpecrefError
+        An input of a type that has no canonical form (an object, a function).
+
+    Examples
+    --------
+    >>> a = hash_inputs({"order": 10, "env": np.zeros(3)})
+    >>> a == hash_inputs({"env": np.zeros(3), "order": 10})
+    True
+    >>> a == hash_inputs({"order": 10, "env": np.zeros(3, np.float32)})
+    False
+    """
+    h = hashlib.sha256()
+    _feed(h, dict(inputs), "inputs")
+    return h.hexdigest()
+
+
+def cache_key(step: str, code_version: str, inputs: Mapping) -> str:
+    """The key of a cached result: the step, its code version and every input, hashed.
+
+    Parameters
+    ----------
+    step : str
+        The producing step, e.g. ``"shrm.create"``.
+    code_version : str
+        The step's code version; bump it when the step's algorithm changes.
+    inputs : mapping
+        Everything the result depends on (see :func:`hash_inputs`).
+
+    Returns
+    -------
+    str
+        64 hexadecimal digits (SHA-256).
+
+    Examples
+    --------
+    >>> k = cache_key("sh.project", "1", {"order": 8})
+    >>> len(k), k == cache_key("sh.project", "2", {"order": 8})
+    (64, False)
+    """
+    require(
+        isinstance(step, str) and step, f"cache key: step must be a non-empty str, got {step!r}"
+    )
+    return hash_inputs({"step": step, "code_version": str(code_version), "inputs": inputs})
+
+
+@dataclass(frozen=True)
+class CacheInfo:
+    """What :meth:`Cache.info` reports.
+
+    Attributes
+    ----------
+    directory : Path
+        The cache folder.
+    entries : int
+        Number of entries (files that carry our magic).
+    total_bytes : int
+        Their total size.
+    max_bytes : int
+        The size limit.
+    foreign : list of str
+        Names of files in the folder that are not ours (ignored, never deleted).
+    """
+
+    directory: Path
+    entries: int
+    total_bytes: int
+    max_bytes: int
+    foreign: list
+
+
+def _encode_payload(arrays: Mapping[str, np.ndarray]) -> tuple[list, bytes]:
+    """The arrays' manifest (name, dtype, shape, offset) and their raw bytes, 64-byte aligned."""
+    manifest, chunks, offset = [], [], 0
+    for name, value in arrays.items():
+        array = np.ascontiguousarray(value)
+        require(
+            array.dtype.kind in "biufc",
+            f"cache entry: array {name!r}: must be numeric, got dtype {array.dtype}",
+        )
+        pad = -offset % 64
+        chunks.append(b"\0" * pad)
+        offset += pad
+        manifest.append([str(name), array.dtype.str, list(array.shape), offset])
+        chunks.append(array.tobytes())
+        offset += array.nbytes
+    return manifest, b"".join(chunks)
+
+
+class _CorruptError(Exception):
+    """An entry that carries our magic but fails a check."""
+
+
+class _ForeignError(Exception):
+    """A file that does not carry our magic (or cannot be read)."""
+
+
+class Cache:
+    """A persistent, content-addressed cache of named arrays, safe against crashes and races.
+
+    Parameters
+    ----------
+    directory : str or Path, optional
+        The cache folder; default :func:`default_cache_dir`. Created on first write.
+    max_bytes : int, optional
+        Size limit; default ``$SPECREF_CACHE_MAX_BYTES`` or :data:`DEFAULT_MAX_BYTES`.
+    enabled : bool
+        False turns the cache into a pass-through (every lookup misses, nothing is written).
+    write_hook : callable, optional
+        ``write_hook(path, bytes_written, total_bytes)``, called once in the middle of
+        writing an entry (after the header and half the payload), while the entry's temporary file
+        beside ``path`` is incomplete. It exists to test crash safety: a test kills the writing
+        process there.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     cache = Cache(folder)
+    ...     key = cache_key("demo", "1", {"n": 3})
+    ...     first = cache.get_or_compute(key, lambda: {"x": np.arange(3.0)})
+    ...     again = cache.get_or_compute(key, lambda: {"x": np.zeros(3)})
+    ...     again["x"], cache.hits, cache.misses
+    (array([0., 1., 2.]), 1, 1)
+    """
+
+    def __init__(
+        self,
+        directory=None,
+        max_bytes: int | None = None,
+        enabled: bool = True,
+        write_hook: Callable | None = None,
+    ):
+        self.directory = Path(directory) if directory is not None else default_cache_dir()
+        if max_bytes is None:
+            env = os.environ.get("SPECREF_CACHE_MAX_BYTES")
+            try:
+                max_bytes = int(env) if env else DEFAULT_MAX_BYTES
+            except ValueError:
+                raise SpecrefError(
+                    f"SPECREF_CACHE_MAX_BYTES: must be an integer number of bytes, got {env!r}"
+                ) from None
+        require(
+            isinstance(max_bytes, int) and max_bytes >= 0,
+            f"cache max_bytes: must be an integer >= 0, got {max_bytes!r}",
+        )
+        self.max_bytes = max_bytes
+        self.enabled = enabled
+        self.write_hook = write_hook
+        self.hits = 0
+        self.misses = 0
+        self._warned: set[tuple[str, str]] = set()
+
+    # --- paths and warnings --------------------------------------------------------------------
+
+    def path_of(self, key: str) -> Path:
+        """The entry file of ``key``."""
+        require(
+            isinstance(key, str) and len(key) == 64 and all(c in "0123456789abcdef" for c in key),
+            f"cache key: must be 64 lowercase hex digits (cache_key), got {key!r:.80}",
+        )
+        return self.directory / f"{key}{_SUFFIX}"
+
+    def _warn(self, path: Path, reason: str) -> None:
+        # Each problem is reported once per file and process.
+        if (str(path), reason) in self._warned:
+            return
+        self._warned.add((str(path), reason))
+        warnings.warn(f"{path}: {reason}", SpecrefWarning, stacklevel=3)
+
+    # --- reading -------------------------------------------------------------------------------
+
+    @staticmethod
+    def _read(path: Path) -> tuple[dict, dict]:
+        """Header and arrays of an entry; raises _ForeignError, _CorruptError, FileNotFoundError."""
+        try:
+            data = path.read_bytes()
+        except FileNotFoundError:
+            raise
+        except OSError as error:
+            raise _ForeignError(f"unreadable ({error.strerror or error})") from None
+        if not data.startswith(CACHE_MAGIC):
+            raise _ForeignError("not a specref cache entry (no specref header)")
+        if len(data) < _HEAD:
+            raise _CorruptError(f"truncated entry ({len(data)} bytes)")
+        version, header_len, digest = _PREFIX.unpack_from(data, len(CACHE_MAGIC))
+        rest = memoryview(data)[_HEAD:]
+        if hashlib.sha256(rest).digest() != digest:
+            raise _CorruptError("checksum mismatch (corrupted or truncated entry)")
+        if version != FORMAT_VERSION:
+            raise _CorruptError(f"entry format version {version}, expected {FORMAT_VERSION}")
+        try:
+            header = json.loads(bytes(rest[:header_len]).decode("utf-8"))
+            start = _HEAD + header_len
+            if len(data) - start != header["payload_bytes"]:
+                raise _CorruptError("payload size does not match the header")
+            arrays = {}
+            for name, dtype, shape, offset in header["arrays"]:
+                dtype = np.dtype(dtype)
+                if dtype.kind not in "biufc":
+                    raise _CorruptError(f"array {name!r} has dtype {dtype}")
+                count = int(np.prod(shape, dtype=np.int64))
+                # A read-only view of the file's bytes: no copy.
+                array = np.frombuffer(data, dtype, count, start + offset).reshape(shape)
+                arrays[name] = array
+        except _CorruptError:
+            raise
+        except Exception as error:  # any decoding failure means a bad entry
+            raise _CorruptError(f"undecodable entry ({type(error).__name__})") from None
+        return header, arrays
+
+    def get(self, key: str) -> dict | None:
+        """The arrays stored under ``key`` (read-only views), or None (a miss).
+
+        A corrupted entry is reported once, deleted and reported as a miss; a foreign or unreadable
+        file is reported once and left alone.
+        """
+        if not self.enabled:
+            return None
+        path = self.path_of(key)
+        try:
+            header, arrays = self._read(path)
+        except FileNotFoundError:
+            return None
+        except _ForeignError as why:
+            self._warn(path, f"{why}; ignored and left in place")
+            return None
+        except _CorruptError as why:
+            self._warn(path, f"{why}; deleted, the result is rebuilt")
+            with contextlib.suppress(FileNotFoundError):
+                path.unlink()
+            return None
+        if header.get("key") != key:
+            self._warn(path, "entry holds another key; deleted, the result is rebuilt")
+            with contextlib.suppress(FileNotFoundError):
+                path.unlink()
+            return None
+        # A hit refreshes the LRU clock.
+        with contextlib.suppress(OSError):
+            os.utime(path)
+        return arrays
+
+    # --- writing -------------------------------------------------------------------------------
+
+    def put(self, key: str, arrays: Mapping[str, np.ndarray], meta: Mapping | None = None) -> bool:
+        """Store ``arrays`` under ``key`` atomically; then evict down to the size limit.
+
+        Parameters
+        ----------
+        key : str
+            From :func:`cache_key`.
+        arrays : mapping of str to ndarray
+            Numeric arrays (no objects: entries are read without pickle).
+        meta : mapping, optional
+            JSON-serializable description kept in the header (step, shapes, ...).
+
+        Returns
+        -------
+        bool
+            True if stored; False if the cache is disabled or a foreign file occupies the entry's
+            name (it is never overwritten).
+        """
+        if not self.enabled:
+            return False
+        path = self.path_of(key)
+        if path.exists():
+            try:
+                self._read(path)
+            except _ForeignError as why:
+                self._warn(path, f"{why}; ignored and left in place, the result is not cached")
+                return False
+            except (_CorruptError, FileNotFoundError):
+                pass
+        manifest, payload = _encode_payload(arrays)
+        header = json.dumps(
+            {
+                "key": key,
+                "created_ms": int(time.time() * 1000),
+                "payload_bytes": len(payload),
+                "arrays": manifest,
+                "meta": dict(meta or {}),
+            },
+            sort_keys=True,
+            default=str,
+        ).encode("utf-8")
+        rest_digest = hashlib.sha256(header + payload).digest()
+        prefix = CACHE_MAGIC + _PREFIX.pack(FORMAT_VERSION, len(header), rest_digest)
+        with atomic_write(path, "wb") as handle:
+            handle.write(prefix + header)
+            half = len(payload) // 2
+            handle.write(payload[:half])
+            if self.write_hook is not None:
+                handle.flush()
+                self.write_hook(
+                    path, len(prefix) + len(header) + half, len(prefix) + len(header) + len(payload)
+                )
+            handle.write(payload[half:])
+        self.evict()
+        return True
+
+    def get_or_compute(
+        self, key: str, compute: Callable[[], Mapping[str, np.ndarray]], meta=None
+    ) -> dict:
+        """The arrays under ``key``; on a miss, ``compute()`` them, store them and return them.
+
+        Parameters
+        ----------
+        key : str
+            From :func:`cache_key`.
+        compute : callable
+            ``compute() -> {name: ndarray}``.
+        meta : mapping, optional
+            Header description, see :meth:`put`.
+
+        Returns
+        -------
+        dict of str to ndarray
+        """
+        arrays = self.get(key)
+        if arrays is not None:
+            self.hits += 1
+            return arrays
+        self.misses += 1
+        arrays = {name: np.asarray(value) for name, value in compute().items()}
+        self.put(key, arrays, meta)
+        return arrays
+
+    # --- housekeeping --------------------------------------------------------------------------
+
+    def _scan(self) -> tuple[list[tuple[float, int, Path]], list[str], list[Path]]:
+        """Our entries (mtime, size, path), foreign file names, and our stale temporary files."""
+        ours, foreign, stale = [], [], []
+        if not self.directory.is_dir():
+            return ours, foreign, stale
+        now = time.time()
+        for path in sorted(self.directory.iterdir()):
+            if _is_our_temp(path.name):
+                # A writer's temporary file: in progress, or left by a writer that died.
+                with contextlib.suppress(OSError):
+                    if now - path.stat().st_mtime > STALE_TEMP_SECONDS and _has_magic(path):
+                        stale.append(path)
+                continue
+            try:
+                if not path.is_file():
+                    foreign.append(path.name)
+                    continue
+                stat = path.stat()
+                with path.open("rb") as handle:
+                    magic = handle.read(len(CACHE_MAGIC))
+            except FileNotFoundError:
+                continue  # removed by another process meanwhile
+            except OSError:
+                foreign.append(path.name)
+                self._warn(path, "unreadable; ignored and left in place")
+                continue
+            if magic != CACHE_MAGIC:
+                foreign.append(path.name)
+                self._warn(path, "not a specref cache entry (no specref header); ignored")
+            else:
+                ours.append((stat.st_mtime, stat.st_size, path))
+        return ours, foreign, stale
+
+    def evict(self) -> int:
+        """Delete least-recently-used entries until the entries fit in ``max_bytes``.
+
+        Returns
+        -------
+        int
+            Number of entries deleted.
+        """
+        ours, _, stale = self._scan()
+        for path in stale:
+            with contextlib.suppress(FileNotFoundError):
+                path.unlink()
+        total = sum(size for _, size, _ in ours)
+        deleted = 0
+        for _, size, path in sorted(ours):
+            if total <= self.max_bytes:
+                break
+            with contextlib.suppress(FileNotFoundError):
+                path.unlink()
+                deleted += 1
+            total -= size
+        return deleted
+
+    def info(self) -> CacheInfo:
+        """Entries, their size, the limit and the foreign files of the cache folder."""
+        ours, foreign, _ = self._scan()
+        return CacheInfo(
+            self.directory, len(ours), sum(size for _, size, _ in ours), self.max_bytes, foreign
+        )
+
+    def clear(self) -> int:
+        """Delete every entry (and our temporary files); foreign files stay. Returns the count."""
+        ours, _, _ = self._scan()
+        count = 0
+        for _, _, path in ours:
+            with contextlib.suppress(FileNotFoundError):
+                path.unlink()
+                count += 1
+        if self.directory.is_dir():
+            for path in self.directory.iterdir():
+                if _is_our_temp(path.name) and _has_magic(path):
+                    with contextlib.suppress(FileNotFoundError):
+                        path.unlink()
+        return count
+
+
+def _is_our_temp(name: str) -> bool:
+    """Whether ``name`` is an entry's temporary file (:func:`reference.images.atomic_write`)."""
+    return name.startswith(".") and name.endswith(".tmp") and f"{_SUFFIX}." in name
+
+
+def _has_magic(path: Path) -> bool:
+    try:
+        with path.open("rb") as handle:
+            return handle.read(len(CACHE_MAGIC)) == CACHE_MAGIC
+    except OSError:
+        return False

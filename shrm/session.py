@@ -1,0 +1,610 @@
+"""Change-driven re-rendering: a render session that recomputes only what a change invalidates.
+
+§5.2, Herbert et al. give the render loop as pseudo-code::
+
+    for each frame
+      for each material group
+        if illuminant (il) or environment (env) changed
+          color manage env for il; SH-project env; create diffuse and specular maps for env
+          If SHRM for il does not exist: create SHRM for env and BRDF
+        if viewpoint (vp) changed: extract reflection map from SHRM for vp
+        if glossiness (gloss) changed: prefilter specular map for gloss
+        set dynamic parameters into shaders
+        render
+
+"(A persistent caching scheme, which is tied into this algorithm [...] realizes map reuse.)"
+
+specref writes the loop as **data**: :data:`HERBERT_STAGES` lists each stage with the scene-state
+keys it reads and the stages whose results it uses. :class:`RenderSession` holds the state and, on
+:meth:`RenderSession.render`, walks the stages in order. Each stage's result is identified by a key
+that hashes its name, code version, the state it reads and the keys of its inputs
+(:func:`shrm.cache.cache_key`), so a stage runs only when something it depends on changed. Results
+are kept in memory (the last few per stage) and, for the expensive stages, in the persistent cache
+(:class:`shrm.cache.Cache`): a change back to an earlier state, or a new session on the same
+scene, is served from the cache without running the stage. Every execution, cache hit and stage
+time is counted (:attr:`RenderSession.executions`, :attr:`RenderSession.hits`,
+:attr:`RenderSession.frame_times`).
+
+Which stages run for each kind of change (tested):
+
+=====================  ========================================================================
+change                 stages that run
+=====================  ========================================================================
+illuminant, env        color_manage, sh_project, diffuse_map, specular_map, shrm_create, extract,
+                       shade
+viewpoint              gbuffer, extract, shade
+gloss                  specular_map, shade
+brdf                   brdf_coeffs, shrm_create, extract, shade
+dynamic parameters     shade
+=====================  ========================================================================
+
+References
+----------
+- F. Herbert, J. Kirkenaer, O. Unter Ecker, "Achieving a Multi-spectral Virtual Reality", 2004.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from collections import OrderedDict
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from reference.errors import require, require_choice
+from shrm.cache import Cache, cache_key, hash_inputs
+
+__all__ = [
+    "HERBERT_STAGES",
+    "STATE_KEYS",
+    "RenderSession",
+    "Stage",
+    "demo_state",
+    "orbit_camera",
+    "render_orbit",
+    "stages_depending_on",
+]
+
+#: Scene-state keys a session holds (§5.2, Herbert et al.) and the fixed configuration it reads.
+STATE_KEYS = (
+    "illuminant",
+    "environment",
+    "viewpoint",
+    "gloss",
+    "brdf",
+    "dynamic",
+    "config",
+)
+
+
+@dataclass(frozen=True)
+class Stage:
+    """One stage of the render loop.
+
+    Parameters
+    ----------
+    name : str
+        Key, e.g. ``"sh_project"``.
+    reads : tuple of str
+        Scene-state keys (:data:`STATE_KEYS`) the stage reads.
+    after : tuple of str
+        Stages whose results it uses (they come earlier in the list).
+    run : callable
+        ``run(state: dict, inputs: dict[str, dict]) -> dict`` of results.
+    version : str
+        Code version, part of the result key; bump it when the stage's algorithm changes.
+    persistent : bool
+        Whether results go to the persistent cache (arrays only).
+    """
+
+    name: str
+    reads: tuple
+    after: tuple
+    run: Callable
+    version: str = "1"
+    persistent: bool = False
+
+
+def stages_depending_on(stages, key: str) -> list[str]:
+    """The stages that must run when state ``key`` changes: its readers and everything after them.
+
+    Examples
+    --------
+    >>> stages_depending_on(HERBERT_STAGES, "gloss")
+    ['specular_map', 'shade']
+    >>> stages_depending_on(HERBERT_STAGES, "dynamic")
+    ['shade']
+    """
+    dirty: list[str] = []
+    for stage in stages:
+        if key in stage.reads or any(a in dirty for a in stage.after):
+            dirty.append(stage.name)
+    return dirty
+
+
+def _canonical(value):
+    """State values in a form :func:`shrm.cache.hash_inputs` accepts (dataclasses as dicts)."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        fields = {f.name: _canonical(getattr(value, f.name)) for f in dataclasses.fields(value)}
+        return {"__class__": type(value).__name__, **fields}
+    if isinstance(value, Mapping):
+        return {str(k): _canonical(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_canonical(v) for v in value]
+    if isinstance(value, np.ndarray | np.generic | int | float | str | bool) or value is None:
+        return value
+    if hasattr(value, "values") and hasattr(value, "wavelengths_nm"):
+        return {"values": np.asarray(value.values), "nm": np.asarray(value.wavelengths_nm)}
+    return repr(value)
+
+
+class RenderSession:
+    """Scene state plus the stage graph: each frame recomputes only the stages that changed.
+
+    §5.2, Herbert et al. (module docstring).
+
+    Parameters
+    ----------
+    state : dict
+        Initial values of the :data:`STATE_KEYS` the stages read.
+    stages : sequence of Stage
+        The graph, in execution order (default :data:`HERBERT_STAGES`).
+    cache : Cache or None
+        Persistent cache for the stages marked ``persistent``; None keeps results in memory only.
+    memory : int
+        Results kept in memory per stage (the most recent), so a change back is free.
+
+    Examples
+    --------
+    >>> def add(state, inputs):
+    ...     return {"x": np.asarray(state["config"]["a"] + 1.0)}
+    >>> session = RenderSession({"config": {"a": 1.0}}, [Stage("add", ("config",), (), add)])
+    >>> float(session.render()["add"]["x"]), session.executions["add"]
+    (2.0, 1)
+    >>> _ = session.render(); session.executions["add"]
+    1
+    """
+
+    def __init__(self, state: dict, stages=None, cache: Cache | None = None, memory: int = 8):
+        self.stages = tuple(HERBERT_STAGES if stages is None else stages)
+        names = [s.name for s in self.stages]
+        require(len(set(names)) == len(names), f"render session: duplicate stage in {names}")
+        for i, stage in enumerate(self.stages):
+            for key in stage.reads:
+                require_choice(key, STATE_KEYS, f"state key of stage {stage.name!r}")
+            for dep in stage.after:
+                require(
+                    dep in names[:i],
+                    f"render session: stage {stage.name!r} uses {dep!r}, which does not come "
+                    "before it",
+                )
+        self.cache = cache
+        self.memory = memory
+        self.state: dict = {}
+        self._state_hash: dict = {}
+        self._results: dict = {s.name: OrderedDict() for s in self.stages}
+        self._current: dict = {}
+        self.executions = {s.name: 0 for s in self.stages}
+        self.hits = {s.name: 0 for s in self.stages}
+        self.frame_times: list[dict] = []
+        self.update(**state)
+
+    def update(self, **changes) -> None:
+        """Change scene state (:data:`STATE_KEYS`); the next frame recomputes what depends on it."""
+        for key, value in changes.items():
+            require_choice(key, STATE_KEYS, "scene state key")
+            self.state[key] = value
+            self._state_hash[key] = hash_inputs({key: _canonical(value)})
+
+    def render(self) -> dict:
+        """Run one frame; return every stage's result (``{stage: {name: array or object}}``).
+
+        Also appends ``{stage: seconds}`` for the stages that ran to :attr:`frame_times` (0 for
+        stages reused from memory, the load time for persistent-cache hits).
+        """
+        keys: dict[str, str] = {}
+        times: dict[str, float] = {}
+        for stage in self.stages:
+            missing = [k for k in stage.reads if k not in self.state]
+            require(not missing, f"render session: stage {stage.name!r} needs state {missing}")
+            key = cache_key(
+                f"session.{stage.name}",
+                stage.version,
+                {
+                    "state": {k: self._state_hash[k] for k in stage.reads},
+                    "inputs": {d: keys[d] for d in stage.after},
+                },
+            )
+            keys[stage.name] = key
+            memory = self._results[stage.name]
+            start = time.perf_counter()
+            if key in memory:
+                memory.move_to_end(key)
+                result = memory[key]
+                if self._current.get(stage.name) != key:
+                    self.hits[stage.name] += 1
+            else:
+                result = self.cache.get(key) if (stage.persistent and self.cache) else None
+                if result is not None:
+                    self.hits[stage.name] += 1
+                else:
+                    inputs = {d: self._results[d][keys[d]] for d in stage.after}
+                    result = stage.run(self.state, inputs)
+                    self.executions[stage.name] += 1
+                    if stage.persistent and self.cache is not None:
+                        self.cache.put(key, result, {"step": f"session.{stage.name}"})
+                memory[key] = result
+                while len(memory) > self.memory:
+                    memory.popitem(last=False)
+            if self._current.get(stage.name) != key:
+                times[stage.name] = time.perf_counter() - start
+            self._current[stage.name] = key
+        self.frame_times.append(times)
+        return {name: self._results[name][key] for name, key in keys.items()}
+
+
+# --- the stages of §5.2, Herbert et al. ------------------------------------------------------
+
+
+def _config(state) -> dict:
+    defaults = {
+        "size": 32,
+        "tol": 0.01,
+        "frame": "reflection",
+        "F_max": 32,
+        "P_max": 10,
+        "F": None,
+        "P": None,
+        "light_order": 32,
+        "width": 96,
+        "height": 96,
+        "backend": "ducc0",
+    }
+    return {**defaults, **state.get("config", {})}
+
+
+def _stage_color_manage(state, inputs):
+    # §4, Herbert et al.: the spectral panorama is colour-managed for the selected illuminant
+    environment = np.asarray(state["environment"], dtype=np.float64)
+    illuminant = np.asarray(state["illuminant"], dtype=np.float64)
+    require(
+        environment.shape[-1] == illuminant.shape[-1],
+        f"render session: environment has {environment.shape[-1]} bands, illuminant "
+        f"{illuminant.shape[-1]}",
+    )
+    return {"radiance": environment * illuminant}
+
+
+def _stage_sh_project(state, inputs):
+    from shrm.transform import project_latlong
+
+    c = _config(state)
+    radiance = inputs["color_manage"]["radiance"]
+    L = min(c["light_order"], radiance.shape[1] // 2 - 1)
+    # §5.3, Herbert et al.: SH-project the environment
+    return {"coeffs": project_latlong(radiance, L, backend=c["backend"], where="environment")}
+
+
+def _prefiltered_cube(coeffs, kernel, c):
+    from reference.cubemap import cubemap_texel_directions
+    from shrm.prefilter import adaptive_order, parse_kernel, prefilter_coefficients
+    from shrm.sh import order_of, sh_evaluate
+
+    k = parse_kernel(kernel)
+    L = min(adaptive_order(k, c["tol"]), order_of(coeffs.shape[1]))
+    # §5.4, Herbert et al.: prefiltering is a product in frequency space
+    E = prefilter_coefficients(coeffs[:, : (L + 1) ** 2], k.Lambda(L))
+    return sh_evaluate(E, cubemap_texel_directions(c["size"]), backend=c["backend"])
+
+
+def _stage_diffuse_map(state, inputs):
+    return {"cube": _prefiltered_cube(inputs["sh_project"]["coeffs"], "lambert", _config(state))}
+
+
+def _stage_specular_map(state, inputs):
+    spec = f"phong:{float(state['gloss']):g}"
+    return {"cube": _prefiltered_cube(inputs["sh_project"]["coeffs"], spec, _config(state))}
+
+
+def _brdf_call(state):
+    from reference.brdf import BRDF_METHODS
+
+    brdf = state["brdf"]
+    method = BRDF_METHODS.lookup(brdf["name"])
+    params = dict(brdf.get("params", method.extra["params"]))
+    return method.reference, params
+
+
+def _stage_brdf_coeffs(state, inputs):
+    from shrm.shrm import brdf_sh_coefficients, shrm_orders
+
+    c = _config(state)
+    brdf, params = _brdf_call(state)
+    rho = brdf_sh_coefficients(brdf, params, c["F_max"], c["P_max"], c["frame"])
+    F, P = shrm_orders(rho, c["tol"], c.get("F"), c.get("P"))
+    return {"rho": rho[:, : F + 1, : P + 1, : min(F, P) + 1]}
+
+
+def _stage_shrm_create(state, inputs):
+    from shrm.shrm import shrm_create
+
+    c = _config(state)
+    rho = inputs["brdf_coeffs"]["rho"]
+    L = inputs["sh_project"]["coeffs"]
+    F = min(rho.shape[1] - 1, round(np.sqrt(L.shape[1])) - 1)
+    # §5.5, Herbert et al.: create the SHRM for environment and BRDF
+    s = shrm_create(L, rho[:, : F + 1], c["frame"], c["size"], backend=c["backend"])
+    return {"coeffs": s.coeffs, "orders": np.array([s.F, s.P])}
+
+
+def _view_of(camera) -> np.ndarray:
+    # Distant viewer (§5.5, Herbert et al.): the direction from the scene towards the eye
+    return np.asarray(camera.basis()[2], dtype=np.float64)
+
+
+def _stage_gbuffer(state, inputs):
+    from reference.gbuffer import render_gbuffer
+
+    c = _config(state)
+    camera = state["viewpoint"]
+    g = render_gbuffer(c["objects"], camera, c["width"], c["height"])
+    return {"gbuffer": g}
+
+
+def _stage_extract(state, inputs):
+    from shrm.shrm import SHRM, shrm_extract
+
+    c = _config(state)
+    F, P = (int(x) for x in inputs["shrm_create"]["orders"])
+    s = SHRM(inputs["shrm_create"]["coeffs"], c["frame"], F, P)
+    # §5.6, Herbert et al.: extract the reflection map for the viewpoint
+    return {"map": shrm_extract(s, _view_of(state["viewpoint"]))}
+
+
+def _stage_shade(state, inputs):
+    from reference.cubemap import cubemap_lookup_bilinear
+    from shrm.shrm import _index_directions
+
+    c = _config(state)
+    d = {"k_d": 0.0, "k_s": 0.0, "k_e": 1.0, **state["dynamic"]}
+    g = inputs["gbuffer"]["gbuffer"]
+    v = _view_of(state["viewpoint"])
+    radiance = np.zeros((*g.shape, inputs["diffuse_map"]["cube"].shape[-1]))
+    sel = g.mask
+    n = g.normal[sel]
+    r = _index_directions("reflection", n, v)
+    # Set dynamic parameters into shaders (§5.2, Herbert et al.): a weighted sum of the maps
+    radiance[sel] = (
+        np.asarray(d["k_d"]) / np.pi * cubemap_lookup_bilinear(inputs["diffuse_map"]["cube"], n)
+        + np.asarray(d["k_s"]) * cubemap_lookup_bilinear(inputs["specular_map"]["cube"], r)
+        + np.asarray(d["k_e"])
+        * cubemap_lookup_bilinear(inputs["extract"]["map"], _index_directions(c["frame"], n, v))
+    )
+    return {"radiance": radiance, "mask": sel}
+
+
+#: The render loop of §5.2, Herbert et al., as data (module docstring).
+HERBERT_STAGES = (
+    Stage("color_manage", ("illuminant", "environment"), (), _stage_color_manage),
+    Stage("sh_project", ("config",), ("color_manage",), _stage_sh_project, persistent=True),
+    Stage("diffuse_map", ("config",), ("sh_project",), _stage_diffuse_map, persistent=True),
+    Stage(
+        "specular_map", ("gloss", "config"), ("sh_project",), _stage_specular_map, persistent=True
+    ),
+    Stage("brdf_coeffs", ("brdf", "config"), (), _stage_brdf_coeffs, persistent=True),
+    Stage(
+        "shrm_create",
+        ("config",),
+        ("sh_project", "brdf_coeffs"),
+        _stage_shrm_create,
+        persistent=True,
+    ),
+    Stage("gbuffer", ("viewpoint", "config"), (), _stage_gbuffer),
+    Stage("extract", ("viewpoint", "config"), ("shrm_create",), _stage_extract),
+    Stage(
+        "shade",
+        ("dynamic", "viewpoint", "config"),
+        ("diffuse_map", "specular_map", "extract", "gbuffer"),
+        _stage_shade,
+    ),
+)
+
+
+# --- a Python-built demo scene and the camera orbit --------------------------------------------
+
+
+def orbit_camera(frame: int, frames: int, radius: float = 5.0, elevation_deg: float = 15.0):
+    """An orthographic camera on a circle about the y axis, looking at the origin.
+
+    Parameters
+    ----------
+    frame, frames : int
+        This frame's index and the number of frames of a full turn.
+    radius : float
+        Distance from the origin.
+    elevation_deg : float
+        Height of the circle, degrees above the horizon.
+
+    Returns
+    -------
+    reference.camera.Camera
+
+    Examples
+    --------
+    >>> orbit_camera(0, 4, elevation_deg=0.0).eye
+    (0.0, 0.0, 5.0)
+    """
+    from reference.camera import Camera
+
+    a = 2.0 * np.pi * frame / frames
+    e = np.radians(elevation_deg)
+    eye = radius * np.array([np.cos(e) * np.sin(a), np.sin(e), np.cos(e) * np.cos(a)])
+    return Camera(
+        eye=tuple(float(x) + 0.0 for x in np.round(eye, 12)),
+        target=(0.0, 0.0, 0.0),
+        projection="orthographic",
+        extent=2.4,
+    )
+
+
+def demo_state(
+    environment_path=None,
+    env_height: int = 64,
+    brdf: str = "effect_pigment",
+    grid=None,
+    size: int = 32,
+    resolution: int = 96,
+    **config,
+) -> dict:
+    """A built-in scene for the orbit and the report: a sphere under a shared environment.
+
+    The environment (default ``venice_sunset_1k.hdr`` from ``../shared/data/environments``, else
+    a synthetic sky) is box-filtered to ``env_height`` rows and turned into spectra by replicating
+    its luminance over the grid (an equal-energy spectral environment); the illuminant is CIE D65.
+
+    Parameters
+    ----------
+    environment_path : str or Path, optional
+        A lat-long ``.hdr`` or ``.exr``.
+    env_height : int
+        Rows of the working environment (a power-of-two fraction of the file's height).
+    brdf : str
+        A key of :data:`reference.brdf.BRDF_METHODS` (isotropic), with its default parameters.
+    grid : reference.spectra.SpectralGrid, optional
+        Default a 16-band 400-700 nm grid (20 nm), which keeps the demo quick.
+    size : int
+        Cube face size of the maps.
+    resolution : int
+        Image width and height.
+    **config
+        Further configuration (``F_max``, ``P_max``, ``light_order``, ``tol``, ``frame``).
+
+    Returns
+    -------
+    dict
+        State for :class:`RenderSession`.
+
+    Examples
+    --------
+    >>> state = demo_state(env_height=16, size=4, resolution=8)
+    >>> state["environment"].shape, sorted(state["dynamic"])
+    ((16, 32, 16), ['k_d', 'k_e', 'k_s'])
+    """
+    from pathlib import Path
+
+    from reference.brdf import BRDF_METHODS
+    from reference.camera import downsample_box
+    from reference.geometry import Sphere
+    from reference.images import read_image
+    from reference.spectra import SpectralGrid, spectrum_from_dataset
+
+    grid = grid or SpectralGrid(400.0, 700.0, 20.0)
+    default = Path(__file__).resolve().parents[2] / "shared/data/environments/venice_sunset_1k.hdr"
+    path = Path(environment_path) if environment_path else default
+    if path.is_file():
+        image = read_image(path)
+        factor = max(1, image.shape[0] // env_height)
+        image = downsample_box(image[: factor * env_height, : factor * 2 * env_height], factor)
+    else:  # a synthetic sky: bright zenith, a warm sun, a dark ground
+        from reference.envmap import latlong_pixel_directions
+
+        d = latlong_pixel_directions(env_height, 2 * env_height)
+        sun = np.exp((d @ np.array([0.6, 0.5, 0.62]) - 1.0) * 40.0)
+        image = (0.2 + 0.8 * np.maximum(d[..., 1], 0.0) + 20.0 * sun)[..., None] * np.ones(3)
+    luminance = image @ np.array([0.2126, 0.7152, 0.0722])
+    environment = np.repeat(luminance[..., None], grid.n_bands, axis=-1)
+    illuminant = spectrum_from_dataset("illuminant", "D65")
+    from reference.spectra import resample_spectrum
+
+    D65 = np.asarray(resample_spectrum(illuminant, grid), dtype=np.float64)
+    method = BRDF_METHODS.lookup(brdf)
+    params = dict(method.extra["params"])
+    if "wavelengths_nm" in params:
+        params["wavelengths_nm"] = grid.wavelengths_nm
+    for key, value in params.items():
+        if np.ndim(value) == 1 and key != "wavelengths_nm":
+            params[key] = np.interp(
+                grid.wavelengths_nm, np.linspace(380, 780, len(value)), np.asarray(value)
+            )
+    return {
+        "illuminant": D65 / D65.max(),
+        "environment": environment,
+        "viewpoint": orbit_camera(0, 8),
+        "gloss": 64.0,
+        "brdf": {"name": brdf, "params": params},
+        "dynamic": {"k_d": 0.0, "k_s": 0.0, "k_e": 1.0},
+        "config": {
+            "size": size,
+            "width": resolution,
+            "height": resolution,
+            "objects": [Sphere((0.0, 0.0, 0.0), 1.0)],
+            "grid": [grid.start_nm, grid.end_nm, grid.step_nm],
+            **config,
+        },
+    }
+
+
+def render_orbit(session: RenderSession, frames: int, out_dir=None, progress: bool = True):
+    """Render a camera orbit; write PNG frames and a per-stage timing table (``timings.csv``).
+
+    The first frame pays for creation; later frames run only ``gbuffer``, ``extract`` and
+    ``shade`` (§5.2, Herbert et al.).
+
+    Parameters
+    ----------
+    session : RenderSession
+        With a ``config.grid`` of ``[start_nm, end_nm, step_nm]``.
+    frames : int
+        Frames of a full turn, >= 1.
+    out_dir : str or Path, optional
+        Where to write ``frame_###.png`` and ``timings.csv`` (atomically); None writes nothing.
+    progress : bool
+        tqdm progress on stderr.
+
+    Returns
+    -------
+    list of dict
+        ``{stage: seconds}`` per frame.
+
+    Examples
+    --------
+    >>> s = RenderSession(demo_state(env_height=16, size=4, resolution=8, F_max=8, P_max=4))
+    >>> times = render_orbit(s, 2, progress=False)
+    >>> sorted(times[1])
+    ['extract', 'gbuffer', 'shade']
+    """
+    import sys
+    from pathlib import Path
+
+    from tqdm import tqdm
+
+    from reference.colorimetry import XYZ_to_display_RGB, band_weights, spectra_to_XYZ
+    from reference.display import linear_to_display
+    from reference.errors import require_positive_int
+    from reference.images import write_png, write_text_atomic
+    from reference.spectra import SpectralGrid
+
+    frames = require_positive_int(frames, "orbit --frames", 100000)
+    grid = SpectralGrid(*session.state["config"]["grid"])
+    W = band_weights(grid, None)
+    white = float(spectra_to_XYZ(np.asarray(session.state["illuminant"]), W)[1])
+    rows = []
+    for f in tqdm(range(frames), desc="orbit", unit="frame", file=sys.stderr, disable=not progress):
+        session.update(viewpoint=orbit_camera(f, frames))
+        result = session.render()
+        times = session.frame_times[-1]
+        rows.append(times)
+        if out_dir is not None:
+            XYZ = spectra_to_XYZ(result["shade"]["radiance"], W) / white
+            RGB = linear_to_display(np.clip(XYZ_to_display_RGB(XYZ), 0.0, None), "srgb")
+            write_png(Path(out_dir) / f"frame_{f:03d}.png", np.clip(RGB, 0.0, 1.0))
+    if out_dir is not None:
+        names = [s.name for s in session.stages]
+        lines = ["frame," + ",".join(names) + ",total"]
+        for f, times in enumerate(rows):
+            cells = [f"{times.get(n, 0.0):.6f}" for n in names]
+            lines.append(f"{f}," + ",".join(cells) + f",{sum(times.values()):.6f}")
+        write_text_atomic(Path(out_dir) / "timings.csv", "\n".join(lines) + "\n")
+    return rows

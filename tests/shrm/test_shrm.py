@@ -1,0 +1,200 @@
+import numpy as np
+import pytest
+
+from reference.brdf import BRDF_METHODS, brdf_lambert
+from reference.brdf_isotropic import brdf_lafortune
+from reference.camera import Camera
+from reference.cubemap import cubemap_texel_directions
+from reference.errors import SpecrefError
+from reference.gbuffer import render_gbuffer
+from reference.geometry import Sphere
+from shrm.prefilter import lambert_Lambda_closed_form
+from shrm.rotation import rotation_matrix, sh_rotation_blocks
+from shrm.sh import sh_evaluate
+from shrm.shrm import (
+    SHRM,
+    _env_quadrature,
+    _reflected_bruteforce,
+    brdf_sh_coefficients,
+    polar_rotate,
+    render_bruteforce,
+    render_shrm,
+    shrm_create,
+    shrm_create_angular,
+    shrm_extract,
+    shrm_orders,
+)
+from shrm.transform import synthesize_latlong
+from validation.cli import main
+
+# A lobe about the normal, ρ_s (n+2)/(2π) (cos θ_i cos θ_o)^n with n = 2: its transfer function is
+# a polynomial of degree 2 in the view (with the even continuation), so P = 2 is exact.
+POLY = {"rho_d": np.array([0.2, 0.4]), "rho_s": 0.5, "C_xy": 0.0, "C_z": 1.0, "n": 2.0}
+
+
+def _env(rng, order=6, channels=2, height=32):
+    c = rng.normal(size=(channels, (order + 1) ** 2)) * 0.2
+    c[:, 0] = np.sqrt(4 * np.pi) * 2.0
+    return c, synthesize_latlong(c, height)
+
+
+def test_polar_rotate_matches_wigner_blocks(rng):
+    # Source: shrm.rotation's Ivanic–Ruedenberg recursion (an independent construction).
+    c = rng.normal(size=(3, 49))
+    for a in (0.3, -1.2, 2.9):
+        blocks = sh_rotation_blocks(rotation_matrix([0.0, 1.0, 0.0], a), 6)
+        expected = np.concatenate(
+            [c[:, l * l : (l + 1) ** 2] @ D.T for l, D in enumerate(blocks)], axis=1
+        )
+        np.testing.assert_allclose(polar_rotate(c, [a])[0], expected, rtol=0, atol=1e-13)
+
+
+def test_lambert_coefficients_match_the_closed_form():
+    # Source: A_l closed form (Ramamoorthi & Hanrahan 2001) via shrm.prefilter:
+    # ρ_{l00} = (ρ/π) Λ_l sqrt((2l+1)/4π) · sqrt(4π), and nothing for p > 0.
+    rho = brdf_sh_coefficients(brdf_lambert, {"rho_d": [0.7]}, 8, 2, "normal")
+    l = np.arange(9)
+    expected = 0.7 / np.pi * lambert_Lambda_closed_form(8) * np.sqrt((2 * l + 1) / (4 * np.pi))
+    np.testing.assert_allclose(rho[0, :, 0, 0], expected * np.sqrt(4 * np.pi), atol=1e-14)
+    assert np.abs(rho[0, :, 1:]).max() < 1e-14
+
+
+def test_brdf_coefficients_converge_with_the_quadrature():
+    m = BRDF_METHODS.lookup("ggx")
+    params = {"rho_d": 0.1, "F_0": 0.5, "alpha": 0.3}
+    a = brdf_sh_coefficients(m.reference, params, 16, 4, "reflection", quadrature=8)
+    b = brdf_sh_coefficients(m.reference, params, 16, 4, "reflection", quadrature=16)
+    # The error estimate by doubling the order is small against the coefficients.
+    assert np.abs(a - b).max() < 1e-4 * np.abs(b).max()
+
+
+def _poly_closed_form(coeffs, n, v):
+    """B(n, v) of the POLY lobe in closed form.
+
+    Source: ρ̃ = ρ_d/π cos⁺θ_i + ρ_s (2/π) cos³⁺θ_i cos²θ_o, so
+    B(n, v) = ρ_d/π E_1(n) + (2ρ_s/π) (n·v)² E_3(n), where E_k = ∫ L cos^k⁺ is a radial prefilter
+    with Λ_l = 2π ∫_0^1 x^k P_l(x) dx (Gauss–Legendre, exact for these polynomials).
+    """
+    x, w = np.polynomial.legendre.leggauss(40)
+    x, w = (x + 1) / 2, w / 2
+    P = np.polynomial.legendre.legvander(x, 6)
+    l = np.repeat(np.arange(7), 2 * np.arange(7) + 1)
+    E = {k: sh_evaluate(coeffs * (2 * np.pi * (w * x**k) @ P)[l], n) for k in (1, 3)}
+    cos_o2 = np.clip(n @ v, 0, None)[..., None] ** 2
+    return POLY["rho_d"] / np.pi * E[1] + 2 * POLY["rho_s"] / np.pi * cos_o2 * E[3]
+
+
+def test_frequency_creation_is_exact_for_band_limited_input(rng):
+    coeffs, _ = _env(rng)
+    rho = brdf_sh_coefficients(brdf_lafortune, POLY, 6, 2, "normal")
+    s = shrm_create(coeffs, rho, "normal", size=3)
+    n = cubemap_texel_directions(3)
+    for v in ([0.0, 0.0, 1.0], [0.6, 0.0, 0.8], [-0.36, 0.48, 0.8]):
+        v = np.array(v)
+        front = (n @ v) > 0
+        expected = _poly_closed_form(coeffs, n, v)
+        np.testing.assert_allclose(
+            shrm_extract(s, v)[front], expected[front], rtol=1e-10, atol=1e-12
+        )
+
+
+@pytest.mark.parametrize("frame", ["normal", "reflection"])
+def test_frequency_creation_against_the_angular_oracle(rng, frame):
+    coeffs, env = _env(rng, order=4, height=24)
+    m = BRDF_METHODS.lookup("lafortune")
+    params = {"rho_d": [0.1, 0.2], "rho_s": 0.6, "C_xy": -1.0, "C_z": 1.0, "n": [4.0, 6.0]}
+    angular = shrm_create_angular(env, m.reference, params, 6, frame, size=2)
+    errors = []
+    for P in (2, 6):
+        rho = brdf_sh_coefficients(m.reference, params, 4, P, frame)
+        s = shrm_create(coeffs, rho, frame, size=2)
+        v = np.array([0.3, 0.5, 0.81])
+        v /= np.linalg.norm(v)
+        truth = _reflected_bruteforce(
+            m.reference,
+            params,
+            frame,
+            cubemap_texel_directions(2).reshape(-1, 3),
+            np.broadcast_to(v, (24, 3)),
+            _env_quadrature(env),
+        ).reshape(6, 2, 2, 2)
+        front = (cubemap_texel_directions(2) @ v) > 0.2
+        E = shrm_extract(s, v)
+        errors.append(np.abs(E - truth)[front].max() / np.abs(truth).max())
+        if P == 6:
+            # Same P: the frequency and angular paths agree to the view-expansion tail.
+            A = shrm_extract(angular, v)
+            assert np.abs(E - A)[front].max() / np.abs(truth).max() < 0.02
+    # More view coefficients, less error (convergence in P).
+    assert errors[1] < errors[0]
+    assert errors[1] < 0.02
+
+
+def test_render_through_the_gbuffer_converges_to_the_closed_form(rng):
+    coeffs, _ = _env(rng, order=6)
+    camera = Camera(eye=(0, 0, 5), projection="orthographic", extent=2.2)
+    g = render_gbuffer([Sphere()], camera, 12, 12)
+    view = np.array([0.0, 0.0, 1.0])
+    truth = np.zeros((12, 12, 2))
+    truth[g.mask] = _poly_closed_form(coeffs, g.normal[g.mask], view)
+    peak = truth[g.mask].max()
+    # The SHRM's texels are exact; what is left is the seamless bilinear lookup of
+    # reference.cubemap, second order inside a face and first order at face edges, where a tap
+    # across the edge snaps to the neighbouring face's nearest texel (observed rates 0.98, 1.04).
+    rho = brdf_sh_coefficients(brdf_lafortune, POLY, 6, 2, "normal")
+    errors = [
+        np.abs(render_shrm(g, shrm_create(coeffs, rho, "normal", size=S), view) - truth)[
+            g.mask
+        ].max()
+        / peak
+        for S in (8, 16, 32)
+    ]
+    rates = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
+    assert np.all(rates > 0.8), (errors, rates)
+    # The per-pixel oracle sums the environment's pixels: its error falls with the map's rows.
+    oracle = [
+        np.abs(
+            render_bruteforce(g, synthesize_latlong(coeffs, H), brdf_lafortune, POLY, view) - truth
+        )[g.mask].max()
+        / peak
+        for H in (16, 32, 64)
+    ]
+    assert oracle[2] < oracle[1] < oracle[0], oracle
+    assert np.all(render_shrm(g, shrm_create(coeffs, rho, "normal", size=2), view)[~g.mask] == 0)
+
+
+def test_orders_from_the_tolerance_and_bad_orders():
+    m = BRDF_METHODS.lookup("ggx")
+    rho = brdf_sh_coefficients(m.reference, {"rho_d": 0.1, "F_0": 0.5, "alpha": 0.3}, 24, 10)
+    F, P = shrm_orders(rho, 0.05)
+    F2, P2 = shrm_orders(rho, 0.01)
+    assert F2 >= F
+    assert P2 >= P
+    assert 2 <= P <= 10
+    with pytest.raises(SpecrefError, match=r"SHRM: P = 1 is outside what tol 0.05 allows"):
+        shrm_orders(rho, 0.05, P=1)
+    with pytest.raises(SpecrefError, match=rf"SHRM: F = {F - 1} is outside what tol 0.05"):
+        shrm_orders(rho, 0.05, F=F - 1)
+    with pytest.raises(SpecrefError, match=r"SHRM: tol: must be in \(0, 1\)"):
+        shrm_orders(rho, 0.0)
+    with pytest.raises(SpecrefError, match="unknown SHRM frame 'half'"):
+        brdf_sh_coefficients(brdf_lambert, {"rho_d": 1.0}, 2, 2, "half")
+    with pytest.raises(SpecrefError, match="lighting has 3 channels but the BRDF has 2"):
+        shrm_create(np.ones((3, 16)), np.ones((2, 4, 3, 3)), "normal", size=1)
+
+
+def test_cli_orbit_refuses_orders_the_tolerance_does_not_allow(tmp_path, capsys):
+    argv = ["shrm", "orbit", "--quick", "--brdf", "lafortune", "--no-cache", "-o", str(tmp_path)]
+    assert main([*argv, "--frames", "1", "--P", "1"]) == 2
+    assert "SHRM: P = 1 is outside what tol 0.01 allows" in capsys.readouterr().err
+
+
+def test_shrm_extract_is_linear_in_the_view_basis():
+    rng = np.random.default_rng(4)
+    s = SHRM(rng.normal(size=(6, 2, 2, 1, 9)), "normal", 2, 2)
+    from shrm.sh import sh_basis
+
+    v = np.array([0.0, 0.6, 0.8])
+    np.testing.assert_allclose(
+        shrm_extract(s, v)[..., 0], s.coeffs[..., 0, :] @ sh_basis(2, v[None])[0]
+    )

@@ -1,0 +1,58 @@
+import json
+
+import pytest
+
+from validation.report import run_report
+from validation.sections.shrm import SUITE
+
+
+def test_shrm_section_quick(tmp_path):
+    results = run_report(tmp_path, quick=True, only=["shrm"], progress=False)["sections"]["shrm"]
+    for name in SUITE:
+        entry = results[name]
+        assert 0 <= entry["max_error"] < 1
+        assert entry["frame"] in ("normal", "reflection")
+        assert 2 <= entry["P"] <= 10
+    creation = results["creation"]
+    assert creation["angular_seconds"] > 0
+    assert creation["ratio"] == creation["angular_seconds"] / creation["frequency_seconds"]
+    assert results["extraction"]["ratio"] > 0
+    orbit = results["orbit"]["seconds"]
+    # The first frame creates the maps; later frames run only gbuffer, extract and shade.
+    names = results["orbit"]["stages"]
+    later = {names[k] for row in orbit[1:] for k, t in enumerate(row[:-1]) if t > 0}
+    assert later <= {"gbuffer", "extract", "shade"}
+    html = (tmp_path / "index.html").read_text()
+    assert "SHRMs" in html
+    assert (tmp_path / "images" / "shrm-error-vs-P.png").is_file()
+    json.dumps(results)
+
+
+@pytest.fixture(scope="module")
+def full_study(tmp_path_factory):
+    # The full study of the report (64×128 environment, 48² image; F, P, size and frame swept).
+    folder = tmp_path_factory.mktemp("shrm-full")
+    return run_report(folder, quick=False, only=["shrm"], progress=False)["sections"]["shrm"]
+
+
+@pytest.mark.xslow
+@pytest.mark.parametrize(
+    "name",
+    [
+        pytest.param(
+            name,
+            marks=pytest.mark.xfail(
+                strict=True,
+                reason="P <= 10 (§5.5) leaves 1.1-2.2 % at grazing pixels for this lobe; see the "
+                "limits in docs/shrm.md",
+            ),
+        )
+        if name != "lafortune"
+        else name
+        for name in SUITE
+    ],
+)
+def test_cheapest_setting_meets_one_percent_of_peak(full_study, name):
+    # The target: some setting renders within 1 % of the per-pixel brute-force render's peak.
+    entry = full_study[name]
+    assert entry["cheapest_under_tolerance"], entry["max_error"]
