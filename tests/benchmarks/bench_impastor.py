@@ -17,7 +17,7 @@ import pytest
 
 from reference.horizon import HORIZON_METHODS
 from reference.specular_lighting import SPECULAR_METHODS
-from validation import impastor as imp
+from validation import impastor_lighting as imp
 
 
 @pytest.fixture(scope="module")

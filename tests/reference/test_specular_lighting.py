@@ -73,7 +73,7 @@ def test_brute_force_under_uniform_sky_is_light_times_albedo():
 
 
 def test_brute_force_converges_with_supersampling():
-    from validation.impastor import booth_plane_light
+    from validation.impastor_lighting import booth_plane_light
 
     plane = booth_plane_light("fluorescent", 32, 16)
     P = np.array([[0.0, 0.0, 0.0], [0.05, 0.0, -0.03]])
@@ -86,7 +86,7 @@ def test_brute_force_converges_with_supersampling():
 
 
 def test_fis_and_point_lights_reach_the_reference_in_their_regimes():
-    from validation.impastor import booth_plane_light
+    from validation.impastor_lighting import booth_plane_light
 
     plane = booth_plane_light("fluorescent", 64, 32)
     lights = point_lights_from_plane(plane, "median_cut", 32)
@@ -138,7 +138,7 @@ def test_specular_bad_input():
     "E17); test_hybrid_within_the_two_methods_and_best_at_the_ends pins what holds",
 )
 def test_hybrid_never_worse_than_the_better_method_by_ten_percent():
-    from validation.impastor import specular_error_vs_alpha
+    from validation.impastor_lighting import specular_error_vs_alpha
 
     result = specular_error_vs_alpha(
         (0.01, 0.03, 0.05, 0.07, 0.1, 0.3), n_side=5, light_resolution=(64, 32), supersample=8
@@ -153,7 +153,7 @@ def test_hybrid_never_worse_than_the_better_method_by_ten_percent():
 
 @pytest.mark.slow
 def test_hybrid_within_the_two_methods_and_best_at_the_ends():
-    from validation.impastor import specular_error_vs_alpha
+    from validation.impastor_lighting import specular_error_vs_alpha
 
     result = specular_error_vs_alpha(
         (0.01, 0.03, 0.07, 0.2, 0.5), n_side=4, light_resolution=(64, 32), supersample=6
