@@ -19,12 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from reference.arealights import (
-    PlaneLight,
-    booth_light_image,
-    illuminance_point_lights,
-    point_lights_from_plane,
-)
+from reference.arealights import PlaneLight, booth_light_image
 from reference.colorimetry import XYZ_to_display_RGB
 from reference.errors import require, require_positive_int
 from reference.horizon import (
@@ -42,11 +37,12 @@ from reference.multispectral import (
     light_to_channels,
     spectra_to_channels,
 )
+from reference.point_lights import illuminance_point_lights, point_lights_from_plane
 from reference.spectra import resample_spectrum, spectrum_from_csv, spectrum_from_dataset
+from reference.specular_hybrid import hybrid_error_estimates, specular_hybrid
 from reference.specular_lighting import (
     specular_brute_force,
     specular_fis,
-    specular_hybrid,
     specular_point_lights,
 )
 
@@ -380,8 +376,6 @@ def specular_error_vs_alpha(
     >>> sorted(r)
     ['alpha', 'fis', 'fis_share', 'hybrid', 'median_cut', 'reference_error']
     """
-    from reference.specular_lighting import hybrid_error_estimates
-
     painting = painting or impasto_painting(128, seed=2)
     P, N, V = _painting_samples(n_side, painting)
     plane = booth_plane_light("fluorescent", *light_resolution)

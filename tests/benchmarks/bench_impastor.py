@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from reference.horizon import HORIZON_METHODS
-from reference.specular_lighting import SPECULAR_METHODS
+from reference.specular_hybrid import SPECULAR_METHODS
 from validation import impastor_lighting as imp
 
 
