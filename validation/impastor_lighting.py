@@ -4,7 +4,8 @@ The lighting half of what ``specref impastor`` and the report's "ImpastoR" secti
 colour half (Table 1, channel counts, metamers, the display) is ``validation.impastor``:
 
 - :func:`booth_plane_light`, :func:`impasto_painting`, :func:`render_painting`: the demo painting
-  under the booth lights, with per-stage frame times.
+  under the booth lights, with per-stage frame times; :func:`cached_horizon_map` computes a height
+  field's horizon map once, not once per frame.
 - :func:`specular_error_vs_alpha`: point lights, FIS and the hybrid against the brute-force
   integral, over roughness (§3.5.2).
 - :func:`shadow_agreement`: horizon maps against ray-marched shadows over the sector count
@@ -14,7 +15,9 @@ colour half (Table 1, channel counts, metamers, the display) is ``validation.imp
 
 from __future__ import annotations
 
+import hashlib
 import time
+from collections import OrderedDict
 from pathlib import Path
 
 import numpy as np
@@ -51,6 +54,7 @@ __all__ = [
     "LIGHTING_METHODS",
     "PAINT_SPECTRA",
     "booth_plane_light",
+    "cached_horizon_map",
     "gloss_validation",
     "impasto_painting",
     "load_paint_spectra",
@@ -213,6 +217,59 @@ def _painting_gbuffer(size: int, width_m: float):
     return render_gbuffer([plane], camera, size, size)
 
 
+#: Horizon maps by height-field content (``cached_horizon_map``); the oldest is dropped first.
+_HORIZON_CACHE: OrderedDict = OrderedDict()
+_HORIZON_CACHE_SIZE = 4
+
+
+def cached_horizon_map(
+    height, pixel_size: float, n_sectors: int = 18, max_steps: int = 32, backend: str = "numba"
+) -> np.ndarray:
+    """:func:`reference.horizon.horizon_map`, computed once per height field and settings.
+
+    The horizon map depends only on the height field (§3.5.3, Ferwerda), not on the light or the
+    view, so the renderer computes it once and every frame looks it up. The cache is keyed by the
+    height field's content (SHA-1 of its bytes, shape and dtype) and the settings, so an edited
+    height field is never served a stale map; it holds the last four maps, read-only.
+
+    Parameters
+    ----------
+    height : array_like, shape (H, W)
+        Height field, m.
+    pixel_size : float
+        Texel size, m.
+    n_sectors, max_steps : int
+        As in :func:`reference.horizon.horizon_map`.
+    backend : {"numba", "numpy"}
+
+    Returns
+    -------
+    ndarray
+        The horizon map (read-only; shared by every caller with the same inputs).
+
+    Examples
+    --------
+    >>> h = impasto_painting(16, seed=1)["height"]
+    >>> first = cached_horizon_map(h, 0.3 / 16, 6, 8, backend="numpy")
+    >>> cached_horizon_map(h.copy(), 0.3 / 16, 6, 8, backend="numpy") is first
+    True
+    >>> cached_horizon_map(h + 1e-4, 0.3 / 16, 6, 8, backend="numpy") is first
+    False
+    """
+    h = np.ascontiguousarray(height, dtype=np.float64)
+    digest = hashlib.sha1(h.tobytes()).hexdigest()
+    key = (digest, h.shape, float(pixel_size), int(n_sectors), int(max_steps), backend)
+    if key in _HORIZON_CACHE:
+        _HORIZON_CACHE.move_to_end(key)
+        return _HORIZON_CACHE[key]
+    hmap = horizon_map(h, pixel_size, n_sectors, max_steps, backend=backend)
+    hmap.setflags(write=False)
+    _HORIZON_CACHE[key] = hmap
+    while len(_HORIZON_CACHE) > _HORIZON_CACHE_SIZE:
+        _HORIZON_CACHE.popitem(last=False)
+    return hmap
+
+
 def render_painting(
     light: str = "D65",
     size: int = 256,
@@ -253,7 +310,8 @@ def render_painting(
     -------
     dict
         ``XYZ`` (H, W, 3) in cd/m², ``sRGB`` encoded (H, W, 3) in [0, 1] (white = 1.2× the
-        white diffuser's luminance), ``seconds`` per stage.
+        white diffuser's luminance), ``seconds`` per stage (``shadows`` is the horizon lookup,
+        plus the horizon map the first time a height field is rendered: :func:`cached_horizon_map`).
 
     Examples
     --------
@@ -285,7 +343,8 @@ def render_painting(
     start = time.perf_counter()
     visibility = None
     if shadows:
-        hmap = horizon_map(painting["height"], painting["pixel_size"], 18, 32, backend=backend)
+        # Once per height field, not per frame (§3.5.3, Ferwerda: a precomputed map).
+        hmap = cached_horizon_map(painting["height"], painting["pixel_size"], 18, 32, backend)
         to_light = lights.position[None] - P[:, None]
         phi, beta = light_azimuth_elevation(to_light, T, B, N_geo)
         visibility = horizon_lookup(hmap[row, col][:, None, :], phi, beta).astype(float)

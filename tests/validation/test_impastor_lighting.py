@@ -34,3 +34,36 @@ def test_missing_shared_data_fails_clearly(tmp_path, monkeypatch):
     monkeypatch.setenv("SPECREF_SHARED_DATA", str(tmp_path))
     with pytest.raises(SpecrefError, match="measured spectra not found"):
         imp.load_paint_spectra()
+
+
+def test_horizon_map_is_computed_once_per_height_field(monkeypatch):
+    from reference import horizon
+
+    calls = []
+
+    def counting(*args, **kwargs):
+        calls.append(args[0].shape)
+        return horizon.horizon_map(*args, **kwargs)
+
+    monkeypatch.setattr(imp, "horizon_map", counting)
+    monkeypatch.setattr(imp, "_HORIZON_CACHE", type(imp._HORIZON_CACHE)())
+    painting = imp.impasto_painting(24, seed=5)
+    settings = {"light_resolution": (16, 8), "backend": "numpy"}
+    first = imp.render_painting("D65", 16, "median_cut", painting, **settings)
+    second = imp.render_painting("A", 16, "fis", painting, **settings)
+    assert len(calls) == 1
+    # The cached map is the map: a frame equals one rendered with a cold cache.
+    imp._HORIZON_CACHE.clear()
+    again = imp.render_painting("D65", 16, "median_cut", painting, **settings)
+    np.testing.assert_array_equal(again["XYZ"], first["XYZ"])
+    assert len(calls) == 2
+    # A different height field gets its own map.
+    other = dict(painting, height=painting["height"] * 1.5)
+    imp.render_painting("D65", 16, "median_cut", other, **settings)
+    assert len(calls) == 3
+    assert np.isfinite(second["XYZ"]).all()
+    cached = imp.cached_horizon_map(painting["height"], painting["pixel_size"], 18, 32, "numpy")
+    assert not cached.flags.writeable
+    np.testing.assert_array_equal(
+        cached, horizon.horizon_map(painting["height"], painting["pixel_size"], 18, 32, "numpy")
+    )

@@ -424,7 +424,8 @@ def run(ctx: ReportContext) -> SectionResult:
         Table(
             ["specular lighting", "size", "shadows s", "diffuse s", "specular s", "frame s"],
             frame_rows,
-            f"Frame time ({backend} backend; G-buffer and materials excluded; one shared core)",
+            f"Frame time ({backend} backend; G-buffer and materials excluded; the horizon map is "
+            "computed once per height field, before these frames; one shared core)",
             "{:.3g}",
         )
     )
