@@ -10,7 +10,8 @@ colour half (Table 1, channel counts, metamers, the display) is ``validation.imp
   integral, over roughness (§3.5.2).
 - :func:`shadow_agreement`: horizon maps against ray-marched shadows over the sector count
   (§3.5.3).
-- :func:`gloss_validation`: goniometric luminance curves of gray Ward–Dür samples (Fig. 15).
+- :func:`gloss_validation`: goniometric luminance curves of gray Ward–Dür samples (Fig. 15);
+  :func:`ward_duer_albedo`: the white-furnace albedo of the Ward–Dür lobe.
 """
 
 from __future__ import annotations
@@ -61,6 +62,7 @@ __all__ = [
     "render_painting",
     "shadow_agreement",
     "specular_error_vs_alpha",
+    "ward_duer_albedo",
 ]
 
 #: Lighting methods of the demo painting (frame times in the report).
@@ -568,3 +570,42 @@ def gloss_validation(
             }
         )
     return {"angles_deg": angles.tolist(), "rho_d": rho_d, "samples": samples}
+
+
+def ward_duer_albedo(
+    alphas=(0.01, 0.05, 0.1, 0.3, 0.5), thetas_deg=(0.0, 30.0, 45.0, 60.0)
+) -> dict:
+    """White-furnace albedo of the Ward–Dür lobe (``ρ_s = 1``, Eq. (4), Ferwerda), by quadrature.
+
+    Dür's normalization claims the albedo stays at or below ρ_s away from grazing incidence
+    (§3.1.2; errata E12 for grazing incidence). Each albedo is
+    :func:`reference.brdf.albedo_quadrature` at order 48, with ``|q48 − q24|`` as its error.
+
+    Returns
+    -------
+    dict
+        ``alpha``, ``theta_deg``, ``albedo`` and ``error`` (lists, one per case), and ``max``.
+
+    Examples
+    --------
+    >>> r = ward_duer_albedo((0.1,), (0.0,))
+    >>> bool(0.9 < r["albedo"][0] <= 1.0), r["error"][0] < 1e-6
+    (True, True)
+    """
+    from reference.brdf import albedo_quadrature, brdf_ward_duer_specular
+
+    normal = np.array([0.0, 0.0, 1.0])
+    out = {"alpha": [], "theta_deg": [], "albedo": [], "error": []}
+    for alpha in alphas:
+        for theta in thetas_deg:
+            t = np.radians(theta)
+            wi = np.array([np.sin(t), 0.0, np.cos(t)])
+            f = lambda a, b, alpha=alpha: brdf_ward_duer_specular(a, b, normal, alpha)  # noqa: E731
+            q48 = albedo_quadrature(f, wi, normal, 48)
+            q24 = albedo_quadrature(f, wi, normal, 24)
+            out["alpha"].append(float(alpha))
+            out["theta_deg"].append(float(theta))
+            out["albedo"].append(q48)
+            out["error"].append(abs(q48 - q24))
+    out["max"] = max(out["albedo"])
+    return out

@@ -20,6 +20,7 @@ def _figures(**changes):
                   "hybrid": [0.105, 0.105]},
         "shadows": {"sectors": [6, 18], "disagreement": [0.05, 0.01]},
         "round_trip": {"counts_mismatches": 0, "n_counts": 100, "XYZ_error_over_bound": 0.5},
+        "albedo": {"albedo": [0.9, 0.99], "error": [1e-3, 1e-3], "theta_deg": [0, 60]},
     }  # fmt: skip
     figures = copy.deepcopy(figures)
     for path, value in changes.items():
@@ -33,8 +34,9 @@ def _figures(**changes):
 
 def test_checks_cover_every_target_and_pass_when_met():
     checks = _figures()
-    # 2 designs × 3 lights × (mean, max), 2 metamers, hybrid, shadows, 2 display round trips.
-    assert len(checks) == 12 + 2 + 1 + 1 + 2
+    # 2 designs × 3 lights × (mean, max), 2 metamers, hybrid, shadows, 2 display round trips,
+    # the Ward–Dür albedo.
+    assert len(checks) == 12 + 2 + 1 + 1 + 2 + 1
     assert all(c.passed for c in checks), [c for c in checks if not c.passed]
 
 
@@ -53,6 +55,7 @@ def test_a_failing_figure_fails_its_check():
         "shadows/disagreement/1": (0.021, "horizon map (18 sectors)", "2.1 %"),
         "round_trip/counts_mismatches": (1, "counts → XYZ → counts", 1),
         "round_trip/XYZ_error_over_bound": (1.2, "XYZ → counts → XYZ", 1.2),
+        "albedo/albedo/1": (1.002, "Ward–Dür white-furnace albedo", 1.002),
     }
     for path, (value, name, measured) in cases.items():
         failed = [c for c in _figures(**{path: value}) if not c.passed]
@@ -67,7 +70,7 @@ def test_a_failing_figure_fails_its_check():
 def test_report_section_quick(tmp_path):
     results = run_report(tmp_path, quick=True, only=["impastor"], progress=False)
     checks = {c["name"]: c for c in results["checks"] if c["section"] == "impastor"}
-    assert len(checks) == 18
+    assert len(checks) == 19
     # The colour, metamer, shadow and display targets hold; the hybrid's is erratum E17.
     failing = [name for name, c in checks.items() if not c["passed"]]
     assert all(name.startswith("hybrid") for name in failing), failing

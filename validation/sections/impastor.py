@@ -32,7 +32,9 @@ SHADOW_LIMIT = 0.02
 SHADOW_SECTORS = 18
 
 
-def impastor_checks(channel_table, metamers, alpha, shadows, round_trip, lights=None) -> list:
+def impastor_checks(
+    channel_table, metamers, alpha, shadows, round_trip, albedo, lights=None
+) -> list:
     """The section's target checks, one per target of issue 6, from the measured figures.
 
     Parameters
@@ -47,6 +49,8 @@ def impastor_checks(channel_table, metamers, alpha, shadows, round_trip, lights=
         :func:`validation.impastor_lighting.shadow_agreement` (18 sectors are checked).
     round_trip : dict
         :func:`validation.impastor.display_round_trip`.
+    albedo : dict
+        :func:`validation.impastor_lighting.ward_duer_albedo` (every case, within its error).
     lights : sequence of str, optional
         Lights with ΔE00 targets; default ``validation.impastor.LIGHTS``.
 
@@ -61,7 +65,8 @@ def impastor_checks(channel_table, metamers, alpha, shadows, round_trip, lights=
     >>> alpha = {"alpha": [0.1], "median_cut": [0.2], "fis": [0.1], "hybrid": [0.12]}
     >>> shadows = {"sectors": [18], "disagreement": [0.01]}
     >>> trip = {"counts_mismatches": 0, "n_counts": 10, "XYZ_error_over_bound": 0.5}
-    >>> checks = impastor_checks(table, metamers, alpha, shadows, trip, lights=("D65",))
+    >>> albedo = {"albedo": [0.99], "error": [1e-4], "theta_deg": [60.0]}
+    >>> checks = impastor_checks(table, metamers, alpha, shadows, trip, albedo, lights=("D65",))
     >>> [c.passed for c in checks if "hybrid" in c.name]
     [False]
     """
@@ -121,6 +126,16 @@ def impastor_checks(channel_table, metamers, alpha, shadows, round_trip, lights=
             "<= 1",
             over,
             over <= 1.0,
+        )
+    )
+    within = all(a - e <= 1.0 for a, e in zip(albedo["albedo"], albedo["error"], strict=True))
+    checks.append(
+        Check(
+            f"Ward–Dür white-furnace albedo (ρ_s = 1), max over α and θ_i ≤ "
+            f"{max(albedo['theta_deg']):g}°",
+            "<= 1",
+            max(albedo["albedo"]),
+            within,
         )
     )
     return checks
@@ -383,7 +398,9 @@ def run(ctx: ReportContext) -> SectionResult:
     results["gloss"] = gloss
     round_trip = imp.display_round_trip()
     results["display_round_trip"] = round_trip
-    checks = impastor_checks(channel_table, metamers, alpha, shadows, round_trip)
+    albedo = lit.ward_duer_albedo()
+    results["ward_duer_albedo"] = albedo
+    checks = impastor_checks(channel_table, metamers, alpha, shadows, round_trip, albedo)
 
     size = 48 if quick else 512
     painting = lit.impasto_painting(size, seed=1)
