@@ -14,15 +14,20 @@ from phong_table.table import build_table
 from validation.phong import (
     ENTRY_LADDER,
     INTERPOLATIONS,
+    NEVER_WORSE_INTERPOLATIONS,
+    TABLE1_ENTRIES,
     TABLE_VARIANTS,
+    TIE_8BIT,
     bimodal_material,
     table_error_row,
+    time_row,
     time_shading,
     tolerance_search,
     view_state,
 )
 from validation.report import (
     REPORT_SECTIONS,
+    Check,
     ReportContext,
     ReportSection,
     SectionResult,
@@ -49,6 +54,154 @@ def _floor(x):
     return max(float(x), 1e-9)
 
 
+def _worst(values, limit, larger_is_worse=True):
+    # the worst figure of a list against its limit; an empty list is a target not measured
+    if not values:
+        return "not measured", False
+    worst = max(values) if larger_is_worse else min(values)
+    return worst, bool(worst <= limit if larger_is_worse else worst >= limit)
+
+
+def _never_worse(records):
+    # error placement minus the best other placement, same view, m and interpolation
+    groups = {}
+    for r in records:
+        if r["interpolation"] in NEVER_WORSE_INTERPOLATIONS:
+            key = (r["scene"], r["view"], r["entries"], r["interpolation"])
+            groups.setdefault(key, {})[(r["placement"], r["segments"])] = r["rms"]
+    worst, where = None, ""
+    for (scene, view, m, interpolation), rms in groups.items():
+        others = [v for k, v in rms.items() if k[0] != "error"]
+        if ("error", None) not in rms or not others:
+            continue
+        margin = rms[("error", None)] - min(others)
+        if worst is None or margin > worst:
+            worst = margin
+            where = (
+                f"{scene} {view} m={m} {interpolation}: error {rms[('error', None)]:.3g} vs "
+                f"{min(others):.3g}"
+            )
+    return worst, where
+
+
+def target_checks(records, picks, failure, speed, speed_source, scope="") -> list[Check]:
+    """The issue's targets as report checks, from the section's measured figures.
+
+    Parameters
+    ----------
+    records : list of dict
+        Rows of ``validation.phong.table_error_row`` with ``scene`` and ``view`` added.
+    picks : list of dict
+        ``--tolerance 0.05`` picks (``validation.phong.tolerance_search``) with ``scene``, ``view``.
+    failure : dict
+        ``n2000_overshoot`` (importance p = m, t-parabola, m = 200, in peaks) and, for the bimodal
+        5/500 material with the t-parabola, ``importance_rms`` and ``error_rms`` at m = 200 and 800.
+    speed : list of float
+        Shading speed-up, exact / (error + monotone, build included), one per row.
+    speed_source : str
+        Where the speed-ups come from (benchmark JSON or this run).
+    scope : str
+        Appended to every name: which rows, views and sizes were measured.
+
+    Returns
+    -------
+    list of Check
+        One per target; a target without a measured figure fails.
+
+    Examples
+    --------
+    >>> rec = [{"scene": "R1", "view": "far", "placement": p, "interpolation": "monotone",
+    ...         "entries": 200, "segments": None, "rms": e, "overshoot": 0.0}
+    ...        for p, e in (("error", 1e-4), ("uniform", 0.2))]
+    >>> checks = target_checks(rec, [], {}, [12.0], "in-run")
+    >>> [(c.name.split(",")[0], c.passed) for c in checks[:3]]
+    [('error/monotone RMS at 200 entries', True), ('error/parabolic RMS at 200 entries', False), \
+('error/linear RMS at 200 entries', False)]
+    """
+    checks = []
+    error_200 = [r for r in records if r["placement"] == "error" and r["entries"] == 200]
+    for interpolation, limit in (("monotone", 1e-3), ("parabolic", 1e-3), ("linear", 1e-2)):
+        rms = [r["rms"] for r in error_200 if r["interpolation"] == interpolation]
+        measured, passed = _worst(rms, limit)
+        name = f"error/{interpolation} RMS at 200 entries, worst of {len(rms)} rows{scope}"
+        checks.append(Check(name, f"<= {limit:g}", measured, passed))
+    entries = [p["entries"] if p["verified"] else np.inf for p in picks]
+    measured, passed = _worst([float(e if e is not None else np.inf) for e in entries], 64)
+    name = f"--tolerance 0.05 picks m (verified on the image), largest of {len(picks)}{scope}"
+    checks.append(Check(name, "<= 64", measured, passed))
+    margin, where = _never_worse(records)
+    measured = "not measured" if margin is None else f"{margin:.3g} ({where})"
+    checks.append(
+        Check(
+            "error placement RMS minus best of uniform/importance (p=m, m/10), same "
+            f"interpolation, worst row and m{scope}",
+            f"<= {TIE_8BIT:g} (tie)",
+            measured,
+            margin is not None and margin <= TIE_8BIT,
+        )
+    )
+    overshoot = [r["overshoot"] for r in records if r["interpolation"] == "monotone"]
+    measured, _ = _worst(overshoot, 0.0)
+    checks.append(
+        Check(
+            f"monotone overshoot, largest of {len(overshoot)} tables{scope}",
+            "== 0",
+            measured,
+            bool(overshoot) and max(overshoot) == 0.0,
+        )
+    )
+    value = failure.get("n2000_overshoot")
+    checks.append(
+        Check(
+            f"n = 2000, importance p = m, t-parabola overshoot at m = 200 (peaks){scope}",
+            ">= 1",
+            "not measured" if value is None else value,
+            value is not None and value >= 1.0,
+        )
+    )
+    for key, name, target, limit in (
+        ("importance_rms", "importance p = m, RMS(800)/RMS(200)", ">= 0.5", 0.5),
+        ("error_rms", "error placement, RMS(200)/RMS(800)", ">= 30", 30.0),
+    ):
+        rms = failure.get(key)
+        if rms is None:
+            value = None
+        elif key == "importance_rms":
+            value = rms[1] / rms[0] if rms[0] > 0 else np.inf
+        else:
+            value = rms[0] / rms[1] if rms[1] > 0 else np.inf
+        checks.append(
+            Check(
+                f"bimodal 5/500, t-parabola, {name}{scope}",
+                target,
+                "not measured" if value is None else value,
+                value is not None and value >= limit,
+            )
+        )
+    measured, passed = _worst(speed, 10.0, larger_is_worse=False)
+    checks.append(
+        Check(
+            f"shading speed-up exact / (error + monotone, build included, m = 200), worst of "
+            f"{len(speed)} rows, {speed_source}",
+            ">= 10",
+            measured,
+            passed,
+        )
+    )
+    return checks
+
+
+def _bench_speedups(bench) -> list[float]:
+    # per benchmark group "phong <scene> <view>": exact / table(error, monotone), minima
+    speed = []
+    for _, records in sorted(bench.items()):
+        exact = [r for r in records if r["name"].startswith("test_exact")]
+        table = [r for r in records if r["name"].endswith("-error-monotone]")]
+        if exact and table:
+            speed.append(exact[0]["stats"]["min"] / table[0]["stats"]["min"])
+    return speed
+
+
 def run(ctx: ReportContext) -> SectionResult:
     """Sweeps of the table methods against the exact render, with charts."""
     import matplotlib.pyplot as plt
@@ -59,6 +212,7 @@ def run(ctx: ReportContext) -> SectionResult:
     scenes = ("R1", "R3") if quick else ("R1", "R2", "R3")
     views = ("near",) if quick else ("far", "near")
     results, blocks, nonfinite = {}, [], 0
+    records, speed, picks = [], [], []
     blocks.append(
         Text(
             f"RMS (8-bit, the larger of display and linear) against shading time (build included) "
@@ -83,6 +237,7 @@ def run(ctx: ReportContext) -> SectionResult:
                 for interpolation in INTERPOLATIONS:
                     for m in ladder:
                         r = table_error_row(state, placement, interpolation, m, segments(m))
+                        records.append({"scene": scene, "view": view, **r})
                         table = build_table(model, m, placement, r["segments"], compiled=compiled)
                         shade_s = time_shading(state, table, interpolation, repeats)
                         nonfinite += int(not np.isfinite(r["rms"]))
@@ -95,6 +250,12 @@ def run(ctx: ReportContext) -> SectionResult:
                     for (v, i, m), (s, e) in zip(labels, points, strict=True)
                 ],
             }
+            # the 200-entry error rows of the targets, and the in-run speed-up of error + monotone
+            for interpolation in () if TABLE1_ENTRIES in ladder else NEVER_WORSE_INTERPOLATIONS:
+                r = table_error_row(state, "error", interpolation, TABLE1_ENTRIES)
+                records.append({"scene": scene, "view": view, **r})
+            r = table_error_row(state, "error", "monotone", TABLE1_ENTRIES)
+            speed.append(time_row(state, r, exact_s, 0.0, repeats)["speedup"])
             ax = axes[row][col]
             for (name, interpolation, _), (s, e) in zip(labels, points, strict=True):
                 ax.scatter(s, e, marker=markers[name], c=colours[interpolation], s=14)
@@ -187,6 +348,7 @@ def run(ctx: ReportContext) -> SectionResult:
             state = view_state(SCENES.lookup(scene).build(), view, resolution, compiled)
             pick = tolerance_search(state, 0.05, "monotone", max_entries=256 if quick else 4096)
             results[f"tolerance {scene} {view}"] = pick
+            picks.append({"scene": scene, "view": view, **pick})
             rows.append(
                 [
                     scene,
@@ -205,15 +367,26 @@ def run(ctx: ReportContext) -> SectionResult:
             "{:.3g}",
         )
     )
+    # the paper's failure modes (far view, t-parabola)
+    n2000 = view_state(SCENES.lookup("n2000").build(), "far", resolution, compiled)
+    bimodal = view_state(SCENES.lookup("bimodal").build(), "far", resolution, compiled)
+    failure = {
+        "n2000_overshoot": table_error_row(n2000, "importance", "parabolic", 200, 200)["overshoot"],
+        "importance_rms": [
+            table_error_row(bimodal, "importance", "parabolic", m, m)["rms"] for m in (200, 800)
+        ],
+        "error_rms": [table_error_row(bimodal, "error", "parabolic", m)["rms"] for m in (200, 800)],
+    }
+    results["failure_modes"] = failure
     results["nonfinite"] = nonfinite
     blocks.append(Text(f"Non-finite RMS values in all sweeps: {nonfinite} (must be 0)."))
     bench = ctx.bench_groups("phong")
     if bench:
         table_rows = []
-        for group, records in sorted(bench.items()):
-            base = [r for r in records if "exact" in r["name"]]
+        for group, group_records in sorted(bench.items()):
+            base = [r for r in group_records if "exact" in r["name"]]
             base_s = base[0]["stats"]["min"] if base else None
-            for r in records:
+            for r in group_records:
                 ratio = base_s / r["stats"]["min"] if base_s else float("nan")
                 table_rows.append([group, r["name"], r["stats"]["min"] * 1e3, ratio])
         blocks.append(
@@ -225,7 +398,30 @@ def run(ctx: ReportContext) -> SectionResult:
             )
         )
         results["bench"] = table_rows
-    return SectionResult(blocks, results)
+    bench_speed = _bench_speedups(bench) if bench else []
+    if bench_speed:
+        speed, speed_source = bench_speed, "from benchmark JSON (make bench, 512×512)"
+    else:
+        speed_source = f"measured in this run at {resolution}×{resolution}" + (
+            " with the NumPy references (quick mode)" if quick else " (compiled)"
+        )
+    scope = (
+        f" [quick: {', '.join(scenes)} {', '.join(views)} only, {resolution}×{resolution}, "
+        f"m in {list(ladder)}]"
+        if quick
+        else f" [{len(scenes) * len(views)} rows, {resolution}×{resolution}]"
+    )
+    checks = target_checks(records, picks, failure, speed, speed_source, scope)
+    results["speedups"] = {"source": speed_source, "values": speed}
+    blocks.append(
+        Table(
+            ["target", "limit", "measured", "holds"],
+            [[c.name, c.target, c.measured, "yes" if c.passed else "NO"] for c in checks],
+            "The issue's targets, from this section's figures",
+            "{:.3g}",
+        )
+    )
+    return SectionResult(blocks, results, checks)
 
 
 REPORT_SECTIONS.register(ReportSection("phong", "Spectral Phong tables", 40, run))
