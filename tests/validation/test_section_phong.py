@@ -3,7 +3,7 @@ import json
 import pytest
 
 from validation.report import run_report
-from validation.sections.phong import target_checks
+from validation.phong_table1 import target_checks
 
 TARGETS = (
     "error/monotone RMS at 200",
