@@ -2,8 +2,8 @@ import json
 
 import pytest
 
-from validation.report import run_report
 from validation.phong_table1 import target_checks
+from validation.report import run_report
 
 TARGETS = (
     "error/monotone RMS at 200",
