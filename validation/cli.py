@@ -292,18 +292,18 @@ def _write_json(path, result) -> None:
 
 def _cmd_phong(args) -> int:
     from reference.errors import SpecrefError
-    from validation import phong
+    from validation import phong, phong_table1
 
     if args.action == "table1":
-        result = phong.run_table1(args.resolution, args.entries, args.repeats, progress=True)
+        result = phong_table1.run_table1(args.resolution, args.entries, args.repeats, progress=True)
         print(f"Table 1 (Wang et al.), {args.resolution}x{args.resolution}, {args.entries} entries")
-        print(phong.format_rows(result["rows"]))
+        print(phong_table1.format_rows(result["rows"]))
         print("\nTargets")
-        print(phong.format_targets(result["targets"]))
+        print(phong_table1.format_targets(result["targets"]))
     else:
         if args.material is None:
             raise SpecrefError("specref phong: give table1 or --material FILE.toml")
-        result = phong.run_material(
+        result = phong_table1.run_material(
             args.material,
             args.view,
             args.entries,
@@ -314,7 +314,7 @@ def _cmd_phong(args) -> int:
             args.resolution,
             args.repeats,
         )
-        print(phong.format_rows(result["rows"]))
+        print(phong_table1.format_rows(result["rows"]))
         if result["tolerance"] is not None:
             print(phong.format_tolerance(result["tolerance"]))
     if args.json:
