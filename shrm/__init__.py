@@ -20,13 +20,14 @@ from shrm.sh import SH_MAX_ORDER, sh_basis, sh_evaluate, sh_index
 from shrm.shrm import (
     SHRM,
     brdf_sh_coefficients,
-    render_bruteforce,
     render_shrm,
+    shade_shrm,
+    shrm_brdf_parts,
     shrm_create,
-    shrm_create_angular,
     shrm_extract,
     shrm_orders,
 )
+from shrm.shrm_oracles import render_bruteforce, shrm_create_angular
 from shrm.transform import SH_BACKENDS, project_function, project_latlong, synthesize_latlong
 from shrm.windows import WINDOWS, apply_window, ringing_statistics
 
@@ -60,6 +61,8 @@ __all__ = [
     "sh_evaluate",
     "sh_index",
     "sh_rotation_blocks",
+    "shade_shrm",
+    "shrm_brdf_parts",
     "shrm_create",
     "shrm_create_angular",
     "shrm_extract",

@@ -252,9 +252,9 @@ def _config(state) -> dict:
     defaults = {
         "size": 32,
         "tol": 0.01,
-        "frame": "reflection",
-        "F_max": 32,
-        "P_max": 10,
+        "frame": "normal",
+        "F_max": 24,
+        "P_max": 14,
         "F": None,
         "P": None,
         "light_order": 32,
@@ -308,35 +308,59 @@ def _stage_specular_map(state, inputs):
     return {"cube": _prefiltered_cube(inputs["sh_project"]["coeffs"], spec, _config(state))}
 
 
-def _brdf_call(state):
-    from reference.brdf import BRDF_METHODS
-
-    brdf = state["brdf"]
-    method = BRDF_METHODS.lookup(brdf["name"])
-    params = dict(brdf.get("params", method.extra["params"]))
-    return method.reference, params
-
-
 def _stage_brdf_coeffs(state, inputs):
-    from shrm.shrm import brdf_sh_coefficients, shrm_orders
+    from shrm.shrm import brdf_sh_coefficients, shrm_brdf_parts, shrm_orders
 
     c = _config(state)
-    brdf, params = _brdf_call(state)
-    rho = brdf_sh_coefficients(brdf, params, c["F_max"], c["P_max"], c["frame"])
+    brdf = state["brdf"]
+    method, params = brdf["name"], brdf.get("params")
+    if params is None:
+        from reference.brdf import BRDF_METHODS
+
+        params = dict(BRDF_METHODS.lookup(method).extra["params"])
+    # R&H 2002: the Lambertian part goes to an irradiance map, the rest is expanded
+    function, expand, lambert, k = shrm_brdf_parts(method, params)
+    rho = brdf_sh_coefficients(function, expand, c["F_max"], c["P_max"], c["frame"], view_power=k)
     F, P = shrm_orders(rho, c["tol"], c.get("F"), c.get("P"))
-    return {"rho": rho[:, : F + 1, : P + 1, : min(F, P) + 1]}
+    return {
+        "rho": rho[:, : F + 1, : P + 1, : min(F, P) + 1],
+        "lambert": np.zeros(0) if lambert is None else lambert,
+        "view_power": np.array(k),
+    }
 
 
 def _stage_shrm_create(state, inputs):
     from shrm.shrm import shrm_create
 
     c = _config(state)
-    rho = inputs["brdf_coeffs"]["rho"]
-    L = inputs["sh_project"]["coeffs"]
+    b = inputs["brdf_coeffs"]
+    rho, L = b["rho"], inputs["sh_project"]["coeffs"]
     F = min(rho.shape[1] - 1, round(np.sqrt(L.shape[1])) - 1)
+    lambert = b["lambert"] if b["lambert"].size else None
     # §5.5, Herbert et al.: create the SHRM for environment and BRDF
-    s = shrm_create(L, rho[:, : F + 1], c["frame"], c["size"], backend=c["backend"])
-    return {"coeffs": s.coeffs, "orders": np.array([s.F, s.P])}
+    s = shrm_create(
+        L, rho[:, : F + 1], c["frame"], c["size"], c["backend"], float(b["view_power"]), lambert
+    )
+    out = {"coeffs": s.coeffs, "orders": np.array([s.F, s.P]), "view_power": b["view_power"]}
+    if lambert is not None:
+        out.update(lambert=s.lambert, irradiance=s.irradiance)
+    return out
+
+
+def _shrm_of(state, created):
+    """The SHRM object of a ``shrm_create`` result."""
+    from shrm.shrm import SHRM
+
+    F, P = (int(x) for x in created["orders"])
+    return SHRM(
+        created["coeffs"],
+        _config(state)["frame"],
+        F,
+        P,
+        float(created["view_power"]),
+        created.get("lambert"),
+        created.get("irradiance"),
+    )
 
 
 def _view_of(camera) -> np.ndarray:
@@ -354,20 +378,17 @@ def _stage_gbuffer(state, inputs):
 
 
 def _stage_extract(state, inputs):
-    from shrm.shrm import SHRM, shrm_extract
+    from shrm.shrm import shrm_extract
 
-    c = _config(state)
-    F, P = (int(x) for x in inputs["shrm_create"]["orders"])
-    s = SHRM(inputs["shrm_create"]["coeffs"], c["frame"], F, P)
+    s = _shrm_of(state, inputs["shrm_create"])
     # §5.6, Herbert et al.: extract the reflection map for the viewpoint
     return {"map": shrm_extract(s, _view_of(state["viewpoint"]))}
 
 
 def _stage_shade(state, inputs):
     from reference.cubemap import cubemap_lookup_bilinear
-    from shrm.shrm import _index_directions
+    from shrm.shrm import _index_directions, shade_shrm
 
-    c = _config(state)
     d = {"k_d": 0.0, "k_s": 0.0, "k_e": 1.0, **state["dynamic"]}
     g = inputs["gbuffer"]["gbuffer"]
     v = _view_of(state["viewpoint"])
@@ -380,7 +401,7 @@ def _stage_shade(state, inputs):
         np.asarray(d["k_d"]) / np.pi * cubemap_lookup_bilinear(inputs["diffuse_map"]["cube"], n)
         + np.asarray(d["k_s"]) * cubemap_lookup_bilinear(inputs["specular_map"]["cube"], r)
         + np.asarray(d["k_e"])
-        * cubemap_lookup_bilinear(inputs["extract"]["map"], _index_directions(c["frame"], n, v))
+        * shade_shrm(_shrm_of(state, inputs["shrm_create"]), inputs["extract"]["map"], n, v)
     )
     return {"radiance": radiance, "mask": sel}
 
@@ -393,12 +414,14 @@ HERBERT_STAGES = (
     Stage(
         "specular_map", ("gloss", "config"), ("sh_project",), _stage_specular_map, persistent=True
     ),
-    Stage("brdf_coeffs", ("brdf", "config"), (), _stage_brdf_coeffs, persistent=True),
+    # Version 2: the Lambertian part split off, the grazing view power factored out
+    Stage("brdf_coeffs", ("brdf", "config"), (), _stage_brdf_coeffs, "2", persistent=True),
     Stage(
         "shrm_create",
         ("config",),
         ("sh_project", "brdf_coeffs"),
         _stage_shrm_create,
+        "2",
         persistent=True,
     ),
     Stage("gbuffer", ("viewpoint", "config"), (), _stage_gbuffer),
@@ -406,7 +429,7 @@ HERBERT_STAGES = (
     Stage(
         "shade",
         ("dynamic", "viewpoint", "config"),
-        ("diffuse_map", "specular_map", "extract", "gbuffer"),
+        ("diffuse_map", "specular_map", "shrm_create", "extract", "gbuffer"),
         _stage_shade,
     ),
 )
