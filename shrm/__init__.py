@@ -6,6 +6,7 @@ Importing ``shrm`` registers the environment-light shaders in ``reference.shadin
 
 from shrm import environment  # noqa: F401  (registers the environment-light shaders)
 from shrm.cache import Cache, cache_key, default_cache_dir
+from shrm.orbit import render_orbit
 from shrm.prefilter import (
     PREFILTER_KERNELS,
     adaptive_order,
@@ -15,7 +16,7 @@ from shrm.prefilter import (
     prefilter_environment,
 )
 from shrm.rotation import rotate_coefficients, rotation_matrix, sh_rotation_blocks
-from shrm.session import HERBERT_STAGES, RenderSession, render_orbit
+from shrm.session import HERBERT_STAGES, RenderSession
 from shrm.sh import SH_MAX_ORDER, sh_basis, sh_evaluate, sh_index
 from shrm.shrm import (
     SHRM,

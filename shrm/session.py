@@ -61,9 +61,6 @@ __all__ = [
     "STATE_KEYS",
     "RenderSession",
     "Stage",
-    "demo_state",
-    "orbit_camera",
-    "render_orbit",
     "stages_depending_on",
 ]
 
@@ -251,13 +248,16 @@ class RenderSession:
 def _config(state) -> dict:
     defaults = {
         "size": 32,
-        "tol": 0.01,
-        "frame": "normal",
+        # An L2 coefficient tail of 5 %: within §5.5's P <= 10 for the synthesized BRDFs
+        "tol": 0.05,
+        "frame": "reflection",
         "F_max": 24,
-        "P_max": 14,
+        "P_max": 10,
         "F": None,
         "P": None,
         "light_order": 32,
+        # Tolerance of the diffuse and specular prefilter orders (shrm.prefilter.adaptive_order)
+        "prefilter_tol": 0.01,
         "width": 96,
         "height": 96,
         "backend": "ducc0",
@@ -293,7 +293,7 @@ def _prefiltered_cube(coeffs, kernel, c):
     from shrm.sh import order_of, sh_evaluate
 
     k = parse_kernel(kernel)
-    L = min(adaptive_order(k, c["tol"]), order_of(coeffs.shape[1]))
+    L = min(adaptive_order(k, c["prefilter_tol"]), order_of(coeffs.shape[1]))
     # §5.4, Herbert et al.: prefiltering is a product in frequency space
     E = prefilter_coefficients(coeffs[:, : (L + 1) ** 2], k.Lambda(L))
     return sh_evaluate(E, cubemap_texel_directions(c["size"]), backend=c["backend"])
@@ -433,201 +433,3 @@ HERBERT_STAGES = (
         _stage_shade,
     ),
 )
-
-
-# --- a Python-built demo scene and the camera orbit --------------------------------------------
-
-
-def orbit_camera(frame: int, frames: int, radius: float = 5.0, elevation_deg: float = 15.0):
-    """An orthographic camera on a circle about the y axis, looking at the origin.
-
-    Parameters
-    ----------
-    frame, frames : int
-        This frame's index and the number of frames of a full turn.
-    radius : float
-        Distance from the origin.
-    elevation_deg : float
-        Height of the circle, degrees above the horizon.
-
-    Returns
-    -------
-    reference.camera.Camera
-
-    Examples
-    --------
-    >>> orbit_camera(0, 4, elevation_deg=0.0).eye
-    (0.0, 0.0, 5.0)
-    """
-    from reference.camera import Camera
-
-    a = 2.0 * np.pi * frame / frames
-    e = np.radians(elevation_deg)
-    eye = radius * np.array([np.cos(e) * np.sin(a), np.sin(e), np.cos(e) * np.cos(a)])
-    return Camera(
-        eye=tuple(float(x) + 0.0 for x in np.round(eye, 12)),
-        target=(0.0, 0.0, 0.0),
-        projection="orthographic",
-        extent=2.4,
-    )
-
-
-def demo_state(
-    environment_path=None,
-    env_height: int = 64,
-    brdf: str = "effect_pigment",
-    grid=None,
-    size: int = 32,
-    resolution: int = 96,
-    **config,
-) -> dict:
-    """A built-in scene for the orbit and the report: a sphere under a shared environment.
-
-    The environment (default ``venice_sunset_1k.hdr`` from ``../shared/data/environments``, else
-    a synthetic sky) is box-filtered to ``env_height`` rows and turned into spectra by replicating
-    its luminance over the grid (an equal-energy spectral environment); the illuminant is CIE D65.
-
-    Parameters
-    ----------
-    environment_path : str or Path, optional
-        A lat-long ``.hdr`` or ``.exr``.
-    env_height : int
-        Rows of the working environment (a power-of-two fraction of the file's height).
-    brdf : str
-        A key of :data:`reference.brdf.BRDF_METHODS` (isotropic), with its default parameters.
-    grid : reference.spectra.SpectralGrid, optional
-        Default a 16-band 400-700 nm grid (20 nm), which keeps the demo quick.
-    size : int
-        Cube face size of the maps.
-    resolution : int
-        Image width and height.
-    **config
-        Further configuration (``F_max``, ``P_max``, ``light_order``, ``tol``, ``frame``).
-
-    Returns
-    -------
-    dict
-        State for :class:`RenderSession`.
-
-    Examples
-    --------
-    >>> state = demo_state(env_height=16, size=4, resolution=8)
-    >>> state["environment"].shape, sorted(state["dynamic"])
-    ((16, 32, 16), ['k_d', 'k_e', 'k_s'])
-    """
-    from pathlib import Path
-
-    from reference.brdf import BRDF_METHODS
-    from reference.camera import downsample_box
-    from reference.geometry import Sphere
-    from reference.images import read_image
-    from reference.spectra import SpectralGrid, spectrum_from_dataset
-
-    grid = grid or SpectralGrid(400.0, 700.0, 20.0)
-    default = Path(__file__).resolve().parents[2] / "shared/data/environments/venice_sunset_1k.hdr"
-    path = Path(environment_path) if environment_path else default
-    if path.is_file():
-        image = read_image(path)
-        factor = max(1, image.shape[0] // env_height)
-        image = downsample_box(image[: factor * env_height, : factor * 2 * env_height], factor)
-    else:  # a synthetic sky: bright zenith, a warm sun, a dark ground
-        from reference.envmap import latlong_pixel_directions
-
-        d = latlong_pixel_directions(env_height, 2 * env_height)
-        sun = np.exp((d @ np.array([0.6, 0.5, 0.62]) - 1.0) * 40.0)
-        image = (0.2 + 0.8 * np.maximum(d[..., 1], 0.0) + 20.0 * sun)[..., None] * np.ones(3)
-    luminance = image @ np.array([0.2126, 0.7152, 0.0722])
-    environment = np.repeat(luminance[..., None], grid.n_bands, axis=-1)
-    illuminant = spectrum_from_dataset("illuminant", "D65")
-    from reference.spectra import resample_spectrum
-
-    D65 = np.asarray(resample_spectrum(illuminant, grid), dtype=np.float64)
-    method = BRDF_METHODS.lookup(brdf)
-    params = dict(method.extra["params"])
-    if "wavelengths_nm" in params:
-        params["wavelengths_nm"] = grid.wavelengths_nm
-    for key, value in params.items():
-        if np.ndim(value) == 1 and key != "wavelengths_nm":
-            params[key] = np.interp(
-                grid.wavelengths_nm, np.linspace(380, 780, len(value)), np.asarray(value)
-            )
-    return {
-        "illuminant": D65 / D65.max(),
-        "environment": environment,
-        "viewpoint": orbit_camera(0, 8),
-        "gloss": 64.0,
-        "brdf": {"name": brdf, "params": params},
-        "dynamic": {"k_d": 0.0, "k_s": 0.0, "k_e": 1.0},
-        "config": {
-            "size": size,
-            "width": resolution,
-            "height": resolution,
-            "objects": [Sphere((0.0, 0.0, 0.0), 1.0)],
-            "grid": [grid.start_nm, grid.end_nm, grid.step_nm],
-            **config,
-        },
-    }
-
-
-def render_orbit(session: RenderSession, frames: int, out_dir=None, progress: bool = True):
-    """Render a camera orbit; write PNG frames and a per-stage timing table (``timings.csv``).
-
-    The first frame pays for creation; later frames run only ``gbuffer``, ``extract`` and
-    ``shade`` (§5.2, Herbert et al.).
-
-    Parameters
-    ----------
-    session : RenderSession
-        With a ``config.grid`` of ``[start_nm, end_nm, step_nm]``.
-    frames : int
-        Frames of a full turn, >= 1.
-    out_dir : str or Path, optional
-        Where to write ``frame_###.png`` and ``timings.csv`` (atomically); None writes nothing.
-    progress : bool
-        tqdm progress on stderr.
-
-    Returns
-    -------
-    list of dict
-        ``{stage: seconds}`` per frame.
-
-    Examples
-    --------
-    >>> s = RenderSession(demo_state(env_height=16, size=4, resolution=8, F_max=8, P_max=4))
-    >>> times = render_orbit(s, 2, progress=False)
-    >>> sorted(times[1])
-    ['extract', 'gbuffer', 'shade']
-    """
-    import sys
-    from pathlib import Path
-
-    from tqdm import tqdm
-
-    from reference.colorimetry import XYZ_to_display_RGB, band_weights, spectra_to_XYZ
-    from reference.display import linear_to_display
-    from reference.errors import require_positive_int
-    from reference.images import write_png, write_text_atomic
-    from reference.spectra import SpectralGrid
-
-    frames = require_positive_int(frames, "orbit --frames", 100000)
-    grid = SpectralGrid(*session.state["config"]["grid"])
-    W = band_weights(grid, None)
-    white = float(spectra_to_XYZ(np.asarray(session.state["illuminant"]), W)[1])
-    rows = []
-    for f in tqdm(range(frames), desc="orbit", unit="frame", file=sys.stderr, disable=not progress):
-        session.update(viewpoint=orbit_camera(f, frames))
-        result = session.render()
-        times = session.frame_times[-1]
-        rows.append(times)
-        if out_dir is not None:
-            XYZ = spectra_to_XYZ(result["shade"]["radiance"], W) / white
-            RGB = linear_to_display(np.clip(XYZ_to_display_RGB(XYZ), 0.0, None), "srgb")
-            write_png(Path(out_dir) / f"frame_{f:03d}.png", np.clip(RGB, 0.0, 1.0))
-    if out_dir is not None:
-        names = [s.name for s in session.stages]
-        lines = ["frame," + ",".join(names) + ",total"]
-        for f, times in enumerate(rows):
-            cells = [f"{times.get(n, 0.0):.6f}" for n in names]
-            lines.append(f"{f}," + ",".join(cells) + f",{sum(times.values()):.6f}")
-        write_text_atomic(Path(out_dir) / "timings.csv", "\n".join(lines) + "\n")
-    return rows

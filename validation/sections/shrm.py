@@ -75,7 +75,7 @@ def study_setup(quick: bool):
     from reference.camera import Camera, downsample_box
     from reference.gbuffer import render_gbuffer
     from reference.geometry import Sphere
-    from shrm.session import demo_state
+    from shrm.orbit import demo_state
 
     rows = 16 if quick else 64
     path = Path(__file__).resolve().parents[3] / "shared/data/environments/venice_sunset_1k.hdr"
@@ -553,7 +553,8 @@ def _orbit_blocks(ctx, results) -> list:
     """Per-stage times of a camera orbit of the render session (§5.2, Herbert et al.)."""
     import matplotlib.pyplot as plt
 
-    from shrm.session import RenderSession, demo_state, render_orbit
+    from shrm.orbit import demo_state, render_orbit
+    from shrm.session import RenderSession
 
     small = {"env_height": 16, "size": 8, "resolution": 24, "F_max": 8, "P_max": 4}
     state = demo_state(brdf="lafortune", **(small if ctx.quick else {}))
