@@ -471,7 +471,7 @@ def _ward_duer_example(rng):
 #: ``extra["params"]`` default parameters; ``extra["albedo_bound"]`` what the source claims.
 #: Isotropic 3-D BRDFs also set ``extra["isotropic"]`` and may name their Lambertian albedo
 #: parameter (``extra["lambert"]``) and their grazing view power (``extra["grazing_view_power"]``),
-#: which SHRMs read (``shrm.shrm.shrm_brdf_parts``).
+#: which SHRMs read (``shrm.brdf_sh.shrm_brdf_parts``).
 BRDF_METHODS = Registry("brdf")
 BRDF_METHODS.register(
     Method(

@@ -162,14 +162,9 @@ def shade_isotropic_brdf_environment(
     ...                                  ctx).shape
     (1, 3)
     """
+    from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts
     from shrm.environment import environment_spectral_radiance
-    from shrm.shrm import (
-        brdf_sh_coefficients,
-        shade_shrm,
-        shrm_brdf_parts,
-        shrm_create,
-        shrm_extract,
-    )
+    from shrm.shrm import shade_shrm, shrm_create, shrm_extract
     from shrm.transform import project_latlong
 
     c = SHADER_SETTINGS

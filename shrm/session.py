@@ -309,7 +309,7 @@ def _stage_specular_map(state, inputs):
 
 
 def _stage_brdf_coeffs(state, inputs):
-    from shrm.shrm import brdf_sh_coefficients, shrm_brdf_parts, shrm_orders
+    from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts, shrm_orders
 
     c = _config(state)
     brdf = state["brdf"]

@@ -22,8 +22,9 @@ from __future__ import annotations
 import numpy as np
 
 from reference.errors import require_choice
+from shrm.brdf_sh import FRAMES
 from shrm.sh import fejer1_weights
-from shrm.shrm import FRAMES, SHRM
+from shrm.shrm import SHRM
 from shrm.transform import project_latlong
 
 __all__ = [
@@ -149,7 +150,7 @@ def shrm_texels_angular(
         Texel directions (unit).
     frame : {"normal", "reflection"}
     view_power : float
-        The grazing view power k of the SHRM (:func:`shrm.shrm.shrm_brdf_parts`).
+        The grazing view power k of the SHRM (:func:`shrm.brdf_sh.shrm_brdf_parts`).
 
     Returns
     -------

@@ -185,7 +185,7 @@ def _cmd_shrm_orbit(args) -> int:
         for flag, value in (("--brdf", args.brdf), ("--env", args.env), ("--quick", args.quick)):
             if value:
                 raise SpecrefError(
-                    f"{args.scene}: {flag} is for the built-in scene; got a scene file"
+                    f"{args.scene}: {flag} is for the built-in scene, not a scene file"
                 )
         state = scene_state(load_scene(args.scene), **orders)
     else:

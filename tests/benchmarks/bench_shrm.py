@@ -1,7 +1,7 @@
 """SHRM and cache speed, as ratios to baselines measured in the same run (report section "SHRMs").
 
-Every BRDF as the report's study renders it (:func:`shrm.shrm.shrm_brdf_parts`: the Lambertian part
-split off to an irradiance map, the grazing view power factored out); the SHRM part is timed.
+Every BRDF as the report's study renders it (:func:`shrm.brdf_sh.shrm_brdf_parts`: the Lambertian
+part split off to an irradiance map, the grazing view power factored out); the SHRM part is timed.
 
 Groups:
 
@@ -31,9 +31,10 @@ import pytest
 from reference.camera import downsample_box
 from reference.cubemap import cubemap_texel_directions
 from reference.images import read_image
+from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts
 from shrm.cache import Cache, cache_key
 from shrm.sh import sh_basis
-from shrm.shrm import brdf_sh_coefficients, shrm_brdf_parts, shrm_create, shrm_extract
+from shrm.shrm import shrm_create, shrm_extract
 from shrm.shrm_oracles import env_quadrature, reflected_bruteforce, shrm_texels_angular
 from shrm.transform import project_latlong
 from validation.sections.shrm import SUITE, study_params

@@ -168,7 +168,8 @@ def study_brdf(name, env, L_env, g, view, plan) -> dict:
         error at N·V > 0.2), the ``choice`` with its measured creation seconds and its ``shrm``,
         and whether it meets :data:`TOLERANCE`.
     """
-    from shrm.shrm import brdf_sh_coefficients, render_shrm, shrm_brdf_parts
+    from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts
+    from shrm.shrm import render_shrm
     from shrm.shrm_oracles import render_bruteforce
 
     params = study_params(name)
@@ -339,7 +340,7 @@ def run(ctx: ReportContext) -> SectionResult:
             "by per-pixel brute force (every pixel sums BRDF × environment over all environment "
             "pixels). The Lambertian part ρ_d/π of Ward, GGX and Lafortune is split off and "
             "rendered from an irradiance map; Ward's 1/sqrt(cos θ_o) is factored out of its "
-            "SHRM (`shrm.shrm.shrm_brdf_parts`). Error is the largest per-pixel difference over "
+            "SHRM (`shrm.brdf_sh.shrm_brdf_parts`). Error is the largest per-pixel difference over "
             f"the peak; the target is {TOLERANCE:.0%}. The chosen setting is the fastest to "
             "create (measured) among those that meet the target (or, failing that, the most "
             "accurate). The last column is the best any setting with P <= 10 (the top of §5.5's "
@@ -377,7 +378,8 @@ def run(ctx: ReportContext) -> SectionResult:
 def _creation_blocks(ctx, env, L_env, view, results) -> list:
     """Creation in frequency space against angular creation, per texel, same input and texels."""
     from reference.cubemap import cubemap_texel_directions
-    from shrm.shrm import brdf_sh_coefficients, shrm_brdf_parts, shrm_extract
+    from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts
+    from shrm.shrm import shrm_extract
     from shrm.shrm_oracles import env_quadrature, reflected_bruteforce, shrm_texels_angular
 
     name = "ggx"
@@ -466,8 +468,9 @@ def _creation_blocks(ctx, env, L_env, view, results) -> list:
 
 def _extraction_blocks(ctx, env, L_env, view, studies, results) -> list:
     """Extraction per viewpoint and a cache hit, against creation (at the default 64² × 6)."""
+    from shrm.brdf_sh import shrm_brdf_parts
     from shrm.cache import Cache, cache_key
-    from shrm.shrm import shrm_brdf_parts, shrm_extract
+    from shrm.shrm import shrm_extract
     from shrm.transform import project_latlong
 
     name = "ggx"
