@@ -11,7 +11,7 @@ export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 export MPLBACKEND ?= Agg
 
-.PHONY: install demo test bench results coverage lint clean
+.PHONY: install demo test bench bench-json results coverage lint clean
 
 $(STAMP): setup.cfg pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -29,14 +29,17 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(PY) -m pytest -q
 
-## make bench: run the pytest-benchmark suite and save JSON (specref report turns it into charts)
-bench: $(STAMP)
+## make bench-json: run the pytest-benchmark suite and save bench.json
+bench-json: $(STAMP)
 	SPECREF_BENCH=1 $(PY) -m pytest -q tests/benchmarks --benchmark-enable \
 		--benchmark-json=bench.json --benchmark-min-rounds=3
+
+## make bench: the benchmarks, then the report with their charts and speed checks in ./report
+bench: bench-json
 	$(VENV)/bin/specref report --out report --bench bench.json
 
 ## make results: benchmarks, then the full report; regenerates docs/results.md and docs/results/
-results: bench
+results: bench-json
 	$(VENV)/bin/specref report --out docs/results --bench bench.json \
 		--markdown docs/results.md --markdown-image-prefix results/
 
