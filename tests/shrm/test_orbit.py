@@ -8,27 +8,13 @@ import pytest
 from reference.errors import SpecrefError
 from reference.images import read_png
 from reference.scene import load_scene, loads_scene
-from shrm.orbit import demo_state, render_orbit, scene_state, turn_camera
+from shrm.orbit import render_orbit, scene_state, turn_camera
 from shrm.session import HERBERT_STAGES, RenderSession
 from validation.cli import main
 
 ALL = [s.name for s in HERBERT_STAGES]
 EXAMPLE = Path(__file__).resolve().parents[2] / "docs" / "examples" / "shrm-orbit.toml"
 LATER = ["extract", "gbuffer", "shade"]
-
-
-@pytest.fixture(scope="module")
-def state():
-    return demo_state(
-        brdf="lafortune",
-        env_height=16,
-        size=4,
-        resolution=12,
-        F_max=8,
-        P_max=4,
-        light_order=8,
-        tol=0.05,
-    )
 
 
 def test_turn_camera_is_a_rotation_about_the_target():

@@ -3,7 +3,7 @@ import pytest
 
 from reference.errors import SpecrefError
 from shrm.cache import Cache
-from shrm.orbit import demo_state, orbit_camera
+from shrm.orbit import orbit_camera
 from shrm.session import (
     HERBERT_STAGES,
     RenderSession,
@@ -12,20 +12,6 @@ from shrm.session import (
 )
 
 ALL = [s.name for s in HERBERT_STAGES]
-
-
-@pytest.fixture(scope="module")
-def state():
-    return demo_state(
-        brdf="lafortune",
-        env_height=16,
-        size=4,
-        resolution=12,
-        F_max=8,
-        P_max=4,
-        light_order=8,
-        tol=0.05,
-    )
 
 
 def _ran(session, before):
