@@ -148,7 +148,8 @@ def shade_isotropic_brdf_environment(
 
     §5.5-5.6, Herbert et al.: project the environment, create the SHRM of the BRDF, extract the
     reflection map for the (distant) view and look it up per point (:func:`shrm.shrm.shade_shrm`).
-    The view is the mean of the points' view directions (module docstring).
+    The view is the mean of the points' view directions (module docstring). Every call creates
+    its SHRM (:data:`SHADER_SETTINGS`, small): a preview; the orbit's session reuses its SHRM.
 
     Examples
     --------
@@ -167,6 +168,8 @@ def shade_isotropic_brdf_environment(
     from shrm.shrm import shade_shrm, shrm_create, shrm_extract
     from shrm.transform import project_latlong
 
+    if surface.normal.shape[0] == 0:
+        return np.zeros((0, 3))
     c = SHADER_SETTINGS
     work = _working_environment(light, c["env_height"])
     radiance = environment_spectral_radiance(work, ctx.grid)
