@@ -76,7 +76,7 @@ def reflected_bruteforce(
     """``∫ L(ω) ρ̃ dω`` by the sum over environment pixels, for pairs (index direction, view).
 
     The reflection equation (R&H 2002) with the transfer function of
-    :func:`shrm.shrm.transfer_function` (views below the horizon mirrored in the normal frame),
+    :func:`shrm.brdf_sh.transfer_function` (views below the horizon mirrored in the normal frame),
     times ``cos^k θ_o`` when ``view_power`` k > 0 (the quantity a SHRM stores).
 
     Parameters
@@ -112,7 +112,7 @@ def reflected_bruteforce(
         n, v = index[a], views[a]
         if frame == "normal":
             normal = n
-            # Views below the horizon are mirrored above it (shrm.shrm.transfer_function)
+            # Views below the horizon are mirrored above it (shrm.brdf_sh.transfer_function)
             v = v if _dot(v, n) >= 0 else v - 2.0 * _dot(v, n) * n
         else:
             h = n + v
