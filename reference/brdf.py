@@ -524,6 +524,9 @@ def _ward_duer_example(rng):
 #: BRDFs by key. ``reference(wi, wo, normal, **params)`` is the BRDF; ``extra["sample"](wi,
 #: normal, u, **params)`` and ``extra["pdf"](wi, wo, normal, **params)`` its sampler and pdf;
 #: ``extra["params"]`` default parameters; ``extra["albedo_bound"]`` what the source claims.
+#: Isotropic 3-D BRDFs also set ``extra["isotropic"]`` and may name their Lambertian albedo
+#: parameter (``extra["lambert"]``) and their grazing view power (``extra["grazing_view_power"]``),
+#: which SHRMs read (``shrm.brdf_sh.shrm_brdf_parts``).
 BRDF_METHODS = Registry("brdf")
 BRDF_METHODS.register(
     Method(

@@ -365,7 +365,7 @@ def register_brdf(method: Method) -> None:
     BRDF_METHODS.register(method)
 
 
-def _register(name, function, cites, params, bound):
+def _register(name, function, cites, params, bound, grazing_view_power=0.0):
     register_brdf(
         Method(
             name,
@@ -380,6 +380,10 @@ def _register(name, function, cites, params, bound):
                 "params": params,
                 "albedo_bound": bound,
                 "isotropic": True,
+                # The model adds rho_d/pi: SHRMs render that part with an irradiance map.
+                "lambert": "rho_d",
+                # k where the model grows like cos^-k(theta_o) towards grazing views.
+                "grazing_view_power": grazing_view_power,
             },
         )
     )
@@ -391,6 +395,8 @@ _register(
     "Eq. (4), Ward 1992",
     _WARD_PARAMS,
     "about rho_d + rho_s for alpha <= 0.2 away from grazing incidence (Ward 1992)",
+    # Eq. (4), Ward 1992: 1 / sqrt(cos θ_i cos θ_o) diverges at grazing views
+    grazing_view_power=0.5,
 )
 _register(
     "ggx",

@@ -5,7 +5,9 @@ Importing ``shrm`` registers the environment-light shaders in ``reference.shadin
 """
 
 from shrm import environment  # noqa: F401  (registers the environment-light shaders)
+from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts, shrm_orders
 from shrm.cache import Cache, cache_key, default_cache_dir
+from shrm.orbit import render_orbit
 from shrm.prefilter import (
     PREFILTER_KERNELS,
     adaptive_order,
@@ -15,18 +17,10 @@ from shrm.prefilter import (
     prefilter_environment,
 )
 from shrm.rotation import rotate_coefficients, rotation_matrix, sh_rotation_blocks
-from shrm.session import HERBERT_STAGES, RenderSession, render_orbit
+from shrm.session import HERBERT_STAGES, RenderSession
 from shrm.sh import SH_MAX_ORDER, sh_basis, sh_evaluate, sh_index
-from shrm.shrm import (
-    SHRM,
-    brdf_sh_coefficients,
-    render_bruteforce,
-    render_shrm,
-    shrm_create,
-    shrm_create_angular,
-    shrm_extract,
-    shrm_orders,
-)
+from shrm.shrm import SHRM, render_shrm, shade_shrm, shrm_create, shrm_extract
+from shrm.shrm_oracles import render_bruteforce, shrm_create_angular
 from shrm.transform import SH_BACKENDS, project_function, project_latlong, synthesize_latlong
 from shrm.windows import WINDOWS, apply_window, ringing_statistics
 
@@ -60,6 +54,8 @@ __all__ = [
     "sh_evaluate",
     "sh_index",
     "sh_rotation_blocks",
+    "shade_shrm",
+    "shrm_brdf_parts",
     "shrm_create",
     "shrm_create_angular",
     "shrm_extract",

@@ -221,7 +221,8 @@ def _encode_payload(arrays: Mapping[str, np.ndarray]) -> tuple[list, bytes]:
     """The arrays' manifest (name, dtype, shape, offset) and their raw bytes, 64-byte aligned."""
     manifest, chunks, offset = [], [], 0
     for name, value in arrays.items():
-        array = np.ascontiguousarray(value)
+        # np.require keeps 0-d arrays 0-d (np.ascontiguousarray would make them 1-d)
+        array = np.require(value, requirements="C")
         require(
             array.dtype.kind in "biufc",
             f"cache entry: array {name!r}: must be numeric, got dtype {array.dtype}",
@@ -241,6 +242,20 @@ class _CorruptError(Exception):
 
 class _ForeignError(Exception):
     """A file that does not carry our magic (or cannot be read)."""
+
+
+def _map_file(path: Path):
+    """The file's bytes, memory-mapped read-only (no copy; b"" for an empty file).
+
+    Entries are replaced by rename, never rewritten in place, so a mapping stays valid while
+    arrays viewing it live.
+    """
+    import mmap
+
+    with open(path, "rb") as file:
+        if os.fstat(file.fileno()).st_size == 0:
+            return b""
+        return mmap.mmap(file.fileno(), 0, access=mmap.ACCESS_READ)
 
 
 class Cache:
@@ -322,12 +337,12 @@ class Cache:
     def _read(path: Path) -> tuple[dict, dict]:
         """Header and arrays of an entry; raises _ForeignError, _CorruptError, FileNotFoundError."""
         try:
-            data = path.read_bytes()
+            data = _map_file(path)
         except FileNotFoundError:
             raise
         except OSError as error:
             raise _ForeignError(f"unreadable ({error.strerror or error})") from None
-        if not data.startswith(CACHE_MAGIC):
+        if bytes(data[: len(CACHE_MAGIC)]) != CACHE_MAGIC:
             raise _ForeignError("not a specref cache entry (no specref header)")
         if len(data) < _HEAD:
             raise _CorruptError(f"truncated entry ({len(data)} bytes)")

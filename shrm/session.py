@@ -61,9 +61,6 @@ __all__ = [
     "STATE_KEYS",
     "RenderSession",
     "Stage",
-    "demo_state",
-    "orbit_camera",
-    "render_orbit",
     "stages_depending_on",
 ]
 
@@ -251,13 +248,16 @@ class RenderSession:
 def _config(state) -> dict:
     defaults = {
         "size": 32,
-        "tol": 0.01,
+        # An L2 coefficient tail of 5 %: within §5.5's P <= 10 for the synthesized BRDFs
+        "tol": 0.05,
         "frame": "reflection",
-        "F_max": 32,
+        "F_max": 24,
         "P_max": 10,
         "F": None,
         "P": None,
         "light_order": 32,
+        # Tolerance of the diffuse and specular prefilter orders (shrm.prefilter.adaptive_order)
+        "prefilter_tol": 0.01,
         "width": 96,
         "height": 96,
         "backend": "ducc0",
@@ -293,7 +293,7 @@ def _prefiltered_cube(coeffs, kernel, c):
     from shrm.sh import order_of, sh_evaluate
 
     k = parse_kernel(kernel)
-    L = min(adaptive_order(k, c["tol"]), order_of(coeffs.shape[1]))
+    L = min(adaptive_order(k, c["prefilter_tol"]), order_of(coeffs.shape[1]))
     # §5.4, Herbert et al.: prefiltering is a product in frequency space
     E = prefilter_coefficients(coeffs[:, : (L + 1) ** 2], k.Lambda(L))
     return sh_evaluate(E, cubemap_texel_directions(c["size"]), backend=c["backend"])
@@ -308,35 +308,59 @@ def _stage_specular_map(state, inputs):
     return {"cube": _prefiltered_cube(inputs["sh_project"]["coeffs"], spec, _config(state))}
 
 
-def _brdf_call(state):
-    from reference.brdf import BRDF_METHODS
-
-    brdf = state["brdf"]
-    method = BRDF_METHODS.lookup(brdf["name"])
-    params = dict(brdf.get("params", method.extra["params"]))
-    return method.reference, params
-
-
 def _stage_brdf_coeffs(state, inputs):
-    from shrm.shrm import brdf_sh_coefficients, shrm_orders
+    from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts, shrm_orders
 
     c = _config(state)
-    brdf, params = _brdf_call(state)
-    rho = brdf_sh_coefficients(brdf, params, c["F_max"], c["P_max"], c["frame"])
+    brdf = state["brdf"]
+    method, params = brdf["name"], brdf.get("params")
+    if params is None:
+        from reference.brdf import BRDF_METHODS
+
+        params = dict(BRDF_METHODS.lookup(method).extra["params"])
+    # R&H 2002: the Lambertian part goes to an irradiance map, the rest is expanded
+    function, expand, lambert, k = shrm_brdf_parts(method, params)
+    rho = brdf_sh_coefficients(function, expand, c["F_max"], c["P_max"], c["frame"], view_power=k)
     F, P = shrm_orders(rho, c["tol"], c.get("F"), c.get("P"))
-    return {"rho": rho[:, : F + 1, : P + 1, : min(F, P) + 1]}
+    return {
+        "rho": rho[:, : F + 1, : P + 1, : min(F, P) + 1],
+        "lambert": np.zeros(0) if lambert is None else lambert,
+        "view_power": np.array(k),
+    }
 
 
 def _stage_shrm_create(state, inputs):
     from shrm.shrm import shrm_create
 
     c = _config(state)
-    rho = inputs["brdf_coeffs"]["rho"]
-    L = inputs["sh_project"]["coeffs"]
+    b = inputs["brdf_coeffs"]
+    rho, L = b["rho"], inputs["sh_project"]["coeffs"]
     F = min(rho.shape[1] - 1, round(np.sqrt(L.shape[1])) - 1)
+    lambert = b["lambert"] if b["lambert"].size else None
     # §5.5, Herbert et al.: create the SHRM for environment and BRDF
-    s = shrm_create(L, rho[:, : F + 1], c["frame"], c["size"], backend=c["backend"])
-    return {"coeffs": s.coeffs, "orders": np.array([s.F, s.P])}
+    s = shrm_create(
+        L, rho[:, : F + 1], c["frame"], c["size"], c["backend"], float(b["view_power"]), lambert
+    )
+    out = {"coeffs": s.coeffs, "orders": np.array([s.F, s.P]), "view_power": b["view_power"]}
+    if lambert is not None:
+        out.update(lambert=s.lambert, irradiance=s.irradiance)
+    return out
+
+
+def _shrm_of(state, created):
+    """The SHRM object of a ``shrm_create`` result."""
+    from shrm.shrm import SHRM
+
+    F, P = (int(x) for x in created["orders"])
+    return SHRM(
+        created["coeffs"],
+        _config(state)["frame"],
+        F,
+        P,
+        float(created["view_power"]),
+        created.get("lambert"),
+        created.get("irradiance"),
+    )
 
 
 def _view_of(camera) -> np.ndarray:
@@ -354,20 +378,17 @@ def _stage_gbuffer(state, inputs):
 
 
 def _stage_extract(state, inputs):
-    from shrm.shrm import SHRM, shrm_extract
+    from shrm.shrm import shrm_extract
 
-    c = _config(state)
-    F, P = (int(x) for x in inputs["shrm_create"]["orders"])
-    s = SHRM(inputs["shrm_create"]["coeffs"], c["frame"], F, P)
+    s = _shrm_of(state, inputs["shrm_create"])
     # §5.6, Herbert et al.: extract the reflection map for the viewpoint
     return {"map": shrm_extract(s, _view_of(state["viewpoint"]))}
 
 
 def _stage_shade(state, inputs):
     from reference.cubemap import cubemap_lookup_bilinear
-    from shrm.shrm import _index_directions
+    from shrm.shrm import _index_directions, shade_shrm
 
-    c = _config(state)
     d = {"k_d": 0.0, "k_s": 0.0, "k_e": 1.0, **state["dynamic"]}
     g = inputs["gbuffer"]["gbuffer"]
     v = _view_of(state["viewpoint"])
@@ -380,7 +401,7 @@ def _stage_shade(state, inputs):
         np.asarray(d["k_d"]) / np.pi * cubemap_lookup_bilinear(inputs["diffuse_map"]["cube"], n)
         + np.asarray(d["k_s"]) * cubemap_lookup_bilinear(inputs["specular_map"]["cube"], r)
         + np.asarray(d["k_e"])
-        * cubemap_lookup_bilinear(inputs["extract"]["map"], _index_directions(c["frame"], n, v))
+        * shade_shrm(_shrm_of(state, inputs["shrm_create"]), inputs["extract"]["map"], n, v)
     )
     return {"radiance": radiance, "mask": sel}
 
@@ -393,12 +414,14 @@ HERBERT_STAGES = (
     Stage(
         "specular_map", ("gloss", "config"), ("sh_project",), _stage_specular_map, persistent=True
     ),
-    Stage("brdf_coeffs", ("brdf", "config"), (), _stage_brdf_coeffs, persistent=True),
+    # Version 2: the Lambertian part split off, the grazing view power factored out
+    Stage("brdf_coeffs", ("brdf", "config"), (), _stage_brdf_coeffs, "2", persistent=True),
     Stage(
         "shrm_create",
         ("config",),
         ("sh_project", "brdf_coeffs"),
         _stage_shrm_create,
+        "2",
         persistent=True,
     ),
     Stage("gbuffer", ("viewpoint", "config"), (), _stage_gbuffer),
@@ -406,205 +429,7 @@ HERBERT_STAGES = (
     Stage(
         "shade",
         ("dynamic", "viewpoint", "config"),
-        ("diffuse_map", "specular_map", "extract", "gbuffer"),
+        ("diffuse_map", "specular_map", "shrm_create", "extract", "gbuffer"),
         _stage_shade,
     ),
 )
-
-
-# --- a Python-built demo scene and the camera orbit --------------------------------------------
-
-
-def orbit_camera(frame: int, frames: int, radius: float = 5.0, elevation_deg: float = 15.0):
-    """An orthographic camera on a circle about the y axis, looking at the origin.
-
-    Parameters
-    ----------
-    frame, frames : int
-        This frame's index and the number of frames of a full turn.
-    radius : float
-        Distance from the origin.
-    elevation_deg : float
-        Height of the circle, degrees above the horizon.
-
-    Returns
-    -------
-    reference.camera.Camera
-
-    Examples
-    --------
-    >>> orbit_camera(0, 4, elevation_deg=0.0).eye
-    (0.0, 0.0, 5.0)
-    """
-    from reference.camera import Camera
-
-    a = 2.0 * np.pi * frame / frames
-    e = np.radians(elevation_deg)
-    eye = radius * np.array([np.cos(e) * np.sin(a), np.sin(e), np.cos(e) * np.cos(a)])
-    return Camera(
-        eye=tuple(float(x) + 0.0 for x in np.round(eye, 12)),
-        target=(0.0, 0.0, 0.0),
-        projection="orthographic",
-        extent=2.4,
-    )
-
-
-def demo_state(
-    environment_path=None,
-    env_height: int = 64,
-    brdf: str = "effect_pigment",
-    grid=None,
-    size: int = 32,
-    resolution: int = 96,
-    **config,
-) -> dict:
-    """A built-in scene for the orbit and the report: a sphere under a shared environment.
-
-    The environment (default ``venice_sunset_1k.hdr`` from ``../shared/data/environments``, else
-    a synthetic sky) is box-filtered to ``env_height`` rows and turned into spectra by replicating
-    its luminance over the grid (an equal-energy spectral environment); the illuminant is CIE D65.
-
-    Parameters
-    ----------
-    environment_path : str or Path, optional
-        A lat-long ``.hdr`` or ``.exr``.
-    env_height : int
-        Rows of the working environment (a power-of-two fraction of the file's height).
-    brdf : str
-        A key of :data:`reference.brdf.BRDF_METHODS` (isotropic), with its default parameters.
-    grid : reference.spectra.SpectralGrid, optional
-        Default a 16-band 400-700 nm grid (20 nm), which keeps the demo quick.
-    size : int
-        Cube face size of the maps.
-    resolution : int
-        Image width and height.
-    **config
-        Further configuration (``F_max``, ``P_max``, ``light_order``, ``tol``, ``frame``).
-
-    Returns
-    -------
-    dict
-        State for :class:`RenderSession`.
-
-    Examples
-    --------
-    >>> state = demo_state(env_height=16, size=4, resolution=8)
-    >>> state["environment"].shape, sorted(state["dynamic"])
-    ((16, 32, 16), ['k_d', 'k_e', 'k_s'])
-    """
-    from pathlib import Path
-
-    from reference.brdf import BRDF_METHODS
-    from reference.camera import downsample_box
-    from reference.geometry import Sphere
-    from reference.images import read_image
-    from reference.spectra import SpectralGrid, spectrum_from_dataset
-
-    grid = grid or SpectralGrid(400.0, 700.0, 20.0)
-    default = Path(__file__).resolve().parents[2] / "shared/data/environments/venice_sunset_1k.hdr"
-    path = Path(environment_path) if environment_path else default
-    if path.is_file():
-        image = read_image(path)
-        factor = max(1, image.shape[0] // env_height)
-        image = downsample_box(image[: factor * env_height, : factor * 2 * env_height], factor)
-    else:  # a synthetic sky: bright zenith, a warm sun, a dark ground
-        from reference.envmap import latlong_pixel_directions
-
-        d = latlong_pixel_directions(env_height, 2 * env_height)
-        sun = np.exp((d @ np.array([0.6, 0.5, 0.62]) - 1.0) * 40.0)
-        image = (0.2 + 0.8 * np.maximum(d[..., 1], 0.0) + 20.0 * sun)[..., None] * np.ones(3)
-    luminance = image @ np.array([0.2126, 0.7152, 0.0722])
-    environment = np.repeat(luminance[..., None], grid.n_bands, axis=-1)
-    illuminant = spectrum_from_dataset("illuminant", "D65")
-    from reference.spectra import resample_spectrum
-
-    D65 = np.asarray(resample_spectrum(illuminant, grid), dtype=np.float64)
-    method = BRDF_METHODS.lookup(brdf)
-    params = dict(method.extra["params"])
-    if "wavelengths_nm" in params:
-        params["wavelengths_nm"] = grid.wavelengths_nm
-    for key, value in params.items():
-        if np.ndim(value) == 1 and key != "wavelengths_nm":
-            params[key] = np.interp(
-                grid.wavelengths_nm, np.linspace(380, 780, len(value)), np.asarray(value)
-            )
-    return {
-        "illuminant": D65 / D65.max(),
-        "environment": environment,
-        "viewpoint": orbit_camera(0, 8),
-        "gloss": 64.0,
-        "brdf": {"name": brdf, "params": params},
-        "dynamic": {"k_d": 0.0, "k_s": 0.0, "k_e": 1.0},
-        "config": {
-            "size": size,
-            "width": resolution,
-            "height": resolution,
-            "objects": [Sphere((0.0, 0.0, 0.0), 1.0)],
-            "grid": [grid.start_nm, grid.end_nm, grid.step_nm],
-            **config,
-        },
-    }
-
-
-def render_orbit(session: RenderSession, frames: int, out_dir=None, progress: bool = True):
-    """Render a camera orbit; write PNG frames and a per-stage timing table (``timings.csv``).
-
-    The first frame pays for creation; later frames run only ``gbuffer``, ``extract`` and
-    ``shade`` (§5.2, Herbert et al.).
-
-    Parameters
-    ----------
-    session : RenderSession
-        With a ``config.grid`` of ``[start_nm, end_nm, step_nm]``.
-    frames : int
-        Frames of a full turn, >= 1.
-    out_dir : str or Path, optional
-        Where to write ``frame_###.png`` and ``timings.csv`` (atomically); None writes nothing.
-    progress : bool
-        tqdm progress on stderr.
-
-    Returns
-    -------
-    list of dict
-        ``{stage: seconds}`` per frame.
-
-    Examples
-    --------
-    >>> s = RenderSession(demo_state(env_height=16, size=4, resolution=8, F_max=8, P_max=4))
-    >>> times = render_orbit(s, 2, progress=False)
-    >>> sorted(times[1])
-    ['extract', 'gbuffer', 'shade']
-    """
-    import sys
-    from pathlib import Path
-
-    from tqdm import tqdm
-
-    from reference.colorimetry import XYZ_to_display_RGB, band_weights, spectra_to_XYZ
-    from reference.display import linear_to_display
-    from reference.errors import require_positive_int
-    from reference.images import write_png, write_text_atomic
-    from reference.spectra import SpectralGrid
-
-    frames = require_positive_int(frames, "orbit --frames", 100000)
-    grid = SpectralGrid(*session.state["config"]["grid"])
-    W = band_weights(grid, None)
-    white = float(spectra_to_XYZ(np.asarray(session.state["illuminant"]), W)[1])
-    rows = []
-    for f in tqdm(range(frames), desc="orbit", unit="frame", file=sys.stderr, disable=not progress):
-        session.update(viewpoint=orbit_camera(f, frames))
-        result = session.render()
-        times = session.frame_times[-1]
-        rows.append(times)
-        if out_dir is not None:
-            XYZ = spectra_to_XYZ(result["shade"]["radiance"], W) / white
-            RGB = linear_to_display(np.clip(XYZ_to_display_RGB(XYZ), 0.0, None), "srgb")
-            write_png(Path(out_dir) / f"frame_{f:03d}.png", np.clip(RGB, 0.0, 1.0))
-    if out_dir is not None:
-        names = [s.name for s in session.stages]
-        lines = ["frame," + ",".join(names) + ",total"]
-        for f, times in enumerate(rows):
-            cells = [f"{times.get(n, 0.0):.6f}" for n in names]
-            lines.append(f"{f}," + ",".join(cells) + f",{sum(times.values()):.6f}")
-        write_text_atomic(Path(out_dir) / "timings.csv", "\n".join(lines) + "\n")
-    return rows

@@ -31,9 +31,10 @@ expansion ``ρ̃ = Σ ρ_{lm,pq} Y_lm(ω_i) Y_pq(ω_o)`` has ``ρ_{lm,pq} = δ_m
     ρ_{lpm} = 2π ∫∫∫ ρ̃(θ_i, θ_o, Δφ) cos(mΔφ) λ_lm(cos θ_i) λ_pm(cos θ_o) dcos θ_i dcos θ_o dΔφ
 
 (R&H 2002, the isotropic BRDF coefficients, in specref's real basis; ``λ_lm`` are the normalized
-Legendre functions of ``shrm.sh``). :func:`brdf_sh_coefficients` computes it by composite
-Gauss–Legendre quadrature in ``cos θ_i`` and ``cos θ_o`` and the trapezoid rule in Δφ. The orders F
-(lighting) and P (view) come from a tolerance on the coefficients' tails (:func:`choose_orders`).
+Legendre functions of ``shrm.sh``). :func:`shrm.brdf_sh.brdf_sh_coefficients` computes it by
+composite Gauss–Legendre quadrature in ``cos θ_i`` and ``cos θ_o`` and the trapezoid rule in Δφ.
+The orders F (lighting) and P (view) come from a tolerance on the coefficients' tails
+(:func:`shrm.brdf_sh.choose_orders`).
 
 **Frequency-space creation** (:func:`shrm_create`). With the lighting ``L_lm`` rotated into the
 texel's frame, ``B^loc_pq(n) = Σ_l ρ_{lp|q|} [D(R_nᵀ) L]_lq`` (R&H 2002, the SHRM coefficients).
@@ -69,11 +70,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from reference.errors import require, require_choice
+from shrm.brdf_sh import (
+    FRAMES,
+)
 from shrm.rotation import rotation_matrix, sh_rotation_blocks
 from shrm.sh import (
-    fejer1_weights,
     latlong_ring_angles,
-    legendre_table,
     sh_basis,
     sh_degrees_orders,
     sh_evaluate,
@@ -81,25 +83,14 @@ from shrm.sh import (
 from shrm.transform import project_latlong
 
 __all__ = [
-    "FRAMES",
-    "P_RANGE",
     "SHRM",
-    "brdf_sh_coefficients",
-    "choose_orders",
     "polar_rotate",
-    "render_bruteforce",
     "render_shrm",
+    "shade_shrm",
     "shrm_create",
-    "shrm_create_angular",
     "shrm_extract",
-    "shrm_orders",
-    "transfer_function",
 ]
 
-#: The index frames of a SHRM (module docstring).
-FRAMES = ("normal", "reflection")
-#: View orders P that §5.5, Herbert et al. allows: "typically between 2 and 10".
-P_RANGE = (2, 10)
 _Y = np.array([0.0, 1.0, 0.0])
 # A quarter turn about z maps x to y: R_x(a) = Qᵀ R_y(a) Q.
 _Q = rotation_matrix([0.0, 0.0, 1.0], np.pi / 2)
@@ -107,239 +98,6 @@ _Q = rotation_matrix([0.0, 0.0, 1.0], np.pi / 2)
 
 def _dot(a, b):
     return np.einsum("...i,...i->...", a, b)
-
-
-def transfer_function(brdf, params: dict, wi, wo, frame: str = "reflection") -> np.ndarray:
-    """The transfer function ρ̃ = BRDF × cosine in a texel's local frame (polar axis +y).
-
-    The integrand of the reflection equation (R&H 2002), in the frame of the module
-    docstring; views below the horizon are mirrored above it.
-
-    Parameters
-    ----------
-    brdf : callable
-        ``brdf(wi, wo, normal, **params) -> (..., C)`` (the :data:`reference.brdf.BRDF_METHODS`
-        convention).
-    params : dict
-        Its parameters.
-    wi, wo : ndarray, shape (..., 3)
-        Local incident and view directions (unit).
-    frame : {"normal", "reflection"}
-
-    Returns
-    -------
-    ndarray, shape (..., C)
-
-    Examples
-    --------
-    >>> from reference.brdf import brdf_lambert
-    >>> y = np.array([0.0, 1.0, 0.0])
-    >>> transfer_function(brdf_lambert, {"rho_d": [np.pi]}, y, y, "normal")
-    array([1.])
-    """
-    require_choice(frame, FRAMES, "SHRM frame")
-    wi, wo = np.asarray(wi, dtype=np.float64), np.asarray(wo, dtype=np.float64)
-    if frame == "normal":
-        normal = np.broadcast_to(_Y, wo.shape)
-        # Views below the horizon never occur: continue ρ̃ evenly across the tangent plane.
-        wo = wo * np.where(wo[..., 1:2] < 0.0, np.array([1.0, -1.0, 1.0]), 1.0)
-    else:
-        # Reflection frame: the surface normal bisects the pole (the reflection vector) and the view
-        h = wo + _Y
-        normal = h / np.maximum(np.linalg.norm(h, axis=-1, keepdims=True), 1e-300)
-    cosine = np.maximum(_dot(wi, normal), 0.0)[..., None]
-    return brdf(wi, wo, normal, **params) * cosine
-
-
-def _panels_gauss(edges, order):
-    x, w = np.polynomial.legendre.leggauss(order)
-    edges = np.unique(np.asarray(edges, dtype=np.float64))
-    half, mid = np.diff(edges) / 2, (edges[:-1] + edges[1:]) / 2
-    return (mid[:, None] + half[:, None] * x).ravel(), (half[:, None] * w).ravel()
-
-
-def _lambda_blocks(order: int, theta: np.ndarray) -> list[np.ndarray]:
-    """λ_lm(cos θ) as a list over m of arrays (L+1-m, N) (l = m..L)."""
-    table = legendre_table(order, theta)
-    starts = np.cumsum([0] + [order + 1 - m for m in range(order + 1)])
-    return [table[starts[m] : starts[m + 1]] for m in range(order + 1)]
-
-
-def brdf_sh_coefficients(
-    brdf,
-    params: dict,
-    F: int,
-    P: int,
-    frame: str = "reflection",
-    quadrature: int = 8,
-    n_phi: int = 64,
-) -> np.ndarray:
-    """The isotropic BRDF's double SH coefficients ``ρ_{lpm}`` (lighting l ≤ F, view p ≤ P).
-
-    R&H 2002, the isotropic BRDF coefficients:
-    ``ρ_{lpm} = 2π ∫∫∫ ρ̃ cos(mΔφ) λ_lm(cos θ_i) λ_pm(cos θ_o)`` over
-    ``cos θ_i, cos θ_o ∈ [−1, 1]`` and ``Δφ ∈ [0, 2π)``.
-
-    Parameters
-    ----------
-    brdf : callable
-        The BRDF (``BRDF_METHODS`` convention).
-    params : dict
-        Its parameters.
-    F, P : int
-        Lighting and view orders, >= 0.
-    frame : {"normal", "reflection"}
-    quadrature : int
-        Gauss–Legendre nodes per panel; θ_i has panels clustered at the pole (0.01·2^k rad) plus
-        ``max(8, F/2)`` uniform ones, θ_o ``max(8, P)`` uniform ones. Doubling it estimates the
-        error.
-    n_phi : int
-        Trapezoid nodes in Δφ (exact for the cos(mΔφ) moments of trigonometric polynomials of
-        degree < n_phi − m).
-
-    Returns
-    -------
-    ndarray, shape (C, F+1, P+1, min(F, P)+1)
-        ``rho[c, l, p, m]``, zero where ``m > min(l, p)``.
-
-    Examples
-    --------
-    >>> from reference.brdf import brdf_lambert
-    >>> rho = brdf_sh_coefficients(brdf_lambert, {"rho_d": [1.0]}, 2, 2, "normal")
-    >>> rho.shape, round(float(rho[0, 0, 0, 0]), 4)   # ∫∫ ρ̃ Y00 Y00 = (1/4π) · 1 · 4π
-    ((1, 3, 3, 3), 1.0)
-    """
-    require_choice(frame, FRAMES, "SHRM frame")
-    require(isinstance(F, int) and F >= 0, f"SHRM: F: must be an integer >= 0, got {F!r}")
-    require(isinstance(P, int) and P >= 0, f"SHRM: P: must be an integer >= 0, got {P!r}")
-    M = min(F, P)
-    near = 0.01 * 2.0 ** np.arange(8)
-    theta_i, w_i = _panels_gauss(
-        np.clip(np.concatenate([np.linspace(0, np.pi, max(8, F // 2) + 1), near]), 0, np.pi),
-        quadrature,
-    )
-    theta_o, w_o = _panels_gauss(np.linspace(0, np.pi, max(8, P) + 1), quadrature)
-    # The panels are in θ; dcos θ = sin θ dθ
-    w_i, w_o = w_i * np.sin(theta_i), w_o * np.sin(theta_o)
-    phi = 2.0 * np.pi * np.arange(n_phi) / n_phi
-    lam_i, lam_o = _lambda_blocks(F, theta_i), _lambda_blocks(P, theta_o)
-    cos_m_phi = np.cos(np.arange(M + 1)[:, None] * phi[None, :]) * (2.0 * np.pi / n_phi)
-    s_i, s_o = np.sin(theta_i), np.sin(theta_o)
-    # Local directions (y polar): ω_o at azimuth 0, ω_i at azimuth Δφ
-    wo_dir = np.stack([np.zeros_like(s_o), np.cos(theta_o), -s_o], axis=-1)
-    rho = None
-    for a, wo_a in enumerate(wo_dir):
-        wi_dir = np.stack(
-            [
-                s_i[:, None] * np.sin(phi)[None, :],
-                np.broadcast_to(np.cos(theta_i)[:, None], (theta_i.size, n_phi)),
-                -s_i[:, None] * np.cos(phi)[None, :],
-            ],
-            axis=-1,
-        )
-        values = transfer_function(brdf, params, wi_dir, np.broadcast_to(wo_a, wi_dir.shape), frame)
-        if rho is None:
-            rho = np.zeros((values.shape[-1], F + 1, P + 1, M + 1))
-        # R&H 2002, the isotropic BRDF coefficients: the Δφ moments, then the θ_i and θ_o sums
-        moments = np.einsum("ijc,mj->mic", values, cos_m_phi) * w_i[None, :, None]
-        for m in range(M + 1):
-            # 2π ∫ λ_lm(θ_i) λ_pm(θ_o) · moment
-            part = 2.0 * np.pi * (lam_i[m] @ moments[m]) * w_o[a]  # (F+1-m, C)
-            rho[:, m:, m:, m] += part.T[:, :, None] * lam_o[m][None, None, :, a]
-    return rho
-
-
-def choose_orders(rho: np.ndarray, tol: float) -> tuple[int, int]:
-    """The smallest orders (F, P) whose coefficient tails are below ``tol`` (relative, L2).
-
-    R&H 2002, the isotropic BRDF coefficients.
-    ``tail_F = sqrt(Σ_{l>F} |ρ_l|² / Σ |ρ|²)`` with
-    ``|ρ_l|²`` summed over p, m (twice for m > 0, which stands for ±m) and bands; likewise for P.
-    P is at least 2 and both at most what ``rho`` holds.
-
-    Parameters
-    ----------
-    rho : ndarray, shape (C, F_max+1, P_max+1, M+1)
-    tol : float
-        In (0, 1).
-
-    Returns
-    -------
-    F, P : int
-
-    Raises
-    ------
-    SpecrefError
-        ``tol`` outside (0, 1), or no order within ``rho`` reaches it.
-
-    Examples
-    --------
-    >>> rho = np.zeros((1, 5, 4, 4)); rho[0, :, 0, 0] = [1.0, 0.5, 0.1, 0.001, 0.0]
-    >>> choose_orders(rho, 0.01)
-    (2, 2)
-    """
-    require(0.0 < tol < 1.0, f"SHRM: tol: must be in (0, 1), got {tol!r}")
-    weight = np.where(np.arange(rho.shape[3]) > 0, 2.0, 1.0)
-    energy = rho**2 * weight
-    total = energy.sum()
-    require(total > 0, "SHRM: the BRDF's transfer function is zero everywhere")
-    orders = []
-    for axis, name in ((1, "F"), (2, "P")):
-        per = energy.sum(axis=tuple(a for a in range(4) if a != axis))
-        tail = np.sqrt(np.maximum(total - np.cumsum(per), 0.0) / total)
-        below = np.nonzero(tail <= tol)[0]
-        require(
-            below.size > 0,
-            f"SHRM: no {name} up to {per.size - 1} reaches tol {tol:g} (tail {tail[-1]:.3g}); "
-            "raise the tolerance or the maximum order",
-        )
-        orders.append(int(below[0]))
-    return orders[0], max(orders[1], P_RANGE[0])
-
-
-def shrm_orders(rho: np.ndarray, tol: float, F: int | None = None, P: int | None = None):
-    """Orders (F, P) for a tolerance, or a check that requested orders meet it.
-
-    R&H 2002, the isotropic BRDF coefficients (their tails, :func:`choose_orders`). P must lie in
-    :data:`P_RANGE` (§5.5, Herbert et al.: "between 2 and 10") and neither order may be below what
-    ``tol`` requires or above what ``rho`` holds.
-
-    Parameters
-    ----------
-    rho : ndarray, shape (C, F_max+1, P_max+1, M+1)
-    tol : float
-    F, P : int, optional
-        Requested orders; default the smallest that meet ``tol``.
-
-    Returns
-    -------
-    F, P : int
-
-    Raises
-    ------
-    SpecrefError
-        A requested order outside what the tolerance allows.
-
-    Examples
-    --------
-    >>> rho = np.zeros((1, 5, 4, 4)); rho[0, :, 0, 0] = [1.0, 0.5, 0.1, 0.001, 0.0]
-    >>> shrm_orders(rho, 0.01, P=3)
-    (2, 3)
-    >>> shrm_orders(rho, 0.01, F=1)
-    Traceback (most recent call last):
-    ...
-    reference.errors.SpecrefError: SHRM: F = 1 is outside what tol 0.01 allows: [2, 4]
-    """
-    F_min, P_min = choose_orders(rho, tol)
-    F_max, P_max = rho.shape[1] - 1, min(rho.shape[2] - 1, P_RANGE[1])
-    for name, value, low, high in (("F", F, F_min, F_max), ("P", P, P_min, P_max)):
-        if value is not None:
-            require(
-                isinstance(value, int | np.integer) and low <= value <= high,
-                f"SHRM: {name} = {value} is outside what tol {tol:g} allows: [{low}, {high}]",
-            )
-    require(P_min <= P_max, f"SHRM: tol {tol:g} needs P = {P_min} > {P_max} (§5.5 allows 2-10)")
-    return (F_min if F is None else int(F)), (P_min if P is None else int(P))
 
 
 def polar_rotate(coeffs, angles) -> np.ndarray:
@@ -389,22 +147,11 @@ def _block_apply(blocks, c, transpose=False):
     return out
 
 
-def _block_diag(blocks) -> np.ndarray:
-    from scipy.linalg import block_diag
-
-    return block_diag(*blocks)
-
-
-def _world_view_rotation(B_local, theta, phi, P):
-    """``D(R_n) B^loc`` for R_n = R_y(−φ) R_x(−θ) = R_y(−φ) Qᵀ R_y(−θ) Q, per row θ and column φ."""
-    DQ = _block_diag(_quarter_turn_blocks(P))
-    x = B_local @ DQ.T  # D(Q)
-    for j in range(x.shape[0]):
-        x[j] = polar_rotate(x[j], np.array([-theta[j]]))[0]  # Y(−θ_j)
-    x = x @ DQ  # D(Qᵀ) = D(Q)ᵀ
-    for k in range(x.shape[1]):
-        x[:, k] = polar_rotate(x[:, k], np.array([-phi[k]]))[0]  # Y(−φ_k)
-    return x
+def _polar_rotate_each(x, a, P):
+    """``Y(a) x`` with one angle per row or column (``a`` broadcast against ``x[..., :1]``)."""
+    l, m = sh_degrees_orders(P)
+    partner = l * l + l - m
+    return np.cos(np.abs(m) * a) * x + np.sign(m) * np.sin(np.abs(m) * a) * x[..., partner]
 
 
 @dataclass(frozen=True, eq=False)
@@ -419,12 +166,24 @@ class SHRM:
         ``"normal"`` or ``"reflection"``: what the texel direction indexes.
     F, P : int
         Lighting and view orders.
+    view_power : float
+        The grazing view power k: ``coeffs`` hold ``cos^k θ_o B`` (the regular part of a BRDF that
+        grows like ``cos^{−k} θ_o``, :func:`shrm_brdf_parts`); shading divides by ``(N·v)^k``.
+    lambert : ndarray, shape (C,), optional
+        The Lambertian albedo ρ_d split off the BRDF; its radiance ``ρ_d/π E(N)`` comes from
+        ``irradiance``, not from ``coeffs``.
+    irradiance : ndarray, shape (6, S, S, C), optional
+        The irradiance cube map ``E(n) = ∫ L max(0, ω·n) dω`` (Eq. (7), Ramamoorthi & Hanrahan
+        2001), when ``lambert`` is given.
     """
 
     coeffs: np.ndarray
     frame: str
     F: int
     P: int
+    view_power: float = 0.0
+    lambert: np.ndarray | None = None
+    irradiance: np.ndarray | None = None
 
     @property
     def size(self) -> int:
@@ -433,7 +192,13 @@ class SHRM:
 
 
 def shrm_create(
-    env_coeffs, rho: np.ndarray, frame: str = "reflection", size: int = 64, backend="ducc0"
+    env_coeffs,
+    rho: np.ndarray,
+    frame: str = "reflection",
+    size: int = 64,
+    backend="ducc0",
+    view_power: float = 0.0,
+    lambert=None,
 ) -> SHRM:
     """Create a SHRM in frequency space from lighting and BRDF coefficients.
 
@@ -454,6 +219,12 @@ def shrm_create(
         Cube face size S (default 64, §5.5, Herbert et al.).
     backend : {"ducc0", "numpy", "numba"}
         SH projection and synthesis path.
+    view_power : float
+        The grazing view power ``rho`` was computed with (:func:`brdf_sh_coefficients`).
+    lambert : array_like, shape (C,) or scalar, optional
+        A Lambertian albedo split off the BRDF (:func:`shrm_brdf_parts`): its irradiance map is
+        made on the irradiance path of the SH engine, exact at low order (Eq. (7), Ramamoorthi &
+        Hanrahan 2001, at the full order of ``env_coeffs``).
 
     Returns
     -------
@@ -462,6 +233,7 @@ def shrm_create(
     Examples
     --------
     >>> from reference.brdf import brdf_lambert
+    >>> from shrm.brdf_sh import brdf_sh_coefficients
     >>> rho = brdf_sh_coefficients(brdf_lambert, {"rho_d": [1.0]}, 4, 2, "normal")
     >>> env = np.zeros((1, 25)); env[0, 0] = np.sqrt(4 * np.pi)        # L = 1 everywhere
     >>> s = shrm_create(env, rho, "normal", size=2)
@@ -521,30 +293,56 @@ def shrm_create(
         A_sin[:, :, :, qs + qmax, : l + 1] += r[None, ..., None] * v[:, :, None]
     cos_phi = np.cos(np.arange(F1)[None, :] * phi[:, None])  # (W, F+1)
     sin_phi = np.sin(np.arange(F1)[None, :] * phi[:, None])
-    B_loc = np.zeros((H, W, C, P1 * P1))
-    for j in range(H):
-        # Σ_m' cos(m'φ_k) A_cos + sin(m'φ_k) A_sin, for every column k
-        values = np.einsum("cpqm,km->kcpq", A_cos[j], cos_phi) + np.einsum(
-            "cpqm,km->kcpq", A_sin[j], sin_phi
-        )
-        for p in range(P1):
-            qs = np.arange(-p, p + 1)
-            B_loc[j, :, :, p * p : (p + 1) * (p + 1)] = values[:, :, p, qs + qmax]
-    # Rotate the view expansion to world axes, D(R_n) B^loc
-    B_world = _world_view_rotation(B_loc, theta, phi, P)
+    # The view coefficients (p, q) in specref's layout: A (H, C, F+1, (P+1)²)
+    p_of, q_of = sh_degrees_orders(P)
+    A = np.moveaxis(np.stack([A_cos, A_sin])[:, :, :, p_of, q_of + qmax], 3, -1)
+    # Rotate the view expansion to world axes, D(R_n) B^loc with
+    # R_n = R_y(−φ) R_x(−θ) = R_y(−φ) Qᵀ R_y(−θ) Q: the row part D(Qᵀ) Y(−θ_j) D(Q) acts on the
+    # Fourier terms of each row, before the sum over m' for every column k
+    DQ = _quarter_turn_blocks(P)
+    A = _polar_rotate_each(_block_apply(DQ, A), -theta[None, :, None, None, None], P)
+    A = np.moveaxis(_block_apply(DQ, A, transpose=True), -1, -2)  # (2, H, C, (P+1)², F+1)
+    # Σ_m' cos(m'φ_k) A_cos + sin(m'φ_k) A_sin, then Y(−φ_k) per column k
+    B_world = np.moveaxis(A[0] @ cos_phi.T + A[1] @ sin_phi.T, -1, 1)  # (H, W, C, (P+1)²)
+    B_world = _polar_rotate_each(B_world, -phi[None, :, None, None], P)
     # B_pq(n) is band-limited to F + P: project exactly (Fejér-1), synthesize at the texels
     from reference.cubemap import cubemap_texel_directions
 
     grid = B_world.reshape(H, W, C * P1 * P1)
     coeffs_n = project_latlong(grid, K, backend=backend, where="SHRM")
-    values = sh_evaluate(coeffs_n, cubemap_texel_directions(size), backend=backend)
-    return SHRM(values.reshape(6, size, size, C, P1 * P1), frame, F, P)
+    texels = cubemap_texel_directions(size)
+    values = sh_evaluate(coeffs_n, texels, backend=backend)
+    irradiance = None
+    if lambert is not None:
+        lambert = np.broadcast_to(np.asarray(lambert, dtype=np.float64), (C,)).copy()
+        irradiance = _irradiance_cube(env_coeffs, texels, backend)
+    return SHRM(
+        values.reshape(6, size, size, C, P1 * P1),
+        frame,
+        F,
+        P,
+        float(view_power),
+        lambert,
+        irradiance,
+    )
+
+
+def _irradiance_cube(env_coeffs, texels, backend) -> np.ndarray:
+    """E(n) = ∫ L max(0, ω·n) dω at the texels, Eq. (7), Ramamoorthi & Hanrahan 2001."""
+    from shrm.prefilter import lambert_Lambda_closed_form, prefilter_coefficients
+    from shrm.sh import order_of
+
+    L = np.atleast_2d(np.asarray(env_coeffs, dtype=np.float64))
+    E_lm = prefilter_coefficients(L, lambert_Lambda_closed_form(order_of(L.shape[1])))
+    return sh_evaluate(E_lm, texels, backend=backend)
 
 
 def shrm_extract(shrm: SHRM, view) -> np.ndarray:
     """A reflection map for one (distant) viewpoint: ``E_v(n) = Σ_pq B_pq(n) Y_pq(v)``.
 
-    §5.6, Herbert et al.; R&H 2002, SHRM evaluation.
+    §5.6, Herbert et al.; R&H 2002, SHRM evaluation. The map holds what the SHRM stores: the
+    reflected radiance of the BRDF without a split-off Lambertian part, times ``cos^k θ_o`` for a
+    grazing view power k; :func:`shade_shrm` completes it per pixel.
 
     Parameters
     ----------
@@ -555,7 +353,7 @@ def shrm_extract(shrm: SHRM, view) -> np.ndarray:
     Returns
     -------
     ndarray, shape (6, S, S, C)
-        Reflected radiance per texel and band.
+        Per texel and band.
 
     Examples
     --------
@@ -578,11 +376,54 @@ def _index_directions(frame: str, normal, view) -> np.ndarray:
     return 2.0 * _dot(normal, view)[..., None] * normal - view
 
 
+def shade_shrm(shrm: SHRM, E, normal, view) -> np.ndarray:
+    """Reflected radiance at surface points from an extracted map (§5.6, Herbert et al.).
+
+    R&H 2002, SHRM evaluation, completed per point:
+    ``B = (N·v)^{−k} E_v(index) + ρ_d/π E_irr(N)``, where ``index`` is the normal or the
+    reflection vector (seamless bilinear lookups), k the grazing view power and the second term
+    the split-off Lambertian part. Points facing away (N·v <= 0) get no view-singular part.
+
+    Parameters
+    ----------
+    shrm : SHRM
+    E : ndarray, shape (6, S, S, C)
+        :func:`shrm_extract` for ``view``.
+    normal : ndarray, shape (N, 3)
+        Unit surface normals.
+    view : array_like, shape (3,)
+        Unit direction towards the distant viewer.
+
+    Returns
+    -------
+    ndarray, shape (N, C)
+
+    Examples
+    --------
+    >>> s = SHRM(np.ones((6, 1, 1, 1, 1)), "normal", 0, 0, 1.0, np.array([np.pi]),
+    ...          np.full((6, 1, 1, 1), 2.0))
+    >>> shade_shrm(s, np.full((6, 1, 1, 1), 0.5), np.array([[0.0, 0.0, 1.0]]), [0.6, 0.0, 0.8])
+    array([[2.625]])
+    """
+    from reference.cubemap import cubemap_lookup_bilinear
+
+    v = np.asarray(view, dtype=np.float64)
+    out = cubemap_lookup_bilinear(E, _index_directions(shrm.frame, normal, v))
+    if shrm.view_power:
+        # cos^k θ_o was factored out at creation: divide it back per pixel
+        cos_o = _dot(normal, v)[..., None]
+        out = np.where(cos_o > 0.0, out / np.maximum(cos_o, 1e-300) ** shrm.view_power, 0.0)
+    if shrm.lambert is not None:
+        # The Lambertian part, ρ_d/π E(N) (Eq. (7), Ramamoorthi & Hanrahan 2001)
+        out = out + shrm.lambert / np.pi * cubemap_lookup_bilinear(shrm.irradiance, normal)
+    return out
+
+
 def render_shrm(gbuffer, shrm: SHRM, view, material_id: int = 0, E=None) -> np.ndarray:
     """Deferred rendering of one material through the G-buffer with a SHRM (distant viewer).
 
-    §5.6, Herbert et al.: extract the reflection map for the viewpoint, then look it up per pixel
-    at the normal (or reflection vector), with seamless bilinear filtering.
+    §5.6, Herbert et al.: extract the reflection map for the viewpoint, then shade every pixel
+    from it (:func:`shade_shrm`).
 
     Parameters
     ----------
@@ -608,8 +449,6 @@ def render_shrm(gbuffer, shrm: SHRM, view, material_id: int = 0, E=None) -> np.n
     >>> render_shrm(empty_gbuffer(2, 2), s, [0.0, 0.0, 1.0]).shape
     (2, 2, 1)
     """
-    from reference.cubemap import cubemap_lookup_bilinear
-
     v = np.asarray(view, dtype=np.float64)
     v = v / np.linalg.norm(v)
     E = shrm_extract(shrm, v) if E is None else E
@@ -617,128 +456,5 @@ def render_shrm(gbuffer, shrm: SHRM, view, material_id: int = 0, E=None) -> np.n
     out = np.zeros((H, W, E.shape[-1]))
     sel = gbuffer.mask & (gbuffer.material_id == material_id)
     if sel.any():
-        n = gbuffer.normal[sel]
-        out[sel] = cubemap_lookup_bilinear(E, _index_directions(shrm.frame, n, v))
-    return out
-
-
-def _env_quadrature(image):
-    """Pixel directions and Fejér-1 × uniform-φ weights of a lat-long map (as project_latlong)."""
-    from reference.envmap import latlong_pixel_directions
-
-    H, W = image.shape[:2]
-    d = latlong_pixel_directions(H, W).reshape(-1, 3)
-    w = np.repeat(fejer1_weights(H), W) * (2.0 * np.pi / W)
-    return d, w, np.asarray(image, dtype=np.float64).reshape(H * W, -1)
-
-
-def _reflected_bruteforce(brdf, params, frame, index, views, env, chunk=4096):
-    """∫ L(ω) ρ̃ dω by the sum over environment pixels, for pairs (index direction, view)."""
-    d, w, Lpx = env
-    out = np.zeros((index.shape[0], Lpx.shape[1]))
-    for a in range(index.shape[0]):
-        n, v = index[a], views[a]
-        if frame == "normal":
-            normal = n
-            v = v if _dot(v, n) >= 0 else v - 2.0 * _dot(v, n) * n
-        else:
-            h = n + v
-            normal = h / max(np.linalg.norm(h), 1e-300)
-        for s in range(0, d.shape[0], chunk):
-            wi = d[s : s + chunk]
-            cosine = np.maximum(wi @ normal, 0.0)
-            f = brdf(wi, np.broadcast_to(v, wi.shape), normal, **params)
-            out[a] += (f * (Lpx[s : s + chunk] * (cosine * w[s : s + chunk])[:, None])).sum(0)
-    return out
-
-
-def shrm_create_angular(image, brdf, params: dict, P: int, frame: str = "reflection", size=8):
-    """The oracle: SHRM texels by brute-force angular integration, projected onto ``Y_pq``.
-
-    The reflection equation (R&H 2002) at every texel n and every view v of a Fejér-1 grid of
-    ``2P + 2`` rows:
-    ``B(n, v) = Σ_pixels L(ω) ρ̃ w`` (the environment's own quadrature weights), then
-    ``B_pq(n) = ∫ B(n, v) Y_pq(v) dv`` (``shrm.sh.project_latlong``). Quadratic per texel.
-
-    Parameters
-    ----------
-    image : ndarray, shape (H, 2H, C)
-        Linear radiance of the environment.
-    brdf, params
-        The BRDF.
-    P : int
-        View order.
-    frame : {"normal", "reflection"}
-    size : int
-        Cube face size (keep it small: the cost is texels × views × pixels).
-
-    Returns
-    -------
-    SHRM
-        With ``F = -1`` (no lighting truncation).
-
-    Examples
-    --------
-    >>> from reference.brdf import brdf_lambert
-    >>> s = shrm_create_angular(np.ones((4, 8, 1)), brdf_lambert, {"rho_d": [1.0]}, 2, "normal", 1)
-    >>> float(shrm_extract(s, [0.0, 0.0, 1.0])[4, 0, 0, 0]).__round__(6)   # facing +z: ρ_d
-    1.0
-    """
-    from reference.cubemap import cubemap_texel_directions
-    from reference.envmap import latlong_pixel_directions
-
-    require_choice(frame, FRAMES, "SHRM frame")
-    env = _env_quadrature(image)
-    Hv = 2 * P + 2
-    views = latlong_pixel_directions(Hv, 2 * Hv).reshape(-1, 3)
-    texels = cubemap_texel_directions(size).reshape(-1, 3)
-    C = env[2].shape[1]
-    out = np.empty((texels.shape[0], C, (P + 1) ** 2))
-    for t, n in enumerate(texels):
-        B = _reflected_bruteforce(brdf, params, frame, np.broadcast_to(n, views.shape), views, env)
-        out[t] = project_latlong(B.reshape(Hv, 2 * Hv, C), P, where="SHRM oracle")
-    return SHRM(out.reshape(6, size, size, C, (P + 1) ** 2), frame, -1, P)
-
-
-def render_bruteforce(gbuffer, image, brdf, params: dict, view, material_id: int = 0):
-    """The per-pixel oracle: every pixel integrates BRDF × environment over all map pixels.
-
-    The reflection equation (R&H 2002), with a distant viewer ``v`` and the environment's
-    Fejér-1 × uniform-φ quadrature.
-
-    Parameters
-    ----------
-    gbuffer : reference.gbuffer.GBuffer
-    image : ndarray, shape (H, 2H, C)
-        Environment radiance.
-    brdf, params
-        The BRDF.
-    view : array_like, shape (3,)
-        Direction towards the viewer.
-    material_id : int
-
-    Returns
-    -------
-    ndarray, shape (H_img, W_img, C)
-
-    Examples
-    --------
-    >>> from reference.brdf import brdf_lambert
-    >>> from reference.gbuffer import empty_gbuffer
-    >>> g = empty_gbuffer(1, 1)
-    >>> g.mask[0, 0] = True; g.material_id[0, 0] = 0; g.normal[0, 0] = [0.0, 0.0, 1.0]
-    >>> render_bruteforce(g, np.ones((8, 16, 1)), brdf_lambert, {"rho_d": [0.5]},
-    ...                   [0.0, 0.0, 1.0]).round(4)
-    array([[[0.5]]])
-    """
-    v = np.asarray(view, dtype=np.float64)
-    v = v / np.linalg.norm(v)
-    env = _env_quadrature(image)
-    H, W = gbuffer.shape
-    out = np.zeros((H, W, env[2].shape[1]))
-    sel = gbuffer.mask & (gbuffer.material_id == material_id)
-    normals = gbuffer.normal[sel]
-    out[sel] = _reflected_bruteforce(
-        brdf, params, "normal", normals, np.broadcast_to(v, normals.shape), env
-    )
+        out[sel] = shade_shrm(shrm, E, gbuffer.normal[sel], v)
     return out

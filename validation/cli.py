@@ -174,20 +174,24 @@ def _add_brdf_parser(sub) -> None:
 
 def _cmd_shrm_orbit(args) -> int:
     from shrm.cache import Cache
-    from shrm.session import RenderSession, demo_state, render_orbit
+    from shrm.orbit import demo_state, render_orbit, scene_state
+    from shrm.session import RenderSession
 
-    if args.scene is not None:
-        try:
-            from reference.scene import load_scene  # noqa: F401  (branch 'scenes')
-        except ImportError:
-            raise SpecrefError(
-                f"{args.scene}: scene files need reference.scene, which this build does not have "
-                "yet; omit SCENE to orbit the built-in scene"
-            ) from None
-        raise SpecrefError(f"{args.scene}: SHRM orbits of scene files are not supported yet")
     quick = {"env_height": 16, "size": 8, "resolution": 48, "F_max": 12, "P_max": 6}
-    orders = {"tol": args.tol, "F": args.F, "P": args.P}
-    state = demo_state(args.env, brdf=args.brdf, **(quick if args.quick else {}), **orders)
+    orders = {k: v for k, v in (("tol", args.tol), ("F", args.F), ("P", args.P)) if v is not None}
+    if args.scene is not None:
+        from reference.scene import load_scene
+
+        for flag, value in (("--brdf", args.brdf), ("--env", args.env), ("--quick", args.quick)):
+            if value:
+                raise SpecrefError(
+                    f"{args.scene}: {flag} is for the built-in scene, not a scene file"
+                )
+        state = scene_state(load_scene(args.scene), **orders)
+    else:
+        state = demo_state(
+            args.env, brdf=args.brdf or "effect_pigment", **(quick if args.quick else {}), **orders
+        )
     session = RenderSession(state, cache=Cache(args.cache_dir, enabled=not args.no_cache))
     rows = render_orbit(session, args.frames, args.out)
     total = [sum(r.values()) for r in rows]
@@ -205,10 +209,10 @@ def _add_shrm_parser(sub) -> None:
     o.add_argument("scene", nargs="?", metavar="SCENE.toml", help="scene file (default: built-in)")
     o.add_argument("--frames", type=int, default=8, help="frames of a full turn (default 8)")
     o.add_argument("-o", "--out", required=True, help="output folder")
-    o.add_argument("--brdf", default="effect_pigment", help="isotropic BRDF of the sphere")
+    o.add_argument("--brdf", help="isotropic BRDF of the built-in sphere (effect_pigment)")
     o.add_argument("--env", help="lat-long environment (.hdr/.exr); default venice_sunset_1k")
     o.add_argument("--quick", action="store_true", help="small maps and images")
-    o.add_argument("--tol", type=float, default=0.01, help="order tolerance (default 0.01)")
+    o.add_argument("--tol", type=float, help="order tolerance (default 0.05, an L2 tail)")
     o.add_argument("--F", type=int, help="lighting order (default: from --tol)")
     o.add_argument("--P", type=int, help="view order, 2-10 (default: from --tol)")
     o.add_argument("--cache-dir", metavar="DIR", help="persistent cache folder")
@@ -292,18 +296,18 @@ def _write_json(path, result) -> None:
 
 def _cmd_phong(args) -> int:
     from reference.errors import SpecrefError
-    from validation import phong
+    from validation import phong, phong_table1
 
     if args.action == "table1":
-        result = phong.run_table1(args.resolution, args.entries, args.repeats, progress=True)
+        result = phong_table1.run_table1(args.resolution, args.entries, args.repeats, progress=True)
         print(f"Table 1 (Wang et al.), {args.resolution}x{args.resolution}, {args.entries} entries")
-        print(phong.format_rows(result["rows"]))
+        print(phong_table1.format_rows(result["rows"]))
         print("\nTargets")
-        print(phong.format_targets(result["targets"]))
+        print(phong_table1.format_targets(result["targets"]))
     else:
         if args.material is None:
             raise SpecrefError("specref phong: give table1 or --material FILE.toml")
-        result = phong.run_material(
+        result = phong_table1.run_material(
             args.material,
             args.view,
             args.entries,
@@ -314,7 +318,7 @@ def _cmd_phong(args) -> int:
             args.resolution,
             args.repeats,
         )
-        print(phong.format_rows(result["rows"]))
+        print(phong_table1.format_rows(result["rows"]))
         if result["tolerance"] is not None:
             print(phong.format_tolerance(result["tolerance"]))
     if args.json:

@@ -3,32 +3,15 @@ import pytest
 
 from reference.errors import SpecrefError
 from shrm.cache import Cache
+from shrm.orbit import orbit_camera
 from shrm.session import (
     HERBERT_STAGES,
     RenderSession,
     Stage,
-    demo_state,
-    orbit_camera,
-    render_orbit,
     stages_depending_on,
 )
-from validation.cli import main
 
 ALL = [s.name for s in HERBERT_STAGES]
-
-
-@pytest.fixture(scope="module")
-def state():
-    return demo_state(
-        brdf="lafortune",
-        env_height=16,
-        size=4,
-        resolution=12,
-        F_max=8,
-        P_max=4,
-        light_order=8,
-        tol=0.05,
-    )
 
 
 def _ran(session, before):
@@ -94,22 +77,6 @@ def test_memory_eviction_falls_back_to_the_persistent_cache(state, tmp_path):
     assert _step(session, gloss=state["gloss"]) == ["shade"]  # specular map from disk
 
 
-def test_orbit_pays_for_creation_once(state, tmp_path):
-    session = RenderSession(state)
-    times = render_orbit(session, 3, tmp_path, progress=False)
-    assert "shrm_create" in times[0]
-    assert all(sorted(t) == ["extract", "gbuffer", "shade"] for t in times[1:])
-    assert session.executions["shrm_create"] == 1
-    assert session.executions["extract"] == 3
-    assert sorted(p.name for p in tmp_path.glob("*.png")) == [
-        "frame_000.png",
-        "frame_001.png",
-        "frame_002.png",
-    ]
-    header = (tmp_path / "timings.csv").read_text().splitlines()[0]
-    assert header == "frame," + ",".join(ALL) + ",total"
-
-
 def test_stage_graph_is_checked():
     run = lambda state, inputs: {}  # noqa: E731
     with pytest.raises(SpecrefError, match="uses 'b', which does not come before it"):
@@ -120,14 +87,3 @@ def test_stage_graph_is_checked():
         RenderSession({}, [Stage("a", (), (), run)]).update(zoom=2)
     with pytest.raises(SpecrefError, match=r"stage 'a' needs state \['gloss'\]"):
         RenderSession({}, [Stage("a", ("gloss",), (), run)]).render()
-
-
-def test_cli_orbit_writes_frames_and_timings(tmp_path, monkeypatch):
-    monkeypatch.setenv("SPECREF_CACHE_DIR", str(tmp_path / "cache"))
-    out = tmp_path / "orbit"
-    argv = ["shrm", "orbit", "--frames", "2", "-o", str(out), "--quick", "--brdf", "lafortune"]
-    assert main(argv) == 0
-    assert (out / "frame_001.png").is_file()
-    assert (out / "timings.csv").read_text().count("\n") == 3
-    assert main(["shrm", "orbit", "--frames", "0", "-o", str(out), "--quick"]) == 2
-    assert main(["shrm", "orbit", str(tmp_path / "scene.toml"), "-o", str(out), "--quick"]) == 2

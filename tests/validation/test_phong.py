@@ -2,10 +2,8 @@ import numpy as np
 import pytest
 
 from phong_table.scenes import SCENES, spectral_phong_unit_peak
-from reference.errors import SpecrefError
 from reference.spectra import DEFAULT_GRID, resample_spectrum, spectrum_from_csv
-from validation.cli import main
-from validation.phong import run_material, table_error_row, tolerance_search, view_state
+from validation.phong import table_error_row, tolerance_search, view_state
 
 MATERIALS = ("brick", "lemon", "orange", "porcelain", "toothpaste", "chocolate")
 
@@ -25,8 +23,9 @@ def _measured(shared_data, name):
             3,
             marks=pytest.mark.xfail(
                 strict=True,
-                reason="counterexample found by this test: the error placement's RMS (0.0167) "
-                "exceeds another placement's (0.0034) at small m (toothpaste k_d, FL11)",
+                reason="counterexample found by this test (docs/phong-tables.md, 'Known gaps'): "
+                "near view, m = 25, linear: error placement RMS 0.0167 > importance p = m 0.0034 "
+                "(toothpaste k_d, FL11)",
             ),
         ),
     ],
@@ -54,7 +53,8 @@ def test_targets_hold_on_measured_materials(shared_data, seed):
                     ("importance", m // 5),
                 ):
                     other = table_error_row(state, placement, interpolation, m, segments)
-                    assert error["rms"] <= other["rms"] + 1e-6, (placement, interpolation, m)
+                    where = (view, placement, segments, interpolation, m)
+                    assert error["rms"] <= other["rms"] + 1e-6, (where, error["rms"], other["rms"])
                 if interpolation == "monotone":
                     assert error["overshoot"] == 0.0
         assert tolerance_search(state, 0.05, placements=("error",))["entries"] <= 64
@@ -73,111 +73,3 @@ def test_failure_modes_of_the_importance_table():
     err = [table_error_row(bimodal, "error", "parabolic", m)["rms"] for m in (200, 800)]
     assert imp[1] >= 0.5 * imp[0]
     assert err[0] >= 30 * err[1]
-
-
-def _write(tmp_path, text):
-    path = tmp_path / "m.toml"
-    path.write_text(text)
-    return str(path)
-
-
-@pytest.mark.parametrize(
-    ("text", "args", "match"),
-    [
-        ("[material]\nk_d = 0.2\nk_s = 0.5\nn = -3\n", [], "material.n: must be >= 0"),
-        ("[material]\nk_d = 0.2\nk_s = 0.5\nn = nan\n", [], "must be finite"),
-        ("[material]\nk_d = [0.1, 0.2]\nk_s = 0.5\nn = 3\n", [], "must have 41 values"),
-        (
-            "[material]\nk_d = 0.2\nk_s = 0.5\nn = 3\n",
-            ["--interp", "parabolic", "--entries", "2"],
-            "needs entries >= 3",
-        ),
-        (
-            "[material]\nk_d = 0.2\nk_s = 0.5\nn = 3\n",
-            ["--placement", "importance", "--segments", "3"],
-            "must divide entries",
-        ),
-        (
-            "[material]\nk_d = 0.2\nk_s = 0.5\nn = 3\n",
-            ["--placement", "best"],
-            "unknown placement 'best'",
-        ),
-        (
-            "[material]\nk_d = 0.2\nk_s = 0.5\nn = 3\n",
-            ["--interp", "cubic"],
-            "unknown interpolation 'cubic'",
-        ),
-        ("[material]\nk_d = 0.2\nk_s = 0.5\n", [], "material.n: missing"),
-        ("[material]\nk_d = 0.2\nk_s = 0.5\nn = 3\ncolour = 1\n", [], "unknown key 'colour'"),
-    ],
-)
-def test_bad_material_input_exits_2(tmp_path, capsys, text, args, match):
-    path = _write(tmp_path, text)
-    argv = ["phong", "--material", path, "--resolution", "8", "--repeats", "1", *args]
-    assert main(argv) == 2
-    err = capsys.readouterr().err
-    assert match in err
-    assert len(err.strip().splitlines()) == 1
-    with pytest.raises(SpecrefError):
-        run_material(path, resolution=8, repeats=1, **_kwargs(args))
-
-
-def _kwargs(args):
-    names = {
-        "--interp": "interpolation",
-        "--entries": "entries",
-        "--placement": "placement",
-        "--segments": "segments",
-    }
-    out = {}
-    for flag, value in zip(args[::2], args[1::2], strict=True):
-        out[names[flag]] = int(value) if flag in ("--entries", "--segments") else value
-    return out
-
-
-def test_material_command_writes_json(tmp_path):
-    import json
-
-    path = _write(tmp_path, "[material]\nk_d = 0.2\nk_s = 0.5\nn = 40\n")
-    out = tmp_path / "out.json"
-    argv = [
-        "phong",
-        "--material",
-        path,
-        "--view",
-        "near",
-        "--entries",
-        "32",
-        "--resolution",
-        "16",
-        "--repeats",
-        "1",
-        "--tolerance",
-        "0.05",
-        "--json",
-        str(out),
-    ]
-    assert main(argv) == 0
-    result = json.loads(out.read_text())
-    keys = {
-        "scene",
-        "view",
-        "placement",
-        "interpolation",
-        "entries",
-        "segments",
-        "rms_display",
-        "rms_linear",
-        "overshoot",
-        "build_s",
-        "shade_s",
-        "exact_shade_s",
-        "frame_s",
-        "exact_frame_s",
-    }
-    assert all(keys <= set(r) for r in result["rows"])
-    assert result["tolerance"]["verified"]
-
-
-def test_phong_without_action_or_material_exits_2(capsys):
-    assert main(["phong"]) == 2

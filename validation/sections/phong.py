@@ -14,13 +14,17 @@ from phong_table.table import build_table
 from validation.phong import (
     ENTRY_LADDER,
     INTERPOLATIONS,
+    NEVER_WORSE_INTERPOLATIONS,
+    TABLE1_ENTRIES,
     TABLE_VARIANTS,
     bimodal_material,
     table_error_row,
+    time_row,
     time_shading,
     tolerance_search,
     view_state,
 )
+from validation.phong_table1 import target_checks
 from validation.report import (
     REPORT_SECTIONS,
     ReportContext,
@@ -31,6 +35,8 @@ from validation.report import (
 )
 
 QUICK_NOTE = " with the NumPy references (quick mode: times not representative)"
+#: Image size of the in-run speed-up in full mode: Table 1's.
+SPEED_RESOLUTION = 512
 VARIANT_NAMES = ("importance p=m", "importance p=m/10", "uniform", "error")
 
 
@@ -49,6 +55,17 @@ def _floor(x):
     return max(float(x), 1e-9)
 
 
+def _bench_speedups(bench) -> list[float]:
+    # per benchmark group "phong <scene> <view>": exact / table(error, monotone), minima
+    speed = []
+    for _, records in sorted(bench.items()):
+        exact = [r for r in records if r["name"].startswith("test_exact")]
+        table = [r for r in records if r["name"].endswith("-error-monotone]")]
+        if exact and table:
+            speed.append(exact[0]["stats"]["min"] / table[0]["stats"]["min"])
+    return speed
+
+
 def run(ctx: ReportContext) -> SectionResult:
     """Sweeps of the table methods against the exact render, with charts."""
     import matplotlib.pyplot as plt
@@ -59,6 +76,8 @@ def run(ctx: ReportContext) -> SectionResult:
     scenes = ("R1", "R3") if quick else ("R1", "R2", "R3")
     views = ("near",) if quick else ("far", "near")
     results, blocks, nonfinite = {}, [], 0
+    records, speed, picks = [], [], []
+    bench_speed = _bench_speedups(ctx.bench_groups("phong"))
     blocks.append(
         Text(
             f"RMS (8-bit, the larger of display and linear) against shading time (build included) "
@@ -83,6 +102,7 @@ def run(ctx: ReportContext) -> SectionResult:
                 for interpolation in INTERPOLATIONS:
                     for m in ladder:
                         r = table_error_row(state, placement, interpolation, m, segments(m))
+                        records.append({"scene": scene, "view": view, **r})
                         table = build_table(model, m, placement, r["segments"], compiled=compiled)
                         shade_s = time_shading(state, table, interpolation, repeats)
                         nonfinite += int(not np.isfinite(r["rms"]))
@@ -95,6 +115,16 @@ def run(ctx: ReportContext) -> SectionResult:
                     for (v, i, m), (s, e) in zip(labels, points, strict=True)
                 ],
             }
+            # the 200-entry error rows of the targets, and the in-run speed-up of error + monotone
+            for interpolation in () if TABLE1_ENTRIES in ladder else NEVER_WORSE_INTERPOLATIONS:
+                r = table_error_row(state, "error", interpolation, TABLE1_ENTRIES)
+                records.append({"scene": scene, "view": view, **r})
+            if not bench_speed and not quick:
+                # at Table 1's size, compiled (the target's); quick mode's NumPy times mean nothing
+                timed = view_state(model, view, SPEED_RESOLUTION, compiled)
+                timed_exact_s = time_shading(timed, None, repeats=repeats)
+                r = table_error_row(timed, "error", "monotone", TABLE1_ENTRIES)
+                speed.append(time_row(timed, r, timed_exact_s, 0.0, repeats)["speedup"])
             ax = axes[row][col]
             for (name, interpolation, _), (s, e) in zip(labels, points, strict=True):
                 ax.scatter(s, e, marker=markers[name], c=colours[interpolation], s=14)
@@ -187,6 +217,7 @@ def run(ctx: ReportContext) -> SectionResult:
             state = view_state(SCENES.lookup(scene).build(), view, resolution, compiled)
             pick = tolerance_search(state, 0.05, "monotone", max_entries=256 if quick else 4096)
             results[f"tolerance {scene} {view}"] = pick
+            picks.append({"scene": scene, "view": view, **pick})
             rows.append(
                 [
                     scene,
@@ -205,15 +236,26 @@ def run(ctx: ReportContext) -> SectionResult:
             "{:.3g}",
         )
     )
+    # the paper's failure modes (far view, t-parabola)
+    n2000 = view_state(SCENES.lookup("n2000").build(), "far", resolution, compiled)
+    bimodal = view_state(SCENES.lookup("bimodal").build(), "far", resolution, compiled)
+    failure = {
+        "n2000_overshoot": table_error_row(n2000, "importance", "parabolic", 200, 200)["overshoot"],
+        "importance_rms": [
+            table_error_row(bimodal, "importance", "parabolic", m, m)["rms"] for m in (200, 800)
+        ],
+        "error_rms": [table_error_row(bimodal, "error", "parabolic", m)["rms"] for m in (200, 800)],
+    }
+    results["failure_modes"] = failure
     results["nonfinite"] = nonfinite
     blocks.append(Text(f"Non-finite RMS values in all sweeps: {nonfinite} (must be 0)."))
     bench = ctx.bench_groups("phong")
     if bench:
         table_rows = []
-        for group, records in sorted(bench.items()):
-            base = [r for r in records if "exact" in r["name"]]
+        for group, group_records in sorted(bench.items()):
+            base = [r for r in group_records if "exact" in r["name"]]
             base_s = base[0]["stats"]["min"] if base else None
-            for r in records:
+            for r in group_records:
                 ratio = base_s / r["stats"]["min"] if base_s else float("nan")
                 table_rows.append([group, r["name"], r["stats"]["min"] * 1e3, ratio])
         blocks.append(
@@ -225,7 +267,31 @@ def run(ctx: ReportContext) -> SectionResult:
             )
         )
         results["bench"] = table_rows
-    return SectionResult(blocks, results)
+    if bench_speed:
+        speed, speed_source = bench_speed, "from benchmark JSON (make bench, 512×512)"
+    else:
+        speed_source = (
+            "not measured in --quick mode without make bench"
+            if quick
+            else f"measured in this run at {SPEED_RESOLUTION}×{SPEED_RESOLUTION} (compiled)"
+        )
+    scope = (
+        f" [quick: {', '.join(scenes)} {', '.join(views)} only, {resolution}×{resolution}, "
+        f"m in {list(ladder)}]"
+        if quick
+        else f" [{len(scenes) * len(views)} rows, {resolution}×{resolution}]"
+    )
+    checks = target_checks(records, picks, failure, speed, speed_source, scope)
+    results["speedups"] = {"source": speed_source, "values": speed}
+    blocks.append(
+        Table(
+            ["target", "limit", "measured", "holds"],
+            [[c.name, c.target, c.measured, "yes" if c.passed else "NO"] for c in checks],
+            "The issue's targets, from this section's figures",
+            "{:.3g}",
+        )
+    )
+    return SectionResult(blocks, results, checks)
 
 
 REPORT_SECTIONS.register(ReportSection("phong", "Spectral Phong tables", 40, run))

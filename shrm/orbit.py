@@ -1,0 +1,484 @@
+"""Camera orbits of a render session: the built-in demo scene, scene files, PNG frames and timings.
+
+§5.2, Herbert et al.: a viewpoint change re-runs only extraction and shading, so an orbit pays for
+SHRM creation on its first frame only. :func:`render_orbit` renders one with a
+:class:`shrm.session.RenderSession` and writes ``frame_###.png`` and ``timings.csv`` (seconds per
+stage per frame). Its state comes from :func:`demo_state` (a sphere under a shared environment) or
+from a scene file (:func:`scene_state`, docs/scene-format.md) whose objects share one
+``isotropic_brdf`` material lit by one environment light.
+
+Importing this module registers the scene-file material type ``isotropic_brdf`` (a registered
+isotropic 3-D BRDF of ``reference.brdf.BRDF_METHODS`` and its parameters) and its shader for
+environment lights, ``IsotropicBRDFMaterial/EnvironmentLight``, which renders through a SHRM
+(§5.5-5.6, Herbert et al.) with the distant-viewer approximation of global SHRMs: one view
+direction, the mean over the shaded points.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from reference.errors import require
+from reference.lights import EnvironmentLight
+from reference.materials import MATERIAL_TYPES, MaterialType
+from reference.registry import Method
+from reference.shading import SHADERS, Surface
+
+__all__ = [
+    "IsotropicBRDFMaterial",
+    "brdf_params_on_grid",
+    "demo_state",
+    "orbit_camera",
+    "render_orbit",
+    "scene_state",
+    "shade_isotropic_brdf_environment",
+]
+
+
+@dataclass(frozen=True)
+class IsotropicBRDFMaterial:
+    """A scene material made of a registered isotropic 3-D BRDF (``type = "isotropic_brdf"``).
+
+    Attributes
+    ----------
+    brdf : str
+        A key of ``reference.brdf.BRDF_METHODS`` with ``extra["isotropic"]``.
+    params : dict
+        Its parameters on the scene's grid (spectral ones per band, :func:`brdf_params_on_grid`).
+    name : str
+    """
+
+    brdf: str
+    params: dict = field(default_factory=dict)
+    name: str = "isotropic_brdf"
+
+
+def _isotropic_method(brdf: str):
+    from reference.brdf import BRDF_METHODS
+
+    method = BRDF_METHODS.lookup(brdf)
+    allowed = [n for n, m in BRDF_METHODS.items() if m.extra.get("isotropic") and n != "table"]
+    require(
+        brdf in allowed,
+        f"must be an analytic isotropic 3-D BRDF; allowed: {', '.join(allowed)}; got {brdf!r}",
+    )
+    return method
+
+
+def brdf_params_on_grid(brdf: str, grid, params: dict | None = None) -> dict:
+    """A BRDF's parameters on a spectral grid: its defaults, overridden by ``params``.
+
+    Spectral parameters (1-D arrays among the defaults) given as k values are spread evenly over
+    380-780 nm and interpolated linearly onto the grid; ``wavelengths_nm`` becomes the grid's.
+
+    Examples
+    --------
+    >>> from reference.spectra import SpectralGrid
+    >>> p = brdf_params_on_grid("ggx", SpectralGrid(380.0, 780.0, 200.0), {"alpha": 0.3})
+    >>> p["rho_d"].tolist(), p["alpha"]
+    ([0.5, 0.3, 0.1], 0.3)
+    """
+    method = _isotropic_method(brdf)
+    out = {**dict(method.extra["params"]), **(params or {})}
+    for key, value in out.items():
+        if key == "wavelengths_nm":
+            out[key] = grid.wavelengths_nm
+        elif np.ndim(value) == 1 and np.size(value) != grid.n_bands:
+            out[key] = np.interp(
+                grid.wavelengths_nm, np.linspace(380, 780, len(value)), np.asarray(value)
+            )
+    return out
+
+
+def _parse_isotropic_brdf(reader, table: dict, key: str, name: str):
+    """Scene-file parser: ``brdf`` (required) and the BRDF's parameters (spectra or numbers)."""
+    brdf = reader.string(table.get("brdf"), f"{key}.brdf") if "brdf" in table else None
+    if brdf is None:
+        reader.fail(key, "missing key 'brdf'")
+    with reader.context(f"{key}.brdf"):
+        method = _isotropic_method(brdf)
+    defaults = {k: v for k, v in method.extra["params"].items() if k != "wavelengths_nm"}
+    reader.table(table, key, ("type", "brdf", *defaults))
+    params = {}
+    for p, default in defaults.items():
+        if p in table:
+            where = f"{key}.{p}"
+            spectral = np.ndim(default) == 1
+            params[p] = (
+                reader.spectrum_on_grid(table[p], where)
+                if spectral
+                else reader.number(table[p], where)
+            )
+    return IsotropicBRDFMaterial(brdf, brdf_params_on_grid(brdf, reader.grid, params), name)
+
+
+MATERIAL_TYPES.register(
+    MaterialType(
+        "isotropic_brdf",
+        IsotropicBRDFMaterial,
+        ("brdf",),
+        (),
+        "§5.5, Herbert et al. (an isotropic 3-D BRDF rendered through a SHRM)",
+        parse=_parse_isotropic_brdf,
+    )
+)
+
+#: SHRM settings of the scene shader (small: a preview of what the orbit renders).
+SHADER_SETTINGS = {"env_height": 32, "F": 12, "P": 8, "size": 16, "frame": "normal"}
+
+
+def _working_environment(light: EnvironmentLight, rows: int) -> EnvironmentLight:
+    """The light with its map box-filtered to at most ``rows`` rows (2:1 lat-long)."""
+    from dataclasses import replace
+
+    from reference.camera import downsample_box
+
+    image = light.image
+    factor = max(1, image.shape[0] // rows)
+    h = factor * (image.shape[0] // factor)
+    return replace(light, image=downsample_box(image[:h, : 2 * h], factor))
+
+
+def shade_isotropic_brdf_environment(
+    surface: Surface, material: IsotropicBRDFMaterial, light: EnvironmentLight, ctx
+) -> np.ndarray:
+    """XYZ of an isotropic 3-D BRDF under an environment, through a global SHRM.
+
+    §5.5-5.6, Herbert et al.: project the environment, create the SHRM of the BRDF, extract the
+    reflection map for the (distant) view and look it up per point (:func:`shrm.shrm.shade_shrm`).
+    The view is the mean of the points' view directions (module docstring). Every call creates
+    its SHRM (:data:`SHADER_SETTINGS`, small): a preview; the orbit's session reuses its SHRM.
+
+    Examples
+    --------
+    >>> from reference.shading import ShadingContext
+    >>> from reference.spectra import SpectralGrid
+    >>> ctx = ShadingContext(SpectralGrid(400.0, 700.0, 20.0))
+    >>> m = IsotropicBRDFMaterial("ggx", brdf_params_on_grid("ggx", ctx.grid))
+    >>> env = EnvironmentLight(np.ones((16, 32, 3)))
+    >>> n = np.array([[0.0, 0.0, 1.0]])
+    >>> shade_isotropic_brdf_environment(Surface(n * 0, n, n, np.zeros((1, 2))), m, env,
+    ...                                  ctx).shape
+    (1, 3)
+    """
+    from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts
+    from shrm.environment import environment_spectral_radiance
+    from shrm.shrm import shade_shrm, shrm_create, shrm_extract
+    from shrm.transform import project_latlong
+
+    if surface.normal.shape[0] == 0:
+        return np.zeros((0, 3))
+    c = SHADER_SETTINGS
+    work = _working_environment(light, c["env_height"])
+    radiance = environment_spectral_radiance(work, ctx.grid)
+    F = min(c["F"], radiance.shape[1] // 2 - 1)
+    L = project_latlong(radiance, F, backend="ducc0", where=light.name)
+    brdf, expand, lam, k = shrm_brdf_parts(material.brdf, material.params)
+    rho = brdf_sh_coefficients(brdf, expand, F, c["P"], c["frame"], view_power=k)
+    s = shrm_create(L, rho, c["frame"], c["size"], "ducc0", k, lam)
+    v = surface.view.mean(axis=0)
+    v = v / np.linalg.norm(v)
+    # §5.6, Herbert et al.: extract for the viewpoint, then shade per point
+    spectra = shade_shrm(s, shrm_extract(s, v), surface.normal, v)
+    return spectra @ ctx.weights(None)
+
+
+SHADERS.register(
+    Method(
+        "IsotropicBRDFMaterial/EnvironmentLight",
+        shade_isotropic_brdf_environment,
+        None,
+        "§5.6, Herbert et al.",
+    )
+)
+
+
+def orbit_camera(frame: int, frames: int, radius: float = 5.0, elevation_deg: float = 15.0):
+    """An orthographic camera on a circle about the y axis, looking at the origin.
+
+    Parameters
+    ----------
+    frame, frames : int
+        This frame's index and the number of frames of a full turn.
+    radius : float
+        Distance from the origin.
+    elevation_deg : float
+        Height of the circle, degrees above the horizon.
+
+    Returns
+    -------
+    reference.camera.Camera
+
+    Examples
+    --------
+    >>> orbit_camera(0, 4, elevation_deg=0.0).eye
+    (0.0, 0.0, 5.0)
+    """
+    from reference.camera import Camera
+
+    a = 2.0 * np.pi * frame / frames
+    e = np.radians(elevation_deg)
+    eye = radius * np.array([np.cos(e) * np.sin(a), np.sin(e), np.cos(e) * np.cos(a)])
+    return Camera(
+        eye=tuple(float(x) + 0.0 for x in np.round(eye, 12)),
+        target=(0.0, 0.0, 0.0),
+        projection="orthographic",
+        extent=2.4,
+    )
+
+
+def demo_state(
+    environment_path=None,
+    env_height: int = 64,
+    brdf: str = "effect_pigment",
+    grid=None,
+    size: int = 32,
+    resolution: int = 96,
+    **config,
+) -> dict:
+    """A built-in scene for the orbit and the report: a sphere under a shared environment.
+
+    The environment (default ``venice_sunset_1k.hdr`` from ``../shared/data/environments``, else
+    a synthetic sky) is box-filtered to ``env_height`` rows and turned into spectra by replicating
+    its luminance over the grid (an equal-energy spectral environment); the illuminant is CIE D65.
+
+    Parameters
+    ----------
+    environment_path : str or Path, optional
+        A lat-long ``.hdr`` or ``.exr``.
+    env_height : int
+        Rows of the working environment (a power-of-two fraction of the file's height).
+    brdf : str
+        A key of :data:`reference.brdf.BRDF_METHODS` (isotropic), with its default parameters.
+    grid : reference.spectra.SpectralGrid, optional
+        Default a 16-band 400-700 nm grid (20 nm), which keeps the demo quick.
+    size : int
+        Cube face size of the maps.
+    resolution : int
+        Image width and height.
+    **config
+        Further configuration (``F_max``, ``P_max``, ``light_order``, ``tol``, ``frame``).
+
+    Returns
+    -------
+    dict
+        State for :class:`RenderSession`.
+
+    Examples
+    --------
+    >>> state = demo_state(env_height=16, size=4, resolution=8)
+    >>> state["environment"].shape, sorted(state["dynamic"])
+    ((16, 32, 16), ['k_d', 'k_e', 'k_s'])
+    """
+    from pathlib import Path
+
+    from reference.camera import downsample_box
+    from reference.geometry import Sphere
+    from reference.images import read_image
+    from reference.spectra import SpectralGrid, spectrum_from_dataset
+
+    grid = grid or SpectralGrid(400.0, 700.0, 20.0)
+    default = Path(__file__).resolve().parents[2] / "shared/data/environments/venice_sunset_1k.hdr"
+    path = Path(environment_path) if environment_path else default
+    if path.is_file():
+        image = read_image(path)
+        factor = max(1, image.shape[0] // env_height)
+        image = downsample_box(image[: factor * env_height, : factor * 2 * env_height], factor)
+    else:  # a synthetic sky: bright zenith, a warm sun, a dark ground
+        from reference.envmap import latlong_pixel_directions
+
+        d = latlong_pixel_directions(env_height, 2 * env_height)
+        sun = np.exp((d @ np.array([0.6, 0.5, 0.62]) - 1.0) * 40.0)
+        image = (0.2 + 0.8 * np.maximum(d[..., 1], 0.0) + 20.0 * sun)[..., None] * np.ones(3)
+    luminance = image @ np.array([0.2126, 0.7152, 0.0722])
+    environment = np.repeat(luminance[..., None], grid.n_bands, axis=-1)
+    illuminant = spectrum_from_dataset("illuminant", "D65")
+    from reference.spectra import resample_spectrum
+
+    D65 = np.asarray(resample_spectrum(illuminant, grid), dtype=np.float64)
+    params = brdf_params_on_grid(brdf, grid)
+    return {
+        "illuminant": D65 / D65.max(),
+        "environment": environment,
+        "viewpoint": orbit_camera(0, 8),
+        "gloss": 64.0,
+        "brdf": {"name": brdf, "params": params},
+        "dynamic": {"k_d": 0.0, "k_s": 0.0, "k_e": 1.0},
+        "config": {
+            "size": size,
+            "width": resolution,
+            "height": resolution,
+            "objects": [Sphere((0.0, 0.0, 0.0), 1.0)],
+            "grid": [grid.start_nm, grid.end_nm, grid.step_nm],
+            **config,
+        },
+    }
+
+
+def turn_camera(camera, angle: float):
+    """The camera turned by ``angle`` radians about the vertical (y) axis through its target.
+
+    Examples
+    --------
+    >>> from reference.camera import Camera
+    >>> turn_camera(Camera(eye=(0.0, 1.0, 5.0)), np.pi / 2).eye
+    (5.0, 1.0, 0.0)
+    """
+    from dataclasses import replace
+
+    t = np.asarray(camera.target, dtype=np.float64)
+    d = np.asarray(camera.eye, dtype=np.float64) - t
+    c, s = np.cos(angle), np.sin(angle)
+    turned = np.array([c * d[0] + s * d[2], d[1], -s * d[0] + c * d[2]]) + t
+    return replace(camera, eye=tuple(float(x) + 0.0 for x in np.round(turned, 12)))
+
+
+def scene_state(scene, env_height: int = 32, size: int = 16, **config) -> dict:
+    """Session state of a scene file (docs/scene-format.md) for :func:`render_orbit`.
+
+    The scene's objects must share one ``isotropic_brdf`` material and its lights be one
+    ``environment`` light; its camera starts the orbit, its ``[render]`` size is the image size.
+    The environment's spectral radiance on the scene's grid (``shrm.environment``) is box-filtered
+    to ``env_height`` rows; the illuminant is flat (the radiance carries the light's colour).
+
+    Parameters
+    ----------
+    scene : reference.scene.Scene
+    env_height : int
+        Rows of the working environment.
+    size : int
+        Cube face size of the maps.
+    **config
+        Further configuration (``F_max``, ``P_max``, ``light_order``, ``tol``, ``F``, ``P``).
+
+    Returns
+    -------
+    dict
+
+    Raises
+    ------
+    SpecrefError
+        Another material or light, or no object, naming the scene file.
+
+    Examples
+    --------
+    >>> from reference.scene import loads_scene
+    >>> scene = loads_scene('''
+    ... [materials.m]
+    ... type = "isotropic_brdf"
+    ... brdf = "ggx"
+    ... [[objects]]
+    ... type = "sphere"
+    ... material = "m"
+    ... [[lights]]
+    ... type = "point"
+    ... position = [0, 0, 5]
+    ... ''', "s.toml")
+    >>> scene_state(scene)
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: s.toml: lights: SHRM orbits need one environment light; got point
+    """
+    from shrm.environment import environment_spectral_radiance
+
+    where = scene.file
+    kinds = [type(m).__name__ for m in scene.materials]
+    require(
+        len(scene.materials) == 1 and isinstance(scene.materials[0], IsotropicBRDFMaterial),
+        f"{where}: materials: SHRM orbits need exactly one material of type isotropic_brdf; "
+        f"got {', '.join(kinds) or 'none'}",
+    )
+    lights = [type(x).__name__.removesuffix("Light").lower() for x in scene.lights]
+    require(
+        len(scene.lights) == 1 and isinstance(scene.lights[0], EnvironmentLight),
+        f"{where}: lights: SHRM orbits need one environment light; "
+        f"got {', '.join(lights) or 'none'}",
+    )
+    require(len(scene.objects) > 0, f"{where}: objects: SHRM orbits need an object; got none")
+    material, grid = scene.materials[0], scene.grid
+    work = _working_environment(scene.lights[0], env_height)
+    return {
+        "illuminant": np.ones(grid.n_bands),
+        "environment": environment_spectral_radiance(work, grid),
+        "viewpoint": scene.camera,
+        "gloss": 64.0,
+        "brdf": {"name": material.brdf, "params": material.params},
+        "dynamic": {"k_d": 0.0, "k_s": 0.0, "k_e": 1.0},
+        "config": {
+            "size": size,
+            "width": scene.render.width,
+            "height": scene.render.height,
+            "objects": list(scene.objects),
+            "grid": [grid.start_nm, grid.end_nm, grid.step_nm],
+            **config,
+        },
+    }
+
+
+def render_orbit(session, frames: int, out_dir=None, progress: bool = True):
+    """Render a camera orbit; write PNG frames and a per-stage timing table (``timings.csv``).
+
+    The orbit turns the session's camera about the vertical axis through its target. The first
+    frame pays for creation; later frames run only ``gbuffer``, ``extract`` and ``shade`` (§5.2,
+    Herbert et al.).
+
+    Parameters
+    ----------
+    session : shrm.session.RenderSession
+        With a ``config.grid`` of ``[start_nm, end_nm, step_nm]``.
+    frames : int
+        Frames of a full turn, >= 1.
+    out_dir : str or Path, optional
+        Where to write ``frame_###.png`` and ``timings.csv`` (atomically); None writes nothing.
+    progress : bool
+        tqdm progress on stderr.
+
+    Returns
+    -------
+    list of dict
+        ``{stage: seconds}`` per frame.
+
+    Examples
+    --------
+    >>> from shrm.session import RenderSession
+    >>> s = RenderSession(demo_state(env_height=16, size=4, resolution=8, F_max=8, P_max=4))
+    >>> times = render_orbit(s, 2, progress=False)
+    >>> sorted(times[1])
+    ['extract', 'gbuffer', 'shade']
+    """
+    import sys
+    from pathlib import Path
+
+    from tqdm import tqdm
+
+    from reference.colorimetry import XYZ_to_display_RGB, band_weights, spectra_to_XYZ
+    from reference.display import linear_to_display
+    from reference.errors import require_positive_int
+    from reference.images import write_png, write_text_atomic
+    from reference.spectra import SpectralGrid
+
+    frames = require_positive_int(frames, "orbit --frames", 100000)
+    grid = SpectralGrid(*session.state["config"]["grid"])
+    W = band_weights(grid, None)
+    white = float(spectra_to_XYZ(np.asarray(session.state["illuminant"]), W)[1])
+    rows, start = [], session.state["viewpoint"]
+    for f in tqdm(range(frames), desc="orbit", unit="frame", file=sys.stderr, disable=not progress):
+        # A full turn about the vertical axis through the first camera's target
+        session.update(viewpoint=turn_camera(start, 2.0 * np.pi * f / frames))
+        result = session.render()
+        times = session.frame_times[-1]
+        rows.append(times)
+        if out_dir is not None:
+            XYZ = spectra_to_XYZ(result["shade"]["radiance"], W) / white
+            RGB = linear_to_display(np.clip(XYZ_to_display_RGB(XYZ), 0.0, None), "srgb")
+            write_png(Path(out_dir) / f"frame_{f:03d}.png", np.clip(RGB, 0.0, 1.0))
+    if out_dir is not None:
+        names = [s.name for s in session.stages]
+        lines = ["frame," + ",".join(names) + ",total"]
+        for f, times in enumerate(rows):
+            cells = [f"{times.get(n, 0.0):.6f}" for n in names]
+            lines.append(f"{f}," + ",".join(cells) + f",{sum(times.values()):.6f}")
+        write_text_atomic(Path(out_dir) / "timings.csv", "\n".join(lines) + "\n")
+    return rows

@@ -1,0 +1,163 @@
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from reference.errors import SpecrefError
+from reference.images import read_png
+from reference.scene import load_scene, loads_scene
+from shrm.orbit import render_orbit, scene_state, turn_camera
+from shrm.session import HERBERT_STAGES, RenderSession
+from validation.cli import main
+
+ALL = [s.name for s in HERBERT_STAGES]
+EXAMPLE = Path(__file__).resolve().parents[2] / "docs" / "examples" / "shrm-orbit.toml"
+LATER = ["extract", "gbuffer", "shade"]
+
+
+def test_turn_camera_is_a_rotation_about_the_target():
+    from reference.camera import Camera
+
+    c = Camera(eye=(1.0, 2.0, 4.0), target=(1.0, 0.0, 0.0))
+    # A quarter turn about y through the target: (0, 2, 4) relative becomes (4, 2, 0)
+    assert turn_camera(c, np.pi / 2).eye == (5.0, 2.0, 0.0)
+    assert turn_camera(c, 2 * np.pi).eye == pytest.approx(c.eye)
+
+
+def test_orbit_pays_for_creation_once(state, tmp_path):
+    session = RenderSession(state)
+    times = render_orbit(session, 3, tmp_path, progress=False)
+    assert "shrm_create" in times[0]
+    assert all(sorted(t) == LATER for t in times[1:])
+    assert session.executions["shrm_create"] == 1
+    assert session.executions["extract"] == 3
+    assert sorted(p.name for p in tmp_path.glob("*.png")) == [
+        "frame_000.png",
+        "frame_001.png",
+        "frame_002.png",
+    ]
+    header = (tmp_path / "timings.csv").read_text().splitlines()[0]
+    assert header == "frame," + ",".join(ALL) + ",total"
+
+
+def test_cli_orbit_of_the_example_scene(tmp_path, capsys):
+    out = tmp_path / "orbit"
+    argv = ["shrm", "orbit", str(EXAMPLE), "--frames", "3", "-o", str(out), "--no-cache"]
+    assert main(argv) == 0
+    assert "wrote 3 frames" in capsys.readouterr().out
+    frames = [read_png(out / f"frame_{f:03d}.png") for f in range(3)]
+    assert all(f.shape == (64, 64, 3) for f in frames)  # the scene's [render] size
+    assert frames[0].max() > 0.2  # the sphere is lit
+    assert not np.array_equal(frames[0], frames[1])  # the camera moved
+    lines = (out / "timings.csv").read_text().splitlines()
+    assert lines[0] == "frame," + ",".join(ALL) + ",total"
+    rows = [
+        dict(zip(lines[0].split(","), map(float, r.split(",")), strict=True)) for r in lines[1:]
+    ]
+    # The first frame pays for creation; later frames only for gbuffer, extraction and shading
+    assert rows[0]["shrm_create"] > 0
+    assert rows[0]["brdf_coeffs"] > 0
+    for r in rows[1:]:
+        assert {k for k, v in r.items() if v > 0} - {"frame", "total"} == set(LATER)
+    assert not list(out.glob("*.tmp*"))  # written atomically: no temporaries left
+
+
+def test_scene_state_counts_stages(tmp_path):
+    state = scene_state(load_scene(EXAMPLE), env_height=16, size=4, F_max=12)
+    state["config"].update(width=8, height=8)
+    session = RenderSession(state)
+    render_orbit(session, 2, progress=False)
+    assert session.executions["shrm_create"] == 1
+    assert session.executions["extract"] == session.executions["shade"] == 2
+
+
+SCENE = """
+[materials.m]
+type = "isotropic_brdf"
+{material}
+[[objects]]
+type = "sphere"
+material = "m"
+[[lights]]
+{light}
+"""
+ENV = 'type = "environment"\nfile = "sky.exr"'
+
+#: name -> (material lines, light lines, expected message)
+BAD_SCENES = {
+    "unknown BRDF": ('brdf = "phong"', ENV, "materials.m.brdf: unknown brdf 'phong'; allowed:"),
+    "anisotropic BRDF": (
+        'brdf = "ward_duer"',
+        ENV,
+        "materials.m.brdf: must be an analytic isotropic 3-D BRDF; allowed: ",
+    ),
+    "missing brdf": ("", ENV, "materials.m: missing key 'brdf'"),
+    "unknown parameter": (
+        'brdf = "ggx"\nroughness = 0.3',
+        ENV,
+        "materials.m: unknown key 'roughness'; allowed: F_0, alpha, brdf, rho_d, type",
+    ),
+    "NaN parameter": ('brdf = "ggx"\nalpha = nan', ENV, "materials.m.alpha: must be finite"),
+    "point light": (
+        'brdf = "ggx"',
+        'type = "point"\nposition = [0, 0, 5]',
+        "lights: SHRM orbits need one environment light; got point",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", BAD_SCENES, ids=list(BAD_SCENES))
+def test_bad_scenes_give_one_line_and_exit_2(case, tmp_path, capsys):
+    from reference.images import write_exr
+
+    write_exr(tmp_path / "sky.exr", np.ones((8, 16, 3), dtype=np.float32))
+    material, light, message = BAD_SCENES[case]
+    path = tmp_path / "scene.toml"
+    path.write_text(SCENE.format(material=material, light=light))
+    with pytest.raises(SpecrefError, match=message.replace("(", r"\(")):
+        scene_state(load_scene(path))
+    assert main(["shrm", "orbit", str(path), "-o", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1
+    assert message in err[0]
+
+
+def test_cli_orbit_refuses_bad_arguments(tmp_path, capsys):
+    out = str(tmp_path / "o")
+    cases = {
+        ("--frames", "0"): "orbit --frames",
+        ("--brdf", "ggx"): "--brdf is for the built-in scene, not a scene file",
+    }
+    for extra, message in cases.items():
+        assert main(["shrm", "orbit", str(EXAMPLE), *extra, "-o", out]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1, err
+        assert message in err[0]
+    assert main(["shrm", "orbit", str(tmp_path / "none.toml"), "-o", out]) == 2
+    assert "none.toml: file not found" in capsys.readouterr().err
+
+
+def test_cli_orbit_without_traceback():
+    # The installed entry point: exit 2, one line, no traceback
+    run = subprocess.run(
+        [sys.executable, "-m", "validation.cli", "shrm", "orbit", "nope.toml", "-o", "x"],
+        capture_output=True,
+        text=True,
+    )
+    assert run.returncode == 2
+    assert run.stderr.strip().count("\n") == 0
+    assert "Traceback" not in run.stderr
+
+
+def test_loads_scene_reads_spectral_parameters(tmp_path):
+    from reference.images import write_exr
+
+    write_exr(tmp_path / "sky.exr", np.ones((8, 16, 3), dtype=np.float32))
+    text = SCENE.format(material='brdf = "lafortune"\nn = 12', light=ENV)
+    scene = loads_scene(text, "s.toml", base_dir=tmp_path)
+    m = scene.materials[0]
+    assert m.params["n"].shape == (41,)
+    assert (m.params["n"] == 12.0).all()
+    assert m.params["rho_s"] == 0.6  # the default, a number
