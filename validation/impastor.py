@@ -1,7 +1,8 @@
-"""ImpastoR validation (§5, Ferwerda): Table 1, metamers, gloss, lighting, shadows, the painting.
+"""ImpastoR colour validation (§3.1, §3.4, §5.1, Ferwerda): Table 1, channels, metamers, display.
 
-Everything the ``specref impastor`` command and the report's "ImpastoR" section show is computed
-here, from the library in ``reference/``:
+The colour half of what the ``specref impastor`` command and the report's "ImpastoR" section show;
+the lighting half (the booth, the painting, gloss curves, shadows, the hybrid) is
+``validation.impastor_lighting``:
 
 - :func:`table1`: the ColorChecker under D65, D50 and A, six-channel simulation against the 5 nm
   spectral truth, and the "screen output" through the virtual display with out-of-gamut patches
@@ -10,28 +11,16 @@ here, from the library in ``reference/``:
   the RGB-product baseline; lights outside the fit (FL2, a white LED) are reported too.
 - :func:`metamer_pair`, :func:`metamer_delta_E`: two reflectances that match under A and differ
   under D65 (Fig. 4, Ferwerda).
-- :func:`specular_error_vs_alpha`: point lights, FIS and the hybrid against the brute-force
-  integral, over roughness (§3.5.2).
-- :func:`shadow_agreement`: horizon maps against ray-marched shadows over the sector count
-  (§3.5.3).
-- :func:`gloss_validation`: goniometric luminance curves of gray Ward–Dür samples (Fig. 15).
-- :func:`impasto_painting`, :func:`render_painting`: the demo painting under the booth lights.
+- :func:`display_round_trip`: digital counts → XYZ → counts, and XYZ → counts → XYZ, through the
+  display model (Eq. (1), Ferwerda, and its inverse).
 """
 
 from __future__ import annotations
 
 import functools
-import time
-from pathlib import Path
 
 import numpy as np
 
-from reference.arealights import (
-    PlaneLight,
-    booth_light_image,
-    illuminance_point_lights,
-    point_lights_from_plane,
-)
 from reference.colorimetry import XYZ_to_display_RGB, XYZ_to_Lab, delta_E_00
 from reference.display_model import (
     XYZ_to_display_counts,
@@ -39,15 +28,7 @@ from reference.display_model import (
     screen_flare_XYZ,
     virtual_display,
 )
-from reference.errors import require, require_positive_int
-from reference.horizon import (
-    horizon_lookup,
-    horizon_map,
-    light_azimuth_elevation,
-    normal_map_from_height,
-    ray_march_shadows,
-    tangent_to_world,
-)
+from reference.errors import require
 from reference.multispectral import (
     MS_GRID,
     MULTISPECTRAL_DESIGNS,
@@ -55,34 +36,20 @@ from reference.multispectral import (
     light_to_channels,
     spectra_to_channels,
 )
-from reference.spectra import resample_spectrum, spectrum_from_csv, spectrum_from_dataset
-from reference.specular_lighting import (
-    specular_brute_force,
-    specular_fis,
-    specular_hybrid,
-    specular_point_lights,
-)
+from reference.spectra import resample_spectrum, spectrum_from_dataset
 from validation.metrics import colorchecker_truth as _colorchecker_truth_uncached
 from validation.metrics import delta_E_stats
 
 __all__ = [
     "EXTRA_LIGHTS",
-    "LIGHTING_METHODS",
     "LIGHTS",
-    "PAINT_SPECTRA",
-    "booth_plane_light",
     "channel_count_errors",
     "colorchecker_truth",
     "design_delta_E",
-    "gloss_validation",
-    "impasto_painting",
-    "load_paint_spectra",
+    "display_round_trip",
     "metamer_delta_E",
     "metamer_pair",
     "naive_rgb_delta_E",
-    "render_painting",
-    "shadow_agreement",
-    "specular_error_vs_alpha",
     "table1",
 ]
 
@@ -90,23 +57,6 @@ __all__ = [
 LIGHTS = ("D65", "D50", "A")
 #: Lights not used in the fit, reported without a target.
 EXTRA_LIGHTS = ("FL2", "LED-B3")
-#: Lighting methods of the demo painting (frame times in the report).
-LIGHTING_METHODS = ("median_cut", "variance_min", "fis", "hybrid")
-#: Measured reflectances used for the painting's strokes (``../shared/data/spectra``).
-PAINT_SPECTRA = (
-    "lemon",
-    "orange",
-    "brick",
-    "terracotta",
-    "chocolate",
-    "blackboard",
-    "egg-shell-brown",
-    "cardboard",
-    "toothpaste",
-    "office-paper",
-)
-#: The booth: the viewer's eye and the ceiling light (§3.2, Fig. 7), metres, y up.
-EYE = (0.0, 0.45, 0.6)
 
 
 @functools.lru_cache(maxsize=32)
@@ -388,436 +338,56 @@ def metamer_delta_E(design: str = "optimized", n_channels: int = 6, lights=("A",
     return out
 
 
-# --- the booth and the painting ------------------------------------------------------------------
+# --- the display round trip (Eq. (1)) -------------------------------------------------------------
 
 
-def booth_plane_light(kind: str = "fluorescent", width: int = 128, height: int = 64) -> PlaneLight:
-    """The booth ceiling: a 1.2 m × 0.8 m light at y = 0.6 m over the painting (Fig. 7, Ferwerda).
+def display_round_trip(display=None, n: int = 500, seed: int = 0) -> dict:
+    """Round trips through the display model, Eq. (1), Ferwerda, and its inverse.
 
-    Examples
-    --------
-    >>> booth_plane_light("fluorescent", 16, 8).n_light
-    array([ 0., -1.,  0.])
-    """
-    image = booth_light_image(kind, width, height)
-    return PlaneLight(image, (-0.6, 0.6, -1.0), (1.0, 0.0, 0.0), (0.0, 0.0, 1.0), 1.2, 0.8)
-
-
-def _booth_kind(light: str) -> str:
-    return "incandescent" if light == "A" else "fluorescent"
-
-
-def load_paint_spectra(shared_data=None, names=PAINT_SPECTRA) -> dict:
-    """Measured reflectances from ``../shared/data/spectra/physicallybased`` on the 5 nm grid.
-
-    Raises
-    ------
-    SpecrefError
-        When the folder is missing, naming it and how to point at it.
-
-    Examples
-    --------
-    >>> spectra = load_paint_spectra(names=("lemon",))
-    >>> spectra["lemon"].shape
-    (81,)
-    """
-    import os
-
-    root = Path(
-        shared_data
-        or os.environ.get("SPECREF_SHARED_DATA")
-        or Path(__file__).resolve().parents[1].parent / "shared" / "data"
-    )
-    folder = root / "spectra" / "physicallybased"
-    require(
-        folder.is_dir(),
-        f"{folder}: measured spectra not found; the ImpastoR painting needs ../shared/data "
-        "(set SPECREF_SHARED_DATA to the shared data folder)",
-    )
-    out = {}
-    for name in names:
-        spectrum = spectrum_from_csv(folder / f"{name}__nix_export.csv", name=name)
-        out[name] = resample_spectrum(spectrum, MS_GRID, extrapolation="constant")
-    return out
-
-
-def impasto_painting(size: int = 256, seed: int = 1, width_m: float = 0.3, n_strokes=None) -> dict:
-    """A procedural impasto painting: brush-stroke height field, stroke materials, gloss maps.
-
-    Strokes are ridged bands (a raised body with a furrow along its middle) of random direction,
-    length and width, laid in order so that later strokes cover earlier ones; a canvas weave lies
-    under them. Everything is periodic, so the surface tiles.
+    Two round trips, on and off axis (θ = 25°, φ = 60°): random digital counts → XYZ → counts
+    (exact, since the inverse searches the 11-bit LUTs), and random in-gamut XYZ → counts → XYZ
+    (within one step of the steepest LUT segment per channel, the quantisation bound).
 
     Parameters
     ----------
-    size : int
-        Pixels per side.
+    display : DisplayModel, optional
+        Default: :func:`reference.display_model.virtual_display`.
+    n : int
+        Random samples per round trip.
     seed : int
-        Random seed.
-    width_m : float
-        Physical width, m (a 30 cm canvas by default).
-    n_strokes : int, optional
-        Default ``400 · (width_m / 0.3)²``.
+        Seed of the samples.
 
     Returns
     -------
     dict
-        ``height`` (m, (size, size)), ``material`` (int index into :data:`PAINT_SPECTRA`, −1 is
-        the primed canvas), ``rho_s`` and ``alpha`` maps, ``pixel_size`` (m).
+        ``counts_mismatches`` (counts that do not come back, of ``n_counts``),
+        ``XYZ_error_over_bound`` (largest XYZ error over the quantisation bound; ≤ 1 holds),
+        ``out_of_gamut`` (in-gamut samples flagged out of gamut).
 
     Examples
     --------
-    >>> p = impasto_painting(64, seed=3)
-    >>> p["height"].shape, bool(p["height"].max() < 5e-3), int(p["material"].max()) < 10
-    ((64, 64), True, True)
+    >>> r = display_round_trip(n=50)
+    >>> r["counts_mismatches"], r["out_of_gamut"], bool(r["XYZ_error_over_bound"] <= 1)
+    (0, 0, True)
     """
-    size = require_positive_int(size, "painting: size", 8192)
+    display = display or virtual_display()
     rng = np.random.default_rng(seed)
-    pixel = width_m / size
-    n = n_strokes or int(400 * (width_m / 0.3) ** 2)
-    y, x = np.meshgrid(np.arange(size) * pixel, np.arange(size) * pixel, indexing="ij")
-    # Canvas weave: two crossed sinusoids, 1 mm period, 20 µm deep.
-    height = 2e-5 * (np.sin(2 * np.pi * x / 1e-3) * np.sin(2 * np.pi * y / 1e-3))
-    material = np.full((size, size), -1, dtype=np.int64)
-    rho_s = np.full((size, size), 0.01)
-    alpha = np.full((size, size), 0.4)
-    for _ in range(n):
-        cx, cy = rng.uniform(0, width_m, 2)
-        theta = rng.uniform(0, np.pi)
-        length = rng.uniform(0.02, 0.07)
-        half_width = rng.uniform(0.002, 0.006)
-        amplitude = rng.uniform(5e-4, 2e-3)
-        # Minimum-image offsets: the canvas tiles.
-        dx = (x - cx + width_m / 2) % width_m - width_m / 2
-        dy = (y - cy + width_m / 2) % width_m - width_m / 2
-        along = dx * np.cos(theta) + dy * np.sin(theta)
-        across = -dx * np.sin(theta) + dy * np.cos(theta)
-        r = np.abs(across) / half_width
-        # A thick body with steep edges and a furrow along its middle (the brush's trace).
-        body = np.sqrt(np.clip(1.0 - r**6, 0.0, None)) * (1.0 - 0.4 * np.exp(-((r / 0.25) ** 2)))
-        ends = np.sqrt(np.clip(1.0 - (2.0 * along / length) ** 6, 0.0, None))
-        bump = amplitude * body * ends
-        covered = bump > 0.15 * amplitude
-        # The new stroke lies on top: it replaces the surface where it is thick.
-        height = np.where(covered, np.maximum(height, bump + 0.5 * height), height)
-        material[covered] = rng.integers(0, len(PAINT_SPECTRA))
-        rho_s[covered] = rng.uniform(0.02, 0.08)
-        alpha[covered] = rng.uniform(0.04, 0.3)
+    counts = rng.integers(0, 2048, size=(n, 3))
+    mismatches, flagged = 0, 0
+    for theta, phi in ((0.0, 0.0), (np.radians(25.0), np.radians(60.0))):
+        XYZ = display_counts_to_XYZ(counts, display, theta, phi)
+        back, in_gamut, _ = XYZ_to_display_counts(XYZ, display, theta, phi)
+        mismatches += int((back != counts).any(axis=-1).sum())
+        flagged += int((~in_gamut).sum())
+    RGB = rng.uniform(0.05, 0.95, size=(n, 3))
+    XYZ = RGB @ display.P.T + display.black_XYZ
+    counts_back, in_gamut, _ = XYZ_to_display_counts(XYZ, display)
+    shown = display_counts_to_XYZ(counts_back, display)
+    # One 11-bit step of the steepest LUT segment bounds the error per channel.
+    bound = np.diff(display.luts, axis=1).max() * np.abs(display.P).sum(axis=1).max()
     return {
-        "height": height,
-        "material": material,
-        "rho_s": rho_s,
-        "alpha": alpha,
-        "pixel_size": pixel,
-        "width_m": width_m,
+        "n_counts": 2 * n,
+        "counts_mismatches": mismatches,
+        "XYZ_error_over_bound": float(np.abs(shown - XYZ).max() / bound),
+        "out_of_gamut": flagged + int((~in_gamut).sum()),
     }
-
-
-def _painting_gbuffer(size: int, width_m: float):
-    from reference.camera import Camera
-    from reference.gbuffer import render_gbuffer
-    from reference.geometry import Plane
-
-    plane = Plane((0.0, 0.0, 0.0), (0.0, 1.0, 0.0), (1.0, 0.0, 0.0), size=(width_m, width_m))
-    camera = Camera(eye=EYE, target=(0.0, 0.0, 0.0), fov_deg=25.0)
-    return render_gbuffer([plane], camera, size, size)
-
-
-def render_painting(
-    light: str = "D65",
-    size: int = 256,
-    method: str = "hybrid",
-    painting=None,
-    design: str = "optimized",
-    n_lights: int = 32,
-    n_samples: int = 32,
-    light_resolution: tuple = (128, 64),
-    shadows: bool = True,
-    spectra=None,
-    backend: str = "numba",
-) -> dict:
-    """Render the demo painting under a booth light through the whole ImpastoR pipeline.
-
-    G-buffer of the canvas plane, normal map from the height map, six-channel ρ_d from measured
-    spectra, diffuse light from median-cut lights (Eqs. (2)-(3), Ferwerda) with horizon-map
-    shadows, specular light by ``method``, and XYZ through the 3×N matrix.
-
-    Parameters
-    ----------
-    light : str
-        Illuminant key; A uses the incandescent booth image, others the fluorescent one.
-    size : int
-        Image side, pixels.
-    method : {"median_cut", "variance_min", "fis", "hybrid"}
-        Specular lighting (the diffuse term always uses the median-cut or variance-min lights).
-    painting : dict, optional
-        From :func:`impasto_painting` (default: one at ``size``).
-    design, n_lights, n_samples, light_resolution, shadows
-        Pipeline settings.
-    backend : {"numba", "numpy"}
-        Kernels or their NumPy twins (no JIT warm-up: for small images).
-    spectra : dict, optional
-        From :func:`load_paint_spectra`.
-
-    Returns
-    -------
-    dict
-        ``XYZ`` (H, W, 3) in cd/m², ``sRGB`` encoded (H, W, 3) in [0, 1] (white = 1.2× the
-        white diffuser's luminance), ``seconds`` per stage.
-
-    Examples
-    --------
-    >>> out = render_painting("D65", size=32, method="median_cut", light_resolution=(32, 16))
-    >>> out["XYZ"].shape, sorted(out["seconds"])
-    ((32, 32, 3), ['diffuse', 'shadows', 'specular'])
-    """
-    from reference.errors import require_choice
-
-    require_choice(method, LIGHTING_METHODS, "lighting method")
-    painting = painting or impasto_painting(size)
-    spectra = spectra or load_paint_spectra()
-    d = MULTISPECTRAL_DESIGNS.lookup(design).reference(6)
-    plane = booth_plane_light(_booth_kind(light), *light_resolution)
-    sampling = "variance_min" if method == "variance_min" else "median_cut"
-    lights = point_lights_from_plane(plane, sampling, n_lights)
-    S6 = light_to_channels(spectrum_from_dataset("illuminant", light), d)
-    g = _painting_gbuffer(size, painting["width_m"])
-    mask = g.mask
-    P, V = g.position[mask], g.view[mask]
-    # Texel of each visible pixel (uv: u along +x columns, v along +z rows).
-    n_tex = painting["height"].shape[0]
-    col = np.clip((g.uv[mask][:, 0] * n_tex).astype(int), 0, n_tex - 1)
-    row = np.clip((g.uv[mask][:, 1] * n_tex).astype(int), 0, n_tex - 1)
-    T, B, N_geo = np.array([1.0, 0, 0]), np.array([0, 0, 1.0]), np.array([0, 1.0, 0])
-    normals_tangent = normal_map_from_height(painting["height"], painting["pixel_size"])
-    N = tangent_to_world(normals_tangent[row, col], T, B, N_geo)
-    seconds = {}
-    start = time.perf_counter()
-    visibility = None
-    if shadows:
-        hmap = horizon_map(painting["height"], painting["pixel_size"], 18, 32, backend=backend)
-        to_light = lights.position[None] - P[:, None]
-        phi, beta = light_azimuth_elevation(to_light, T, B, N_geo)
-        visibility = horizon_lookup(hmap[row, col][:, None, :], phi, beta).astype(float)
-    seconds["shadows"] = time.perf_counter() - start
-    # Six-channel materials: ρ_d from the measured spectra, ρ_s and α from the maps.
-    names = list(PAINT_SPECTRA)
-    R6 = spectra_to_channels(np.stack([spectra[n] for n in names]), d)
-    canvas = spectra_to_channels(spectra.get("office-paper", np.full(81, 0.85)), d)
-    table = np.concatenate([R6, canvas[None]])
-    material = painting["material"][row, col]
-    rho_d = table[np.where(material < 0, len(names), material)]
-    rho_s = painting["rho_s"][row, col][:, None]
-    alpha = painting["alpha"][row, col]
-    start = time.perf_counter()
-    # Eq. (2), Ferwerda: illuminance from the point lights (luminance image: one channel)
-    E = illuminance_point_lights(P, N, lights, visibility)
-    # Eq. (3), Ferwerda: L_out,j = ρ_d,j S_j E / π
-    L_diffuse = rho_d * S6 * E / np.pi
-    seconds["diffuse"] = time.perf_counter() - start
-    start = time.perf_counter()
-    if method in ("median_cut", "variance_min"):
-        I_s = specular_point_lights(P, N, V, alpha, lights, visibility, backend=backend)
-    elif method == "fis":
-        I_s = specular_fis(P, N, V, alpha, plane, n_samples, backend=backend)
-    else:
-        I_s = specular_hybrid(P, N, V, alpha, plane, lights, n_samples, visibility, backend)
-    L_specular = rho_s * S6 * I_s
-    seconds["specular"] = time.perf_counter() - start
-    XYZ = np.zeros((*g.shape, 3))
-    XYZ[mask] = channels_to_XYZ(L_diffuse + L_specular, d)
-    # Display: linear sRGB with the white diffuser under the booth light at 1/1.2 of white.
-    white_Y = float(np.median(E)) / np.pi
-    rgb = XYZ_to_display_RGB(XYZ / (1.2 * white_Y))
-    from reference.display import linear_to_display
-
-    return {"XYZ": XYZ, "sRGB": linear_to_display(rgb, "srgb"), "seconds": seconds}
-
-
-# --- lighting and shadow errors ------------------------------------------------------------------
-
-
-def _painting_samples(n_side: int, painting: dict):
-    """Surface points on a grid over the painting, with normal-mapped normals and view vectors."""
-    w = painting["width_m"]
-    g = (np.arange(n_side) + 0.5) / n_side
-    u, v = np.meshgrid(g, g)
-    P = np.stack([(u - 0.5) * w, np.zeros_like(u), (v - 0.5) * w], axis=-1).reshape(-1, 3)
-    n_tex = painting["height"].shape[0]
-    col = np.clip((u.ravel() * n_tex).astype(int), 0, n_tex - 1)
-    row = np.clip((v.ravel() * n_tex).astype(int), 0, n_tex - 1)
-    tangent = normal_map_from_height(painting["height"], painting["pixel_size"])[row, col]
-    N = tangent_to_world(tangent, [1.0, 0, 0], [0, 0, 1.0], [0, 1.0, 0])
-    V = np.asarray(EYE) - P
-    V /= np.linalg.norm(V, axis=-1, keepdims=True)
-    return P, N, V
-
-
-def _relative_rms(x, reference) -> float:
-    return float(np.sqrt(np.mean((x - reference) ** 2)) / np.sqrt(np.mean(reference**2)))
-
-
-def specular_error_vs_alpha(
-    alphas=(0.01, 0.02, 0.03, 0.05, 0.07, 0.1, 0.15, 0.2, 0.3, 0.5),
-    n_side: int = 12,
-    light_resolution: tuple = (128, 64),
-    n_lights: int = 32,
-    n_samples: int = 32,
-    supersample: int = 8,
-    painting=None,
-    backend: str = "numba",
-) -> dict:
-    """Relative RMS error of point lights, FIS and the hybrid against the brute-force integral.
-
-    §3.5.2, Ferwerda: at each roughness α (uniform over the painting), the specular integral at
-    ``n_side²`` normal-mapped points under the fluorescent booth light. The reference sums every
-    light pixel split into ``supersample²`` sub-pixels; its own error is estimated by doubling the
-    supersampling and reported.
-
-    Returns
-    -------
-    dict
-        ``alpha`` and, per method, the relative RMS errors; ``reference_error``; ``fis_share`` (the
-        mean weight the hybrid gives FIS).
-
-    Examples
-    --------
-    >>> r = specular_error_vs_alpha((0.05,), n_side=3, light_resolution=(32, 16), supersample=2)
-    >>> sorted(r)
-    ['alpha', 'fis', 'fis_share', 'hybrid', 'median_cut', 'reference_error']
-    """
-    from reference.specular_lighting import hybrid_error_estimates
-
-    painting = painting or impasto_painting(128, seed=2)
-    P, N, V = _painting_samples(n_side, painting)
-    plane = booth_plane_light("fluorescent", *light_resolution)
-    lights = point_lights_from_plane(plane, "median_cut", n_lights)
-    out = {k: [] for k in ("alpha", "median_cut", "fis", "hybrid", "reference_error", "fis_share")}
-    for alpha in alphas:
-        a = np.full(len(P), float(alpha))
-        reference = specular_brute_force(P, N, V, a, plane, 2 * supersample, backend)[..., 0]
-        coarse = specular_brute_force(P, N, V, a, plane, supersample, backend)[..., 0]
-        pl = specular_point_lights(P, N, V, a, lights, backend=backend)[..., 0]
-        fis = specular_fis(P, N, V, a, plane, n_samples, backend=backend)[..., 0]
-        hybrid = specular_hybrid(P, N, V, a, plane, lights, n_samples, backend=backend)[..., 0]
-        e_pl, e_fis = hybrid_error_estimates(P, N, V, a, plane, lights, n_samples)
-        out["alpha"].append(float(alpha))
-        out["median_cut"].append(_relative_rms(pl, reference))
-        out["fis"].append(_relative_rms(fis, reference))
-        out["hybrid"].append(_relative_rms(hybrid, reference))
-        out["reference_error"].append(_relative_rms(coarse, reference))
-        out["fis_share"].append(float((e_pl**2 / (e_pl**2 + e_fis**2)).mean()))
-    return out
-
-
-def shadow_agreement(
-    sector_counts=(3, 6, 9, 12, 18, 24, 36),
-    size: int = 256,
-    elevations_deg=(15.0, 30.0, 45.0),
-    n_azimuths: int = 16,
-    max_steps: int = 32,
-    painting=None,
-    backend: str = "numba",
-) -> dict:
-    """Share of pixels where horizon-map and ray-marched shadows disagree, per sector count.
-
-    §3.5.3, Ferwerda. Lights at each elevation and ``n_azimuths`` azimuths offset from the sector
-    centres (raking light across a painting-like height field); both methods march the same steps,
-    so only the azimuth quantisation differs.
-
-    Returns
-    -------
-    dict
-        ``sectors``, ``disagreement`` (share of pixel-light pairs), ``shadowed`` (share of
-        pixel-light pairs in shadow by the reference).
-
-    Examples
-    --------
-    >>> r = shadow_agreement((4, 18), size=32, n_azimuths=4, max_steps=8)
-    >>> r["sectors"], all(0 <= v <= 1 for v in r["disagreement"])
-    ([4, 18], True)
-    """
-    painting = painting or impasto_painting(size, seed=4)
-    h, pixel = painting["height"], painting["pixel_size"]
-    azimuths = (np.arange(n_azimuths) + 0.37) * 2.0 * np.pi / n_azimuths
-    reference = {}
-    for beta in elevations_deg:
-        for phi in azimuths:
-            reference[(beta, phi)] = ray_march_shadows(
-                h, pixel, phi, np.radians(beta), max_steps, backend=backend
-            )
-    shadowed = float(np.mean([~lit for lit in reference.values()]))
-    out = {"sectors": [], "disagreement": [], "shadowed": shadowed}
-    for S in sector_counts:
-        hmap = horizon_map(h, pixel, int(S), max_steps, backend=backend)
-        wrong = [
-            np.mean(horizon_lookup(hmap, phi, np.radians(beta)) != lit)
-            for (beta, phi), lit in reference.items()
-        ]
-        out["sectors"].append(int(S))
-        out["disagreement"].append(float(np.mean(wrong)))
-    return out
-
-
-def gloss_validation(
-    gloss=((0.06, 0.01), (0.06, 0.02), (0.06, 0.04), (0.06, 0.07), (0.06, 0.12), (0.06, 0.2)),
-    rho_d: float = 0.18,
-    angles_deg=None,
-    source_luminance: float = 20000.0,
-    n_samples: int = 32,
-    backend: str = "numba",
-) -> dict:
-    """Goniometric luminance curves of gray Ward–Dür samples under a small area source (Fig. 15).
-
-    §5.2, Ferwerda: a 2.3 cm × 3.5 cm source 0.5 m away at 7.5° incidence, the detector swept
-    from 6° to 30° in the plane of incidence. The pipeline (median-cut diffuse, hybrid specular) is
-    compared with the brute-force integral, sample by sample from high to low gloss.
-
-    Returns
-    -------
-    dict
-        ``angles_deg``, and per sample (``rho_s``, ``alpha``) the ``pipeline`` and ``reference``
-        luminances (cd/m²) and the largest relative error near the peak.
-
-    Examples
-    --------
-    >>> r = gloss_validation(gloss=((0.06, 0.05),), angles_deg=[7.5])
-    >>> abs(r["samples"][0]["pipeline"][0] / r["samples"][0]["reference"][0] - 1) < 0.05
-    True
-    """
-    angles = np.asarray(angles_deg if angles_deg is not None else np.concatenate(
-        [np.arange(6.0, 10.01, 0.5), [11, 12, 14, 16, 20, 25, 30]]
-    ), dtype=np.float64)  # fmt: skip
-    theta_i = np.radians(7.5)
-    L_hat = np.array([-np.sin(theta_i), np.cos(theta_i), 0.0])
-    A = np.array([np.cos(theta_i), np.sin(theta_i), 0.0])
-    B = np.array([0.0, 0.0, 1.0])
-    l_A, l_B = 0.023, 0.035
-    centre = 0.5 * L_hat
-    origin = centre - 0.5 * l_A * A - 0.5 * l_B * B
-    plane = PlaneLight(np.full((16, 16), source_luminance), origin, A, B, l_A, l_B)
-    lights = point_lights_from_plane(plane, "median_cut", 32)
-    theta = np.radians(angles)
-    V = np.stack([np.sin(theta), np.cos(theta), np.zeros_like(theta)], axis=-1)
-    P = np.zeros_like(V)
-    N = np.tile([0.0, 1.0, 0.0], (len(V), 1))
-    E = illuminance_point_lights(P, N, lights)[:, 0]
-    samples = []
-    for rho_s, alpha in gloss:
-        a = np.full(len(V), alpha)
-        specular = specular_hybrid(P, N, V, a, plane, lights, n_samples, backend=backend)[:, 0]
-        brute = specular_brute_force(P, N, V, a, plane, 8, backend)[:, 0]
-        # Eq. (3), Ferwerda, for the gray diffuse part, plus ρ_s times the specular integral
-        pipeline = rho_d * E / np.pi + rho_s * specular
-        reference = rho_d * E / np.pi + rho_s * brute
-        error = np.abs(pipeline / reference - 1.0)
-        samples.append(
-            {
-                "rho_s": rho_s,
-                "alpha": alpha,
-                "pipeline": pipeline.tolist(),
-                "reference": reference.tolist(),
-                "max_relative_error": float(error.max()),
-            }
-        )
-    return {"angles_deg": angles.tolist(), "rho_d": rho_d, "samples": samples}

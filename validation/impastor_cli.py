@@ -77,7 +77,7 @@ def render_for_cli(light: str, size: int, method: str, out) -> str:
     from reference.errors import require_choice, require_positive_int
     from reference.images import write_png
     from reference.spectra import spectrum_from_dataset
-    from validation.impastor import LIGHTING_METHODS, render_painting
+    from validation.impastor_lighting import LIGHTING_METHODS, render_painting
 
     require_choice(method, LIGHTING_METHODS, "lighting method")
     size = require_positive_int(size, "--size", 4096)

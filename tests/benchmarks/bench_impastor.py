@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 
 from reference.horizon import HORIZON_METHODS
-from reference.specular_lighting import SPECULAR_METHODS
-from validation import impastor as imp
+from reference.specular_hybrid import SPECULAR_METHODS
+from validation import impastor_lighting as imp
 
 
 @pytest.fixture(scope="module")

@@ -114,7 +114,7 @@ def test_horizon_bad_input():
 
 @pytest.mark.slow
 def test_horizon_map_agrees_with_ray_marching_on_a_painting():
-    from validation.impastor import shadow_agreement
+    from validation.impastor_lighting import shadow_agreement
 
     result = shadow_agreement((18,), size=128, n_azimuths=8)
     # Issue 6 target: at most 2 % of pixels disagree at 18 sectors on a painting-like field, and

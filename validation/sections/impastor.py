@@ -12,6 +12,7 @@ import numpy as np
 
 from validation.report import (
     REPORT_SECTIONS,
+    Check,
     ReportContext,
     ReportSection,
     SectionResult,
@@ -19,8 +20,125 @@ from validation.report import (
     Text,
 )
 
+__all__ = ["TARGETS", "impastor_checks"]
+
 #: Targets of issue 6 for the held-out ColorChecker (mean, max ΔE00 per light, one matrix).
 TARGETS = {"box": (0.8, 2.2), "optimized": (0.25, 0.6)}
+#: Other targets of issue 6: metamers (ΔE00 under A below, under D65 above), the hybrid against
+#: the better of median cut and FIS, and horizon-map disagreement at the paper's 18 sectors.
+METAMER_TARGETS = {"A": 0.5, "D65": 3.0}
+HYBRID_LIMIT = 1.1
+SHADOW_LIMIT = 0.02
+SHADOW_SECTORS = 18
+
+
+def impastor_checks(
+    channel_table, metamers, alpha, shadows, round_trip, albedo, lights=None
+) -> list:
+    """The section's target checks, one per target of issue 6, from the measured figures.
+
+    Parameters
+    ----------
+    channel_table : dict
+        :func:`validation.impastor.channel_count_errors` (six-channel rows are checked).
+    metamers : dict
+        :func:`validation.impastor.metamer_delta_E`.
+    alpha : dict
+        :func:`validation.impastor_lighting.specular_error_vs_alpha`.
+    shadows : dict
+        :func:`validation.impastor_lighting.shadow_agreement` (18 sectors are checked).
+    round_trip : dict
+        :func:`validation.impastor.display_round_trip`.
+    albedo : dict
+        :func:`validation.impastor_lighting.ward_duer_albedo` (every case, within its error).
+    lights : sequence of str, optional
+        Lights with ΔE00 targets; default ``validation.impastor.LIGHTS``.
+
+    Returns
+    -------
+    list of Check
+
+    Examples
+    --------
+    >>> table = {d: {"6": {"D65": {"mean": 0.2, "max": 0.5}}} for d in TARGETS}
+    >>> metamers = {"A": {"pipeline": 0.1}, "D65": {"pipeline": 4.0}}
+    >>> alpha = {"alpha": [0.1], "median_cut": [0.2], "fis": [0.1], "hybrid": [0.12]}
+    >>> shadows = {"sectors": [18], "disagreement": [0.01]}
+    >>> trip = {"counts_mismatches": 0, "n_counts": 10, "XYZ_error_over_bound": 0.5}
+    >>> albedo = {"albedo": [0.99], "error": [1e-4], "theta_deg": [60.0]}
+    >>> checks = impastor_checks(table, metamers, alpha, shadows, trip, albedo, lights=("D65",))
+    >>> [c.passed for c in checks if "hybrid" in c.name]
+    [False]
+    """
+    from validation.impastor import LIGHTS
+
+    checks = []
+    for design, (limit_mean, limit_max) in TARGETS.items():
+        for light in lights or LIGHTS:
+            s = channel_table[design]["6"][light]
+            name = f"{design} 6 channels, ColorChecker under {light}"
+            checks.append(
+                Check(f"{name}, mean ΔE00", f"<= {limit_mean}", s["mean"], s["mean"] <= limit_mean)
+            )
+            checks.append(
+                Check(f"{name}, max ΔE00", f"<= {limit_max}", s["max"], s["max"] <= limit_max)
+            )
+    a, d65 = metamers["A"]["pipeline"], metamers["D65"]["pipeline"]
+    limit_a, limit_d65 = METAMER_TARGETS["A"], METAMER_TARGETS["D65"]
+    checks.append(Check("metamers rendered under A, ΔE00", f"< {limit_a}", a, a < limit_a))
+    checks.append(
+        Check("metamers rendered under D65, ΔE00", f"> {limit_d65}", d65, d65 > limit_d65)
+    )
+    best = np.minimum(alpha["median_cut"], alpha["fis"])
+    ratio = np.asarray(alpha["hybrid"]) / best
+    worst = int(np.argmax(ratio))
+    checks.append(
+        Check(
+            f"hybrid / better of median cut and FIS, worst α ({alpha['alpha'][worst]:g})",
+            f"<= {HYBRID_LIMIT} at every α",
+            float(ratio[worst]),
+            bool(ratio.max() <= HYBRID_LIMIT),
+        )
+    )
+    sectors = list(shadows["sectors"])
+    share = shadows["disagreement"][sectors.index(SHADOW_SECTORS)]
+    checks.append(
+        Check(
+            f"horizon map ({SHADOW_SECTORS} sectors) vs ray-marched shadows, pixels that disagree",
+            f"<= {100 * SHADOW_LIMIT:g} %",
+            f"{100 * share:.3g} %",
+            share <= SHADOW_LIMIT,
+        )
+    )
+    mismatches = round_trip["counts_mismatches"]
+    checks.append(
+        Check(
+            "display round trip counts → XYZ → counts, mismatches",
+            f"0 of {round_trip['n_counts']}",
+            mismatches,
+            mismatches == 0,
+        )
+    )
+    over = round_trip["XYZ_error_over_bound"]
+    checks.append(
+        Check(
+            "display round trip XYZ → counts → XYZ, error / one 11-bit LUT step",
+            "<= 1",
+            over,
+            over <= 1.0,
+        )
+    )
+    within = all(a - e <= 1.0 for a, e in zip(albedo["albedo"], albedo["error"], strict=True))
+    checks.append(
+        Check(
+            f"Ward–Dür white-furnace albedo (ρ_s = 1), max over α and θ_i ≤ "
+            f"{max(albedo['theta_deg']):g}°",
+            "<= 1",
+            max(albedo["albedo"]),
+            within,
+        )
+    )
+    return checks
 
 
 def _stats_cells(stats):
@@ -220,9 +338,10 @@ def _gloss_blocks(ctx, result) -> list:
 def run(ctx: ReportContext) -> SectionResult:
     """Table 1, channel counts, metamers, gloss, error vs α, shadows, the painting, frame times."""
     from validation import impastor as imp
+    from validation import impastor_lighting as lit
 
     quick = ctx.quick
-    spectra = imp.load_paint_spectra()  # fails first, with a clear message, without shared data
+    spectra = lit.load_paint_spectra()  # fails first, with a clear message, without shared data
     backend = "numpy" if quick else "numba"
     results: dict = {}
     blocks: list = [
@@ -252,24 +371,24 @@ def run(ctx: ReportContext) -> SectionResult:
     blocks += _metamer_blocks(ctx, metamers)
 
     if quick:
-        alpha = imp.specular_error_vs_alpha(
+        alpha = lit.specular_error_vs_alpha(
             (0.01, 0.05, 0.2),
             n_side=3,
             light_resolution=(32, 16),
             supersample=2,
-            painting=imp.impasto_painting(32, seed=2),
+            painting=lit.impasto_painting(32, seed=2),
             backend=backend,
         )
-        shadows = imp.shadow_agreement(
+        shadows = lit.shadow_agreement(
             (6, 18), size=64, n_azimuths=4, elevations_deg=(15.0,), max_steps=16, backend=backend
         )
-        gloss = imp.gloss_validation(
+        gloss = lit.gloss_validation(
             gloss=((0.06, 0.02), (0.06, 0.15)), angles_deg=[6, 7.5, 10, 20], backend=backend
         )
     else:
-        alpha = imp.specular_error_vs_alpha(supersample=4, backend=backend)
-        shadows = imp.shadow_agreement(backend=backend)
-        gloss = imp.gloss_validation(backend=backend)
+        alpha = lit.specular_error_vs_alpha(supersample=4, backend=backend)
+        shadows = lit.shadow_agreement(backend=backend)
+        gloss = lit.gloss_validation(backend=backend)
     alpha_blocks, alpha_summary = _alpha_blocks(ctx, alpha)
     blocks += alpha_blocks
     results["error_vs_alpha"] = {**alpha, **alpha_summary}
@@ -277,14 +396,19 @@ def run(ctx: ReportContext) -> SectionResult:
     results["shadows"] = shadows
     blocks += _gloss_blocks(ctx, gloss)
     results["gloss"] = gloss
+    round_trip = imp.display_round_trip()
+    results["display_round_trip"] = round_trip
+    albedo = lit.ward_duer_albedo()
+    results["ward_duer_albedo"] = albedo
+    checks = impastor_checks(channel_table, metamers, alpha, shadows, round_trip, albedo)
 
     size = 48 if quick else 512
-    painting = imp.impasto_painting(size, seed=1)
+    painting = lit.impasto_painting(size, seed=1)
     light_resolution = (32, 16) if quick else (128, 64)
     frame_rows = []
     for light in ("D65", "A"):
         start = time.perf_counter()
-        out = imp.render_painting(
+        out = lit.render_painting(
             light,
             size,
             "hybrid",
@@ -297,9 +421,9 @@ def run(ctx: ReportContext) -> SectionResult:
         caption = f"Demo painting under the booth light, {light} ({size}×{size})"
         blocks.append(ctx.image(f"painting-{light}", out["sRGB"], caption))
         results[f"painting_{light}_seconds"] = seconds
-    methods = ("median_cut", "fis") if quick else imp.LIGHTING_METHODS
+    methods = ("median_cut", "fis") if quick else lit.LIGHTING_METHODS
     for method in methods:
-        out = imp.render_painting(
+        out = lit.render_painting(
             "D65",
             size,
             method,
@@ -317,14 +441,15 @@ def run(ctx: ReportContext) -> SectionResult:
         Table(
             ["specular lighting", "size", "shadows s", "diffuse s", "specular s", "frame s"],
             frame_rows,
-            f"Frame time ({backend} backend; G-buffer and materials excluded; one shared core)",
+            f"Frame time ({backend} backend; G-buffer and materials excluded; the horizon map is "
+            "computed once per height field, before these frames; one shared core)",
             "{:.3g}",
         )
     )
     for group, records in sorted(ctx.bench_groups("impastor").items()):
         rows = [[r["name"], r["stats"]["mean"]] for r in records]
         blocks.append(Table(["benchmark", "mean s"], rows, f"make bench: {group}", "{:.4g}"))
-    return SectionResult(blocks, results)
+    return SectionResult(blocks, results, checks)
 
 
 REPORT_SECTIONS.register(ReportSection("impastor", "ImpastoR", 70, run))
