@@ -7,15 +7,9 @@ Importing ``shrm`` registers the environment-light shaders in ``reference.shadin
 from shrm import environment  # noqa: F401  (registers the environment-light shaders)
 from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts, shrm_orders
 from shrm.cache import Cache, cache_key, default_cache_dir
+from shrm.lobes import PREFILTER_KERNELS, adaptive_order, parse_kernel
 from shrm.orbit import render_orbit
-from shrm.prefilter import (
-    PREFILTER_KERNELS,
-    adaptive_order,
-    parse_kernel,
-    prefilter_bruteforce,
-    prefilter_coefficients,
-    prefilter_environment,
-)
+from shrm.prefilter import prefilter_bruteforce, prefilter_coefficients, prefilter_environment
 from shrm.rotation import rotate_coefficients, rotation_matrix, sh_rotation_blocks
 from shrm.session import HERBERT_STAGES, RenderSession
 from shrm.sh import SH_MAX_ORDER, sh_basis, sh_evaluate, sh_index

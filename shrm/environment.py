@@ -12,7 +12,7 @@ Importing ``shrm`` registers two shaders in ``reference.shading.SHADERS``:
   normalized Phong kernel times ``2 / (n + 1)``.
 
 The maps are computed in frequency space (project, scale by Λ_l, synthesize a 64×64×6 cube map per
-band), at the order :func:`shrm.prefilter.adaptive_order` picks for the tolerance, and cached per
+band), at the order :func:`shrm.lobes.adaptive_order` picks for the tolerance, and cached per
 environment. With ``ctx.options["environment"] == "bruteforce"`` (``specref render --oracle``) each
 pixel integrates the whole map instead (:func:`shrm.prefilter.prefilter_bruteforce`).
 
@@ -23,7 +23,7 @@ and renders white; option ``ctx.options["upsampling"]``). XYZ uses the equal-ene
 radiance spectra carry no light to fold in.
 
 Options read from ``ctx.options``: ``environment`` (``"frequency"`` default, or ``"bruteforce"``),
-``environment_tol`` (default :data:`shrm.prefilter.DEFAULT_TOL`), ``environment_size`` (cube
+``environment_tol`` (default :data:`shrm.lobes.DEFAULT_TOL`), ``environment_size`` (cube
 face, default 64), ``upsampling``.
 """
 
@@ -41,14 +41,8 @@ from reference.registry import Method
 from reference.shading import SHADERS, Surface
 from reference.spectra import SpectralGrid
 from reference.upsampling import DEFAULT_UPSAMPLING, RGB_to_radiance_spectra
-from shrm.prefilter import (
-    DEFAULT_TOL,
-    adaptive_order,
-    kernel_phong,
-    parse_kernel,
-    prefilter_bruteforce,
-    prefilter_coefficients,
-)
+from shrm.lobes import DEFAULT_TOL, adaptive_order, kernel_phong, parse_kernel
+from shrm.prefilter import prefilter_bruteforce, prefilter_coefficients
 from shrm.sh import sh_evaluate
 from shrm.transform import project_latlong
 

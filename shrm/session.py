@@ -256,7 +256,7 @@ def _config(state) -> dict:
         "F": None,
         "P": None,
         "light_order": 32,
-        # Tolerance of the diffuse and specular prefilter orders (shrm.prefilter.adaptive_order)
+        # Tolerance of the diffuse and specular prefilter orders (shrm.lobes.adaptive_order)
         "prefilter_tol": 0.01,
         "width": 96,
         "height": 96,
@@ -289,7 +289,8 @@ def _stage_sh_project(state, inputs):
 
 def _prefiltered_cube(coeffs, kernel, c):
     from reference.cubemap import cubemap_texel_directions
-    from shrm.prefilter import adaptive_order, parse_kernel, prefilter_coefficients
+    from shrm.lobes import adaptive_order, parse_kernel
+    from shrm.prefilter import prefilter_coefficients
     from shrm.sh import order_of, sh_evaluate
 
     k = parse_kernel(kernel)

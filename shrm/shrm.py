@@ -329,7 +329,8 @@ def shrm_create(
 
 def _irradiance_cube(env_coeffs, texels, backend) -> np.ndarray:
     """E(n) = ∫ L max(0, ω·n) dω at the texels, Eq. (7), Ramamoorthi & Hanrahan 2001."""
-    from shrm.prefilter import lambert_Lambda_closed_form, prefilter_coefficients
+    from shrm.lobes import lambert_Lambda_closed_form
+    from shrm.prefilter import prefilter_coefficients
     from shrm.sh import order_of
 
     L = np.atleast_2d(np.asarray(env_coeffs, dtype=np.float64))

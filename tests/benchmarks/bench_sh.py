@@ -25,7 +25,8 @@ from reference.cubemap import cubemap_texel_directions, latlong_to_cubemap
 from reference.images import read_hdr
 from reference.spectra import GRID_41
 from reference.upsampling import RGB_to_spectra
-from shrm.prefilter import parse_kernel, prefilter_bruteforce, prefilter_coefficients
+from shrm.lobes import parse_kernel
+from shrm.prefilter import prefilter_bruteforce, prefilter_coefficients
 from shrm.sh import sh_evaluate
 from shrm.transform import SH_BACKENDS, project_latlong
 

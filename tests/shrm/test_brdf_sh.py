@@ -4,7 +4,7 @@ import pytest
 from reference.brdf import BRDF_METHODS, brdf_lambert
 from reference.errors import SpecrefError
 from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts, shrm_orders
-from shrm.prefilter import lambert_Lambda_closed_form
+from shrm.lobes import lambert_Lambda_closed_form
 from shrm.shrm import shrm_create
 
 

@@ -21,7 +21,7 @@ from reference.lights import PointLight, attenuation_Wang
 from reference.render import RenderResult, render_scene
 from reference.scene import load_scene
 from reference.spectra import spectrum_to_colour_sd
-from shrm.prefilter import DEFAULT_TOL
+from shrm.lobes import DEFAULT_TOL
 from validation.report import (
     REPORT_SECTIONS,
     Check,
@@ -47,7 +47,7 @@ def environment_oracle_error(scene_path: Path, width: int) -> dict:
 
     The brute-force path (``specref render --oracle``) integrates every environment pixel per
     shading point with the same upsampled spectra, so the difference is the SH truncation at the
-    adaptive order that the frequency path picks for its tolerance (``shrm.prefilter.DEFAULT_TOL``).
+    adaptive order that the frequency path picks for its tolerance (``shrm.lobes.DEFAULT_TOL``).
 
     Returns
     -------

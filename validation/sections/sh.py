@@ -22,14 +22,8 @@ import numpy as np
 
 from reference.display import linear_to_display
 from reference.images import read_hdr
-from shrm.prefilter import (
-    adaptive_order,
-    parse_kernel,
-    phong_Lambda_gaussian,
-    prefilter_bruteforce,
-    prefilter_coefficients,
-    truncation_tail,
-)
+from shrm.lobes import adaptive_order, parse_kernel, phong_Lambda_gaussian, truncation_tail
+from shrm.prefilter import prefilter_bruteforce, prefilter_coefficients
 from shrm.sh import PLAIN_ORDER_LIMIT, legendre_table, order_of, sh_evaluate
 from shrm.transform import project_latlong, synthesize_latlong
 from shrm.windows import WINDOWS, apply_window, ringing_statistics
