@@ -26,11 +26,13 @@ import numpy as np
 
 from reference.errors import require, require_choice, require_finite
 
-__all__ = ["MAX_RESOLUTION", "PROJECTIONS", "Camera", "downsample_box"]
+__all__ = ["MAX_COORDINATE", "MAX_RESOLUTION", "PROJECTIONS", "Camera", "downsample_box"]
 
 PROJECTIONS = ("perspective", "orthographic")
 #: Largest image side specref renders; larger requests are refused as absurd.
 MAX_RESOLUTION = 16384
+#: Largest camera coordinate magnitude (scene units); past it float64 view directions break down.
+MAX_COORDINATE = 1e9
 
 
 @dataclass(frozen=True)
@@ -75,6 +77,12 @@ class Camera:
                 value.shape == (3,), f"{where}.{key}: must be 3 numbers, got shape {value.shape}"
             )
         require_choice(self.projection, PROJECTIONS, "projection")
+        for key, value in (("eye", eye), ("target", target)):
+            require(
+                np.abs(value).max() <= MAX_COORDINATE,
+                f"{where}.{key}: coordinates must be within ±{MAX_COORDINATE:g}, "
+                f"got {value.tolist()}",
+            )
         forward = target - eye
         require(np.linalg.norm(forward) > 1e-12, f"{where}.target: must differ from eye")
         cross = np.linalg.norm(np.cross(forward / np.linalg.norm(forward), up))

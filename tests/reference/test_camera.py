@@ -62,6 +62,8 @@ def test_project_inverts_rays(rng, projection):
         ({"fov_deg": 180}, "fov_deg"),
         ({"eye": (0, 0, 0), "target": (0, 0, 0)}, "target: must differ from eye"),
         ({"eye": (0, 5, 0), "target": (0, 0, 0)}, "up: must not be parallel"),
+        ({"eye": (1e200, 0, 5), "target": (0, 0, 0)}, r"eye: coordinates must be within ±1e\+09"),
+        ({"eye": (0, 0, 5), "target": (0, -1e10, 0)}, r"target: coordinates must be within"),
         ({"eye": (0, float("nan"), 5)}, "eye: must be finite"),
         ({"eye": (0, 5)}, "eye: must be 3 numbers"),
         ({"projection": "fisheye"}, "unknown projection 'fisheye'"),
