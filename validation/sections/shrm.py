@@ -331,6 +331,16 @@ def run(ctx: ReportContext) -> SectionResult:
                 err <= TOLERANCE,
             )
         )
+        # the same target inside the issue's and §5.5's view orders, P from 2 to 10 (erratum E23)
+        checks.append(
+            Check(
+                f"{label}image within 1 % of peak of brute force with P <= 10 (§5.5), {name} "
+                f"(best: {low[0]} F={low[1]} P={low[2]} S={low[3]})",
+                f"<= {TOLERANCE:g}",
+                low[4],
+                low[4] <= TOLERANCE,
+            )
+        )
     blocks = [
         Text(
             "A sphere under `venice_sunset_1k.hdr` (box-filtered to "
