@@ -216,11 +216,15 @@ def cubemap_lookup_bilinear(cube, directions, backend: str = "numpy") -> np.ndar
 
 
 @functools.lru_cache(maxsize=8)
-def _latlong_taps(height: int, width: int, size: int, dtype: str) -> tuple[np.ndarray, np.ndarray]:
-    """Bilinear taps (flat pixel indices) and weights of the texel centres in a lat-long map.
+def _latlong_taps(
+    height: int, width: int, size: int, dtype: str
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Bilinear taps (flat pixel indices), weights and output texels of a cube map's texel centres.
 
     The sampling pattern depends only on the sizes, so it is computed once (``reference.envmap``
-    lookup rules: u wraps, v clamps at the poles). Shapes (N, 4); weights in ``dtype``.
+    lookup rules: u wraps, v clamps at the poles). Rows are sorted by their first tap, so that
+    :func:`gather_bilinear` reads the lat-long map in memory order; ``texel`` (N,) is the flat
+    (face, row, column) index each row writes. Shapes (N, 4), (N, 4), (N,); weights in ``dtype``.
     """
     d = cubemap_texel_directions(size).reshape(-1, 3)
     u, v = direction_to_latlong_uv(d)
@@ -233,14 +237,15 @@ def _latlong_taps(height: int, width: int, size: int, dtype: str) -> tuple[np.nd
     x0 = x0 % width
     taps = np.stack([y0 * width + x0, y0 * width + x1, y1 * width + x0, y1 * width + x1], -1)
     weights = np.stack([(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy], -1)
-    weights = weights.astype(dtype)
-    for array in (taps, weights):
+    texel = np.argsort(taps[:, 0], kind="stable")
+    taps, weights = np.ascontiguousarray(taps[texel]), np.ascontiguousarray(weights[texel], dtype)
+    for array in (taps, weights, texel):
         array.setflags(write=False)
-    return taps, weights
+    return taps, weights, texel
 
 
-def gather_bilinear(image, taps, weights) -> np.ndarray:
-    """Weighted sum of four taps per output: ``out[n] = Σ_k weights[n, k] image[taps[n, k]]``.
+def gather_bilinear(image, taps, weights, texel=None) -> np.ndarray:
+    """Weighted sum of four taps per output: ``out[texel[j]] = Σ_k w[j, k] image[taps[j, k]]``.
 
     The data movement of §7.1, Herbert et al. (bilinear filtering at memory bandwidth), as used by
     :func:`latlong_to_cubemap`; the numba twin streams all channels of a texel together. Eq. (1),
@@ -254,6 +259,9 @@ def gather_bilinear(image, taps, weights) -> np.ndarray:
         Flat pixel indices.
     weights : ndarray, shape (N, 4)
         Bilinear weights.
+    texel : ndarray of int, shape (N,), optional
+        The output row of each tap row, a permutation of ``range(N)`` (default: the identity), so
+        that the rows can be sorted for the order in which they read ``image``.
 
     Returns
     -------
@@ -263,11 +271,19 @@ def gather_bilinear(image, taps, weights) -> np.ndarray:
     --------
     >>> gather_bilinear(np.array([[0.0], [2.0]]), np.array([[0, 1, 0, 1]]), np.full((1, 4), 0.25))
     array([[1.]])
+    >>> taps, w = np.array([[0] * 4, [1] * 4]), np.full((2, 4), 0.25)
+    >>> gather_bilinear(np.array([[0.0], [2.0]]), taps, w, texel=np.array([1, 0]))
+    array([[2.],
+           [0.]])
     """
-    out = np.zeros((taps.shape[0], image.shape[1]), dtype=np.result_type(image, weights))
+    gathered = np.zeros((taps.shape[0], image.shape[1]), dtype=np.result_type(image, weights))
     for k in range(4):
-        out += weights[:, k, None] * image[taps[:, k]]
-    return out.astype(image.dtype)
+        gathered += weights[:, k, None] * image[taps[:, k]]
+    if texel is None:
+        return gathered.astype(image.dtype)
+    out = np.empty_like(gathered, dtype=image.dtype)
+    out[texel] = gathered
+    return out
 
 
 def latlong_to_cubemap(image, size: int = 64, backend: str = "numba", out=None) -> np.ndarray:
@@ -305,10 +321,10 @@ def latlong_to_cubemap(image, size: int = 64, backend: str = "numba", out=None) 
     if image.dtype not in (np.float32, np.float64):
         image = image.astype(np.float64)
     H, W, C = image.shape
-    taps, weights = _latlong_taps(H, W, size, image.dtype.str)
+    taps, weights, texel = _latlong_taps(H, W, size, image.dtype.str)
     flat = np.ascontiguousarray(image).reshape(H * W, C)
     if backend == "numpy":
-        return gather_bilinear(flat, taps, weights).reshape(6, size, size, C)
+        return gather_bilinear(flat, taps, weights, texel).reshape(6, size, size, C)
     if out is None:
         out = np.empty((6, size, size, C), dtype=image.dtype)
     require(
@@ -316,7 +332,7 @@ def latlong_to_cubemap(image, size: int = 64, backend: str = "numba", out=None) 
         f"latlong_to_cubemap: out must be a C-contiguous {image.dtype} array (6, {size}, {size}, "
         f"{C}), got {out.dtype} {out.shape}",
     )
-    _k.gather_bilinear_kernel(flat, taps, weights, out.reshape(-1, C))
+    _k.gather_bilinear_kernel(flat, taps, weights, texel, out.reshape(-1, C))
     return out
 
 
@@ -343,7 +359,12 @@ CUBEMAP_METHODS.register(
         gather_bilinear,
         _k.gather_bilinear_kernel,
         "Eq. (1), Herbert et al. (§7.1 environment transforms)",
-        lambda rng: (rng.random((50, 3)), rng.integers(0, 50, (20, 4)), rng.random((20, 4))),
+        lambda rng: (
+            rng.random((50, 3)),
+            rng.integers(0, 50, (20, 4)),
+            rng.random((20, 4)),
+            rng.permutation(20),
+        ),
     )
 )
 CUBEMAP_METHODS.register(

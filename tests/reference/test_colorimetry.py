@@ -4,6 +4,7 @@ import pytest
 
 from reference.colorimetry import (
     BAND_WEIGHT_METHODS,
+    ROWS_PER_THREAD,
     XYZ_to_display_RGB,
     XYZ_to_Lab,
     XYZ_to_RGB_matrix,
@@ -154,6 +155,26 @@ def test_spectra_to_XYZ_shapes(rng, shape):
 def test_spectra_to_XYZ_band_mismatch():
     with pytest.raises(SpecrefError, match="have \\(31,\\) bands but the weights have 41"):
         spectra_to_XYZ(np.ones(31), band_weights(GRID_41, None))
+
+
+def test_spectra_to_XYZ_row_blocks_dtype_and_out(rng):
+    # Two row blocks on two threads give the one-block product; float32 stays float32.
+    W = band_weights(GRID_41, spectrum_from_dataset("illuminant", "D65"))
+    spectra = rng.random((3, 2 * ROWS_PER_THREAD // 3 + 1, 41))
+    one = spectra_to_XYZ(spectra, W, threads=1)
+    np.testing.assert_allclose(spectra_to_XYZ(spectra, W, threads=2), one, rtol=1e-14, atol=0)
+    np.testing.assert_allclose(one[1, 7], spectra[1, 7] @ W, rtol=1e-14)
+    single = spectra_to_XYZ(spectra.astype(np.float32), W)
+    assert single.dtype == np.float32
+    np.testing.assert_allclose(single, one, rtol=2e-6)
+    out = np.empty((3, spectra.shape[1], 3))
+    assert spectra_to_XYZ(spectra, W, out=out) is out
+    with pytest.raises(SpecrefError, match="out must be a C-contiguous float64"):
+        spectra_to_XYZ(spectra, W, out=np.empty((3, 3)))
+    with pytest.raises(SpecrefError, match="threads must be >= 1"):
+        spectra_to_XYZ(spectra, W, threads=0)
+    with pytest.raises(SpecrefError, match=r"weights must be \(n_bands, 3\)"):
+        spectra_to_XYZ(spectra, W[:, :2])
 
 
 def test_XYZ_to_RGB_matrix_is_IEC_sRGB():

@@ -30,7 +30,7 @@ def test_cube_solid_angles_sum_and_twins(rng):
         args = method.example_inputs(rng)
         if method.name == "gather_bilinear":
             out = np.empty((args[1].shape[0], args[0].shape[1]))
-            method.kernel(args[0], args[1], args[2], out)
+            method.kernel(*args, out)
         else:
             out = method.reference(*args, backend="numba")
         np.testing.assert_allclose(out, method.reference(*args), rtol=1e-12, atol=1e-14)
