@@ -222,13 +222,17 @@ def _shade_table_loop(
     uniform,
     code,
     a,
+    zero_below,
     out,
 ):
     """The pixel loop of :func:`shade_table_kernel` for one lookup and one interpolation."""
-    # at t = 0 every interpolation returns the first tabulated value exactly (unlit pixels)
+    # below ``zero_below`` every interpolation returns exactly 0 (SpecularTable.zero_below); at
+    # t = 0 every interpolation returns the first tabulated value exactly (unlit pixels)
     if code == LINEAR:
         for p in range(t.size):
-            if t[p] == 0.0:
+            if t[p] < zero_below:
+                r, g, b = 0.0, 0.0, 0.0
+            elif t[p] == 0.0:
                 r, g, b = values[0, 0], values[0, 1], values[0, 2]
             else:
                 i = _interval(nodes, guide, steps, uniform, t[p])
@@ -236,7 +240,9 @@ def _shade_table_loop(
             _write(out, p, ambient_RGB, diffuse_RGB, f_att[p], cos_theta[p], r, g, b)
     elif code == MONOTONE:
         for p in range(t.size):
-            if t[p] == 0.0:
+            if t[p] < zero_below:
+                r, g, b = 0.0, 0.0, 0.0
+            elif t[p] == 0.0:
                 r, g, b = values[0, 0], values[0, 1], values[0, 2]
             else:
                 i = _interval(nodes, guide, steps, uniform, t[p])
@@ -245,7 +251,9 @@ def _shade_table_loop(
     else:
         in_w = code == PARABOLIC_W
         for p in range(t.size):
-            if t[p] == 0.0:
+            if t[p] < zero_below:
+                r, g, b = 0.0, 0.0, 0.0
+            elif t[p] == 0.0:
                 r, g, b = values[0, 0], values[0, 1], values[0, 2]
             else:
                 i = _interval(nodes, guide, steps, uniform, t[p])
@@ -269,12 +277,16 @@ def shade_table_kernel(
     uniform,
     code,
     a,
+    zero_below,
     out,
 ):
     """Table-based spectral Phong shading to linear RGB: one lookup per pixel, no ``exp``.
 
     Twin of ``phong_table.render.shade_table`` (Eq. (7) and Eq. (11), Wang et al.; the table
-    holds ``f_sp`` without ``f_att``, Erratum E18); writes ``out`` (N, 3).
+    holds ``f_sp`` without ``f_att``, Erratum E18); writes ``out`` (N, 3). Pixels with ``t`` below
+    ``zero_below`` (``SpecularTable.zero_below``: every interpolation of the table is exactly 0
+    there) skip the lookup, as the exact kernel skips the bands whose ``t^n`` underflows; the
+    result is the same to the bit.
     """
     # one loop per lookup and interpolation, so that each compiles without a branch per pixel
     if uniform:
@@ -293,6 +305,7 @@ def shade_table_kernel(
             True,
             code,
             a,
+            zero_below,
             out,
         )
     else:
@@ -311,6 +324,7 @@ def shade_table_kernel(
             False,
             code,
             a,
+            zero_below,
             out,
         )
     return out

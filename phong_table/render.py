@@ -302,6 +302,7 @@ def compiled_shader(
         table.uniform,
         INTERPOLATION_METHODS.lookup(interpolation).extra["code"],
         table.an + 1.0,
+        table.zero_below,
     )
 
     def shade(buffer: ShadingBuffer, out):

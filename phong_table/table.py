@@ -30,6 +30,7 @@ __all__ = [
     "build_table",
     "check_interpolation",
     "tabulate",
+    "zero_below",
 ]
 
 #: Points per interval at which :meth:`SpecularTable.overshoot` evaluates the interpolant.
@@ -83,6 +84,9 @@ class SpecularTable:
         The placement key.
     segments : int or None
         ``p`` of an importance table.
+    zero_below : float
+        Every interpolation of the table is exactly 0 for ``t`` below this (:func:`zero_below`);
+        -1 when there is no such run. The compiled shader skips the lookup there.
 
     Examples
     --------
@@ -103,6 +107,7 @@ class SpecularTable:
     an: float
     placement: str
     segments: int | None = None
+    zero_below: float = -1.0
 
     @property
     def entries(self) -> int:
@@ -162,6 +167,33 @@ class SpecularTable:
         excess = np.maximum(np.maximum(f - high, low - f), 0.0).max()
         peak = np.abs(self.values).max()
         return float(excess / peak) if peak > 0 else 0.0
+
+
+def zero_below(nodes, values) -> float:
+    """The ``t`` below which every interpolation of a table returns exactly 0.
+
+    High exponents make ``t^n`` underflow to 0 over most of [0, 1], so the leading values are
+    exactly 0. If ``values[0 .. z + 1]`` are all 0 (every channel), the interval ``[t_j, t_{j+1}]``
+    with ``j + 1 <= z`` is interpolated from nodes ``j − 1 .. j + 2`` at most (the widest stencil,
+    the parabola's), whose values and monotone slopes are 0: the result is 0 for ``t < t_z``.
+
+    Returns
+    -------
+    float
+        ``t_z``, or -1.0 when fewer than three leading values are 0 (no ``t`` qualifies).
+
+    Examples
+    --------
+    >>> nodes = np.linspace(0.0, 1.0, 6)
+    >>> zero_below(nodes, np.array([[0.0] * 3] * 4 + [[0.1] * 3, [1.0] * 3]))
+    0.4
+    >>> zero_below(nodes, np.ones((6, 3)))
+    -1.0
+    """
+    nonzero = np.flatnonzero((np.asarray(values) != 0.0).any(axis=-1))
+    first = int(nonzero[0]) if nonzero.size else len(nodes)
+    z = first - 2
+    return float(nodes[z]) if z >= 1 else -1.0
 
 
 def tabulate(nodes, C, n, cells_per_entry: int = GUIDE_CELLS_PER_ENTRY) -> tuple:
@@ -294,4 +326,5 @@ def build_table(
         an=material.an,
         placement=placement,
         segments=p,
+        zero_below=zero_below(nodes, values),
     )

@@ -57,6 +57,26 @@ def test_table_kernel_on_exact_node_hits():
         )
 
 
+@pytest.mark.parametrize("scene", ["R3", "n2000"])
+def test_table_kernel_skips_only_where_every_interpolation_is_zero(scene):
+    # High exponents: t^n underflows below ~0.6-0.7, so the table's leading values are exactly 0.
+    model = SCENES.lookup(scene).build()
+    buffer = shading_buffer(sphere_gbuffer("far", 48), model, False)
+    for placement in PLACEMENT_METHODS.names():
+        table = build_table(model, 64, placement, compiled=True)
+        if placement != "importance":  # its first node is above 0.99: no run of zeros to skip
+            assert 0.3 < table.zero_below < 1.0
+            assert (buffer.t < table.zero_below).mean() > 0.5  # most pixels skip the lookup
+        t = np.linspace(0.0, table.zero_below, 4001, endpoint=False)
+        for interpolation in INTERPOLATION_METHODS.names():
+            assert not table.lookup(t, interpolation).any()
+            compiled = shade_pixels(buffer, model, "table", table, interpolation)
+            reference = shade_pixels(buffer, model, "table", table, interpolation, compiled=False)
+            _close(compiled, reference)
+    # a material whose specular is never 0 has no skip
+    assert build_table(SCENES.lookup("R1").build(), 64, "error").zero_below == -1.0
+
+
 def test_tabulate_kernel_equals_numpy():
     entry = RENDER_METHODS.lookup("tabulate")
     for scene in SCENES.names():
