@@ -114,7 +114,10 @@ def test_flipped_byte_is_detected_reported_once_deleted_and_rebuilt(tmp_path, wh
     cache.put(_key(), {"x": np.arange(100.0)})
     path = _entry(cache, _key())
     data = bytearray(path.read_bytes())
-    offset = {"payload": len(data) - 40, "header": len(CACHE_MAGIC) + 45, "checksum": 30}[where]
+    checksum = len(CACHE_MAGIC) + 8  # after the format version and the header length
+    offset = {"payload": len(data) - 40, "header": len(CACHE_MAGIC) + 45, "checksum": checksum}[
+        where
+    ]
     data[offset] ^= 0x01
     path.write_bytes(bytes(data))
     with pytest.warns(SpecrefWarning, match="deleted, the result is rebuilt") as record:
