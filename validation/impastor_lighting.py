@@ -458,11 +458,11 @@ def specular_error_vs_alpha(
         out["hybrid"].append(_relative_rms(hybrid, reference))
         out["reference_error"].append(_relative_rms(coarse, reference))
         # The hybrid's FIS weight e_pl²/(e_pl² + e_fis²), scaled to avoid overflow (all FIS at 0/0).
+        e_pl, e_fis = np.minimum(e_pl, 1e150), np.minimum(e_fis, 1e150)  # relative to FIS ≈ 0
         m = np.maximum(e_pl, e_fis)
         safe = np.where(m > 0, m, 1.0)
-        share = np.where(
-            m > 0, (e_pl / safe) ** 2 / ((e_pl / safe) ** 2 + (e_fis / safe) ** 2), 1.0
-        )
+        r_pl, r_fis = (e_pl / safe) ** 2, (e_fis / safe) ** 2
+        share = np.where(m > 0, r_pl / np.where(m > 0, r_pl + r_fis, 1.0), 1.0)
         out["fis_share"].append(float(share.mean()))
     return out
 
