@@ -2,8 +2,11 @@
 
 ImpastoR renders specular reflection per pixel with either median-cut point lights or filtered
 importance sampling, chosen by a "custom error minimization metric" that the paper does not give
-(§3.5.2, Ferwerda). specref's metric, :func:`hybrid_error_estimates`, predicts each method's
-relative error from the lobe's width, the light's layout and the sample count;
+(§3.5.2, Ferwerda). specref's metric, :func:`hybrid_error_estimates`, estimates each method's
+error at each pixel from the estimates themselves: the point lights' second-moment error from
+sigma-point lights (:func:`sigma_point_lights`), FIS's by Richardson's rule from a second FIS
+estimate with half the samples, and whatever part of the two methods' disagreement these leave
+unexplained is charged to the method whose error estimate is outside its range of validity.
 :func:`specular_hybrid` combines the two estimates (``reference.specular_lighting``) with
 inverse-variance weights.
 
@@ -13,6 +16,9 @@ the brute-force reference); it lives here, beside the hybrid that uses the other
 References
 ----------
 - J. A. Ferwerda, "ImpastoR: A realistic surface display system", Vision Research 109, 2015.
+- S. J. Julier, J. K. Uhlmann, "Unscented filtering and nonlinear estimation", Proc. IEEE 92(3),
+  2004 (sigma points that match a distribution's mean and variance).
+- L. F. Richardson, "The deferred approach to the limit", Phil. Trans. R. Soc. A 226, 1927.
 """
 
 from __future__ import annotations
@@ -25,26 +31,105 @@ from reference._specular_lighting_kernels import (
     specular_point_lights_kernel,
 )
 from reference.arealights import PlaneLight, booth_light_image, light_plane_uv
-from reference.errors import require_positive_int
-from reference.point_lights import PointLights, point_lights_from_plane
+from reference.errors import require, require_positive_int
+from reference.point_lights import PointLights, _box, point_lights_from_plane, summed_area_table
 from reference.registry import Method, Registry
 from reference.specular_lighting import (
     _flat,
-    mip_lookup,
-    mip_pyramid,
     specular_brute_force,
     specular_fis,
     specular_point_lights,
 )
 
-__all__ = ["SPECULAR_METHODS", "hybrid_error_estimates", "specular_hybrid"]
+__all__ = [
+    "SPECULAR_METHODS",
+    "hybrid_error_estimates",
+    "sigma_point_lights",
+    "specular_hybrid",
+]
 
 
 # --- the hybrid ----------------------------------------------------------------------------------
 
 
-def _lobe_scales(P, N, V, a, light: PlaneLight, lights: PointLights):
-    """Per pixel: ``x_pl = σ²/s²`` and ``x_fis = Ω_lobe/Ω_texel`` (see hybrid_error_estimates)."""
+def sigma_point_lights(light: PlaneLight, lights: PointLights) -> PointLights:
+    """Four lights per median-cut region at ``c ± σ_x e_x`` and ``c ± σ_y e_y``, a quarter each.
+
+    Each region's point light ``c`` (its energy centroid) is replaced by four points on the
+    light plane at ± the region's energy-weighted standard deviations ``σ_x, σ_y`` along the
+    image's axes: a central-difference stencil of step σ (a sigma-point set, Julier & Uhlmann
+    2004, with half the region's variance). For a lobe ``g`` smooth over the region, with ``Φ``
+    the region's power, ``Σ_sigma − Σ_point ≈ ¼ Φ (σ_x² g_xx + σ_y² g_yy)``, half the
+    second-moment error of the one-point rule, ``−½ Φ (σ_x² g_xx + σ_y² g_yy)``, with its sign
+    reversed. The hybrid uses them to estimate the point lights' error; ``spread`` is zero (each
+    is a point). (The unscented set, at ``±√2 σ``, carries the full variance; its larger step
+    made a worse estimate on one of the six configurations in ``docs/impastor.md``.)
+
+    Parameters
+    ----------
+    light : PlaneLight
+        The light the point lights were made from.
+    lights : PointLights
+        From ``point_lights_from_plane``.
+
+    Returns
+    -------
+    PointLights
+        ``4 N`` lights; light ``4 n + j`` belongs to region ``n``. Power and each region's
+        centroid are conserved, and half its spread.
+
+    Examples
+    --------
+    >>> from reference.point_lights import point_lights_from_plane
+    >>> plane = PlaneLight(booth_light_image("fluorescent", 32, 16), (-0.6, 0.6, -1.0), (1, 0, 0),
+    ...                    (0, 0, 1), 1.2, 0.8)
+    >>> lights = point_lights_from_plane(plane, "median_cut", 8)
+    >>> sigma = sigma_point_lights(plane, lights)
+    >>> x = sigma.position.reshape(8, 4, 3)
+    >>> bool(np.allclose(x.mean(axis=1), lights.position))           # centroids
+    True
+    >>> spread = ((x - lights.position[:, None]) ** 2).sum(axis=-1).mean(axis=1)
+    >>> bool(np.allclose(spread, lights.spread / 2))                   # half the spreads
+    True
+    """
+    require(not lights.directional, "sigma_point_lights: directional lights are not supported")
+    H, W = light.shape
+    energy = light.image.mean(axis=-1)
+    rows, cols = np.meshgrid(np.arange(H) + 0.5, np.arange(W) + 0.5, indexing="ij")
+    x_m, y_m = cols * (light.l_A / W), rows * (light.l_B / H)
+    tables = [summed_area_table(v) for v in (energy, energy * x_m**2, energy * y_m**2)]
+    A, B = np.asarray(light.A, float), np.asarray(light.B, float)
+    e_A, e_B = A / np.linalg.norm(A), B / np.linalg.norm(B)
+    positions, L = [], []
+    for region, c, L_n in zip(lights.regions, lights.position, lights.L, strict=True):
+        e, xx, yy = (_box(T, *region) for T in tables)
+        # The centroid in plane metres, then the per-axis variances about it.
+        x_c, y_c = (c - np.asarray(light.origin)) @ e_A, (c - np.asarray(light.origin)) @ e_B
+        s_x = np.sqrt(max(xx / e - x_c**2, 0.0)) if e > 0 else 0.0
+        s_y = np.sqrt(max(yy / e - y_c**2, 0.0)) if e > 0 else 0.0
+        # Central differences of step σ along each axis (sigma points with half the variance).
+        for offset in (s_x * e_A, -s_x * e_A, s_y * e_B, -s_y * e_B):
+            positions.append(c + offset)
+            L.append(L_n / 4.0)
+    return PointLights(
+        np.array(positions),
+        np.array(L),
+        [r for r in lights.regions for _ in range(4)],
+        False,
+        lights.n_light,
+        lights.pixel_area,
+        np.zeros(len(positions)),
+        lights.method,
+    )
+
+
+def _lobe_over_region(P, N, V, a, light: PlaneLight, lights: PointLights):
+    """Per pixel: ``x_pl = σ²/s²``, the lobe's angular variance over the spread of the region hit.
+
+    ``σ² = 2α²`` (Ward's ``exp(−tan²θ_h/α²)`` with ``θ_i ≈ 2θ_h``, both axes); ``s²`` is the
+    energy spread (``PointLights.spread`` × cos θ_l / d², sr) of the median-cut region that the
+    mirror direction meets, or the mean region's where it misses the light.
+    """
     H, W = light.shape
     to_light = lights.position[None] - P[:, None]
     d2 = np.einsum("pni,pni->pn", to_light, to_light)
@@ -60,35 +145,70 @@ def _lobe_scales(P, N, V, a, light: PlaneLight, lights: PointLights):
     for k, (y0, y1, x0, x1) in enumerate(lights.regions):
         owner[y0:y1, x0:x1] = k
     s2 = np.where(on, spread[np.arange(P.shape[0]), owner[row, col]], spread.mean(axis=1))
-    sigma2 = 2.0 * a**2
-    x_pl = sigma2 / np.maximum(s2, 1e-300)
-    safe_d = np.where(on, d, 1.0)
-    omega_texel = light.pixel_area * np.where(on, -(mirror @ light.n_light), 1.0) / safe_d**2
-    omega_lobe = 4.0 * np.pi * a**2 * cos_o
-    x_fis = omega_lobe / omega_texel
-    return x_pl, x_fis, on, mirror, a_uv, b_uv, d, cos_o
+    return 2.0 * a**2 / np.maximum(s2, 1e-300)
 
 
-def hybrid_error_estimates(points, normals, views, alpha, light: PlaneLight, lights, n_samples):
-    """Predicted relative errors of point lights and FIS at each pixel (specref's hybrid metric).
+def _hybrid_parts(P, N, V, a, light, lights, K, vis, backend):
+    """Both estimates ``(P, C)`` and their estimated absolute errors ``(P,)`` (channel mean)."""
+    sigma = sigma_point_lights(light, lights)
+    vis_sigma = None if vis is None else np.repeat(vis, 4, axis=1)
+    I_pl = specular_point_lights(P, N, V, a, lights, vis, backend=backend)
+    I_sigma = specular_point_lights(P, N, V, a, sigma, vis_sigma, backend=backend)
+    I_fis = specular_fis(P, N, V, a, light, K, backend=backend)
+    I_half = specular_fis(P, N, V, a, light, K // 2, backend=backend)
+    pl, sig, fis, half = (x.mean(axis=-1) for x in (I_pl, I_sigma, I_fis, I_half))
+    x_pl = _lobe_over_region(P, N, V, a, light, lights)
+    # The Taylor expansion behind the sigma points holds where the lobe is wider than the region.
+    narrow = x_pl < 1.0
+    # Point lights: twice the sigma points' correction is their second-moment error; where the
+    # lobe is narrower than the region, at least the one-point rule's error at the lobe's peak,
+    # min(1, s²/(2σ²)) of the integral (FIS's estimate of it).
+    peak = np.minimum(1.0, 1.0 / (2.0 * x_pl))
+    e_pl = np.maximum(2.0 * np.abs(sig - pl), np.where(narrow, peak * np.abs(fis), 0.0))
+    # FIS: error ∝ 1/K (stratified samples and the mip filter's blur, both ∝ 1/K), so
+    # Richardson's rule gives e_K ≈ |I_K − I_{K/2}|.
+    e_fis = np.abs(fis - half)
+    # |I_pl − I_fis| ≤ e_pl + e_fis; the excess goes to the method outside its model's validity.
+    excess = np.maximum(np.abs(pl - fis) - e_pl - e_fis, 0.0)
+    e_pl = np.where(narrow, e_pl + excess, e_pl)
+    e_fis = np.where(narrow, e_fis, e_fis + excess)
+    return I_pl, I_fis, e_pl, e_fis
+
+
+def hybrid_error_estimates(
+    points,
+    normals,
+    views,
+    alpha,
+    light: PlaneLight,
+    lights: PointLights,
+    n_samples: int = 32,
+    visibility=None,
+    backend: str = "numpy",
+):
+    """Estimated relative errors of point lights and FIS at each pixel (specref's hybrid metric).
 
     The paper's "custom error minimization metric" is not given (§3.5.2, Ferwerda). specref
-    predicts each method's error from the lobe's width, the light's layout and the sample count:
+    estimates each method's error at each pixel from the estimates themselves:
 
-    - **Point lights** put each region's energy at its centroid. For a lobe of angular variance
-      ``σ² = 2α²`` (Ward's ``exp(−tan²θ_h/α²)`` with ``θ_i ≈ 2θ_h``; both axes) the one-point rule
-      errs by its second-moment term, ``(s²/4)|∇²g|/g = s²/(2σ²)`` at the lobe's peak, with ``s²``
-      the energy spread (``PointLights.spread`` × cos θ_l / d², sr) of the median-cut region that
-      the mirror direction meets (the mean region's where it misses the light):
-      ``e_pl = min(1, s² / (4α²))``.
-    - **FIS** draws K samples in proportion to the lobe, so its weights are nearly constant and
-      its error is that of K samples of the light itself, ``CV / sqrt(K)``, with CV the light's
-      coefficient of variation over the lobe's footprint, read from mip pyramids of L and L² at
-      the level whose texel covers ``Ω_lobe = 4π α² cos θ_o`` (one over the lobe pdf's peak)
-      around the mirror direction. The part of the lobe that misses the light adds the binomial
-      noise ``sqrt((1 − q)/(K q))``, ``q = min(1, Ω_light / (4 Ω_lobe))``.
+    - **Point lights** put each region's energy at its centroid, which is exact to first order
+      in the lobe's variation over the region. The second-moment error of the one-point rule,
+      ``−½ Φ (σ_x² g_xx + σ_y² g_yy)``, is twice the difference between the point lights'
+      estimate and the :func:`sigma_point_lights` one (Eq. (2), Ferwerda, with both).
+      That expansion holds where the lobe is wider than the region the mirror direction meets,
+      ``x = σ²/s² ≥ 1`` (``σ² = 2α²`` the lobe's angular variance, ``s²`` the region's angular
+      spread); where it is narrower, the estimate is at least the one-point rule's error at the
+      lobe's peak, ``min(1, s²/(2σ²))`` of the integral.
+    - **FIS**: its error falls as 1/K (the K Hammersley samples are stratified, and the mip
+      level's blur covers ``Ω_s = 1/(K p)``), so Richardson's rule with a second FIS estimate of
+      K/2 samples gives ``e_K ≈ |I_K − I_{K/2}|``.
+    - **Consistency**: the two errors must explain the methods' disagreement,
+      ``|I_pl − I_fis| ≤ e_pl + e_fis``. What they leave unexplained is added to the point
+      lights' error where ``x < 1`` (the point lights' estimate is outside its validity) and to
+      FIS's elsewhere (a bias of the mip filter that does not change between K/2 and K).
 
-    Every constant comes from these models; none is fitted to a scene. :func:`specular_hybrid`
+    No constant is fitted to a scene: 2 and ½ come from the expansions, 1/K from the sampler,
+    and ``x = 1`` is where the lobe and the region have the same width. :func:`specular_hybrid`
     combines the two estimates with inverse-variance weights.
 
     Parameters
@@ -99,15 +219,18 @@ def hybrid_error_estimates(points, normals, views, alpha, light: PlaneLight, lig
     lights : PointLights
         The point lights the hybrid uses (their regions and spreads).
     n_samples : int
-        K of FIS.
+        K of FIS (>= 2: the error estimate uses K/2).
+    visibility : array_like, shape (..., N), optional
+        Shadowing per point light.
+    backend : {"numpy", "numba"}
 
     Returns
     -------
     e_point_lights, e_fis : ndarray, shape (...,)
+        Relative to the FIS estimate (channel mean).
 
     Examples
     --------
-    >>> from reference.arealights import PlaneLight, booth_light_image
     >>> from reference.point_lights import point_lights_from_plane
     >>> plane = PlaneLight(booth_light_image("fluorescent", 32, 16), (-0.6, 0.6, -1.0), (1, 0, 0),
     ...                    (0, 0, 1), 1.2, 0.8)
@@ -120,30 +243,18 @@ def hybrid_error_estimates(points, normals, views, alpha, light: PlaneLight, lig
     """
     P, N, V, a, shape = _flat(points, normals, views, alpha)
     K = require_positive_int(n_samples, "hybrid: n_samples", 1 << 20)
-    x_pl, _, on, mirror, a_uv, b_uv, d, cos_o = _lobe_scales(P, N, V, a, light, lights)
-    # Point lights: the one-point rule's second-moment error at the lobe's peak, s²/(2σ²).
-    e_point_lights = np.minimum(1.0, 1.0 / (2.0 * x_pl))
-    # FIS: K lobe-proportional samples of the light: CV/√K over the lobe's footprint.
-    omega_lobe = 4.0 * np.pi * a**2 * cos_o
-    luminance = light.image.mean(axis=-1)
-    mean_levels, square_levels = mip_pyramid(luminance), mip_pyramid(luminance**2)
-    safe_d = np.where(on, d, 1.0)
-    omega_texel = light.pixel_area * np.where(on, -(mirror @ light.n_light), 1.0) / safe_d**2
-    level = np.maximum(0.5 * np.log2(omega_lobe / omega_texel), 0.0)
-    a_on, b_on = np.where(on, a_uv, 0.5), np.where(on, b_uv, 0.5)
-    mean = mip_lookup(mean_levels, a_on, b_on, level)
-    square = mip_lookup(square_levels, a_on, b_on, level)
-    safe_mean = np.where(mean > 0, mean, 1.0)
-    cv = np.where(on & (mean > 0), np.sqrt(np.maximum(square - mean**2, 0.0)) / safe_mean, 1.0)
-    # The part of the lobe that misses the light: binomial noise of the hits.
-    area = np.array([(y1 - y0) * (x1 - x0) for y0, y1, x0, x1 in lights.regions])
-    to_light = lights.position[None] - P[:, None]
-    d2 = np.einsum("pni,pni->pn", to_light, to_light)
-    cos_l = np.maximum(-(to_light @ light.n_light) / np.sqrt(d2), 0.0)
-    omega_light = (area * light.pixel_area * cos_l / d2).sum(axis=1)
-    q = np.clip(omega_light / (4.0 * omega_lobe), 1e-12, 1.0)
-    e_fis = cv / np.sqrt(K) + np.sqrt((1.0 - q) / (K * q))
-    return e_point_lights.reshape(shape), e_fis.reshape(shape)
+    require(K >= 2, f"hybrid: n_samples: must be >= 2 (the error estimate uses K/2), got {K}")
+    vis = _visibility(visibility, shape, P.shape[0], len(lights.regions))
+    _, I_fis, e_pl, e_fis = _hybrid_parts(P, N, V, a, light, lights, K, vis, backend)
+    scale = np.maximum(np.abs(I_fis.mean(axis=-1)), 1e-300)
+    return (e_pl / scale).reshape(shape), (e_fis / scale).reshape(shape)
+
+
+def _visibility(visibility, shape, n_points, n_lights):
+    if visibility is None:
+        return None
+    vis = np.broadcast_to(np.asarray(visibility, float), (*shape, n_lights))
+    return np.ascontiguousarray(vis.reshape(n_points, -1))
 
 
 def specular_hybrid(
@@ -161,13 +272,14 @@ def specular_hybrid(
 
     Eq. (4), Ferwerda, estimated at each pixel by both methods and combined with the weights that
     minimise the variance of the combination, given the errors :func:`hybrid_error_estimates`
-    predicts: ``I = (e_fis² I_pl + e_pl² I_fis) / (e_pl² + e_fis²)``. Where one prediction is far
-    below the other this is a switch; near the crossover it averages the two.
+    estimates: ``I = (e_fis² I_pl + e_pl² I_fis) / (e_pl² + e_fis²)``. Where one error is far
+    below the other this is a switch; near the crossover it averages the two. Besides the two
+    methods it evaluates the sigma-point lights (4N) and FIS with K/2 samples for the estimates.
 
     Parameters
     ----------
     points, normals, views, alpha, light, lights, n_samples, visibility, backend
-        As in :func:`specular_point_lights` and :func:`specular_fis`.
+        As in :func:`specular_point_lights` and :func:`specular_fis`; ``n_samples >= 2``.
 
     Returns
     -------
@@ -175,7 +287,6 @@ def specular_hybrid(
 
     Examples
     --------
-    >>> from reference.arealights import PlaneLight
     >>> from reference.point_lights import point_lights_from_plane
     >>> plane = PlaneLight(np.full((8, 8), 100.0), (-1, 1, -1), (1, 0, 0), (0, 0, 1), 2.0, 2.0)
     >>> lights = point_lights_from_plane(plane, "median_cut", 4)
@@ -184,25 +295,14 @@ def specular_hybrid(
     array([99.51])
     """
     P, N, V, a, shape = _flat(points, normals, views, alpha)
-    e_pl, e_fis = hybrid_error_estimates(P, N, V, a, light, lights, n_samples)
-    vis = None
-    if visibility is not None:
-        vis = np.broadcast_to(np.asarray(visibility, float), (*shape, len(lights.regions)))
-        vis = vis.reshape(P.shape[0], -1)
-    w_pl = (e_fis**2 / np.maximum(e_pl**2 + e_fis**2, 1e-300))[:, None]
-    out = np.zeros((P.shape[0], light.image.shape[-1]))
-    # Evaluate each method only where its weight matters (> 1e-6).
-    need_pl, need_fis = w_pl[:, 0] > 1e-6, w_pl[:, 0] < 1.0 - 1e-6
-    if need_pl.any():
-        k = need_pl
-        out[k] += w_pl[k] * specular_point_lights(
-            P[k], N[k], V[k], a[k], lights, None if vis is None else vis[k], backend=backend
-        )
-    if need_fis.any():
-        k = need_fis
-        out[k] += (1.0 - w_pl[k]) * specular_fis(
-            P[k], N[k], V[k], a[k], light, n_samples, backend=backend
-        )
+    K = require_positive_int(n_samples, "hybrid: n_samples", 1 << 20)
+    require(K >= 2, f"hybrid: n_samples: must be >= 2 (the error estimate uses K/2), got {K}")
+    vis = _visibility(visibility, shape, P.shape[0], len(lights.regions))
+    I_pl, I_fis, e_pl, e_fis = _hybrid_parts(P, N, V, a, light, lights, K, vis, backend)
+    total = e_pl**2 + e_fis**2
+    # Inverse-variance weights; where both errors vanish the two estimates agree: take FIS.
+    w_pl = np.where(total > 0, e_fis**2 / np.where(total > 0, total, 1.0), 0.0)[:, None]
+    out = w_pl * I_pl + (1.0 - w_pl) * I_fis
     return out.reshape((*shape, -1))
 
 

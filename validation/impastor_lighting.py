@@ -417,11 +417,13 @@ def specular_error_vs_alpha(
     supersample: int = 8,
     painting=None,
     backend: str = "numba",
+    light_kind: str = "fluorescent",
 ) -> dict:
     """Relative RMS error of point lights, FIS and the hybrid against the brute-force integral.
 
     §3.5.2, Ferwerda: at each roughness α (uniform over the painting), the specular integral at
-    ``n_side²`` normal-mapped points under the fluorescent booth light. The reference sums every
+    ``n_side²`` normal-mapped points under the booth light (``light_kind``, a kind of
+    ``reference.arealights.booth_light_image``; fluorescent by default). The reference sums every
     light pixel split into ``supersample²`` sub-pixels; its own error is estimated by doubling the
     supersampling and reported.
 
@@ -439,7 +441,7 @@ def specular_error_vs_alpha(
     """
     painting = painting or impasto_painting(128, seed=2)
     P, N, V = _painting_samples(n_side, painting)
-    plane = booth_plane_light("fluorescent", *light_resolution)
+    plane = booth_plane_light(light_kind, *light_resolution)
     lights = point_lights_from_plane(plane, "median_cut", n_lights)
     out = {k: [] for k in ("alpha", "median_cut", "fis", "hybrid", "reference_error", "fis_share")}
     for alpha in alphas:
@@ -449,13 +451,19 @@ def specular_error_vs_alpha(
         pl = specular_point_lights(P, N, V, a, lights, backend=backend)[..., 0]
         fis = specular_fis(P, N, V, a, plane, n_samples, backend=backend)[..., 0]
         hybrid = specular_hybrid(P, N, V, a, plane, lights, n_samples, backend=backend)[..., 0]
-        e_pl, e_fis = hybrid_error_estimates(P, N, V, a, plane, lights, n_samples)
+        e_pl, e_fis = hybrid_error_estimates(P, N, V, a, plane, lights, n_samples, None, backend)
         out["alpha"].append(float(alpha))
         out["median_cut"].append(_relative_rms(pl, reference))
         out["fis"].append(_relative_rms(fis, reference))
         out["hybrid"].append(_relative_rms(hybrid, reference))
         out["reference_error"].append(_relative_rms(coarse, reference))
-        out["fis_share"].append(float((e_pl**2 / (e_pl**2 + e_fis**2)).mean()))
+        # The hybrid's FIS weight e_pl²/(e_pl² + e_fis²), scaled to avoid overflow (all FIS at 0/0).
+        e_pl, e_fis = np.minimum(e_pl, 1e150), np.minimum(e_fis, 1e150)  # relative to FIS ≈ 0
+        m = np.maximum(e_pl, e_fis)
+        safe = np.where(m > 0, m, 1.0)
+        r_pl, r_fis = (e_pl / safe) ** 2, (e_fis / safe) ** 2
+        share = np.where(m > 0, r_pl / np.where(m > 0, r_pl + r_fis, 1.0), 1.0)
+        out["fis_share"].append(float(share.mean()))
     return out
 
 
