@@ -488,6 +488,6 @@ def table_error_kernel(t_fine, C, n, entries, floor):
         width = cdf[q + 1] - cdf[q]
         s = (target - cdf[q]) / width
         nodes[k] = t_fine[q] + min(max(s, 0.0), 1.0) * (t_fine[q + 1] - t_fine[q])
-    nodes[0] = 0.0
-    nodes[entries] = 1.0
+    nodes[0] = t_fine[0]
+    nodes[entries] = t_fine[F - 1]
     return nodes

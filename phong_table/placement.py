@@ -41,6 +41,8 @@ __all__ = [
     "fine_grid",
     "importance_ratio_Wang",
     "inverse_importance_ratio_Wang",
+    "place_seen",
+    "seen_interval",
     "table_error",
     "table_importance_Wang",
     "table_uniform",
@@ -217,13 +219,84 @@ _FINE_GRID = fine_grid()
 _FINE_GRID.setflags(write=False)
 
 
+def seen_interval(t_range, entries: int) -> tuple[float, float, int]:
+    """The seen interval of :func:`table_error` before margins: ``(t_lo, t_hi, m_inner)``.
+
+    A frame whose lit pixels see ``t`` in ``[t_lo, t_hi]`` (``ShadingBuffer.t_range``) needs the
+    table there: ``m_inner`` intervals are equidistributed over the seen interval, and each side
+    that stops short of 0 or 1 gets two more (:func:`place_seen`). Without a range (or with too
+    few entries for the extra intervals, or a single ``t``) the whole of [0, 1] is seen.
+
+    Examples
+    --------
+    >>> seen_interval(None, 8), seen_interval((0.9, 1.0), 8), seen_interval((0.2, 0.7), 8)
+    ((0.0, 1.0, 8), (0.9, 1.0, 6), (0.2, 0.7, 4))
+    >>> seen_interval((0.2, 0.7), 4)
+    (0.0, 1.0, 4)
+    """
+    if t_range is None:
+        return 0.0, 1.0, entries
+    t_lo, t_hi = (float(x) for x in t_range)
+    require(
+        np.isfinite(t_lo) and np.isfinite(t_hi) and 0.0 <= t_lo <= t_hi <= 1.0,
+        f"error table: t_range: must be 0 <= t_lo <= t_hi <= 1, got {t_range!r}",
+    )
+    inner = entries - 2 * (t_lo > 0.0) - 2 * (t_hi < 1.0)
+    if inner < 2 or t_lo == t_hi:
+        return 0.0, 1.0, entries
+    return t_lo, t_hi, inner
+
+
+def place_seen(place, entries: int, t_range) -> np.ndarray:
+    """Nodes over the seen interval, a margin on each open side, then 0 and 1.
+
+    ``place(t_lo, t_hi, m)`` returns ``m + 1`` nodes from ``t_lo`` to ``t_hi``. Below ``t_lo``
+    (if > 0) come a node at ``t_lo − h``, with ``h`` the first seen interval's width, and 0; above
+    ``t_hi`` (if < 1) likewise. The margin gives the slopes and parabolas at ``t_lo`` and ``t_hi``
+    evenly spaced neighbours: PCHIP's slope and the 3-point parabola are first-order accurate only
+    where neighbouring widths are alike, and a node whose other neighbour is 0 (or 1) is off by
+    the whole of ``f`` there. Where a margin would reach 0 or 1, the seen interval is widened to
+    0 or 1 instead (no end interval much narrower than its neighbour).
+
+    Examples
+    --------
+    >>> line = lambda lo, hi, m: np.linspace(lo, hi, m + 1)
+    >>> place_seen(line, 8, (0.5, 0.8)).round(3)       # four seen intervals, margins of 0.075
+    array([0.   , 0.425, 0.5  , 0.575, 0.65 , 0.725, 0.8  , 0.875, 1.   ])
+    >>> place_seen(line, 8, (0.5, 0.95)).round(3)      # 0.95 + 0.075 > 1: seen up to 1
+    array([0.   , 0.417, 0.5  , 0.583, 0.667, 0.75 , 0.833, 0.917, 1.   ])
+    """
+    t_lo, t_hi, m = seen_interval(t_range, entries)
+    # a gap to 0 or 1 narrower than the mean seen interval is taken at once (saves a placement)
+    mean = (t_hi - t_lo) / m
+    t_lo, t_hi = (0.0 if t_lo < mean else t_lo), (1.0 if 1.0 - t_hi < mean else t_hi)
+    m = entries - 2 * (t_lo > 0.0) - 2 * (t_hi < 1.0)
+    for _ in range(3):
+        nodes = place(t_lo, t_hi, m)
+        low = t_lo - (nodes[1] - nodes[0]) if t_lo > 0.0 else 0.0
+        high = t_hi + (nodes[-1] - nodes[-2]) if t_hi < 1.0 else 1.0
+        if (low > 0.0 or t_lo == 0.0) and (high < 1.0 or t_hi == 1.0):
+            break
+        # a margin reaches 0 or 1: the seen interval takes that end and the margin's intervals
+        t_lo = t_lo if low > 0.0 else 0.0
+        t_hi = t_hi if high < 1.0 else 1.0
+        m = entries - 2 * (t_lo > 0.0) - 2 * (t_hi < 1.0)
+    below = [0.0, low] if t_lo > 0.0 else []
+    above = [high, 1.0] if t_hi < 1.0 else []
+    return np.concatenate([below, nodes, above])
+
+
 def table_error(
-    model: SpectralPhong, entries: int, segments=None, floor: float = ERROR_DENSITY_FLOOR
+    model: SpectralPhong,
+    entries: int,
+    segments=None,
+    floor: float = ERROR_DENSITY_FLOOR,
+    t_range=None,
 ) -> np.ndarray:
     """Nodes that equidistribute the interpolation error of the true specular functions (ours).
 
     Eq. (11), Wang et al. gives ``f_sp``; this placement replaces the proxy of Eqs. (12)-(13),
-    Wang et al. by the derivatives of ``f_sp`` itself.
+    Wang et al. by the derivatives of ``f_sp`` itself, over the range of ``t`` the frame sees.
 
     Parameters
     ----------
@@ -235,6 +308,10 @@ def table_error(
         Not used by this placement.
     floor : float
         Uniform share of the density, > 0 (:data:`ERROR_DENSITY_FLOOR`).
+    t_range : (float, float), optional
+        ``(t_lo, t_hi)``, the range of ``t`` over the frame's lit pixels
+        (``phong_table.render.ShadingBuffer.t_range``); the nodes go there
+        (:func:`seen_interval`). None: all of [0, 1].
 
     Returns
     -------
@@ -263,9 +340,17 @@ def table_error(
     own optimal nodes. A floor keeps intervals bounded where the derivative vanishes (zero crossings
     of ``f^(k)``, ``n(λ) ≤ 1``): ``ρ = ρ_error/∫ρ_error + floor``.
 
-    The derivatives are evaluated at the midpoints of :func:`fine_grid`, the density integrated
-    there, and the cumulative density inverted at ``q/m`` by linear interpolation. The compiled twin
-    is ``phong_table._kernels.table_error_kernel``.
+    **The seen range.** A view sees only part of [0, 1]: the scenes' near view, zoomed on the
+    highlight, sees ``t`` from about 0.78 to 1, and nodes below that are wasted on its pixels.
+    Given the frame's range ``[t_lo, t_hi]``, the density is equidistributed there
+    (:func:`fine_grid` mapped onto it) and each open side gets a margin interval and one more to
+    0 or 1 (:func:`place_seen`). The table is then exact only on the frame it was built for; in
+    Wang et al.'s use (editing spectra on a fixed view) that is the frame. The paper's placements
+    (``uniform``, ``importance``) do not read the range.
+
+    The derivatives are evaluated at the midpoints of the fine grid, the density integrated there,
+    and the cumulative density inverted at ``q/m`` by linear interpolation. The compiled twin is
+    ``phong_table._kernels.table_error_kernel``.
 
     Examples
     --------
@@ -276,7 +361,12 @@ def table_error(
     """
     m, _ = check_entries(entries, None, "error table")
     require(np.isfinite(floor) and floor > 0, f"error table: floor: must be > 0, got {floor}")
-    t_fine = _FINE_GRID
+    return place_seen(lambda t_lo, t_hi, m: _error_nodes(model, m, floor, t_lo, t_hi), m, t_range)
+
+
+def _error_nodes(model: SpectralPhong, m: int, floor: float, t_lo: float, t_hi: float):
+    """``m + 1`` nodes from ``t_lo`` to ``t_hi`` that equidistribute the error (table_error)."""
+    t_fine = t_lo + (t_hi - t_lo) * _FINE_GRID
     h = np.diff(t_fine)
     t_mid = 0.5 * (t_fine[1:] + t_fine[:-1])
     rho = np.zeros_like(t_mid)
@@ -287,18 +377,25 @@ def table_error(
         if mass > 0:
             rho = np.maximum(rho, rho_k / mass)
     mass = (rho * h).sum()
-    rho = (rho / mass if mass > 0 else rho) + floor
+    # the floor keeps its share of the nodes whatever the width of the seen interval
+    rho = (rho / mass if mass > 0 else rho) + floor / (t_hi - t_lo)
     cdf = np.concatenate([[0.0], np.cumsum(rho * h)])
     nodes = np.interp(cdf[-1] * np.arange(m + 1) / m, cdf, t_fine)
-    nodes[0], nodes[-1] = 0.0, 1.0
+    nodes[0], nodes[-1] = t_lo, t_hi
     return nodes
 
 
-def _table_error_compiled(model: SpectralPhong, entries: int, segments=None) -> np.ndarray:
+def _table_error_compiled(
+    model: SpectralPhong, entries: int, segments=None, t_range=None
+) -> np.ndarray:
     m, _ = check_entries(entries, None, "error table")
-    return _kernels.table_error_kernel(
-        _FINE_GRID, model.specular_weights, model.n, m, ERROR_DENSITY_FLOOR
-    )
+
+    def place(t_lo, t_hi, m):
+        t_fine = t_lo + (t_hi - t_lo) * _FINE_GRID
+        floor = ERROR_DENSITY_FLOOR / (t_hi - t_lo)
+        return _kernels.table_error_kernel(t_fine, model.specular_weights, model.n, m, floor)
+
+    return place_seen(place, m, t_range)
 
 
 def _example_inputs(rng):
@@ -309,7 +406,8 @@ def _example_inputs(rng):
 
 #: Placements by the keys of ``--placement``. ``reference(model, entries, segments) -> nodes``;
 #: ``kernel`` (if any) is the numba twin of its density computation and ``extra["compiled"]`` calls
-#: it with the reference's signature; ``extra["segments"]`` says whether ``segments`` applies.
+#: it with the reference's signature; ``extra["segments"]`` says whether ``segments`` applies and
+#: ``extra["t_range"]`` whether the placement reads the frame's range of ``t`` (``t_range=``).
 PLACEMENT_METHODS = Registry("placement")
 PLACEMENT_METHODS.register(
     Method(
@@ -338,6 +436,6 @@ PLACEMENT_METHODS.register(
         _kernels.table_error_kernel,
         "Eq. (11), Wang et al.",
         _example_inputs,
-        {"segments": False, "source": "ours", "compiled": _table_error_compiled},
+        {"segments": False, "source": "ours", "compiled": _table_error_compiled, "t_range": True},
     )
 )

@@ -20,7 +20,7 @@ public entry point. The per-pixel geometry (:func:`light_geometry`) is computed 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cached_property, lru_cache
 
 import numpy as np
 
@@ -171,6 +171,21 @@ class ShadingBuffer:
     cos_theta: np.ndarray
     t: np.ndarray
     f_att: np.ndarray
+
+    @cached_property
+    def t_range(self) -> tuple[float, float] | None:
+        """``(min, max)`` of ``t`` over the lit pixels (``t > 0``), or None when none is lit.
+
+        The range a table for this frame must cover (``build_table(..., t_range=)``); pixels at
+        ``t = 0`` read the table's first value exactly.
+
+        Examples
+        --------
+        >>> ShadingBuffer(None, np.ones(3), np.array([0.0, 0.5, 0.9]), np.ones(3)).t_range
+        (0.5, 0.9)
+        """
+        lit = self.t[self.t > 0.0]
+        return (float(lit.min()), float(lit.max())) if lit.size else None
 
 
 def shading_buffer(
@@ -470,10 +485,12 @@ def render_sphere(
     """
     require_choice(method, SHADING_PATHS, "shading path")
     geometry = sphere_gbuffer(view, resolution)
+    buffer = shading_buffer(geometry, material, compiled)
     table = None
     if method == "table":
-        table = build_table(material, entries, placement, segments, compiled=compiled)
+        table = build_table(
+            material, entries, placement, segments, compiled=compiled, t_range=buffer.t_range
+        )
         check_interpolation(interpolation, table.entries)
-    buffer = shading_buffer(geometry, material, compiled)
     pixels = shade_pixels(buffer, material, method, table, interpolation, compiled)
     return geometry.to_image(pixels)

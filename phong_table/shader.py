@@ -73,10 +73,6 @@ def shade_phong_point_table(surface, material, light, ctx) -> np.ndarray:
         observer=ctx.observer,
         weights_method=ctx.weights_method,
     )
-    table = build_table(
-        model, settings["entries"], settings["placement"], settings["segments"], compiled=True
-    )
-    check_interpolation(settings["interpolation"], table.entries)
     position = np.ascontiguousarray(surface.position, dtype=np.float64)
     rows = _kernels.light_geometry_kernel(
         position,
@@ -87,6 +83,15 @@ def shade_phong_point_table(surface, material, light, ctx) -> np.ndarray:
         np.empty((3, position.shape[0])),
     )
     buffer = ShadingBuffer(None, *(np.ascontiguousarray(r) for r in rows))
+    table = build_table(
+        model,
+        settings["entries"],
+        settings["placement"],
+        settings["segments"],
+        compiled=True,
+        t_range=buffer.t_range,
+    )
+    check_interpolation(settings["interpolation"], table.entries)
     shade = compiled_shader(model, table, settings["interpolation"])
     return shade(buffer, np.empty((position.shape[0], 3)))
 

@@ -251,6 +251,7 @@ def build_table(
     placement: str = "error",
     segments: int | None = None,
     compiled: bool = False,
+    t_range=None,
 ) -> SpecularTable:
     """Tabulate the specular functions of a material: place nodes, evaluate, precompute lookups.
 
@@ -270,6 +271,10 @@ def build_table(
     compiled : bool
         Use the numba twins of the placement (where it has one) and of :func:`tabulate` (the
         timed path).
+    t_range : (float, float), optional
+        The range of ``t`` over the frame's lit pixels (``ShadingBuffer.t_range``), for the
+        placements that read it (``error``: ``phong_table.placement.seen_interval``); the paper's
+        placements ignore it. The table still covers [0, 1].
 
     Returns
     -------
@@ -304,7 +309,8 @@ def build_table(
     )
     m, p = check_entries(entries, segments, f"{placement} table")
     place = method.extra.get("compiled", method.reference) if compiled else method.reference
-    nodes = np.ascontiguousarray(place(material, m, p), dtype=np.float64)
+    seen = {"t_range": t_range} if method.extra.get("t_range") and t_range is not None else {}
+    nodes = np.ascontiguousarray(place(material, m, p, **seen), dtype=np.float64)
     require(
         nodes[0] == 0.0 and nodes[-1] == 1.0 and bool((np.diff(nodes) > 0).all()),
         f"{placement} table: nodes are not strictly increasing from 0 to 1 (m = {m}); use fewer "

@@ -176,7 +176,9 @@ def table_error_row(
     (True, 0.0)
     """
     check_interpolation(interpolation, entries)
-    table = build_table(state.model, entries, placement, segments, compiled=state.compiled)
+    table = build_table(
+        state.model, entries, placement, segments, state.compiled, state.buffer.t_range
+    )
     RGB = shade_pixels(
         state.buffer, state.model, "table", table, interpolation, compiled=state.compiled
     )
@@ -278,8 +280,9 @@ def time_row(state: ViewState, row: dict, exact_shade_s: float, shared_s: float,
     """
     args = (state.model, row["entries"], row["placement"], row["segments"])
     compiled = state.compiled
-    build_s = _minimum_time(lambda: build_table(*args, compiled=compiled), repeats)
-    table = build_table(*args, compiled=compiled)
+    t_range = state.buffer.t_range  # a property of the cached G-buffer, like t itself
+    build_s = _minimum_time(lambda: build_table(*args, compiled, t_range), repeats)
+    table = build_table(*args, compiled, t_range)
     shade_s = build_s + time_shading(state, table, row["interpolation"], repeats)
     row.update(
         build_s=build_s,

@@ -85,3 +85,26 @@ def test_error_placement_has_a_density_floor():
 def test_bad_table_arguments(kwargs, match):
     with pytest.raises(SpecrefError, match=match):
         build_table(constant_material(10.0), **kwargs)
+
+
+@pytest.mark.parametrize(
+    "t_range", [(0.0, 1.0), (0.78, 1.0), (0.3, 0.97), (0.2, 0.2), (1e-6, 0.999999), (0.5, 0.6)]
+)
+@pytest.mark.parametrize("entries", [4, 25, 200])
+def test_seen_range_nodes_are_monotone_sized_and_twins_agree(t_range, entries):
+    model = SCENES.lookup("R2").build()
+    nodes = table_error(model, entries, t_range=t_range)
+    assert nodes.size == entries + 1
+    assert nodes[0] == 0.0
+    assert nodes[-1] == 1.0
+    assert (np.diff(nodes) > 0).all()
+    # below the seen range: at most node 0 and the margin's node
+    if t_range[0] < t_range[1]:
+        assert (nodes < t_range[0]).sum() <= 2
+    compiled = PLACEMENT_METHODS.lookup("error").extra["compiled"](model, entries, t_range=t_range)
+    np.testing.assert_allclose(compiled, nodes, rtol=0, atol=1e-12)
+
+
+def test_bad_seen_range():
+    with pytest.raises(SpecrefError, match="t_range: must be 0 <= t_lo <= t_hi <= 1"):
+        table_error(constant_material(10.0), 10, t_range=(0.7, 0.2))

@@ -3,7 +3,7 @@ import pytest
 
 from phong_table.scenes import SCENES, spectral_phong_unit_peak
 from reference.spectra import DEFAULT_GRID, resample_spectrum, spectrum_from_csv
-from validation.phong import table_error_row, tolerance_search, view_state
+from validation.phong import rms_8bit, table_error_row, tolerance_search, view_state
 
 MATERIALS = ("brick", "lemon", "orange", "porcelain", "toothpaste", "chocolate")
 
@@ -11,6 +11,17 @@ MATERIALS = ("brick", "lemon", "orange", "porcelain", "toothpaste", "chocolate")
 def _measured(shared_data, name):
     path = shared_data / "spectra" / "physicallybased" / f"{name}__nix_export.csv"
     return resample_spectrum(spectrum_from_csv(path), DEFAULT_GRID, extrapolation="constant")
+
+
+def _measured_material(shared_data, seed):
+    # materials not in the repository: measured reflectances as k_d and k_s, random exponent curves
+    rng = np.random.default_rng(seed)
+    wl = DEFAULT_GRID.wavelengths_nm
+    k_d = _measured(shared_data, MATERIALS[seed])
+    k_s = 0.6 * _measured(shared_data, MATERIALS[(seed + 3) % len(MATERIALS)])
+    low, high = np.exp(rng.uniform(np.log(2.0), np.log(5000.0), 2))
+    n = low + (high - low) / (1 + np.exp(-(wl - rng.uniform(420, 740)) / rng.uniform(5, 80)))
+    return spectral_phong_unit_peak(k_d, k_s, n, ("D65", "A", "FL2", "FL11")[seed], "measured")
 
 
 @pytest.mark.parametrize(
@@ -31,14 +42,7 @@ def _measured(shared_data, name):
     ],
 )
 def test_targets_hold_on_measured_materials(shared_data, seed):
-    # materials not in the repository: measured reflectances as k_d and k_s, random exponent curves
-    rng = np.random.default_rng(seed)
-    wl = DEFAULT_GRID.wavelengths_nm
-    k_d = _measured(shared_data, MATERIALS[seed])
-    k_s = 0.6 * _measured(shared_data, MATERIALS[(seed + 3) % len(MATERIALS)])
-    low, high = np.exp(rng.uniform(np.log(2.0), np.log(5000.0), 2))
-    n = low + (high - low) / (1 + np.exp(-(wl - rng.uniform(420, 740)) / rng.uniform(5, 80)))
-    model = spectral_phong_unit_peak(k_d, k_s, n, ("D65", "A", "FL2", "FL11")[seed], "measured")
+    model = _measured_material(shared_data, seed)
     for view in ("far", "near"):
         state = view_state(model, view, 48)
         for interpolation, limit in (("monotone", 1e-3), ("parabolic", 1e-3), ("linear", 1e-2)):
@@ -58,6 +62,24 @@ def test_targets_hold_on_measured_materials(shared_data, seed):
                 if interpolation == "monotone":
                     assert error["overshoot"] == 0.0
         assert tolerance_search(state, 0.05, placements=("error",))["entries"] <= 64
+
+
+def test_seen_range_wins_where_the_whole_range_placement_lost(shared_data):
+    # Seed 3 (toothpaste k_d, FL11), near view: the error placement over all of [0, 1] loses to
+    # the importance table (p = m); placed over the frame's range of t it wins with the cubic
+    # interpolations (linear at m = 25 is the xfail above).
+    from phong_table.render import shade_pixels
+    from phong_table.table import build_table
+
+    state = view_state(_measured_material(shared_data, 3), "near", 48)
+    for interpolation in ("parabolic", "monotone"):
+        for m in (25, 100):
+            seen = table_error_row(state, "error", interpolation, m)["rms"]
+            importance = table_error_row(state, "importance", interpolation, m, m)["rms"]
+            whole = build_table(state.model, m, "error", compiled=True)
+            rgb = shade_pixels(state.buffer, state.model, "table", whole, interpolation)
+            whole_rms = max(rms_8bit(rgb, state.exact, exact_encoded=state.exact_encoded))
+            assert seen <= importance < whole_rms, (interpolation, m, seen, importance, whole_rms)
 
 
 @pytest.mark.parametrize("scene", ["R1", "R2", "R3"])
