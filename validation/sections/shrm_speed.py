@@ -120,9 +120,9 @@ def _creation_blocks(ctx, env, L_env, view, results) -> list:
             f"SHRM creation for {name} at its chosen setting, frequency space (the whole "
             f"{S}²×6 cube) against brute-force angular integration (a spread of {pick.size} of "
             "its texels facing the view; the angular cost is the same for every texel), same "
-            "environment, measured in this run. The BRDF's SH projection is a separate stage, reused for every "
-            "environment and illuminant. Errors: against brute-force reflected radiance at those "
-            "texels for the study's view, over its peak",
+            "environment, measured in this run. The BRDF's SH projection is a separate stage, "
+            "reused for every environment and illuminant. Errors: against brute-force reflected "
+            "radiance at those texels for the study's view, over its peak",
             "{:.4g}",
         )
     ]
