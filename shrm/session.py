@@ -310,7 +310,7 @@ def _stage_specular_map(state, inputs):
 
 
 def _stage_brdf_coeffs(state, inputs):
-    from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts, shrm_orders
+    from shrm.brdf_sh import brdf_sh_coefficients, default_view_fit, shrm_brdf_parts, shrm_orders
 
     c = _config(state)
     brdf = state["brdf"]
@@ -321,10 +321,17 @@ def _stage_brdf_coeffs(state, inputs):
         params = dict(BRDF_METHODS.lookup(method).extra["params"])
     # R&H 2002: the Lambertian part goes to an irradiance map, the rest is expanded
     function, expand, lambert, k = shrm_brdf_parts(method, params)
-    rho = brdf_sh_coefficients(function, expand, c["F_max"], c["P_max"], c["frame"], view_power=k)
+    # The orders from the tails of the projection over all views; the hemisphere fit of the normal
+    # frame (shrm.brdf_sh) is no worse on the seen views at the same orders, and is made at them
+    rho = brdf_sh_coefficients(
+        function, expand, c["F_max"], c["P_max"], c["frame"], view_power=k, view_fit="sphere"
+    )
     F, P = shrm_orders(rho, c["tol"], c.get("F"), c.get("P"))
+    rho = rho[:, : F + 1, : P + 1, : min(F, P) + 1]
+    if default_view_fit(c["frame"]) == "hemisphere":
+        rho = brdf_sh_coefficients(function, expand, F, P, c["frame"], view_power=k)
     return {
-        "rho": rho[:, : F + 1, : P + 1, : min(F, P) + 1],
+        "rho": rho,
         "lambert": np.zeros(0) if lambert is None else lambert,
         "view_power": np.array(k),
     }
@@ -416,7 +423,7 @@ HERBERT_STAGES = (
         "specular_map", ("gloss", "config"), ("sh_project",), _stage_specular_map, persistent=True
     ),
     # Version 2: the Lambertian part split off, the grazing view power factored out
-    Stage("brdf_coeffs", ("brdf", "config"), (), _stage_brdf_coeffs, "2", persistent=True),
+    Stage("brdf_coeffs", ("brdf", "config"), (), _stage_brdf_coeffs, "3", persistent=True),
     Stage(
         "shrm_create",
         ("config",),

@@ -22,8 +22,12 @@ BRDF times the cosine. Two frames (R&H 2002, "reparameterization"):
   Ward, GGX) then stay centred on the pole for every view and change little with it, so far fewer
   view coefficients P are needed.
 
-Views below the horizon never reach a texel; there the transfer function is continued evenly
-(``ω_o`` mirrored across the tangent plane) so that no jump slows the convergence in P.
+Views below the horizon never reach a texel. The projection over all views continues the transfer
+function evenly there (``ω_o`` mirrored across the tangent plane), so that no jump slows the
+convergence in P; in the normal frame the default *hemisphere fit* (:mod:`shrm.brdf_sh`) instead
+fits the view dependence to the seen views by regularized weighted least squares, which also
+avoids the kink of the even continuation at the horizon (the grazing error of R&H 2002's
+projection). Creation, extraction and shading are the same for both.
 
 **BRDF coefficients.** Isotropy makes ``ρ̃`` depend on ``(θ_i, θ_o, Δφ)`` only, so its double SH
 expansion ``ρ̃ = Σ ρ_{lm,pq} Y_lm(ω_i) Y_pq(ω_o)`` has ``ρ_{lm,pq} = δ_mq ρ_{lp|m|}`` with

@@ -6,8 +6,9 @@ of the lat-long environment, with the environment's own Fejér-1 × uniform-φ q
 path of :mod:`shrm.shrm` only by the truncation of the SH series:
 
 - :func:`shrm_texels_angular` and :func:`shrm_create_angular`: the SHRM texels, for a Fejér grid of
-  views, projected onto ``Y_pq`` (§5.5, Herbert et al., in angular space; the baseline of the
-  creation-speed target);
+  views, projected onto ``Y_pq`` or fitted to the views above the texel's horizon, as
+  :func:`shrm.brdf_sh.brdf_sh_coefficients` fits them (§5.5, Herbert et al., in angular space;
+  the baseline of the creation-speed target);
 - :func:`render_bruteforce`: every G-buffer pixel integrates BRDF × environment (the baseline of
   the image-error target).
 
@@ -21,9 +22,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from reference.errors import require_choice
-from shrm.brdf_sh import FRAMES
-from shrm.sh import fejer1_weights
+from reference.errors import require, require_choice
+from shrm.brdf_sh import FRAMES, VIEW_FIT_RIDGE, VIEW_FITS, default_view_fit
+from shrm.sh import fejer1_weights, sh_basis
 from shrm.shrm import SHRM
 from shrm.transform import project_latlong
 
@@ -129,14 +130,25 @@ def reflected_bruteforce(
 
 
 def shrm_texels_angular(
-    image, brdf, params: dict, P: int, directions, frame: str = "reflection", view_power=0.0
+    image,
+    brdf,
+    params: dict,
+    P: int,
+    directions,
+    frame: str = "reflection",
+    view_power=0.0,
+    view_fit: str | None = None,
 ) -> np.ndarray:
     """SHRM coefficients ``B_pq`` at given texel directions, by brute-force angular integration.
 
     The reflection equation (R&H 2002) at every texel n and every view v of a Fejér-1 grid of
     ``2P + 2`` rows, ``B(n, v) = Σ_pixels L(ω) ρ̃ w``, then ``B_pq(n) = ∫ B(n, v) Y_pq(v) dv``
-    (``shrm.transform.project_latlong``). The cost is texels × views × environment pixels, the
-    same for every texel, so a few texels give the per-texel time of the angular path.
+    (``shrm.transform.project_latlong``) for ``view_fit="sphere"``, or for ``"hemisphere"`` the
+    fit of :mod:`shrm.brdf_sh` in world axes: ``min Σ_v w_v (n·v)^{−2k} |B − Σ B_pq Y_pq(v)|² +
+    μ Σ (B_pq − B^sphere_pq)²`` over the grid's views above the texel's horizon (``w_v`` the
+    grid's weights, ``B^sphere`` the projection with views below the horizon mirrored). The cost
+    is texels × views × environment pixels, the same for every texel, so a few texels give the
+    per-texel time of the angular path.
 
     Parameters
     ----------
@@ -151,6 +163,8 @@ def shrm_texels_angular(
     frame : {"normal", "reflection"}
     view_power : float
         The grazing view power k of the SHRM (:func:`shrm.brdf_sh.shrm_brdf_parts`).
+    view_fit : {"sphere", "hemisphere"}, optional
+        Default :func:`shrm.brdf_sh.default_view_fit` of the frame.
 
     Returns
     -------
@@ -163,27 +177,62 @@ def shrm_texels_angular(
     ...                         [[0.0, 0.0, 1.0]], "normal")
     >>> B.shape, round(float(B[0, 0, 0] * np.sqrt(1 / (4 * np.pi))), 6)   # B_00 Y_00 = ρ_d
     ((1, 1, 9), 1.0)
+    >>> B = shrm_texels_angular(np.ones((4, 8, 1)), brdf_lambert, {"rho_d": [1.0]}, 2,
+    ...                         [[0.0, 0.0, 1.0]], "normal", view_fit="hemisphere")
+    >>> round(float(B[0, 0, 0] * np.sqrt(1 / (4 * np.pi))), 6)
+    1.0
     """
     from reference.envmap import latlong_pixel_directions
 
     require_choice(frame, FRAMES, "SHRM frame")
+    view_fit = default_view_fit(frame) if view_fit is None else view_fit
+    require_choice(view_fit, VIEW_FITS, "SHRM view fit")
+    require(
+        view_fit == "sphere" or frame == "normal",
+        "SHRM: view_fit 'hemisphere' needs frame 'normal'",
+    )
     env = env_quadrature(image)
     Hv = 2 * P + 2
     views = latlong_pixel_directions(Hv, 2 * Hv).reshape(-1, 3)
     texels = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
     C = env[2].shape[1]
     out = np.empty((texels.shape[0], C, (P + 1) ** 2))
+    if view_fit == "hemisphere":
+        Y = sh_basis(P, views)
+        w_v = np.repeat(fejer1_weights(Hv), 2 * Hv) * (2.0 * np.pi / (2 * Hv))
     for t, n in enumerate(texels):
+        if view_fit == "sphere":
+            B = reflected_bruteforce(
+                brdf, params, frame, np.broadcast_to(n, views.shape), views, env, view_power
+            )
+            # B_pq(n) = ∫ B(n, v) Y_pq(v) dv on the Fejér-1 grid of views
+            out[t] = project_latlong(B.reshape(Hv, 2 * Hv, C), P, where="SHRM oracle")
+            continue
+        # The hemisphere fit (shrm.brdf_sh): weighted least squares over the seen views, plus
+        # μ |B − B_sphere|², B_sphere the projection of the even continuation (views mirrored)
+        x = views @ n
+        seen = x > 0.0
+        v = views[seen]
         B = reflected_bruteforce(
-            brdf, params, frame, np.broadcast_to(n, views.shape), views, env, view_power
+            brdf, params, frame, np.broadcast_to(n, v.shape), v, env, view_power
         )
-        # B_pq(n) = ∫ B(n, v) Y_pq(v) dv on the Fejér-1 grid of views
-        out[t] = project_latlong(B.reshape(Hv, 2 * Hv, C), P, where="SHRM oracle")
+        mirrored = sh_basis(P, v - 2.0 * x[seen, None] * n)
+        prior = ((Y[seen] + mirrored).T * w_v[seen]) @ B
+        w = w_v[seen] * x[seen] ** (-2.0 * view_power)
+        G = (Y[seen].T * w) @ Y[seen] + VIEW_FIT_RIDGE * np.eye(Y.shape[1])
+        out[t] = np.linalg.solve(G, (Y[seen].T * w) @ B + VIEW_FIT_RIDGE * prior).T
     return out
 
 
 def shrm_create_angular(
-    image, brdf, params: dict, P: int, frame: str = "reflection", size=8, view_power=0.0
+    image,
+    brdf,
+    params: dict,
+    P: int,
+    frame: str = "reflection",
+    size=8,
+    view_power=0.0,
+    view_fit: str | None = None,
 ) -> SHRM:
     """The oracle: every texel of a cube-map SHRM by :func:`shrm_texels_angular`.
 
@@ -199,6 +248,8 @@ def shrm_create_angular(
     size : int
         Cube face size (keep it small: the cost is texels × views × pixels).
     view_power : float
+    view_fit : {"sphere", "hemisphere"}, optional
+        Default :func:`shrm.brdf_sh.default_view_fit` of the frame.
 
     Returns
     -------
@@ -216,7 +267,7 @@ def shrm_create_angular(
     from reference.cubemap import cubemap_texel_directions
 
     texels = cubemap_texel_directions(size).reshape(-1, 3)
-    out = shrm_texels_angular(image, brdf, params, P, texels, frame, view_power)
+    out = shrm_texels_angular(image, brdf, params, P, texels, frame, view_power, view_fit)
     C = out.shape[1]
     return SHRM(out.reshape(6, size, size, C, (P + 1) ** 2), frame, -1, P, float(view_power))
 

@@ -31,6 +31,8 @@ def test_shrm_section_quick(tmp_path):
     assert len(checks) == 2 * len(SUITE) + 3
     assert all(c["name"].startswith("quick") for c in checks)
     for name in SUITE:
+        entry = results[name]
+        assert entry["view_fit"] in ("sphere", "hemisphere")
         (check, p10) = [c for c in checks if f", {name} (" in c["name"]]
         assert check["passed"] == (results[name]["max_error"] <= TOLERANCE)
         # the same target within §5.5's view orders (P <= 10)
@@ -60,23 +62,48 @@ def test_cheapest_setting_meets_one_percent_of_peak(full_study, name):
     assert entry["max_error"] <= TOLERANCE
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize(("name", "size"), [("ward_isotropic", 64), ("ggx", 32)])
-def test_full_setting_meets_one_percent_of_peak(name, size):
-    # The full study's environment (64×128) and image (48²) at the setting its sweep picks for
-    # these BRDFs (normal frame, F 16, P 12, size² faces). Oracle: the per-pixel brute-force render.
+def _normal_frame_errors(env, g, view, F, P, size, fit):
+    """Image error of each BRDF of the study (normal frame) against the per-pixel brute force."""
     from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts
     from shrm.shrm import render_shrm, shrm_create
     from shrm.shrm_oracles import render_bruteforce
     from shrm.transform import project_latlong
-    from validation.sections.shrm import image_error, study_params, study_setup
+    from validation.sections.shrm import image_error, study_params
+
+    L = project_latlong(env, F)
+    errors = {}
+    for name in SUITE:
+        params = study_params(name)
+        brdf, expand, lam, k = shrm_brdf_parts(name, params)
+        rho = brdf_sh_coefficients(brdf, expand, F, P, "normal", view_power=k, view_fit=fit)
+        s = shrm_create(L, rho, "normal", size, "ducc0", k, lam)
+        truth = render_bruteforce(g, env, brdf, params, view)
+        errors[name] = image_error(render_shrm(g, s, view), truth, g.mask)
+    return errors
+
+
+def test_every_brdf_meets_one_percent_with_P_at_most_10_on_a_small_setting():
+    # §5.5's "SH order typically between 2 and 10" (issue 7, erratum E23): the quick study's
+    # environment (16×32) and image (20²), normal frame, F 12, P 10, 32² faces. Oracle: the
+    # per-pixel brute-force render. The hemisphere fit meets 1 % of the peak for all four BRDFs;
+    # R&H 2002's projection over all views (the even continuation below the horizon) does not.
+    from validation.sections.shrm import study_setup
+
+    env, g, view = study_setup(quick=True)
+    hemisphere = _normal_frame_errors(env, g, view, 12, 10, 32, "hemisphere")
+    sphere = _normal_frame_errors(env, g, view, 12, 10, 32, "sphere")
+    assert max(hemisphere.values()) <= TOLERANCE, hemisphere
+    assert max(sphere.values()) > TOLERANCE, sphere
+    for name in ("ggx", "effect_pigment"):  # the lobes with a slope at the horizon
+        assert hemisphere[name] < 0.6 * sphere[name]
+
+
+@pytest.mark.slow
+def test_full_setting_meets_one_percent_of_peak_with_P_at_most_10():
+    # The full study's environment (64×128) and image (48²), normal frame, F 16, P 8, 64² faces
+    # (§5.5's default cube size). Oracle: the per-pixel brute-force render.
+    from validation.sections.shrm import study_setup
 
     env, g, view = study_setup(quick=False)
-    params = study_params(name)
-    brdf, expand, lam, k = shrm_brdf_parts(name, params)
-    rho = brdf_sh_coefficients(brdf, expand, 16, 12, "normal", view_power=k)
-    s = shrm_create(project_latlong(env, 16), rho, "normal", size, "ducc0", k, lam)
-    error = image_error(
-        render_shrm(g, s, view), render_bruteforce(g, env, brdf, params, view), g.mask
-    )
-    assert error <= TOLERANCE
+    errors = _normal_frame_errors(env, g, view, 16, 8, 64, "hemisphere")
+    assert max(errors.values()) <= TOLERANCE, errors

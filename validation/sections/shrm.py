@@ -4,8 +4,9 @@
 
 - the image error of SHRM rendering against a per-pixel brute-force render (every pixel integrates
   BRDF × environment over all environment pixels), as a function of the view order P, the
-  lighting order F, the cube-map size and the frame, marking the cheapest setting (by measured
-  creation time) under a tolerance of 1 % of the peak;
+  lighting order F, the cube-map size, the frame and the view fit (:mod:`shrm.brdf_sh`: in the
+  normal frame the hemisphere fit, and for comparison R&H 2002's projection over all views),
+  marking the cheapest setting (by measured creation time) under a tolerance of 1 % of the peak;
 - the creation time in frequency space against angular (brute-force) creation, on the same input
   and the same texels (the angular path on a few of them: its cost is the same for every texel,
   so the ratio is per texel);
@@ -105,11 +106,17 @@ def study_params(name: str) -> dict:
     }
 
 
-def sweep_plan(quick: bool) -> dict:
-    """The settings the study sweeps: per frame, lighting orders F, cube sizes S and P up to P_max.
+#: The (frame, view fit) pairs of the study: the default fit of each frame, and R&H 2002's
+#: projection over all views in the normal frame for comparison.
+FITS = (("normal", "hemisphere"), ("normal", "sphere"), ("reflection", "sphere"))
 
-    Every (frame, F, S) is created once at ``P_max``; a lower P is the same SHRM truncated to
-    ``(P+1)²`` view coefficients (``B_pq`` does not depend on the orders above p).
+
+def sweep_plan(quick: bool) -> dict:
+    """The settings the study sweeps: per frame and fit, lighting orders F, cube sizes S, and P.
+
+    With the sphere fit every (frame, F, S) is created once at ``P_max`` and a lower P is the same
+    SHRM truncated to ``(P+1)²`` view coefficients (``B_pq`` does not depend on the orders above
+    p); a hemisphere fit is created at each P (it is not a truncation).
 
     Examples
     --------
@@ -119,13 +126,15 @@ def sweep_plan(quick: bool) -> dict:
     if quick:
         return {
             "P": (2, 4, 6, 8, 10, 12),
-            "normal": ((12, 16),),
-            "reflection": ((12, 16),),
+            ("normal", "hemisphere"): ((12, 16),),
+            ("normal", "sphere"): ((12, 16),),
+            ("reflection", "sphere"): ((12, 16),),
         }
     return {
         "P": (2, 4, 6, 8, 10, 12, 14),
-        "normal": ((8, 32), (16, 32), (24, 32), (16, 64)),
-        "reflection": ((16, 64),),
+        ("normal", "hemisphere"): ((8, 32), (16, 32), (24, 32), (16, 64)),
+        ("normal", "sphere"): ((16, 32), (16, 64)),
+        ("reflection", "sphere"): ((16, 64),),
     }
 
 
@@ -164,8 +173,8 @@ def study_brdf(name, env, L_env, g, view, plan) -> dict:
     -------
     dict
         ``truth`` (the brute-force image) and its seconds, ``candidates`` (frame, F, P, S, error,
-        error at N·V > 0.2), the ``choice`` with its measured creation seconds and its ``shrm``,
-        and whether it meets :data:`TOLERANCE`.
+        error at N·V > 0.2, view fit), the ``choice`` with its measured creation seconds, its
+        ``shrm`` and BRDF coefficients ``rho``, and whether it meets :data:`TOLERANCE`.
     """
     from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts
     from shrm.shrm import render_shrm
@@ -179,32 +188,57 @@ def study_brdf(name, env, L_env, g, view, plan) -> dict:
     far = np.einsum("...i,...i->...", g.normal, g.view) > 0.2
     P_max = max(plan["P"])
     candidates, rho = [], {}
-    for frame in ("normal", "reflection"):
-        F_max = max(F for F, _ in plan[frame])
-        rho[frame] = brdf_sh_coefficients(brdf, expand, F_max, P_max, frame, view_power=k)
-        for F, S in plan[frame]:
-            s, _ = _creation_timed(L_env, _rho_of(rho[frame], F, P_max), frame, F, S, k, lam)
+
+    def coefficients(frame, fit, F, P):
+        # A sphere fit of order P is the corner of one at P_max; a hemisphere fit is made at P
+        key = (frame, fit, P_max if fit == "sphere" else P)
+        if key not in rho:
+            F_max = max(F for F, _ in plan[(frame, fit)])
+            rho[key] = brdf_sh_coefficients(
+                brdf, expand, F_max, key[2], frame, view_power=k, view_fit=fit
+            )
+        return _rho_of(rho[key], F, P)
+
+    for frame, fit in FITS:
+        for F, S in plan[(frame, fit)]:
+            if fit == "sphere":
+                s, _ = _creation_timed(
+                    L_env, coefficients(frame, fit, F, P_max), frame, F, S, k, lam
+                )
             for P in plan["P"]:
-                image = render_shrm(g, _truncated(s, P), view)
+                if fit == "sphere":
+                    shrm = _truncated(s, P)
+                else:
+                    shrm, _ = _creation_timed(
+                        L_env, coefficients(frame, fit, F, P), frame, F, S, k, lam
+                    )
+                image = render_shrm(g, shrm, view)
                 err = image_error(image, truth, g.mask)
                 inner = image_error(image, truth, g.mask, far)
-                candidates.append((frame, F, P, S, err, inner))
+                candidates.append((frame, F, P, S, err, inner, fit))
     ok = [c for c in candidates if c[4] <= TOLERANCE]
-    # Time the settings that meet the tolerance and are not dominated (same frame, no more F, P, S)
+    # Time the settings that meet the tolerance and are not dominated (same frame and fit, no
+    # more F, P, S)
     pareto = [
         c
         for c in ok
         if not any(
-            o is not c and o[0] == c[0] and o[1] <= c[1] and o[2] <= c[2] and o[3] <= c[3]
+            o is not c
+            and (o[0], o[6]) == (c[0], c[6])
+            and o[1] <= c[1]
+            and o[2] <= c[2]
+            and o[3] <= c[3]
             for o in ok
         )
     ] or [min(candidates, key=lambda c: c[4])]
     timed = []
     for c in pareto:
         frame, F, P, S = c[:4]
-        s, seconds = _creation_timed(L_env, _rho_of(rho[frame], F, P), frame, F, S, k, lam)
-        timed.append((seconds, c, s))
-    seconds, choice, shrm = min(timed, key=lambda t: t[0])
+        r = coefficients(frame, c[6], F, P)
+        s, seconds = _creation_timed(L_env, r, frame, F, S, k, lam)
+        timed.append((seconds, c, s, r))
+    seconds, choice, shrm, r = min(timed, key=lambda t: t[0])
+    low = [c for c in candidates if c[2] <= 10]
     return {
         "truth": truth,
         "bruteforce_seconds": t_truth,
@@ -212,9 +246,12 @@ def study_brdf(name, env, L_env, g, view, plan) -> dict:
         "meets_tolerance": bool(ok),
         "choice": choice,
         "shrm": shrm,
-        "rho": rho[choice[0]],
+        "rho": r,
         "create_seconds": seconds,
-        "best_with_P_at_most_10": min((c for c in candidates if c[2] <= 10), key=lambda c: c[4]),
+        "best_with_P_at_most_10": min(low, key=lambda c: c[4]),
+        "best_sphere_fit_with_P_at_most_10": min(
+            (c for c in low if c[6] == "sphere"), key=lambda c: c[4]
+        ),
         "lambert_split": lam is not None,
         "grazing_view_power": k,
     }
@@ -230,11 +267,14 @@ def _error_chart(ctx, studies, plan):
 
     fig, axes = plt.subplots(1, len(studies), figsize=(4.2 * len(studies), 3.6), sharey=True)
     for ax, (name, st) in zip(np.atleast_1d(axes), studies.items(), strict=True):
-        for frame in ("normal", "reflection"):
-            for F, S in plan[frame]:
-                errs = [c[4] for c in st["candidates"] if c[:2] == (frame, F) and c[3] == S]
-                style = "-" if frame == "normal" else ":"
-                ax.plot(plan["P"], errs, style, marker="o", ms=3, label=f"{frame}, F={F}, S={S}")
+        for frame, fit in FITS:
+            for F, S in plan[(frame, fit)]:
+                errs = [
+                    c[4] for c in st["candidates"] if (c[0], c[1], c[3], c[6]) == (frame, F, S, fit)
+                ]
+                style = {"hemisphere": "-", "sphere": "--" if frame == "normal" else ":"}[fit]
+                label = f"{frame} ({fit} fit), F={F}, S={S}"
+                ax.plot(plan["P"], errs, style, marker="o", ms=3, label=label)
         ax.axhline(TOLERANCE, color="k", lw=0.8, ls="--")
         ax.axvline(10, color="grey", lw=0.6, ls=":")
         c = st["choice"]
@@ -247,8 +287,9 @@ def _error_chart(ctx, studies, plan):
     return ctx.figure(
         "error-vs-P",
         fig,
-        "Image error against P, per frame, F and cube size S; dashed: the 1 % target; dotted: "
-        "P = 10, the top of §5.5's range; star: the cheapest setting under the target",
+        "Image error against P, per frame, view fit, F and cube size S; black dashed: the 1 % "
+        "target; dotted: P = 10, the top of §5.5's range; star: the cheapest setting under the "
+        "target",
     )
 
 
@@ -285,17 +326,18 @@ def run(ctx: ReportContext) -> SectionResult:
     label = "quick (16-row environment, 20² image): " if quick else ""
     env, g, view = study_setup(quick)
     plan = sweep_plan(quick)
-    F_env = max(F for frame in ("normal", "reflection") for F, _ in plan[frame])
+    F_env = max(F for key in FITS for F, _ in plan[key])
     L_env = project_latlong(env, F_env, backend="ducc0")
     studies, rows, results, checks = {}, [], {}, []
     for name in SUITE:
         st = studies[name] = study_brdf(name, env, L_env, g, view, plan)
-        frame, F, P, S, err, inner = st["choice"]
-        low = st["best_with_P_at_most_10"]
+        frame, F, P, S, err, inner, fit = st["choice"]
+        low, sphere = st["best_with_P_at_most_10"], st["best_sphere_fit_with_P_at_most_10"]
         results[name] = {
             "bruteforce_seconds": st["bruteforce_seconds"],
             "cheapest_under_tolerance": st["meets_tolerance"],
             "frame": frame,
+            "view_fit": fit,
             "F": F,
             "P": P,
             "size": S,
@@ -303,7 +345,8 @@ def run(ctx: ReportContext) -> SectionResult:
             "max_error": err,
             "error_away_from_silhouette": inner,
             "best_error_with_P_at_most_10": low[4],
-            "best_setting_with_P_at_most_10": list(low[:4]),
+            "best_setting_with_P_at_most_10": [*low[:4], low[6]],
+            "best_sphere_fit_error_with_P_at_most_10": sphere[4],
             "lambert_split": st["lambert_split"],
             "grazing_view_power": st["grazing_view_power"],
             "sweep": [list(c) for c in st["candidates"]],
@@ -312,7 +355,7 @@ def run(ctx: ReportContext) -> SectionResult:
             [
                 name,
                 "yes" if st["meets_tolerance"] else "no",
-                frame,
+                f"{frame} ({fit})",
                 F,
                 P,
                 S,
@@ -320,12 +363,13 @@ def run(ctx: ReportContext) -> SectionResult:
                 inner,
                 st["create_seconds"],
                 low[4],
+                sphere[4],
             ]
         )
         checks.append(
             Check(
                 f"{label}image within 1 % of peak of brute force, {name} "
-                f"({frame} F={F} P={P} S={S})",
+                f"({frame} {fit} fit F={F} P={P} S={S})",
                 f"<= {TOLERANCE:g}",
                 err,
                 err <= TOLERANCE,
@@ -335,7 +379,7 @@ def run(ctx: ReportContext) -> SectionResult:
         checks.append(
             Check(
                 f"{label}image within 1 % of peak of brute force with P <= 10 (§5.5), {name} "
-                f"(best: {low[0]} F={low[1]} P={low[2]} S={low[3]})",
+                f"(best: {low[0]} {low[6]} fit F={low[1]} P={low[2]} S={low[3]})",
                 f"<= {TOLERANCE:g}",
                 low[4],
                 low[4] <= TOLERANCE,
@@ -349,17 +393,20 @@ def run(ctx: ReportContext) -> SectionResult:
             "by per-pixel brute force (every pixel sums BRDF × environment over all environment "
             "pixels). The Lambertian part ρ_d/π of Ward, GGX and Lafortune is split off and "
             "rendered from an irradiance map; Ward's 1/sqrt(cos θ_o) is factored out of its "
-            "SHRM (`shrm.brdf_sh.shrm_brdf_parts`). Error is the largest per-pixel difference over "
-            f"the peak; the target is {TOLERANCE:.0%}. The chosen setting is the fastest to "
+            "SHRM (`shrm.brdf_sh.shrm_brdf_parts`). In the normal frame the view dependence is "
+            "fitted to the views above each texel's horizon (the hemisphere fit of "
+            "`shrm.brdf_sh`); R&H 2002's projection over all views (sphere fit, views below the "
+            "horizon mirrored) is swept for comparison. Error is the largest per-pixel difference "
+            f"over the peak; the target is {TOLERANCE:.0%}. The chosen setting is the fastest to "
             "create (measured) among those that meet the target (or, failing that, the most "
-            "accurate). The last column is the best any setting with P <= 10 (the top of §5.5's "
-            "range) reaches."
+            "accurate). The last columns are the best any setting with P <= 10 (the top of §5.5's "
+            "range) reaches, and the best with the sphere fit."
         ),
         Table(
             [
                 "BRDF",
                 "meets 1 %",
-                "frame",
+                "frame (view fit)",
                 "F",
                 "P",
                 "cube size",
@@ -367,6 +414,7 @@ def run(ctx: ReportContext) -> SectionResult:
                 "error N·V>0.2",
                 "create s",
                 "best, P <= 10",
+                "best, P <= 10, sphere fit",
             ],
             rows,
             "Cheapest SHRM setting under the tolerance, per BRDF",
