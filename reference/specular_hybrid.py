@@ -46,6 +46,7 @@ __all__ = [
     "hybrid_error_estimates",
     "sigma_point_lights",
     "specular_hybrid",
+    "specular_hybrid_parts",
 ]
 
 
@@ -257,6 +258,62 @@ def _visibility(visibility, shape, n_points, n_lights):
     return np.ascontiguousarray(vis.reshape(n_points, -1))
 
 
+def specular_hybrid_parts(
+    points,
+    normals,
+    views,
+    alpha,
+    light: PlaneLight,
+    lights: PointLights,
+    n_samples: int = 32,
+    visibility=None,
+    backend: str = "numpy",
+) -> dict:
+    """The hybrid and what it is made of: both estimates, their errors and the weights.
+
+    :func:`specular_hybrid` returns ``["hybrid"]``; the report's error-against-α study reads the
+    rest from the same evaluation instead of shading each method again.
+
+    Parameters
+    ----------
+    points, normals, views, alpha, light, lights, n_samples, visibility, backend
+        As in :func:`specular_hybrid`.
+
+    Returns
+    -------
+    dict
+        ``hybrid``, ``point_lights``, ``fis``: shape (..., C); ``e_point_lights``, ``e_fis``
+        (absolute, channel mean) and ``w_point_lights`` (the point lights' weight): shape (...,).
+
+    Examples
+    --------
+    >>> from reference.point_lights import point_lights_from_plane
+    >>> plane = PlaneLight(np.full((8, 8), 100.0), (-1, 1, -1), (1, 0, 0), (0, 0, 1), 2.0, 2.0)
+    >>> lights = point_lights_from_plane(plane, "median_cut", 4)
+    >>> up = np.array([0.0, 1.0, 0.0])
+    >>> parts = specular_hybrid_parts(np.zeros(3), up, up, 0.05, plane, lights, 16)
+    >>> sorted(parts), bool(0.0 <= parts["w_point_lights"] <= 1.0)
+    (['e_fis', 'e_point_lights', 'fis', 'hybrid', 'point_lights', 'w_point_lights'], True)
+    """
+    P, N, V, a, shape = _flat(points, normals, views, alpha)
+    K = require_positive_int(n_samples, "hybrid: n_samples", 1 << 20)
+    require(K >= 2, f"hybrid: n_samples: must be >= 2 (the error estimate uses K/2), got {K}")
+    vis = _visibility(visibility, shape, P.shape[0], len(lights.regions))
+    I_pl, I_fis, e_pl, e_fis = _hybrid_parts(P, N, V, a, light, lights, K, vis, backend)
+    total = e_pl**2 + e_fis**2
+    # Inverse-variance weights; where both errors vanish the two estimates agree: take FIS.
+    w_pl = np.where(total > 0, e_fis**2 / np.where(total > 0, total, 1.0), 0.0)
+    I_hybrid = w_pl[:, None] * I_pl + (1.0 - w_pl[:, None]) * I_fis
+    return {
+        "hybrid": I_hybrid.reshape((*shape, -1)),
+        "point_lights": I_pl.reshape((*shape, -1)),
+        "fis": I_fis.reshape((*shape, -1)),
+        "e_point_lights": e_pl.reshape(shape),
+        "e_fis": e_fis.reshape(shape),
+        "w_point_lights": w_pl.reshape(shape),
+    }
+
+
 def specular_hybrid(
     points,
     normals,
@@ -274,7 +331,8 @@ def specular_hybrid(
     minimise the variance of the combination, given the errors :func:`hybrid_error_estimates`
     estimates: ``I = (e_fis² I_pl + e_pl² I_fis) / (e_pl² + e_fis²)``. Where one error is far
     below the other this is a switch; near the crossover it averages the two. Besides the two
-    methods it evaluates the sigma-point lights (4N) and FIS with K/2 samples for the estimates.
+    methods it evaluates the sigma-point lights (4N) and FIS with K/2 samples for the estimates
+    (:func:`specular_hybrid_parts` returns them too).
 
     Parameters
     ----------
@@ -294,16 +352,9 @@ def specular_hybrid(
     >>> specular_hybrid(np.zeros(3), up, up, 0.05, plane, lights, 16).round(2)
     array([99.51])
     """
-    P, N, V, a, shape = _flat(points, normals, views, alpha)
-    K = require_positive_int(n_samples, "hybrid: n_samples", 1 << 20)
-    require(K >= 2, f"hybrid: n_samples: must be >= 2 (the error estimate uses K/2), got {K}")
-    vis = _visibility(visibility, shape, P.shape[0], len(lights.regions))
-    I_pl, I_fis, e_pl, e_fis = _hybrid_parts(P, N, V, a, light, lights, K, vis, backend)
-    total = e_pl**2 + e_fis**2
-    # Inverse-variance weights; where both errors vanish the two estimates agree: take FIS.
-    w_pl = np.where(total > 0, e_fis**2 / np.where(total > 0, total, 1.0), 0.0)[:, None]
-    out = w_pl * I_pl + (1.0 - w_pl) * I_fis
-    return out.reshape((*shape, -1))
+    return specular_hybrid_parts(
+        points, normals, views, alpha, light, lights, n_samples, visibility, backend
+    )["hybrid"]
 
 
 def _example_scene(rng):

@@ -43,7 +43,7 @@ from reference.multispectral import (
 )
 from reference.point_lights import illuminance_point_lights, point_lights_from_plane
 from reference.spectra import resample_spectrum, spectrum_from_csv, spectrum_from_dataset
-from reference.specular_hybrid import hybrid_error_estimates, specular_hybrid
+from reference.specular_hybrid import specular_hybrid, specular_hybrid_parts
 from reference.specular_lighting import (
     specular_brute_force,
     specular_fis,
@@ -448,22 +448,15 @@ def specular_error_vs_alpha(
         a = np.full(len(P), float(alpha))
         reference = specular_brute_force(P, N, V, a, plane, 2 * supersample, backend)[..., 0]
         coarse = specular_brute_force(P, N, V, a, plane, supersample, backend)[..., 0]
-        pl = specular_point_lights(P, N, V, a, lights, backend=backend)[..., 0]
-        fis = specular_fis(P, N, V, a, plane, n_samples, backend=backend)[..., 0]
-        hybrid = specular_hybrid(P, N, V, a, plane, lights, n_samples, backend=backend)[..., 0]
-        e_pl, e_fis = hybrid_error_estimates(P, N, V, a, plane, lights, n_samples, None, backend)
+        # one evaluation gives all three methods: the hybrid shades both of the others
+        parts = specular_hybrid_parts(P, N, V, a, plane, lights, n_samples, backend=backend)
+        pl, fis, hybrid = (parts[k][..., 0] for k in ("point_lights", "fis", "hybrid"))
         out["alpha"].append(float(alpha))
         out["median_cut"].append(_relative_rms(pl, reference))
         out["fis"].append(_relative_rms(fis, reference))
         out["hybrid"].append(_relative_rms(hybrid, reference))
         out["reference_error"].append(_relative_rms(coarse, reference))
-        # The hybrid's FIS weight e_pl²/(e_pl² + e_fis²), scaled to avoid overflow (all FIS at 0/0).
-        e_pl, e_fis = np.minimum(e_pl, 1e150), np.minimum(e_fis, 1e150)  # relative to FIS ≈ 0
-        m = np.maximum(e_pl, e_fis)
-        safe = np.where(m > 0, m, 1.0)
-        r_pl, r_fis = (e_pl / safe) ** 2, (e_fis / safe) ** 2
-        share = np.where(m > 0, r_pl / np.where(m > 0, r_pl + r_fis, 1.0), 1.0)
-        out["fis_share"].append(float(share.mean()))
+        out["fis_share"].append(float((1.0 - parts["w_point_lights"]).mean()))
     return out
 
 

@@ -7,7 +7,7 @@ import pytest
 
 from reference.arealights import PlaneLight, booth_light_image
 from reference.point_lights import point_lights_from_plane
-from reference.specular_hybrid import sigma_point_lights, specular_hybrid
+from reference.specular_hybrid import sigma_point_lights, specular_hybrid, specular_hybrid_parts
 from reference.specular_lighting import specular_fis, specular_point_lights
 
 
@@ -68,6 +68,25 @@ def test_hybrid_matches_its_numba_backend():
         ref = specular_hybrid(P, up, V, a, plane, lights, 16, backend="numpy")
         fast = specular_hybrid(P, up, V, a, plane, lights, 16, backend="numba")
         assert np.allclose(ref, fast, rtol=1e-9, atol=1e-12)
+
+
+def test_hybrid_parts_are_the_two_methods_and_their_weighted_mean():
+    # The error-against-α study reads point lights and FIS from the hybrid's own evaluation.
+    plane = _plane()
+    lights = point_lights_from_plane(plane, "median_cut", 8)
+    P = np.array([[0.01, 0.0, -0.02], [-0.05, 0.0, 0.03], [0.2, 0.0, 0.1]])
+    V = np.array([0.0, 0.5, 0.6]) - P
+    V /= np.linalg.norm(V, axis=-1, keepdims=True)
+    up = np.array([0.0, 1.0, 0.0])
+    a = np.array([0.02, 0.1, 0.4])
+    parts = specular_hybrid_parts(P, up, V, a, plane, lights, 16)
+    np.testing.assert_array_equal(parts["hybrid"], specular_hybrid(P, up, V, a, plane, lights, 16))
+    np.testing.assert_array_equal(parts["point_lights"], specular_point_lights(P, up, V, a, lights))
+    np.testing.assert_array_equal(parts["fis"], specular_fis(P, up, V, a, plane, 16))
+    w = parts["w_point_lights"][:, None]
+    mean = w * parts["point_lights"] + (1.0 - w) * parts["fis"]
+    np.testing.assert_allclose(parts["hybrid"], mean, rtol=1e-15)
+    assert ((w >= 0.0) & (w <= 1.0)).all()
 
 
 @pytest.mark.slow
