@@ -141,19 +141,35 @@ def transfer_function(
     return rho
 
 
-def default_view_fit(frame: str) -> str:
-    """The view fit of a frame: ``"hemisphere"`` in the normal frame, else ``"sphere"``.
+def default_view_fit(frame: str, view_fit: str | None = None) -> str:
+    """The view fit of a frame: ``view_fit`` checked, or the frame's default.
 
+    The default is ``"hemisphere"`` in the normal frame and ``"sphere"`` in the reflection frame.
     In the normal frame only views above a texel's horizon reach it; in the reflection frame every
-    view but ``−r`` does (R&H 2002, reparameterization), so there is nothing to leave out.
+    view but ``−r`` does (R&H 2002, reparameterization), so there is nothing to leave out and the
+    hemisphere fit is refused.
 
     Examples
     --------
     >>> default_view_fit("normal"), default_view_fit("reflection")
     ('hemisphere', 'sphere')
+    >>> default_view_fit("normal", "sphere")
+    'sphere'
+    >>> default_view_fit("reflection", "hemisphere")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: SHRM: view_fit 'hemisphere' needs frame 'normal' ...
     """
     require_choice(frame, FRAMES, "SHRM frame")
-    return "hemisphere" if frame == "normal" else "sphere"
+    if view_fit is None:
+        return "hemisphere" if frame == "normal" else "sphere"
+    require_choice(view_fit, VIEW_FITS, "SHRM view fit")
+    require(
+        view_fit == "sphere" or frame == "normal",
+        "SHRM: view_fit 'hemisphere' needs frame 'normal' (in the reflection frame every view but "
+        "one reaches a texel)",
+    )
+    return view_fit
 
 
 def _view_nodes(P: int, quadrature: int, view_fit: str, view_power: float):
@@ -351,13 +367,7 @@ def brdf_sh_coefficients(
     hemisphere [0.   2.09 0.   0.  ]
     """
     require_choice(frame, FRAMES, "SHRM frame")
-    view_fit = default_view_fit(frame) if view_fit is None else view_fit
-    require_choice(view_fit, VIEW_FITS, "SHRM view fit")
-    require(
-        view_fit == "sphere" or frame == "normal",
-        "SHRM: view_fit 'hemisphere' needs frame 'normal' (in the reflection frame every view but "
-        "one reaches a texel)",
-    )
+    view_fit = default_view_fit(frame, view_fit)
     require(isinstance(F, int) and F >= 0, f"SHRM: F: must be an integer >= 0, got {F!r}")
     require(isinstance(P, int) and P >= 0, f"SHRM: P: must be an integer >= 0, got {P!r}")
     M = min(F, P)

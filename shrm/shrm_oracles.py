@@ -22,8 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from reference.errors import require, require_choice
-from shrm.brdf_sh import FRAMES, VIEW_FIT_RIDGE, VIEW_FITS, default_view_fit
+from reference.errors import require_choice
+from shrm.brdf_sh import FRAMES, VIEW_FIT_RIDGE, default_view_fit
 from shrm.sh import fejer1_weights, sh_basis
 from shrm.shrm import SHRM
 from shrm.transform import project_latlong
@@ -164,7 +164,7 @@ def shrm_texels_angular(
     view_power : float
         The grazing view power k of the SHRM (:func:`shrm.brdf_sh.shrm_brdf_parts`).
     view_fit : {"sphere", "hemisphere"}, optional
-        Default :func:`shrm.brdf_sh.default_view_fit` of the frame.
+        Default and check: :func:`shrm.brdf_sh.default_view_fit`.
 
     Returns
     -------
@@ -184,13 +184,7 @@ def shrm_texels_angular(
     """
     from reference.envmap import latlong_pixel_directions
 
-    require_choice(frame, FRAMES, "SHRM frame")
-    view_fit = default_view_fit(frame) if view_fit is None else view_fit
-    require_choice(view_fit, VIEW_FITS, "SHRM view fit")
-    require(
-        view_fit == "sphere" or frame == "normal",
-        "SHRM: view_fit 'hemisphere' needs frame 'normal'",
-    )
+    view_fit = default_view_fit(frame, view_fit)
     env = env_quadrature(image)
     Hv = 2 * P + 2
     views = latlong_pixel_directions(Hv, 2 * Hv).reshape(-1, 3)
@@ -249,7 +243,7 @@ def shrm_create_angular(
         Cube face size (keep it small: the cost is texels × views × pixels).
     view_power : float
     view_fit : {"sphere", "hemisphere"}, optional
-        Default :func:`shrm.brdf_sh.default_view_fit` of the frame.
+        Default and check: :func:`shrm.brdf_sh.default_view_fit`.
 
     Returns
     -------
