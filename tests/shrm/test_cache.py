@@ -175,9 +175,10 @@ def test_lru_eviction_keeps_recently_used_entries(tmp_path):
     for n in range(3):
         cache.put(_key(n), {"x": np.full(1000, float(n))})
     size = _entry(cache, _key(0)).stat().st_size
-    now = time.time()
+    # the LRU clock is the modification time: set the three entries' in order, in the past
+    epoch = 1_700_000_000
     for n in range(3):
-        os.utime(_entry(cache, _key(n)), (now - 100 + n, now - 100 + n))
+        os.utime(_entry(cache, _key(n)), (epoch + n, epoch + n))
     assert cache.get(_key(0)) is not None  # key 0 becomes the most recently used
     cache.max_bytes = 3 * size + 64  # room for three entries, not four (headers vary by bytes)
     cache.put(_key(3), {"x": np.full(1000, 3.0)})
