@@ -82,7 +82,7 @@ def gather_bilinear_kernel(image, taps, weights, texel, out):
     ``image``: (P, C) flattened pixels; ``taps``, ``weights``: (N, 4); ``texel``: (N,) output rows;
     ``out``: (N, C). The four rows of a texel are read as contiguous channel vectors. Taps sorted
     by input pixel (``reference.cubemap._latlong_taps``) read the input in memory order and write
-    the output through ``texel``, 2× faster on a 41-band map than walking the output in order,
+    the output through ``texel``, faster on a 41-band map than walking the output in order,
     whose taps jump between distant input rows.
     """
     N = out.shape[0]

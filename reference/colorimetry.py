@@ -295,7 +295,7 @@ def spectra_to_XYZ(
     product per block on up to ``threads`` threads (:data:`XYZ_THREADS`); each
     product keeps whatever BLAS threading the process set (the Makefile sets one thread, and
     ``docs/dependencies.md`` says why). The product is memory-bound: a second thread reads the
-    input at nearly twice the rate, while ``np.copyto`` of the same bytes gains only ~8 % from it.
+    input at nearly twice the rate, while ``np.copyto`` of the same bytes gains little from it.
 
     Parameters
     ----------
