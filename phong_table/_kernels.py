@@ -72,7 +72,7 @@ def light_geometry_kernel(position, normal, view, light_position, attenuation, o
 def _interval(nodes, guide, steps, uniform, t):
     """Index i of the interval ``[t_i, t_{i+1}]`` holding ``t`` (``searchsorted`` − 1, clipped).
 
-    Branch-free, so that the pixel loop compiles to conditional moves.
+    Branch-free, so that it compiles to conditional moves.
     """
     m = nodes.size - 1
     if uniform:
@@ -163,11 +163,15 @@ def _parabolic(nodes, values, in_w, a, i, t):
 
 
 @numba.njit(cache=False, inline="always")
-def _write(out, p, ambient_RGB, diffuse_RGB, f_att, cos_theta, r, g, b):
-    """Eq. (7), Wang et al.: ambient + f_att (cos θ · diffuse RGB + specular RGB), pixel ``p``."""
-    out[p, 0] = ambient_RGB[0] + f_att * (cos_theta * diffuse_RGB[0] + r)
-    out[p, 1] = ambient_RGB[1] + f_att * (cos_theta * diffuse_RGB[1] + g)
-    out[p, 2] = ambient_RGB[2] + f_att * (cos_theta * diffuse_RGB[2] + b)
+def _write(out, p, A, D, f_att, cos_theta, r, g, b):
+    """Eq. (7), Wang et al.: ambient + f_att (cos θ · diffuse RGB + specular RGB), pixel ``p``.
+
+    ``A`` and ``D`` are the ambient and diffuse RGB as 3-tuples, read once before the pixel loop
+    (read from arrays in the loop, they are reloaded after every store to ``out``).
+    """
+    out[p, 0] = A[0] + f_att * (cos_theta * D[0] + r)
+    out[p, 1] = A[1] + f_att * (cos_theta * D[1] + g)
+    out[p, 2] = A[2] + f_att * (cos_theta * D[2] + b)
 
 
 @numba.njit(cache=False)
@@ -178,6 +182,8 @@ def shade_exact_kernel(cos_theta, t, f_att, diffuse_RGB, C, n, ambient_RGB, out)
     Eq. (11), Wang et al.); writes ``out`` (N, 3).
     """
     n_bands = n.size
+    A = ambient_RGB[0], ambient_RGB[1], ambient_RGB[2]
+    D = diffuse_RGB[0], diffuse_RGB[1], diffuse_RGB[2]
     for p in range(t.size):
         r = 0.0
         g = 0.0
@@ -202,7 +208,7 @@ def shade_exact_kernel(cos_theta, t, f_att, diffuse_RGB, C, n, ambient_RGB, out)
                     g += C[k, 1]
                     b += C[k, 2]
         # Eq. (7), Wang et al.: ambient + f_att (cos θ · diffuse RGB + specular RGB)
-        _write(out, p, ambient_RGB, diffuse_RGB, f_att[p], cos_theta[p], r, g, b)
+        _write(out, p, A, D, f_att[p], cos_theta[p], r, g, b)
     return out
 
 
@@ -228,37 +234,34 @@ def _shade_table_loop(
     """The pixel loop of :func:`shade_table_kernel` for one lookup and one interpolation."""
     # below ``zero_below`` every interpolation returns exactly 0 (SpecularTable.zero_below); at
     # t = 0 every interpolation returns the first tabulated value exactly (unlit pixels)
-    if code == LINEAR:
-        for p in range(t.size):
-            if t[p] < zero_below:
-                r, g, b = 0.0, 0.0, 0.0
-            elif t[p] == 0.0:
-                r, g, b = values[0, 0], values[0, 1], values[0, 2]
+    A = ambient_RGB[0], ambient_RGB[1], ambient_RGB[2]
+    D = diffuse_RGB[0], diffuse_RGB[1], diffuse_RGB[2]
+    f_0 = values[0, 0], values[0, 1], values[0, 2]
+    in_w = code == PARABOLIC_W
+    # Neighbouring pixels of a raster-ordered G-buffer see nearby t: the interval found last
+    # (``hint``) is tried first, and :func:`_interval` runs only when it does not hold t. A branch,
+    # not a conditional move, so that the CPU runs ahead over pixels that hit; carrying ``hint``
+    # only through the misses keeps numba/LLVM from turning it into a select (measured 2.5x slower).
+    # The interval found does not depend on the pixel order.
+    hint = 0
+    for p in range(t.size):
+        t_p = t[p]
+        if t_p < zero_below:
+            r, g, b = 0.0, 0.0, 0.0
+        elif t_p == 0.0:
+            r, g, b = f_0
+        else:
+            i = hint
+            if not (nodes[i] <= t_p and t_p < nodes[i + 1]):
+                i = _interval(nodes, guide, steps, uniform, t_p)
+                hint = i
+            if code == LINEAR:
+                r, g, b = _linear(nodes, values, inv_width, i, t_p)
+            elif code == MONOTONE:
+                r, g, b = _monotone(nodes, values, inv_width, cubic, i, t_p)
             else:
-                i = _interval(nodes, guide, steps, uniform, t[p])
-                r, g, b = _linear(nodes, values, inv_width, i, t[p])
-            _write(out, p, ambient_RGB, diffuse_RGB, f_att[p], cos_theta[p], r, g, b)
-    elif code == MONOTONE:
-        for p in range(t.size):
-            if t[p] < zero_below:
-                r, g, b = 0.0, 0.0, 0.0
-            elif t[p] == 0.0:
-                r, g, b = values[0, 0], values[0, 1], values[0, 2]
-            else:
-                i = _interval(nodes, guide, steps, uniform, t[p])
-                r, g, b = _monotone(nodes, values, inv_width, cubic, i, t[p])
-            _write(out, p, ambient_RGB, diffuse_RGB, f_att[p], cos_theta[p], r, g, b)
-    else:
-        in_w = code == PARABOLIC_W
-        for p in range(t.size):
-            if t[p] < zero_below:
-                r, g, b = 0.0, 0.0, 0.0
-            elif t[p] == 0.0:
-                r, g, b = values[0, 0], values[0, 1], values[0, 2]
-            else:
-                i = _interval(nodes, guide, steps, uniform, t[p])
-                r, g, b = _parabolic(nodes, values, in_w, a, i, t[p])
-            _write(out, p, ambient_RGB, diffuse_RGB, f_att[p], cos_theta[p], r, g, b)
+                r, g, b = _parabolic(nodes, values, in_w, a, i, t_p)
+        _write(out, p, A, D, f_att[p], cos_theta[p], r, g, b)
 
 
 @numba.njit(cache=False)
@@ -288,7 +291,7 @@ def shade_table_kernel(
     there) skip the lookup, as the exact kernel skips the bands whose ``t^n`` underflows; the
     result is the same to the bit.
     """
-    # one loop per lookup and interpolation, so that each compiles without a branch per pixel
+    # one loop per lookup (uniform or not), so that neither tests the table kind per pixel
     if uniform:
         _shade_table_loop(
             cos_theta,

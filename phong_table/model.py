@@ -229,6 +229,11 @@ class SpectralPhong:
         ``I_a k_a`` in RGB (zeros without an ambient light).
     n : ndarray, shape (n_bands,)
         The exponents.
+    n_distinct : ndarray, shape (n_distinct,)
+        The distinct exponents, increasing.
+    specular_weights_distinct : ndarray, shape (n_distinct, 3)
+        ``C`` summed over the bands of each distinct exponent: ``Σ_λ C(λ) t^{n(λ)}`` is the same
+        sum over fewer powers (the table build's; the exact baseline keeps one power per band).
 
     Raises
     ------
@@ -241,6 +246,8 @@ class SpectralPhong:
     >>> model = SpectralPhong(m, PointLight((0.0, 0.0, 5.0)))
     >>> model.diffuse_RGB.round(3), model.specular(np.array([1.0])).round(3)
     (array([0.5, 0.5, 0.5]), array([[0.25, 0.25, 0.25]]))
+    >>> model.n_distinct, model.specular_weights_distinct.round(3)
+    (array([10.]), array([[0.25, 0.25, 0.25]]))
     """
 
     material: PhongMaterial
@@ -254,6 +261,8 @@ class SpectralPhong:
     diffuse_RGB: np.ndarray = field(init=False, repr=False)
     specular_weights: np.ndarray = field(init=False, repr=False)
     ambient_RGB: np.ndarray = field(init=False, repr=False)
+    n_distinct: np.ndarray = field(init=False, repr=False)
+    specular_weights_distinct: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self):
         m = self.material
@@ -283,6 +292,10 @@ class SpectralPhong:
             "specular_weights": specular_RGB_weights(m.k_s, M, self.light.intensity),
             "ambient_RGB": ambient,
         }
+        # Eq. (11), Wang et al., with the terms of equal exponents merged: Σ_{λ: n(λ) = ν} C(λ)
+        values["n_distinct"], band_of = np.unique(m.n, return_inverse=True)
+        values["specular_weights_distinct"] = np.zeros((values["n_distinct"].size, 3))
+        np.add.at(values["specular_weights_distinct"], band_of, values["specular_weights"])
         for key, value in values.items():
             value = np.ascontiguousarray(value, dtype=np.float64)
             value.setflags(write=False)

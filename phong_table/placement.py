@@ -393,7 +393,9 @@ def _table_error_compiled(
     def place(t_lo, t_hi, m):
         t_fine = t_lo + (t_hi - t_lo) * _FINE_GRID
         floor = ERROR_DENSITY_FLOOR / (t_hi - t_lo)
-        return _kernels.table_error_kernel(t_fine, model.specular_weights, model.n, m, floor)
+        # the same f_sp with one power per distinct exponent (SpectralPhong.n_distinct)
+        C, n = model.specular_weights_distinct, model.n_distinct
+        return _kernels.table_error_kernel(t_fine, C, n, m, floor)
 
     return place_seen(place, m, t_range)
 

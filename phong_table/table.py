@@ -317,9 +317,9 @@ def build_table(
         "entries",
     )
     make = _kernels.tabulate_kernel if compiled else tabulate
-    values, slopes, inv_width, cubic, guide, steps = make(
-        nodes, material.specular_weights, material.n, GUIDE_CELLS_PER_ENTRY
-    )
+    # Eq. (11), Wang et al. at the nodes, one power per distinct exponent (the same sum)
+    C, n = material.specular_weights_distinct, material.n_distinct
+    values, slopes, inv_width, cubic, guide, steps = make(nodes, C, n, GUIDE_CELLS_PER_ENTRY)
     return SpecularTable(
         nodes=nodes,
         values=values,

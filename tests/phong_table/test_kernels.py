@@ -57,6 +57,27 @@ def test_table_kernel_on_exact_node_hits():
         )
 
 
+@pytest.mark.parametrize("placement", PLACEMENT_METHODS.names())
+def test_table_kernel_does_not_depend_on_pixel_order(placement):
+    # The kernel tries the previous pixel's interval first; in any pixel order (raster, sorted,
+    # reversed, random, and alternating between the ends) each pixel finds its own interval.
+    from phong_table.render import ShadingBuffer
+
+    model = SCENES.lookup("R3").build()
+    table = build_table(model, 64, placement)
+    rng = np.random.default_rng(4)
+    raster = shading_buffer(sphere_gbuffer("near", 32), model, False).t
+    ends = np.ravel(np.column_stack([np.linspace(0.7, 1.0, 500), np.linspace(1.0, 0.7, 500)]))
+    orders = [raster, np.sort(raster), np.sort(raster)[::-1], rng.permutation(raster), ends]
+    for t in orders:
+        buffer = ShadingBuffer(None, np.full(t.size, 0.5), t, np.ones(t.size))
+        for interpolation in INTERPOLATION_METHODS.names():
+            expected = table.lookup(t, interpolation)
+            RGB = shade_pixels(buffer, model, "table", table, interpolation)
+            _close(RGB, shade_pixels(buffer, model, "table", table, interpolation, compiled=False))
+            _close((RGB - model.ambient_RGB) - 0.5 * model.diffuse_RGB, expected)
+
+
 @pytest.mark.parametrize("scene", ["R3", "n2000"])
 def test_table_kernel_skips_only_where_every_interpolation_is_zero(scene):
     # High exponents: t^n underflows below ~0.6-0.7, so the table's leading values are exactly 0.
