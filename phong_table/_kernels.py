@@ -427,16 +427,20 @@ def tabulate_kernel(nodes, C, n, cells_per_entry):
 
 
 @numba.njit(cache=False)
-def table_error_kernel(t_fine, C, n, entries, floor):
+def table_error_kernel(t_fine, C, n, entries, floor, p):
     """Nodes that equidistribute the interpolation error of the true ``f_sp``.
 
     Twin of ``phong_table.placement.table_error``; one ``exp`` per band and fine point gives both
-    ``t^{n−3}`` and ``t^{n−2} = t · t^{n−3}`` (Eq. (11), Wang et al., differentiated).
+    ``t^{n−3}`` and ``t^{n−2} = t · t^{n−3}`` (Eq. (11), Wang et al., differentiated). ``p`` is
+    the pixel density at the fine grid's midpoints (size 0: none).
     """
     F = t_fine.size
     n_bands = n.size
+    weighted = p.size > 0
     rho2 = np.zeros(F - 1)
     rho3 = np.zeros(F - 1)
+    rho2p = np.zeros(F - 1)
+    rho3p = np.zeros(F - 1)
     for q in range(F - 1):
         t = 0.5 * (t_fine[q] + t_fine[q + 1])
         log_t = math.log(t)
@@ -460,21 +464,30 @@ def table_error_kernel(t_fine, C, n, entries, floor):
             d3r += C[k, 0] * a3
             d3g += C[k, 1] * a3
             d3b += C[k, 2] * a3
-        rho2[q] = math.sqrt(max(abs(d2r), abs(d2g), abs(d2b)))
-        rho3[q] = np.cbrt(max(abs(d3r), abs(d3g), abs(d3b)))
-    # normalise each density, take the larger, add the floor, integrate (Notes of table_error)
-    mass2 = 0.0
-    mass3 = 0.0
+        f2 = max(abs(d2r), abs(d2g), abs(d2b))
+        f3 = max(abs(d3r), abs(d3g), abs(d3b))
+        # largest error: |f^(k)|^(1/k); pixels' mean square error: (p |f^(k)|²)^(1/(2k+1))
+        rho2[q] = math.sqrt(f2)
+        rho3[q] = np.cbrt(f3)
+        if weighted:
+            rho2p[q] = (p[q] * f2 * f2) ** (1.0 / 5.0)
+            rho3p[q] = (p[q] * f3 * f3) ** (1.0 / 7.0)
+    # normalise each density, take the largest, add the floor, integrate (Notes of table_error)
+    mass2, mass3, mass2p, mass3p = 0.0, 0.0, 0.0, 0.0
     for q in range(F - 1):
         h = t_fine[q + 1] - t_fine[q]
         mass2 += rho2[q] * h
         mass3 += rho3[q] * h
+        mass2p += rho2p[q] * h
+        mass3p += rho3p[q] * h
     rho = np.zeros(F - 1)
     mass = 0.0
     for q in range(F - 1):
         r2 = rho2[q] / mass2 if mass2 > 0.0 else 0.0
         r3 = rho3[q] / mass3 if mass3 > 0.0 else 0.0
-        rho[q] = max(r2, r3)
+        r2p = rho2p[q] / mass2p if mass2p > 0.0 else 0.0
+        r3p = rho3p[q] / mass3p if mass3p > 0.0 else 0.0
+        rho[q] = max(r2, r3, r2p, r3p)
         mass += rho[q] * (t_fine[q + 1] - t_fine[q])
     cdf = np.zeros(F)
     for q in range(F - 1):

@@ -27,6 +27,7 @@ import numpy as np
 from phong_table import _kernels
 from phong_table.interpolation import INTERPOLATION_METHODS
 from phong_table.model import SpectralPhong
+from phong_table.placement import pixel_density
 from phong_table.scenes import SPHERE, view_camera
 from phong_table.table import SpecularTable, build_table, check_interpolation, tabulate
 from reference.camera import MAX_RESOLUTION
@@ -186,6 +187,22 @@ class ShadingBuffer:
         """
         lit = self.t[self.t > 0.0]
         return (float(lit.min()), float(lit.max())) if lit.size else None
+
+    @cached_property
+    def t_density(self) -> np.ndarray | None:
+        """The lit pixels' density in ``t`` over :attr:`t_range` (``build_table(..., t_density=)``).
+
+        ``phong_table.placement.pixel_density``: pixels per unit ``t`` on 64 uniform cells,
+        integrating to 1; None when :attr:`t_range` is None or a single ``t``.
+
+        Examples
+        --------
+        >>> buffer = ShadingBuffer(None, np.ones(4), np.array([0.0, 0.5, 0.6, 0.9]), np.ones(4))
+        >>> density = buffer.t_density
+        >>> density.shape, float(density.sum() * (0.9 - 0.5) / density.size)
+        ((64,), 1.0)
+        """
+        return pixel_density(self.t, self.t_range)
 
 
 def shading_buffer(
@@ -489,7 +506,13 @@ def render_sphere(
     table = None
     if method == "table":
         table = build_table(
-            material, entries, placement, segments, compiled=compiled, t_range=buffer.t_range
+            material,
+            entries,
+            placement,
+            segments,
+            compiled=compiled,
+            t_range=buffer.t_range,
+            t_density=buffer.t_density,
         )
         check_interpolation(interpolation, table.entries)
     pixels = shade_pixels(buffer, material, method, table, interpolation, compiled)

@@ -252,6 +252,7 @@ def build_table(
     segments: int | None = None,
     compiled: bool = False,
     t_range=None,
+    t_density=None,
 ) -> SpecularTable:
     """Tabulate the specular functions of a material: place nodes, evaluate, precompute lookups.
 
@@ -275,6 +276,9 @@ def build_table(
         The range of ``t`` over the frame's lit pixels (``ShadingBuffer.t_range``), for the
         placements that read it (``error``: ``phong_table.placement.seen_interval``); the paper's
         placements ignore it. The table still covers [0, 1].
+    t_density : ndarray, optional
+        The frame's pixel density in ``t`` over ``t_range`` (``ShadingBuffer.t_density``), for
+        the same placements (``error`` also equidistributes the pixels' RMS error).
 
     Returns
     -------
@@ -309,7 +313,9 @@ def build_table(
     )
     m, p = check_entries(entries, segments, f"{placement} table")
     place = method.extra.get("compiled", method.reference) if compiled else method.reference
-    seen = {"t_range": t_range} if method.extra.get("t_range") and t_range is not None else {}
+    seen = {}
+    if method.extra.get("t_range") and t_range is not None:
+        seen = {"t_range": t_range, "t_density": t_density}
     nodes = np.ascontiguousarray(place(material, m, p, **seen), dtype=np.float64)
     require(
         nodes[0] == 0.0 and nodes[-1] == 1.0 and bool((np.diff(nodes) > 0).all()),

@@ -176,8 +176,9 @@ def table_error_row(
     (True, 0.0)
     """
     check_interpolation(interpolation, entries)
+    buffer = state.buffer
     table = build_table(
-        state.model, entries, placement, segments, state.compiled, state.buffer.t_range
+        state.model, entries, placement, segments, state.compiled, buffer.t_range, buffer.t_density
     )
     RGB = shade_pixels(
         state.buffer, state.model, "table", table, interpolation, compiled=state.compiled
@@ -280,9 +281,10 @@ def time_row(state: ViewState, row: dict, exact_shade_s: float, shared_s: float,
     """
     args = (state.model, row["entries"], row["placement"], row["segments"])
     compiled = state.compiled
-    t_range = state.buffer.t_range  # a property of the cached G-buffer, like t itself
-    build_s = _minimum_time(lambda: build_table(*args, compiled, t_range), repeats)
-    table = build_table(*args, compiled, t_range)
+    # properties of the cached G-buffer, like t itself
+    seen = (state.buffer.t_range, state.buffer.t_density)
+    build_s = _minimum_time(lambda: build_table(*args, compiled, *seen), repeats)
+    table = build_table(*args, compiled, *seen)
     shade_s = build_s + time_shading(state, table, row["interpolation"], repeats)
     row.update(
         build_s=build_s,

@@ -31,10 +31,11 @@ def test_table(benchmark, scene, view, placement, interpolation):
     model, buffer, out = _setup(scene, view)
     benchmark.group = f"phong {scene} {view}"
 
-    t_range = buffer.t_range  # a property of the cached G-buffer (computed once, like t)
+    # properties of the cached G-buffer (computed once, like t)
+    seen = {"t_range": buffer.t_range, "t_density": buffer.t_density}
 
     def run():
-        table = build_table(model, 200, placement, compiled=True, t_range=t_range)
+        table = build_table(model, 200, placement, compiled=True, **seen)
         return compiled_shader(model, table, interpolation)(buffer, out)
 
     run()
@@ -45,7 +46,8 @@ def test_table(benchmark, scene, view, placement, interpolation):
 def test_lookup_index(benchmark, method):
     # the index method for non-uniform tables: np.searchsorted against the kernel's guide index
     model, buffer, out = _setup("R1", "near")
-    table = build_table(model, 200, "error", compiled=True, t_range=buffer.t_range)
+    seen = {"t_range": buffer.t_range, "t_density": buffer.t_density}
+    table = build_table(model, 200, "error", compiled=True, **seen)
     benchmark.group = "phong lookup R1 near"
     if method == "binary search":
         benchmark(interval_index, table.nodes, buffer.t)

@@ -105,6 +105,41 @@ def test_seen_range_nodes_are_monotone_sized_and_twins_agree(t_range, entries):
     np.testing.assert_allclose(compiled, nodes, rtol=0, atol=1e-12)
 
 
+@pytest.mark.parametrize("view", ["far", "near"])
+def test_pixel_weighted_nodes_twins_agree_and_follow_the_pixels(view):
+    from phong_table.placement import pixel_density
+    from phong_table.render import shading_buffer, sphere_gbuffer
+
+    model = SCENES.lookup("R1").build()
+    buffer = shading_buffer(sphere_gbuffer(view, 64), model)
+    t_range, t_density = buffer.t_range, buffer.t_density
+    np.testing.assert_array_equal(t_density, pixel_density(buffer.t, t_range))
+    nodes = table_error(model, 50, t_range=t_range, t_density=t_density)
+    compiled = PLACEMENT_METHODS.lookup("error").extra["compiled"]
+    np.testing.assert_allclose(
+        compiled(model, 50, t_range=t_range, t_density=t_density), nodes, rtol=0, atol=1e-12
+    )
+    assert nodes[0] == 0.0
+    assert nodes[-1] == 1.0
+    assert (np.diff(nodes) > 0).all()
+    # more nodes where more pixels are: a density that is all in the upper half of the range
+    # moves nodes up against one all in the lower half
+    lo, hi = t_range
+    upper = np.r_[np.zeros(32), np.ones(32)] * 2 / (hi - lo)
+    lower = upper[::-1].copy()
+    up = table_error(model, 50, t_range=t_range, t_density=upper)
+    down = table_error(model, 50, t_range=t_range, t_density=lower)
+    middle = 0.5 * (lo + hi)
+    assert (up > middle).sum() > (down > middle).sum()
+
+
+def test_bad_pixel_density():
+    with pytest.raises(SpecrefError, match="t_density: must be >= 0"):
+        table_error(constant_material(10.0), 10, t_range=(0.2, 0.7), t_density=[1.0, -1.0])
+    with pytest.raises(SpecrefError, match="t_density: must be >= 0"):
+        table_error(constant_material(10.0), 10, t_density=[1.0])
+
+
 def test_bad_seen_range():
     with pytest.raises(SpecrefError, match="t_range: must be 0 <= t_lo <= t_hi <= 1"):
         table_error(constant_material(10.0), 10, t_range=(0.7, 0.2))

@@ -103,9 +103,8 @@ def run(ctx: ReportContext) -> SectionResult:
                     for m in ladder:
                         r = table_error_row(state, placement, interpolation, m, segments(m))
                         records.append({"scene": scene, "view": view, **r})
-                        table = build_table(
-                            model, m, placement, r["segments"], compiled, state.buffer.t_range
-                        )
+                        seen = (state.buffer.t_range, state.buffer.t_density)
+                        table = build_table(model, m, placement, r["segments"], compiled, *seen)
                         shade_s = time_shading(state, table, interpolation, repeats)
                         nonfinite += int(not np.isfinite(r["rms"]))
                         points.append((shade_s, _floor(r["rms"])))
