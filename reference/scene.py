@@ -58,6 +58,7 @@ __all__ = [
     "check_render_size",
     "load_scene",
     "loads_scene",
+    "parse_spectral",
     "scene_from_dict",
 ]
 
@@ -284,7 +285,17 @@ def _is_count(value) -> bool:
 # -------------------------------------------------------------------------------------
 
 
-def _parse_spectral(reader: SceneReader, data: dict) -> tuple[SpectralGrid, str, str]:
+def parse_spectral(reader: SceneReader, data: dict) -> tuple[SpectralGrid, str, str]:
+    """The ``[spectral]`` table of a file: wavelength grid, observer and band-weight method.
+
+    Scenes and ``specref phong`` material files share it (``docs/scene-format.md``).
+
+    Examples
+    --------
+    >>> grid, observer, method = parse_spectral(SceneReader("s.toml"), {"spectral": {"grid": "31"}})
+    >>> grid.n_bands, method
+    (31, 'astm_e308')
+    """
     key = "spectral"
     table = reader.table(
         data.get(key, {}),
@@ -466,7 +477,7 @@ def scene_from_dict(data: dict, file: str = "<string>", base_dir=".", path=None)
     title = reader.string(data.get("title", "untitled"), "title")
     if "description" in data:
         reader.string(data["description"], "description")
-    grid, observer, method = _parse_spectral(reader, data)
+    grid, observer, method = parse_spectral(reader, data)
     reader.grid = grid
 
     materials_table = reader.table(data.get("materials", {}), "materials")

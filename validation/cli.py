@@ -335,7 +335,11 @@ def _add_phong_parser(sub) -> None:
         "[--json FILE]",
     )
     p.add_argument("action", nargs="?", choices=["table1"], help="reproduce Table 1")
-    p.add_argument("--material", metavar="FILE.toml", help="a material file (docs/phong-tables.md)")
+    p.add_argument(
+        "--material",
+        metavar="FILE.toml",
+        help="a material file (docs/scene-format.md, Phong material files)",
+    )
     p.add_argument("--view", default="far", help="far (whole sphere) or near (the highlight)")
     p.add_argument("--entries", type=int, default=200, help="table entries m (default 200)")
     p.add_argument("--placement", default="error", help="uniform, importance or error")

@@ -16,7 +16,19 @@ def _write(tmp_path, text):
     [
         ("[material]\nk_d = 0.2\nk_s = 0.5\nn = -3\n", [], "material.n: must be >= 0"),
         ("[material]\nk_d = 0.2\nk_s = 0.5\nn = nan\n", [], "must be finite"),
-        ("[material]\nk_d = [0.1, 0.2]\nk_s = 0.5\nn = 3\n", [], "must have 41 values"),
+        (
+            "[material]\nk_d = { wavelengths = [400, 500, 600], values = [0.1, 0.2] }\n"
+            "k_s = 0.5\nn = 3\n",
+            [],
+            "material.k_d: 3 wavelengths but 2 values",
+        ),
+        ("[material]\nk_d = [0.1, 0.2]\nk_s = 0.5\nn = 3\n", [], "must be a number or a spectrum"),
+        (
+            '[material]\nk_d = 0.2\nk_s = { illuminant = "D65", scale = -1 }\nn = 3\n',
+            [],
+            "material.k_s: unknown key 'scale'",
+        ),
+        ('[spectral]\ngrid = "40"\n[material]\nk_d = 0.2\nk_s = 0.5\nn = 3\n', [], "spectral.grid"),
         (
             "[material]\nk_d = 0.2\nk_s = 0.5\nn = 3\n",
             ["--interp", "parabolic", "--entries", "2"],
@@ -37,7 +49,7 @@ def _write(tmp_path, text):
             ["--interp", "cubic"],
             "unknown interpolation 'cubic'",
         ),
-        ("[material]\nk_d = 0.2\nk_s = 0.5\n", [], "material.n: missing"),
+        ("[material]\nk_d = 0.2\nk_s = 0.5\n", [], "material: missing key 'n'"),
         ("[material]\nk_d = 0.2\nk_s = 0.5\nn = 3\ncolour = 1\n", [], "unknown key 'colour'"),
     ],
 )
@@ -111,3 +123,25 @@ def test_material_command_writes_json(tmp_path):
 
 def test_phong_without_action_or_material_exits_2(capsys):
     assert main(["phong"]) == 2
+
+
+def test_material_files_take_the_spectra_of_scenes(tmp_path):
+    # the forms of reference.scene_values.SPECTRUM_FORMS and the [spectral] table, as in scenes
+    from phong_table.materialfile import load_material_file
+    from reference.scene_values import SceneReader
+
+    text = (
+        '[spectral]\ngrid = "31"\n'
+        '[material]\nk_d = { colorchecker = "dark skin" }\nk_s = { constant = 0.3 }\n'
+        "n = { wavelengths = [400, 700], values = [10, 2000] }\n"
+        '[light]\nspectrum = { illuminant = "FL2" }\n'
+    )
+    model = load_material_file(_write(tmp_path, text))
+    reader = SceneReader("s.toml", grid=model.grid)
+    assert model.grid.n_bands == 31
+    assert model.material.k_d == pytest.approx(
+        reader.spectrum_on_grid({"colorchecker": "dark skin"}, "k_d")
+    )
+    assert model.material.n[0] == 10.0
+    assert model.material.n[-1] == 2000.0
+    assert model.light.spectrum.name == "illuminant:FL2"
