@@ -110,3 +110,17 @@ def test_tabulate_kernel_equals_numpy():
         assert a[5] == b[5]
         assert np.abs(a[4] - b[4]).max() <= 1  # the index may differ at a cell edge by rounding
     assert tabulate is entry.reference
+
+
+@pytest.mark.parametrize("scene", ["R1", "R2", "R3", "bimodal"])
+def test_merged_exponents_give_the_same_table(scene):
+    # build_table sums the weights of equal exponents (SpectralPhong.n_distinct): the same f_sp
+    model = SCENES.lookup(scene).build()
+    assert model.n_distinct.size == np.unique(model.n).size
+    np.testing.assert_allclose(
+        model.specular_weights_distinct.sum(axis=0), model.specular_weights.sum(axis=0), rtol=1e-14
+    )
+    for compiled in (False, True):
+        table = build_table(model, 64, "error", compiled=compiled)
+        exact = model.specular(table.nodes)
+        np.testing.assert_allclose(table.values, exact, rtol=1e-13, atol=1e-300)
