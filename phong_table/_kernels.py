@@ -240,9 +240,10 @@ def _shade_table_loop(
     in_w = code == PARABOLIC_W
     # Neighbouring pixels of a raster-ordered G-buffer see nearby t: the interval found last
     # (``hint``) is tried first, and :func:`_interval` runs only when it does not hold t. A branch,
-    # not a conditional move, so that the CPU runs ahead over pixels that hit; carrying ``hint``
-    # only through the misses keeps numba/LLVM from turning it into a select (measured 2.5x slower).
-    # The interval found does not depend on the pixel order.
+    # not a conditional move, so that the CPU runs ahead over pixels that hit. ``hint`` changes only
+    # on a miss: reassigned on every pixel (``i = near(..., i)``), the loop ran 2.5x slower, we
+    # think because numba/LLVM then made the test a select. The interval found does not depend on
+    # the pixel order.
     hint = 0
     for p in range(t.size):
         t_p = t[p]

@@ -24,7 +24,7 @@ tables, with an inverse-map index (:func:`guide_index`): ``K = 16 m`` uniform ce
 storing the first and last interval it overlaps, then a fixed number of branch-free halvings
 inside the cell, ``O(log(nodes per cell))``. Before either, the kernel tries the interval the
 previous pixel found: pixels of a raster-ordered G-buffer see nearby ``t``, and on the scenes'
-views 90-95 % of the lookups end there, with one comparison.
+views most lookups end there, with one comparison.
 
 References
 ----------
