@@ -428,12 +428,13 @@ def tabulate_kernel(nodes, C, n, cells_per_entry):
 
 
 @numba.njit(cache=False)
-def table_error_kernel(t_fine, C, n, entries, floor, p):
+def table_error_kernel(t_fine, C, n, entries, floor, p, hedge):
     """Nodes that equidistribute the interpolation error of the true ``f_sp``.
 
     Twin of ``phong_table.placement.table_error``; one ``exp`` per band and fine point gives both
     ``t^{n−3}`` and ``t^{n−2} = t · t^{n−3}`` (Eq. (11), Wang et al., differentiated). ``p`` is
-    the pixel density at the fine grid's midpoints (size 0: none).
+    the pixel density at the fine grid's midpoints (size 0: none); with it, the max-norm densities
+    enter at the weight ``hedge``.
     """
     F = t_fine.size
     n_bands = n.size
@@ -488,7 +489,7 @@ def table_error_kernel(t_fine, C, n, entries, floor, p):
         r3 = rho3[q] / mass3 if mass3 > 0.0 else 0.0
         r2p = rho2p[q] / mass2p if mass2p > 0.0 else 0.0
         r3p = rho3p[q] / mass3p if mass3p > 0.0 else 0.0
-        rho[q] = max(r2, r3, r2p, r3p)
+        rho[q] = max(hedge * r2, hedge * r3, r2p, r3p) if weighted else max(r2, r3)
         mass += rho[q] * (t_fine[q + 1] - t_fine[q])
     cdf = np.zeros(F)
     for q in range(F - 1):

@@ -35,6 +35,7 @@ from reference.registry import Method, Registry
 
 __all__ = [
     "ERROR_DENSITY_FLOOR",
+    "ERROR_HEDGE",
     "MAX_ENTRIES",
     "PIXEL_DENSITY_CELLS",
     "PLACEMENT_METHODS",
@@ -59,6 +60,10 @@ MAX_ENTRIES = 1_000_000
 ERROR_DENSITY_FLOOR = 0.1
 #: Uniform cells over the seen range on which :func:`pixel_density` counts the frame's pixels.
 PIXEL_DENSITY_CELLS = 64
+#: Weight of the max-norm densities of :func:`table_error` when the pixels' density is given: they
+#: hedge against a sparse or noisy pixel histogram and take over only where they ask for more
+#: than ``1/ERROR_HEDGE`` times the pixel-weighted density.
+ERROR_HEDGE = 0.5
 
 
 def check_entries(entries, segments=None, where: str = "table") -> tuple[int, int | None]:
@@ -381,7 +386,7 @@ def table_error(
     One node set serves the three channels and every interpolation: the density is the larger of
     the normalised ``max_c |f_c''|^{1/2}`` and ``max_c |f_c'''|^{1/3}`` (``c`` over R, G, B; each
     channel's error is in the same display units), which costs each interpolation at most half its
-    own optimal nodes (a quarter with the pixel-weighted densities below). A floor keeps
+    own optimal nodes. A floor keeps
     intervals bounded where the derivative vanishes (zero crossings of ``f^(k)``, ``n(λ) ≤ 1``):
     ``ρ = ρ_error/∫ρ_error + floor``.
 
@@ -399,10 +404,11 @@ def table_error(
     |f^(k)|² ρ^(−2k) dt``, which under ``∫ρ = m`` is smallest (a Lagrange multiplier) for ``ρ ∝
     (p |f^(k)|²)^{1/(2k+1)}``. Pixels bunch where the view sees the highlight (the near view has
     most of its pixels at ``t > 0.9``), where the max-norm density alone puts too few nodes. The
-    density is then the largest of the four normalised densities (``k = 2, 3``, max-norm and
-    pixel-weighted), so that no criterion gets less than a quarter of the nodes; the max-norm terms
-    bound the error where few pixels are. ``tests/validation/test_phong.py`` checks the result
-    against uniform and importance tables on measured materials.
+    density is then the largest of the four normalised densities (``k = 2, 3``, pixel-weighted,
+    and max-norm at the weight :data:`ERROR_HEDGE`): the pixel-weighted ones lead, and the
+    max-norm ones take over only where they ask for more than twice as many nodes, which guards
+    against a histogram of few pixels (a small frame). ``tests/validation/test_phong.py`` checks
+    the result against uniform and importance tables on measured materials.
 
     The derivatives are evaluated at the midpoints of the fine grid, the density integrated there,
     and the cumulative density inverted at ``q/m`` by linear interpolation. The compiled twin is
@@ -460,13 +466,13 @@ def _error_nodes(model: SpectralPhong, m: int, floor: float, t_fine, p):
         f_k = np.abs(model.specular_derivative(t_mid, k)).max(axis=-1)
         # the largest error c_k h^k |f^(k)| is equidistributed by |f^(k)|^(1/k); the pixels'
         # mean square error Σ p (c_k h^k f^(k))² by (p |f^(k)|²)^(1/(2k+1)) (Notes)
-        densities = [f_k ** (1.0 / k)]
+        densities = [(f_k ** (1.0 / k), ERROR_HEDGE if p.size else 1.0)]
         if p.size:
-            densities.append((p * f_k * f_k) ** (1.0 / (2 * k + 1)))
-        for rho_k in densities:
+            densities.append(((p * f_k * f_k) ** (1.0 / (2 * k + 1)), 1.0))
+        for rho_k, weight in densities:
             mass = (rho_k * h).sum()
             if mass > 0:
-                rho = np.maximum(rho, rho_k / mass)
+                rho = np.maximum(rho, weight * rho_k / mass)
     mass = (rho * h).sum()
     # the floor keeps its share of the nodes whatever the width of the seen interval
     rho = (rho / mass if mass > 0 else rho) + floor / (t_hi - t_lo)
@@ -488,7 +494,7 @@ def _table_error_compiled(
         t_fine = t_lo + (t_hi - t_lo) * _FINE_GRID
         floor = ERROR_DENSITY_FLOOR / (t_hi - t_lo)
         p = _pixel_weight(0.5 * (t_fine[1:] + t_fine[:-1]), t_range, t_density)
-        return _kernels.table_error_kernel(t_fine, C, n, m, floor, p)
+        return _kernels.table_error_kernel(t_fine, C, n, m, floor, p, ERROR_HEDGE)
 
     return place_seen(place, m, t_range)
 

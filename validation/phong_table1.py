@@ -241,18 +241,19 @@ def table1_targets(
             table_error_row(bimodal, "importance", interpolation, m, m)["rms"] for m in (200, 800)
         ]
         err = [table_error_row(bimodal, "error", interpolation, m)["rms"] for m in (200, 800)]
+        # the paper's failure mode is its parabola; the monotone figures are reported (INFO)
         gate = interpolation == "parabolic"
         add(
             f"bimodal 5/500, importance p = m, RMS(800)/RMS(200), {interpolation}",
             _ratio(imp[1], imp[0]),
             0.5,
-            imp[1] >= 0.5 * imp[0] or not gate,
+            imp[1] >= 0.5 * imp[0] if gate else None,
         )
         add(
             f"bimodal 5/500, error placement RMS(200)/RMS(800), {interpolation}",
             _ratio(err[0], err[1]),
             30.0,
-            err[0] >= 30.0 * err[1] or not gate,
+            err[0] >= 30.0 * err[1] if gate else None,
         )
     tick()
     return checks

@@ -62,7 +62,9 @@ def test_seen_range_wins_where_the_whole_range_placement_lost(shared_data):
             whole = build_table(state.model, m, "error", compiled=True)
             rgb = shade_pixels(state.buffer, state.model, "table", whole, interpolation)
             whole_rms = max(rms_8bit(rgb, state.exact, exact_encoded=state.exact_encoded))
-            assert seen <= importance < whole_rms, (interpolation, m, seen, importance, whole_rms)
+            # never worse within the target's 1e-6 (8-bit units; at m = 100 all three are ~1e-6)
+            assert seen <= importance + 1e-6, (interpolation, m, seen, importance)
+            assert importance < whole_rms, (interpolation, m, importance, whole_rms)
 
 
 @pytest.mark.parametrize("scene", ["R1", "R2", "R3"])
