@@ -242,13 +242,20 @@ def hybrid_error_estimates(
     >>> bool(e_fis[0] < e_pl[0]), bool(e_fis[1] > e_pl[1])
     (True, True)
     """
+    shape, _, I_fis, e_pl, e_fis = _evaluate(
+        points, normals, views, alpha, light, lights, n_samples, visibility, backend
+    )
+    scale = np.maximum(np.abs(I_fis.mean(axis=-1)), 1e-300)
+    return (e_pl / scale).reshape(shape), (e_fis / scale).reshape(shape)
+
+
+def _evaluate(points, normals, views, alpha, light, lights, n_samples, visibility, backend):
+    # the inputs of the public hybrid functions, checked and flattened, through _hybrid_parts
     P, N, V, a, shape = _flat(points, normals, views, alpha)
     K = require_positive_int(n_samples, "hybrid: n_samples", 1 << 20)
     require(K >= 2, f"hybrid: n_samples: must be >= 2 (the error estimate uses K/2), got {K}")
     vis = _visibility(visibility, shape, P.shape[0], len(lights.regions))
-    _, I_fis, e_pl, e_fis = _hybrid_parts(P, N, V, a, light, lights, K, vis, backend)
-    scale = np.maximum(np.abs(I_fis.mean(axis=-1)), 1e-300)
-    return (e_pl / scale).reshape(shape), (e_fis / scale).reshape(shape)
+    return (shape, *_hybrid_parts(P, N, V, a, light, lights, K, vis, backend))
 
 
 def _visibility(visibility, shape, n_points, n_lights):
@@ -295,11 +302,9 @@ def specular_hybrid_parts(
     >>> sorted(parts), bool(0.0 <= parts["w_point_lights"] <= 1.0)
     (['e_fis', 'e_point_lights', 'fis', 'hybrid', 'point_lights', 'w_point_lights'], True)
     """
-    P, N, V, a, shape = _flat(points, normals, views, alpha)
-    K = require_positive_int(n_samples, "hybrid: n_samples", 1 << 20)
-    require(K >= 2, f"hybrid: n_samples: must be >= 2 (the error estimate uses K/2), got {K}")
-    vis = _visibility(visibility, shape, P.shape[0], len(lights.regions))
-    I_pl, I_fis, e_pl, e_fis = _hybrid_parts(P, N, V, a, light, lights, K, vis, backend)
+    shape, I_pl, I_fis, e_pl, e_fis = _evaluate(
+        points, normals, views, alpha, light, lights, n_samples, visibility, backend
+    )
     total = e_pl**2 + e_fis**2
     # Inverse-variance weights; where both errors vanish the two estimates agree: take FIS.
     w_pl = np.where(total > 0, e_fis**2 / np.where(total > 0, total, 1.0), 0.0)
