@@ -14,7 +14,16 @@ import pytest
 from reference.registry import Method, Registry
 
 ROOT = Path(__file__).resolve().parents[1]
-PACKAGES = ("reference", "phong_table", "shrm", "validation")
+PACKAGES = ("reference", "phong_table", "shrm", "impastor", "validation")
+#: What each package may import (STYLE.md §2): the papers import the shared core only, and
+#: nothing imports ``validation``.
+ALLOWED_IMPORTS = {
+    "reference": {"reference"},
+    "phong_table": {"reference", "phong_table"},
+    "shrm": {"reference", "shrm"},
+    "impastor": {"reference", "impastor"},
+    "validation": set(PACKAGES),
+}
 
 
 def _modules():
@@ -150,3 +159,24 @@ def test_ruff_lint_and_format():
         [*command, "format", "--check", "--no-cache", str(ROOT)], capture_output=True, text=True
     )
     assert fmt.returncode == 0, fmt.stdout[-3000:]
+
+
+def _imported_packages(path: Path) -> set[str]:
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            found |= {alias.name.split(".")[0] for alias in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            found.add(node.module.split(".")[0])
+    return found & set(PACKAGES)
+
+
+def test_imports_point_one_way():
+    # reference imports no paper package; each paper package imports reference only; nothing
+    # imports validation (function-level imports count too).
+    offenders = []
+    for package, allowed in ALLOWED_IMPORTS.items():
+        for path in (ROOT / package).rglob("*.py"):
+            for imported in sorted(_imported_packages(path) - allowed):
+                offenders.append(f"{path.relative_to(ROOT)} imports {imported}")
+    assert not offenders, "; ".join(offenders)

@@ -21,6 +21,13 @@ import functools
 
 import numpy as np
 
+from impastor.multispectral import (
+    MS_GRID,
+    MULTISPECTRAL_DESIGNS,
+    channels_to_XYZ,
+    light_to_channels,
+    spectra_to_channels,
+)
 from reference.colorimetry import XYZ_to_display_RGB, XYZ_to_Lab, delta_E_00
 from reference.display_model import (
     XYZ_to_display_counts,
@@ -29,13 +36,6 @@ from reference.display_model import (
     virtual_display,
 )
 from reference.errors import require
-from reference.multispectral import (
-    MS_GRID,
-    MULTISPECTRAL_DESIGNS,
-    channels_to_XYZ,
-    light_to_channels,
-    spectra_to_channels,
-)
 from reference.spectra import resample_spectrum, spectrum_from_dataset
 from validation.metrics import colorchecker_truth as _colorchecker_truth_uncached
 from validation.metrics import delta_E_stats
@@ -95,7 +95,7 @@ def design_delta_E(design: str = "optimized", n_channels: int = 6, light: str = 
     Parameters
     ----------
     design : str
-        A key of :data:`reference.multispectral.MULTISPECTRAL_DESIGNS`.
+        A key of :data:`impastor.multispectral.MULTISPECTRAL_DESIGNS`.
     n_channels : int
         N (3 … 10).
     light : str
@@ -273,7 +273,7 @@ def metamer_pair(
     Returns
     -------
     R1, R2 : ndarray, shape (81,)
-        On :data:`reference.multispectral.MS_GRID`.
+        On :data:`impastor.multispectral.MS_GRID`.
 
     Examples
     --------

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from impastor.multispectral import MIN_CHANNELS, MULTISPECTRAL_DESIGNS
 from reference.errors import require
-from reference.multispectral import MIN_CHANNELS, MULTISPECTRAL_DESIGNS
 
 __all__ = ["format_table1", "render_for_cli", "table1_for_cli"]
 
@@ -74,12 +74,12 @@ def render_for_cli(light: str, size: int, method: str, out) -> str:
     reference.errors.SpecrefError: unknown lighting method 'nearest'; allowed: fis, hybrid,
     median_cut, variance_min
     """
-    from reference.errors import require_choice, require_positive_int
+    from impastor.painting import PAINTING_LIGHTING_METHODS, render_painting
+    from reference.errors import require_positive_int
     from reference.images import write_png
     from reference.spectra import spectrum_from_dataset
-    from validation.impastor_lighting import LIGHTING_METHODS, render_painting
 
-    require_choice(method, LIGHTING_METHODS, "lighting method")
+    PAINTING_LIGHTING_METHODS.lookup(method)
     size = require_positive_int(size, "--size", 4096)
     spectrum_from_dataset("illuminant", light)
     result = render_painting(light, size, method)

@@ -15,19 +15,20 @@ from operator import attrgetter
 import numpy as np
 import pytest
 
-from reference.horizon import HORIZON_METHODS
-from reference.specular_hybrid import SPECULAR_METHODS
-from validation import impastor_lighting as imp
+from impastor import painting as imp
+from impastor.horizon import HORIZON_METHODS
+from impastor.point_lights import point_lights_from_plane
+from impastor.specular_hybrid import SPECULAR_METHODS
 
 
 @pytest.fixture(scope="module")
 def specular_scene():
     rng = np.random.default_rng(7)
     painting = imp.impasto_painting(128, seed=2)
-    P, N, V = imp._painting_samples(64, painting)
+    P, N, V = imp.painting_samples(64, painting)
     alpha = rng.uniform(0.02, 0.3, len(P))
     plane = imp.booth_plane_light("fluorescent", 64, 32)
-    lights = imp.point_lights_from_plane(plane, "median_cut", 32)
+    lights = point_lights_from_plane(plane, "median_cut", 32)
     return P, N, V, alpha, plane, lights
 
 
@@ -65,7 +66,7 @@ def test_bench_horizon(benchmark, method, backend):
     benchmark(method.reference, *args, backend=backend)
 
 
-@pytest.mark.parametrize("method", imp.LIGHTING_METHODS)
+@pytest.mark.parametrize("method", imp.PAINTING_LIGHTING_METHODS.names())
 def test_bench_frame_512(benchmark, method):
     benchmark.group = "impastor-frame-512"
     painting = imp.impasto_painting(512, seed=1)

@@ -1,7 +1,7 @@
 """Fit the ImpastoR channel designs (``box`` and ``optimized``, N = 3 … 10) and ship them as JSON.
 
 Run ``python -m validation.precompute.impastor_designs`` to rewrite
-``reference/data/impastor_designs.json`` (about an hour on one core).
+``impastor/data/designs.json`` (about an hour on one core).
 
 Training data (all shipped with colour-science, none of it a ColorChecker):
 
@@ -36,9 +36,9 @@ import time
 
 import numpy as np
 
+from impastor.multispectral import DESIGNS_FILE, MS_GRID, box_sampling_functions
 from reference.colorimetry import band_weights
 from reference.images import write_text_atomic
-from reference.multispectral import DESIGNS_FILE, MS_GRID, box_sampling_functions
 from reference.spectra import make_spectrum, resample_spectrum, spectrum_from_dataset
 
 TRAINING_LIGHTS = ("D65", "D50", "A")
@@ -336,7 +336,7 @@ def fit_all(channel_counts=CHANNEL_COUNTS, verbose: bool = True) -> dict:
 
 
 def main(argv=None) -> int:
-    """Fit every design and write :data:`reference.multispectral.DESIGNS_FILE` atomically."""
+    """Fit every design and write :data:`impastor.multispectral.DESIGNS_FILE` atomically."""
     document = fit_all()
     write_text_atomic(DESIGNS_FILE, json.dumps(document, indent=1) + "\n")
     sys.stderr.write(f"wrote {DESIGNS_FILE}\n")

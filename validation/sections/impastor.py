@@ -337,11 +337,12 @@ def _gloss_blocks(ctx, result) -> list:
 
 def run(ctx: ReportContext) -> SectionResult:
     """Table 1, channel counts, metamers, gloss, error vs α, shadows, the painting, frame times."""
+    from impastor import painting as art
     from validation import impastor as imp
     from validation import impastor_lighting as lit
 
     quick = ctx.quick
-    spectra = lit.load_paint_spectra()  # fails first, with a clear message, without shared data
+    spectra = art.load_paint_spectra()  # fails first, with a clear message, without shared data
     backend = "numpy" if quick else "numba"
     results: dict = {}
     blocks: list = [
@@ -376,7 +377,7 @@ def run(ctx: ReportContext) -> SectionResult:
             n_side=3,
             light_resolution=(32, 16),
             supersample=2,
-            painting=lit.impasto_painting(32, seed=2),
+            painting=art.impasto_painting(32, seed=2),
             backend=backend,
         )
         shadows = lit.shadow_agreement(
@@ -403,12 +404,12 @@ def run(ctx: ReportContext) -> SectionResult:
     checks = impastor_checks(channel_table, metamers, alpha, shadows, round_trip, albedo)
 
     size = 48 if quick else 512
-    painting = lit.impasto_painting(size, seed=1)
+    painting = art.impasto_painting(size, seed=1)
     light_resolution = (32, 16) if quick else (128, 64)
     frame_rows = []
     for light in ("D65", "A"):
         start = time.perf_counter()
-        out = lit.render_painting(
+        out = art.render_painting(
             light,
             size,
             "hybrid",
@@ -421,9 +422,9 @@ def run(ctx: ReportContext) -> SectionResult:
         caption = f"Demo painting under the booth light, {light} ({size}×{size})"
         blocks.append(ctx.image(f"painting-{light}", out["sRGB"], caption))
         results[f"painting_{light}_seconds"] = seconds
-    methods = ("median_cut", "fis") if quick else lit.LIGHTING_METHODS
+    methods = ("median_cut", "fis") if quick else art.PAINTING_LIGHTING_METHODS.names()
     for method in methods:
-        out = lit.render_painting(
+        out = art.render_painting(
             "D65",
             size,
             method,

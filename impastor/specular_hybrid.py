@@ -7,7 +7,7 @@ error at each pixel from the estimates themselves: the point lights' second-mome
 sigma-point lights (:func:`sigma_point_lights`), FIS's by Richardson's rule from a second FIS
 estimate with half the samples, and whatever part of the two methods' disagreement these leave
 unexplained is charged to the method whose error estimate is outside its range of validity.
-:func:`specular_hybrid` combines the two estimates (``reference.specular_lighting``) with
+:func:`specular_hybrid` combines the two estimates (``impastor.specular_lighting``) with
 inverse-variance weights.
 
 :data:`SPECULAR_METHODS` registers all four specular methods (point lights, FIS, the hybrid and
@@ -25,21 +25,21 @@ from __future__ import annotations
 
 import numpy as np
 
-from reference._specular_lighting_kernels import (
+from impastor._kernels import (
     specular_brute_force_kernel,
     specular_fis_kernel,
     specular_point_lights_kernel,
 )
-from reference.arealights import PlaneLight, booth_light_image, light_plane_uv
-from reference.errors import require, require_positive_int
-from reference.point_lights import PointLights, _box, point_lights_from_plane, summed_area_table
-from reference.registry import Method, Registry
-from reference.specular_lighting import (
+from impastor.arealights import PlaneLight, booth_light_image, light_plane_uv
+from impastor.point_lights import PointLights, _box, point_lights_from_plane, summed_area_table
+from impastor.specular_lighting import (
     _flat,
     specular_brute_force,
     specular_fis,
     specular_point_lights,
 )
+from reference.errors import require, require_positive_int
+from reference.registry import Method, Registry
 
 __all__ = [
     "SPECULAR_METHODS",
@@ -81,7 +81,7 @@ def sigma_point_lights(light: PlaneLight, lights: PointLights) -> PointLights:
 
     Examples
     --------
-    >>> from reference.point_lights import point_lights_from_plane
+    >>> from impastor.point_lights import point_lights_from_plane
     >>> plane = PlaneLight(booth_light_image("fluorescent", 32, 16), (-0.6, 0.6, -1.0), (1, 0, 0),
     ...                    (0, 0, 1), 1.2, 0.8)
     >>> lights = point_lights_from_plane(plane, "median_cut", 8)
@@ -232,7 +232,7 @@ def hybrid_error_estimates(
 
     Examples
     --------
-    >>> from reference.point_lights import point_lights_from_plane
+    >>> from impastor.point_lights import point_lights_from_plane
     >>> plane = PlaneLight(booth_light_image("fluorescent", 32, 16), (-0.6, 0.6, -1.0), (1, 0, 0),
     ...                    (0, 0, 1), 1.2, 0.8)
     >>> lights = point_lights_from_plane(plane, "median_cut", 32)
@@ -294,7 +294,7 @@ def specular_hybrid_parts(
 
     Examples
     --------
-    >>> from reference.point_lights import point_lights_from_plane
+    >>> from impastor.point_lights import point_lights_from_plane
     >>> plane = PlaneLight(np.full((8, 8), 100.0), (-1, 1, -1), (1, 0, 0), (0, 0, 1), 2.0, 2.0)
     >>> lights = point_lights_from_plane(plane, "median_cut", 4)
     >>> up = np.array([0.0, 1.0, 0.0])
@@ -350,7 +350,7 @@ def specular_hybrid(
 
     Examples
     --------
-    >>> from reference.point_lights import point_lights_from_plane
+    >>> from impastor.point_lights import point_lights_from_plane
     >>> plane = PlaneLight(np.full((8, 8), 100.0), (-1, 1, -1), (1, 0, 0), (0, 0, 1), 2.0, 2.0)
     >>> lights = point_lights_from_plane(plane, "median_cut", 4)
     >>> up = np.array([0.0, 1.0, 0.0])

@@ -3,7 +3,7 @@
 ImpastoR (Ferwerda 2015, §3.2 and §3.5) captures each light of its viewing booth as a
 high-dynamic-range image mapped onto the booth ceiling, a rectangle (:class:`PlaneLight`). Its
 point lights (median cut, variance minimization) and their diffuse illuminance, Eqs. (2)-(3),
-Ferwerda, are ``reference.point_lights``; the light-plane lookup of Eqs. (5)-(8), Ferwerda, that
+Ferwerda, are ``impastor.point_lights``; the light-plane lookup of Eqs. (5)-(8), Ferwerda, that
 specular lighting uses is here.
 
 Plane lights (Fig. 7, Ferwerda). The rectangle has its top-left corner ``o_TL``, unit directions
@@ -13,7 +13,7 @@ pixel has area ``A/P = l_A l_B / (H W)``. The light emits from the side of ``n_l
 (for a ceiling with A = +x and B = +z this is −y, downwards). Pixel values are luminance (cd/m²)
 or any per-channel radiance ``(H, W, C)``; the light's spectrum is applied separately (Eq. (3)).
 
-Lat-long lights follow ``reference.envmap``'s convention (see ``reference.point_lights``).
+Lat-long lights follow ``reference.envmap``'s convention (see ``impastor.point_lights``).
 
 References
 ----------

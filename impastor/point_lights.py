@@ -1,7 +1,7 @@
 """Point lights from area lights: median cut, variance minimization, Eqs. (2)-(3), Ferwerda.
 
 ImpastoR (Ferwerda 2015, §3.5.1) renders diffuse reflection from 32 point lights that the
-median-cut algorithm places on the booth-ceiling light image (``reference.arealights``).
+median-cut algorithm places on the booth-ceiling light image (``impastor.arealights``).
 
 Point lights. A *partition* splits the image into N axis-aligned regions with summed-area tables
 (:data:`LIGHT_SAMPLING_METHODS`): Debevec's median cut, which halves the energy across the longer
@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reference.arealights import PlaneLight, check_light_image
+from impastor.arealights import PlaneLight, check_light_image
 from reference.envmap import check_latlong_shape, latlong_pixel_directions
 from reference.errors import require, require_positive_int
 from reference.registry import Method, Registry
@@ -329,7 +329,7 @@ def point_lights_from_plane(light: PlaneLight, method: str = "median_cut", n_lig
 
     Examples
     --------
-    >>> from reference.arealights import booth_light_image
+    >>> from impastor.arealights import booth_light_image
     >>> plane = PlaneLight(booth_light_image("fluorescent", 32, 16), (0, 1, 0), (1, 0, 0),
     ...                    (0, 0, 1), 1.2, 0.6)
     >>> lights = point_lights_from_plane(plane, "median_cut", 8)

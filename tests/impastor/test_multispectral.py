@@ -1,4 +1,4 @@
-"""Tests of reference.multispectral: the designs, their ColorChecker accuracy, the shipped data."""
+"""Tests of impastor.multispectral: the designs, their ColorChecker accuracy, the shipped data."""
 
 from __future__ import annotations
 
@@ -9,8 +9,7 @@ from operator import attrgetter
 import numpy as np
 import pytest
 
-from reference.errors import SpecrefError
-from reference.multispectral import (
+from impastor.multispectral import (
     DESIGNS_FILE,
     MS_GRID,
     MULTISPECTRAL_DESIGNS,
@@ -21,6 +20,7 @@ from reference.multispectral import (
     render_channels,
     spectra_to_channels,
 )
+from reference.errors import SpecrefError
 from reference.spectra import spectrum_from_dataset
 
 

@@ -22,7 +22,7 @@ Designs are a registry, :data:`MULTISPECTRAL_DESIGNS`: ``box`` (contiguous boxes
 band edges, the paper-level baseline) and ``optimized`` (non-negative smooth functions fitted
 jointly with M). Both are fitted by ``validation/precompute/impastor_designs.py`` on reflectance
 sets that colour-science ships, with ColorChecker look-alikes removed, under D65, D50 and A, and
-are shipped as package data in ``reference/data/impastor_designs.json``.
+are shipped as package data in ``impastor/data/designs.json``.
 
 References
 ----------
@@ -64,7 +64,7 @@ MS_GRID = SpectralGrid(380.0, 780.0, 5.0)
 #: Fewest channels a design may have (three are needed to reach XYZ at all).
 MIN_CHANNELS = 3
 #: The fitted designs, written by ``validation/precompute/impastor_designs.py``.
-DESIGNS_FILE = Path(__file__).with_name("data") / "impastor_designs.json"
+DESIGNS_FILE = Path(__file__).with_name("data") / "designs.json"
 
 
 @dataclass(frozen=True)

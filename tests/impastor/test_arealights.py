@@ -1,11 +1,11 @@
-"""Tests of reference.arealights: plane lights, bad input, the light-plane lookup Eqs. (5)-(8)."""
+"""Tests of impastor.arealights: plane lights, bad input, the light-plane lookup Eqs. (5)-(8)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from reference.arealights import PlaneLight, light_plane_lookup, light_plane_uv
+from impastor.arealights import PlaneLight, light_plane_lookup, light_plane_uv
 from reference.errors import SpecrefError
 
 

@@ -1,4 +1,4 @@
-"""Tests of reference.specular_lighting: twins, convergence, closed forms, edge values."""
+"""Tests of impastor.specular_lighting: twins, convergence, closed forms, edge values."""
 
 from __future__ import annotations
 
@@ -7,11 +7,10 @@ from operator import attrgetter
 import numpy as np
 import pytest
 
-from reference.arealights import PlaneLight
-from reference.errors import SpecrefError
-from reference.point_lights import point_lights_from_plane
-from reference.specular_hybrid import SPECULAR_METHODS
-from reference.specular_lighting import (
+from impastor.arealights import PlaneLight
+from impastor.point_lights import point_lights_from_plane
+from impastor.specular_hybrid import SPECULAR_METHODS
+from impastor.specular_lighting import (
     hammersley,
     mip_lookup,
     mip_pyramid,
@@ -19,6 +18,7 @@ from reference.specular_lighting import (
     specular_fis,
     specular_point_lights,
 )
+from reference.errors import SpecrefError
 
 UP = np.array([0.0, 1.0, 0.0])
 
@@ -74,7 +74,7 @@ def test_brute_force_under_uniform_sky_is_light_times_albedo():
 
 
 def test_brute_force_converges_with_supersampling():
-    from validation.impastor_lighting import booth_plane_light
+    from impastor.painting import booth_plane_light
 
     plane = booth_plane_light("fluorescent", 32, 16)
     P = np.array([[0.0, 0.0, 0.0], [0.05, 0.0, -0.03]])
@@ -87,7 +87,7 @@ def test_brute_force_converges_with_supersampling():
 
 
 def test_fis_and_point_lights_reach_the_reference_in_their_regimes():
-    from validation.impastor_lighting import booth_plane_light
+    from impastor.painting import booth_plane_light
 
     plane = booth_plane_light("fluorescent", 64, 32)
     lights = point_lights_from_plane(plane, "median_cut", 32)

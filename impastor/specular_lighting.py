@@ -2,8 +2,8 @@
 
 ImpastoR's specular pipeline (§3.5.2 and §3.5.4, Ferwerda): median-cut point lights, filtered
 importance sampling and a brute-force reference. The per-pixel hybrid of the first two, and the
-registry of all four methods, :data:`reference.specular_hybrid.SPECULAR_METHODS`, are in
-``reference.specular_hybrid``.
+registry of all four methods, :data:`impastor.specular_hybrid.SPECULAR_METHODS`, are in
+``impastor.specular_hybrid``.
 
 Every method computes the *specular integral* of the Ward–Dür lobe (Eq. (4), Ferwerda, with
 ``ρ_s = 1``) against the light image,
@@ -38,15 +38,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from reference._specular_lighting_kernels import (
+from impastor._kernels import (
     specular_brute_force_kernel,
     specular_fis_kernel,
     specular_point_lights_kernel,
 )
-from reference.arealights import PlaneLight, light_plane_uv
+from impastor.arealights import PlaneLight, light_plane_uv
+from impastor.point_lights import PointLights
 from reference.brdf import brdf_ward_duer_specular, frame_from_normal, pdf_ward_duer_lobe
 from reference.errors import require, require_choice, require_nonnegative, require_positive_int
-from reference.point_lights import PointLights
 
 __all__ = [
     "BACKENDS",
@@ -192,8 +192,8 @@ def specular_point_lights(
 
     Examples
     --------
-    >>> from reference.arealights import PlaneLight
-    >>> from reference.point_lights import point_lights_from_plane
+    >>> from impastor.arealights import PlaneLight
+    >>> from impastor.point_lights import point_lights_from_plane
     >>> plane = PlaneLight(np.full((1, 1), 100.0), (-0.05, 1, -0.05), (1, 0, 0), (0, 0, 1), 0.1,
     ...                    0.1)
     >>> lights = point_lights_from_plane(plane, "median_cut", 1)
@@ -269,7 +269,7 @@ def specular_fis(
 
     Examples
     --------
-    >>> from reference.arealights import PlaneLight
+    >>> from impastor.arealights import PlaneLight
     >>> plane = PlaneLight(np.full((8, 8), 100.0), (-1, 1, -1), (1, 0, 0), (0, 0, 1), 2.0, 2.0)
     >>> up = np.array([0.0, 1.0, 0.0])
     >>> specular_fis(np.zeros(3), up, up, 0.05, plane, 16).round(2)
@@ -355,7 +355,7 @@ def specular_brute_force(
 
     Examples
     --------
-    >>> from reference.arealights import PlaneLight
+    >>> from impastor.arealights import PlaneLight
     >>> plane = PlaneLight(np.full((4, 4), 100.0), (-1, 1, -1), (1, 0, 0), (0, 0, 1), 2.0, 2.0)
     >>> up = np.array([0.0, 1.0, 0.0])
     >>> specular_brute_force(np.zeros(3), up, up, 0.05, plane, 8, backend="numpy").round(2)

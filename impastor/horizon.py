@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from reference._horizon_kernels import horizon_map_kernel, ray_march_shadows_kernel
+from impastor._kernels import horizon_map_kernel, ray_march_shadows_kernel
 from reference.errors import require, require_choice, require_finite, require_positive_int
 from reference.registry import Method, Registry
 

@@ -1,4 +1,4 @@
-"""Tests of reference.point_lights: SATs, partitions, power conservation, Eqs. (2)-(3)."""
+"""Tests of impastor.point_lights: SATs, partitions, power conservation, Eqs. (2)-(3)."""
 
 from __future__ import annotations
 
@@ -7,9 +7,8 @@ from operator import attrgetter
 import numpy as np
 import pytest
 
-from reference.arealights import PlaneLight, booth_light_image
-from reference.errors import SpecrefError
-from reference.point_lights import (
+from impastor.arealights import PlaneLight, booth_light_image
+from impastor.point_lights import (
     LIGHT_SAMPLING_METHODS,
     diffuse_radiance,
     illuminance_point_lights,
@@ -20,6 +19,7 @@ from reference.point_lights import (
     summed_area_table,
     variance_minimization,
 )
+from reference.errors import SpecrefError
 
 
 def _ceiling(image, size=(1.2, 0.8)):
@@ -61,7 +61,7 @@ def test_median_cut_halves_energy():
 
 
 def test_variance_minimization_has_lower_variance_than_median_cut():
-    from reference.point_lights import _coordinates, _variance
+    from impastor.point_lights import _coordinates, _variance
 
     image = booth_light_image("fluorescent", 64, 32)
     total = {}

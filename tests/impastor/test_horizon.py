@@ -1,4 +1,4 @@
-"""Tests of reference.horizon: closed forms, twins, lookup, packing, agreement with ray marching."""
+"""Tests of impastor.horizon: closed forms, twins, lookup, packing, agreement with ray marching."""
 
 from __future__ import annotations
 
@@ -7,8 +7,7 @@ from operator import attrgetter
 import numpy as np
 import pytest
 
-from reference.errors import SpecrefError
-from reference.horizon import (
+from impastor.horizon import (
     HORIZON_METHODS,
     horizon_images_to_map,
     horizon_lookup,
@@ -19,6 +18,7 @@ from reference.horizon import (
     ray_march_shadows,
     tangent_to_world,
 )
+from reference.errors import SpecrefError
 
 
 @pytest.mark.parametrize("method", HORIZON_METHODS.values(), ids=attrgetter("name"))

@@ -1,14 +1,14 @@
-"""Tests of reference.specular_hybrid: the hybrid against the better of point lights and FIS."""
+"""Tests of impastor.specular_hybrid: the hybrid against the better of point lights and FIS."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from reference.arealights import PlaneLight, booth_light_image
-from reference.point_lights import point_lights_from_plane
-from reference.specular_hybrid import sigma_point_lights, specular_hybrid, specular_hybrid_parts
-from reference.specular_lighting import specular_fis, specular_point_lights
+from impastor.arealights import PlaneLight, booth_light_image
+from impastor.point_lights import point_lights_from_plane
+from impastor.specular_hybrid import sigma_point_lights, specular_hybrid, specular_hybrid_parts
+from impastor.specular_lighting import specular_fis, specular_point_lights
 
 
 def _plane(kind="fluorescent"):
@@ -94,7 +94,8 @@ def test_hybrid_parts_are_the_two_methods_and_their_weighted_mean():
     ("seed", "kind"), [(2, "fluorescent"), (7, "fluorescent"), (5, "incandescent")]
 )
 def test_hybrid_never_worse_than_the_better_method_by_ten_percent(seed, kind):
-    from validation.impastor_lighting import impasto_painting, specular_error_vs_alpha
+    from impastor.painting import impasto_painting
+    from validation.impastor_lighting import specular_error_vs_alpha
 
     result = specular_error_vs_alpha(
         (0.01, 0.03, 0.05, 0.07, 0.1, 0.3),
