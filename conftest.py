@@ -13,11 +13,12 @@ import pytest
 # Import the packages (and with them every registry) once, under their package names: pytest's
 # importlib mode then finds them in sys.modules instead of executing a module a second time when a
 # test run names its file directly, which would register its methods twice.
+import impastor  # noqa: F401
 import phong_table  # noqa: F401
 import reference  # noqa: F401
 import shrm  # noqa: F401
 import validation.cli
-import validation.sections  # noqa: F401
+import validation.report.runner  # noqa: F401  (imports every section)
 
 matplotlib.use("Agg")
 np.set_printoptions(legacy=False)
@@ -29,6 +30,8 @@ SHARED_DATA = Path(os.environ.get("SPECREF_SHARED_DATA", ROOT.parent / "shared" 
 # Benchmarks run only under `make bench` (SPECREF_BENCH=1); the ordinary suite does not collect
 # them.
 collect_ignore = [] if os.environ.get("SPECREF_BENCH") else ["tests/benchmarks"]
+# ``python -m validation.cli`` runs the command on import: never collect it for doctests.
+collect_ignore.append("validation/cli/__main__.py")
 
 
 @pytest.fixture

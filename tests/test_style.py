@@ -31,7 +31,8 @@ def _modules():
         module = importlib.import_module(package)
         yield module
         for info in pkgutil.walk_packages(module.__path__, prefix=f"{package}."):
-            yield importlib.import_module(info.name)
+            if not info.name.endswith(".__main__"):  # runs the command when imported
+                yield importlib.import_module(info.name)
 
 
 MODULES = list(_modules())
@@ -110,7 +111,7 @@ def test_no_kernel_sets_fastmath():
 def test_print_only_in_cli_and_examples():
     offenders = []
     for path in SOURCES:
-        if path.name == "cli.py":
+        if "cli" in path.relative_to(ROOT).parts[:2]:
             continue
         for node in ast.walk(ast.parse(path.read_text())):
             if isinstance(node, ast.Call) and getattr(node.func, "id", None) == "print":

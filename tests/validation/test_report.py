@@ -5,16 +5,16 @@ import pytest
 
 from reference.errors import SpecrefError
 from validation.report import (
-    REPORT_SECTIONS,
     Check,
     ReportContext,
     ReportSection,
+    SectionData,
     SectionResult,
     Table,
     Text,
-    run_report,
     to_jsonable,
 )
+from validation.report.runner import REPORT_SECTIONS, SECTIONS, run_report
 
 
 def test_report_spectral_section_quick(tmp_path):
@@ -61,11 +61,10 @@ def test_registered_section_renders_blocks(tmp_path):
         checks = [Check("a", "<= 1", 0.5, True), Check("b", "<= 1", 2.0, False)]
         return SectionResult(blocks, {"value": np.float64(2.5), "arr": np.arange(2)}, checks)
 
-    REPORT_SECTIONS.register(ReportSection("test-only", "Test only", 999, run))
-    try:
-        results = run_report(tmp_path, quick=True, only=["test-only"], progress=False)
-    finally:
-        REPORT_SECTIONS._entries.pop("test-only")
+    section = ReportSection("test-only", "Test only", legacy_run=run)
+    results = run_report(
+        tmp_path, quick=True, only=["test-only"], progress=False, sections=[section]
+    )
     section = results["sections"]["test-only"]
     assert section["value"] == 2.5
     assert section["arr"] == [0, 1]
@@ -87,3 +86,34 @@ def test_bench_groups_filters_by_prefix():
 def test_to_jsonable():
     value = {"a": (np.int32(1), np.bool_(True)), 2: [np.inf, np.float32(0.5)]}
     assert to_jsonable(value) == {"a": [1, True], "2": [None, 0.5]}
+
+
+def test_sections_compute_present_check(tmp_path):
+    calls = []
+
+    def compute(ctx):
+        calls.append("compute")
+        return SectionData({"x": np.float64(0.5)}, {"image": np.zeros((2, 2, 3))})
+
+    def present(ctx, data):
+        calls.append("present")
+        assert "image" in data.arrays
+        return [Text(f"x = {data.results['x']}"), ctx.image("img", data.arrays["image"])]
+
+    def checks(data):
+        calls.append("checks")
+        return [Check("x", "<= 1", data.results["x"], data.results["x"] <= 1)]
+
+    section = ReportSection("three-steps", "Three steps", compute, present, checks)
+    results = run_report(tmp_path, quick=True, progress=False, sections=[section])
+    assert calls == ["compute", "present", "checks"]
+    # The presenter's arrays stay out of results.json; the results go in.
+    stored = json.loads((tmp_path / "results.json").read_text())["sections"]["three-steps"]
+    assert stored["x"] == 0.5
+    assert "image" not in stored
+    assert results["checks"][0]["passed"] is True
+
+
+def test_section_registry_is_the_tuple_of_sections():
+    assert REPORT_SECTIONS.names() == [s.name for s in SECTIONS]
+    assert len(set(REPORT_SECTIONS.names())) == len(SECTIONS)

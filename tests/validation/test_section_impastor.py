@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import copy
 
-from validation.report import run_report
+from validation.report.runner import run_report
 from validation.sections.impastor import impastor_checks
 
 

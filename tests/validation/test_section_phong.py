@@ -3,7 +3,7 @@ import json
 import pytest
 
 from validation.phong_table1 import target_checks
-from validation.report import run_report
+from validation.report.runner import run_report
 
 TARGETS = (
     "error/monotone RMS at 200",

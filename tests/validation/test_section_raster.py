@@ -1,6 +1,6 @@
 import json
 
-from validation.report import run_report
+from validation.report.runner import run_report
 
 
 def test_report_rasterizer_section_quick(tmp_path):

@@ -2,7 +2,7 @@ import json
 
 import pytest
 
-from validation.report import run_report
+from validation.report.runner import run_report
 
 
 def _record(group, name, role, median, **extra):

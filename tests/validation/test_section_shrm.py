@@ -2,7 +2,7 @@ import json
 
 import pytest
 
-from validation.report import run_report
+from validation.report.runner import run_report
 from validation.sections.shrm import SUITE, TOLERANCE
 
 

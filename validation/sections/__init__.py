@@ -1,6 +1,4 @@
-"""Report sections; importing this package registers them in ``validation.report.REPORT_SECTIONS``.
+"""Report sections: one module per section, each defining ``SECTION`` (a ``ReportSection``).
 
-Each module registers one section. A new section is a new module plus one import line here.
+``validation.report.runner.SECTIONS`` lists them in order; nothing registers on import.
 """
-
-from validation.sections import examples, impastor, phong, raster, sh, shrm, spectral  # noqa: F401

@@ -23,7 +23,6 @@ from reference.scene import load_scene
 from reference.spectra import spectrum_to_colour_sd
 from shrm.lobes import DEFAULT_TOL
 from validation.report import (
-    REPORT_SECTIONS,
     Check,
     ReportContext,
     ReportSection,
@@ -227,4 +226,4 @@ def run(ctx: ReportContext) -> SectionResult:
     return SectionResult(blocks, results, checks)
 
 
-REPORT_SECTIONS.register(ReportSection("examples", "Examples", 30, run))
+SECTION = ReportSection("examples", "Examples", legacy_run=run)

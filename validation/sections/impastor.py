@@ -11,7 +11,6 @@ import time
 import numpy as np
 
 from validation.report import (
-    REPORT_SECTIONS,
     Check,
     ReportContext,
     ReportSection,
@@ -453,4 +452,4 @@ def run(ctx: ReportContext) -> SectionResult:
     return SectionResult(blocks, results, checks)
 
 
-REPORT_SECTIONS.register(ReportSection("impastor", "ImpastoR", 70, run))
+SECTION = ReportSection("impastor", "ImpastoR", legacy_run=run)

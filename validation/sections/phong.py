@@ -26,7 +26,6 @@ from validation.phong import (
 )
 from validation.phong_table1 import target_checks
 from validation.report import (
-    REPORT_SECTIONS,
     ReportContext,
     ReportSection,
     SectionResult,
@@ -295,4 +294,4 @@ def run(ctx: ReportContext) -> SectionResult:
     return SectionResult(blocks, results, checks)
 
 
-REPORT_SECTIONS.register(ReportSection("phong", "Spectral Phong tables", 40, run))
+SECTION = ReportSection("phong", "Spectral Phong tables", legacy_run=run)

@@ -17,7 +17,6 @@ from reference.geometry import Plane, Sphere
 from reference.mesh import TriangleMesh, grid_mesh, uv_sphere_mesh
 from reference.raster import RASTER_METHODS, pixel_coverage, rasterize_mesh
 from validation.report import (
-    REPORT_SECTIONS,
     Check,
     ReportContext,
     ReportSection,
@@ -296,5 +295,4 @@ def run(ctx: ReportContext) -> SectionResult:
 
 
 # pytest's importlib mode may execute this module a second time: register once.
-if "rasterizer" not in REPORT_SECTIONS:
-    REPORT_SECTIONS.register(ReportSection("rasterizer", "Rasterizer", 20, run))
+SECTION = ReportSection("rasterizer", "Rasterizer", legacy_run=run)

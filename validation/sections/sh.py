@@ -28,7 +28,6 @@ from shrm.sh import PLAIN_ORDER_LIMIT, legendre_table, order_of, sh_evaluate
 from shrm.transform import project_latlong, synthesize_latlong
 from shrm.windows import WINDOWS, apply_window, ringing_statistics
 from validation.report import (
-    REPORT_SECTIONS,
     Check,
     ReportContext,
     ReportSection,
@@ -494,4 +493,4 @@ def run(ctx: ReportContext) -> SectionResult:
     return SectionResult(blocks, results, checks)
 
 
-REPORT_SECTIONS.register(ReportSection("sh", "Spherical harmonics", 50, run))
+SECTION = ReportSection("sh", "Spherical harmonics", legacy_run=run)

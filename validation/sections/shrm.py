@@ -25,7 +25,6 @@ import time
 import numpy as np
 
 from validation.report import (
-    REPORT_SECTIONS,
     Check,
     ReportContext,
     ReportSection,
@@ -477,4 +476,4 @@ def _orbit_blocks(ctx, results) -> list:
     ]
 
 
-REPORT_SECTIONS.register(ReportSection("shrm", "SHRMs", 60, run))
+SECTION = ReportSection("shrm", "SHRMs", legacy_run=run)

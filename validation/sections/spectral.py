@@ -1,4 +1,7 @@
-"""Report section "Spectral core": ColorChecker accuracy of the band weights (2 grids, 4 lights)."""
+"""Report section "Spectral core": ColorChecker accuracy of the band weights (2 grids, 4 lights).
+
+compute → :func:`colorchecker_band_weights`; present → :func:`present`; checks → :func:`checks`.
+"""
 
 from __future__ import annotations
 
@@ -7,44 +10,57 @@ import numpy as np
 from reference.spectra import GRID_31, GRID_41
 from validation.metrics import COLORCHECKER, colorchecker_delta_E, delta_E_stats
 from validation.report import (
-    REPORT_SECTIONS,
     Check,
     ReportContext,
     ReportSection,
-    SectionResult,
+    SectionData,
     Table,
     Text,
 )
 
 LIGHTS = ("D65", "A", "D50", "FL2")
+GRIDS = (GRID_41, GRID_31)
+BAND_WEIGHTS = ("astm_e308", "point")
 # Targets of issue 3: ΔE00 against the 5 nm truth, (mean, max), for the shipped E308 weights.
 TARGETS = {"D65": (0.03, 0.10), "A": (0.03, 0.10), "D50": (0.03, 0.10), "FL2": (0.06, 0.15)}
 
 
-def run(ctx: ReportContext) -> SectionResult:
-    """ΔE00 statistics of E308 and point-sampled band weights, per grid and light, and a chart."""
+def colorchecker_band_weights(ctx: ReportContext | None = None) -> SectionData:
+    """ΔE00 of the ColorChecker per grid, light and band-weight method, against the 5 nm truth.
+
+    Returns
+    -------
+    SectionData
+        ``results["<grid> <light> <method>"]``: ΔE00 statistics (mean, p90, max, ...);
+        ``arrays[(grid label, light, method)]``: the 24 per-patch ΔE00.
+
+    Examples
+    --------
+    >>> data = colorchecker_band_weights()
+    >>> round(data.results["380-780/10 FL2 point"]["mean"], 1)
+    4.0
+    """
+    data = SectionData()
+    for grid in GRIDS:
+        for light in LIGHTS:
+            for method in BAND_WEIGHTS:
+                dE = colorchecker_delta_E(grid, light, method)
+                data.results[f"{grid.label} {light} {method}"] = delta_E_stats(dE)
+                data.arrays[(grid.label, light, method)] = dE
+    return data
+
+
+def present(ctx: ReportContext, data: SectionData) -> list:
+    """The statistics table and the per-patch chart under FL2."""
+    import colour
     import matplotlib.pyplot as plt
 
-    rows, results, per_patch, checks = [], {}, {}, []
-    for grid in (GRID_41, GRID_31):
+    rows = []
+    for grid in GRIDS:
         for light in LIGHTS:
-            for method in ("astm_e308", "point"):
-                dE = colorchecker_delta_E(grid, light, method)
-                stats = delta_E_stats(dE)
-                key = f"{grid.label} {light} {method}"
-                results[key] = stats
-                per_patch[(grid.label, light, method)] = dE
+            for method in BAND_WEIGHTS:
+                stats = data.results[f"{grid.label} {light} {method}"]
                 rows.append([grid.label, light, method, stats["mean"], stats["p90"], stats["max"]])
-                if method == "astm_e308":
-                    for stat, limit in zip(("mean", "max"), TARGETS[light], strict=True):
-                        checks.append(
-                            Check(
-                                f"{stat} ΔE00, {light}, {grid.n_bands} bands",
-                                f"<= {limit}",
-                                stats[stat],
-                                stats[stat] <= limit,
-                            )
-                        )
     blocks = [
         Text(
             "ColorChecker (N Ohta) under four lights: specref's band weights (ASTM E2022 factors "
@@ -59,19 +75,37 @@ def run(ctx: ReportContext) -> SectionResult:
             "{:.3f}",
         ),
     ]
-    import colour
-
     names = list(colour.SDS_COLOURCHECKERS[COLORCHECKER])
     fig, ax = plt.subplots(figsize=(9, 3.6))
     x = np.arange(len(names))
     for offset, method in ((-0.2, "astm_e308"), (0.2, "point")):
-        ax.bar(x + offset, per_patch[(GRID_41.label, "FL2", method)], width=0.4, label=method)
+        ax.bar(x + offset, data.arrays[(GRID_41.label, "FL2", method)], width=0.4, label=method)
     ax.set_yscale("log")
     ax.set_xticks(x, names, rotation=60, ha="right", fontsize=8)
     ax.set_ylabel("ΔE00 under FL2 (41 bands)")
     ax.legend(ncol=2, loc="lower center", bbox_to_anchor=(0.5, 1.0), frameon=False)
     blocks.append(ctx.figure("fl2-patches", fig, "Per-patch ΔE00 under FL2, 41-band grid"))
-    return SectionResult(blocks, results, checks)
+    return blocks
 
 
-REPORT_SECTIONS.register(ReportSection("spectral-core", "Spectral core", 10, run))
+def checks(data: SectionData) -> list[Check]:
+    """Mean and max ΔE00 of the E308 weights against issue 3's targets, per grid and light."""
+    found = []
+    for grid in GRIDS:
+        for light in LIGHTS:
+            stats = data.results[f"{grid.label} {light} astm_e308"]
+            for stat, limit in zip(("mean", "max"), TARGETS[light], strict=True):
+                found.append(
+                    Check(
+                        f"{stat} ΔE00, {light}, {grid.n_bands} bands",
+                        f"<= {limit}",
+                        stats[stat],
+                        stats[stat] <= limit,
+                    )
+                )
+    return found
+
+
+SECTION = ReportSection(
+    "spectral-core", "Spectral core", colorchecker_band_weights, present, checks
+)

@@ -1,0 +1,62 @@
+"""The ``specref`` command: argument parsing and dispatch to library functions, nothing else.
+
+One module per subcommand (:data:`COMMANDS`), each with ``add_parser(sub)``; every subcommand is a
+small function that calls the library. Bad input raises :class:`~reference.errors.SpecrefError` in
+the library; :func:`main` prints its one-line message to stderr and exits with code 2, without a
+traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from reference.errors import SpecrefError
+from validation.cli import brdf, cache, impastor, phong, render, report, sh, shrm
+from validation.cli.parser import Parser
+
+__all__ = ["COMMANDS", "build_parser", "main"]
+
+#: The subcommands, in the order ``specref --help`` lists them.
+COMMANDS = (report, render, cache, brdf, shrm, sh, impastor, phong)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser for all subcommands.
+
+    Examples
+    --------
+    >>> build_parser().parse_args(["report", "--quick"]).quick
+    True
+    """
+    parser = Parser(prog="specref", description="specref: a spectral rendering reference.")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
+    for command in COMMANDS:
+        command.add_parser(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the ``specref`` command; return the exit code (2 for bad input).
+
+    Examples
+    --------
+    >>> main(["report", "--only", "no-such-section", "--out", "/tmp/specref-doctest"])
+    2
+    """
+    import shrm  # noqa: F401  (registers the environment-light shaders before any rendering)
+
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except SpecrefError as error:
+        print(f"specref: error: {error}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("specref: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

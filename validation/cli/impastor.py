@@ -1,0 +1,48 @@
+"""``specref impastor``: Table 1 of Ferwerda 2015 and the demo painting."""
+
+from __future__ import annotations
+
+from validation.cli.parser import Parser
+
+
+def _cmd_impastor_table1(args) -> int:
+    import json
+
+    from validation.impastor_cli import format_table1, table1_for_cli
+
+    result = table1_for_cli(args.design, args.channels, args.white_luminance, args.display)
+    print(format_table1(result))
+    if args.json:
+        from reference.images import write_text_atomic
+
+        write_text_atomic(args.json, json.dumps(result, indent=1) + "\n")
+        print(f"wrote {args.json}")
+    return 0
+
+
+def _cmd_impastor_render(args) -> int:
+    from validation.impastor_cli import render_for_cli
+
+    print(render_for_cli(args.light, args.size, args.method, args.out))
+    return 0
+
+
+def add_parser(sub) -> None:
+    """Add ``specref impastor`` and its options to the subcommand parsers ``sub``."""
+    p = sub.add_parser("impastor", help="ImpastoR (Ferwerda 2015): Table 1 and the demo painting")
+    isub = p.add_subparsers(dest="impastor_command", required=True, parser_class=Parser)
+    t = isub.add_parser("table1", help="Table 1: ColorChecker simulation and screen output")
+    t.add_argument("--json", metavar="FILE", help="also write the table as JSON")
+    t.add_argument("--design", default="optimized", help="channel design (box, optimized)")
+    t.add_argument("--channels", type=int, default=6, help="channel count (3-10)")
+    t.add_argument(
+        "--white-luminance", type=float, default=200.0, help="white diffuser luminance, cd/m²"
+    )
+    t.add_argument("--display", metavar="JSON", help="display measurement file (default: virtual)")
+    t.set_defaults(func=_cmd_impastor_table1)
+    r = isub.add_parser("render", help="render the demo painting under a booth light to a PNG")
+    r.add_argument("--light", default="D65", help="illuminant key (D65, D50, A, FL2, ...)")
+    r.add_argument("--size", type=int, default=512, help="image side in pixels")
+    r.add_argument("--method", default="hybrid", help="median_cut, variance_min, fis, hybrid")
+    r.add_argument("--out", default="impastor.png", help="output PNG")
+    r.set_defaults(func=_cmd_impastor_render)

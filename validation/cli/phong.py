@@ -1,0 +1,66 @@
+"""``specref phong``: Table 1 of Wang et al., or one material file's tables."""
+
+from __future__ import annotations
+
+from validation.cli.parser import write_json
+
+
+def _cmd_phong(args) -> int:
+    from reference.errors import SpecrefError
+    from validation import phong, phong_table1
+
+    if args.action == "table1":
+        result = phong_table1.run_table1(args.resolution, args.entries, args.repeats, progress=True)
+        print(f"Table 1 (Wang et al.), {args.resolution}x{args.resolution}, {args.entries} entries")
+        print(phong_table1.format_rows(result["rows"]))
+        print("\nTargets")
+        print(phong_table1.format_targets(result["targets"]))
+    else:
+        if args.material is None:
+            raise SpecrefError("specref phong: give table1 or --material FILE.toml")
+        result = phong_table1.run_material(
+            args.material,
+            args.view,
+            args.entries,
+            args.placement,
+            args.interp,
+            args.segments,
+            args.tolerance,
+            args.resolution,
+            args.repeats,
+        )
+        print(phong_table1.format_rows(result["rows"]))
+        if result["tolerance"] is not None:
+            print(phong.format_tolerance(result["tolerance"]))
+    if args.json:
+        write_json(args.json, result)
+    return 0
+
+
+def add_parser(sub) -> None:
+    """Add ``specref phong`` and its options to the subcommand parsers ``sub``."""
+    p = sub.add_parser(
+        "phong",
+        help="spectral Phong tables: Table 1 of Wang et al., or one material file",
+        description="specref phong table1 [--json FILE] | specref phong --material FILE.toml "
+        "--view far|near --entries M --placement P --interp I [--segments S] [--tolerance T] "
+        "[--json FILE]",
+    )
+    p.add_argument("action", nargs="?", choices=["table1"], help="reproduce Table 1")
+    p.add_argument(
+        "--material",
+        metavar="FILE.toml",
+        help="a material file (docs/scene-format.md, Phong material files)",
+    )
+    p.add_argument("--view", default="far", help="far (whole sphere) or near (the highlight)")
+    p.add_argument("--entries", type=int, default=200, help="table entries m (default 200)")
+    p.add_argument("--placement", default="error", help="uniform, importance or error")
+    p.add_argument(
+        "--interp", default="monotone", help="linear, parabolic, parabolic_w or monotone"
+    )
+    p.add_argument("--segments", type=int, help="importance segments p (must divide m)")
+    p.add_argument("--tolerance", type=float, help="pick the smallest table with RMS <= T")
+    p.add_argument("--resolution", type=int, default=512, help="image size (default 512)")
+    p.add_argument("--repeats", type=int, default=9, help="timing repetitions (minimum kept)")
+    p.add_argument("--json", metavar="FILE", help="write the records as JSON")
+    p.set_defaults(func=_cmd_phong)

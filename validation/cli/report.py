@@ -1,0 +1,38 @@
+"""``specref report``: the main job (every section's figures, charts, images and checks)."""
+
+from __future__ import annotations
+
+
+def _cmd_report(args) -> int:
+    from validation.report.runner import run_report
+
+    run_report(
+        out_dir=args.out,
+        quick=args.quick,
+        only=args.only,
+        bench_json=args.bench,
+        markdown=args.markdown,
+        markdown_image_prefix=args.markdown_image_prefix,
+    )
+    print(f"wrote {args.out}/index.html and {args.out}/results.json")
+    return 0
+
+
+def add_parser(sub) -> None:
+    """Add ``specref report`` and its options to the subcommand parsers ``sub``."""
+    p = sub.add_parser(
+        "report", help="run the main job: every section's figures, charts and images"
+    )
+    p.add_argument("--out", default="report", help="output folder (default: report)")
+    p.add_argument("--quick", action="store_true", help="small sizes; under a minute")
+    p.add_argument("--only", nargs="+", metavar="SECTION", help="run only these sections")
+    p.add_argument("--bench", metavar="JSON", help="pytest-benchmark JSON from make bench")
+    p.add_argument(
+        "--markdown", metavar="MD", help="also write a Markdown rendering (docs/results.md)"
+    )
+    p.add_argument(
+        "--markdown-image-prefix",
+        default="",
+        help="path from the Markdown file to the report folder",
+    )
+    p.set_defaults(func=_cmd_report)

@@ -1,0 +1,48 @@
+"""``specref sh``: SH projection and frequency-space prefiltering of environment maps."""
+
+from __future__ import annotations
+
+from validation.cli.parser import Parser
+
+
+def _cmd_sh_project(args) -> int:
+    from shrm.files import project_file
+
+    info = project_file(args.env, args.order, args.out, args.window, args.bands, args.backend)
+    print(f"wrote {info['out']}: {info['channels']} channels to order {info['order']}")
+    return 0
+
+
+def _cmd_sh_prefilter(args) -> int:
+    from shrm.files import prefilter_file
+
+    info = prefilter_file(
+        args.env, args.kernel, args.out, args.tol, args.format, args.size, args.bands
+    )
+    print(
+        f"wrote {info['out']}: {info['kernel']} at order {info['order']} (tail {info['tail']:.2g})"
+    )
+    return 0
+
+
+def add_parser(sub) -> None:
+    """Add ``specref sh`` and its options to the subcommand parsers ``sub``."""
+    p = sub.add_parser("sh", help="spherical harmonics: project and prefilter environment maps")
+    sh = p.add_subparsers(dest="sh_command", required=True, parser_class=Parser)
+    q = sh.add_parser("project", help="SH coefficients of a lat-long map (.npz)")
+    q.add_argument("env", help="lat-long map, .hdr or .exr (RGB or spectral)")
+    q.add_argument("--order", type=int, required=True, help="SH order L")
+    q.add_argument("--window", default=None, help="none, hanning, lanczos, gaussian[:SIGMA]")
+    q.add_argument("--bands", choices=("spectral", "rgb"), default=None, help="convert first")
+    q.add_argument("--backend", default="ducc0", help="numpy, numba or ducc0")
+    q.add_argument("-o", "--out", required=True, help="output .npz")
+    q.set_defaults(func=_cmd_sh_project)
+    r = sh.add_parser("prefilter", help="frequency-space prefiltered cube or lat-long map (.exr)")
+    r.add_argument("env", help="lat-long map, .hdr or .exr")
+    r.add_argument("--kernel", required=True, help="lambert, phong:S or table:FILE")
+    r.add_argument("--out", required=True, help="output .exr")
+    r.add_argument("--tol", type=float, default=1e-2, help="adaptive-order tolerance")
+    r.add_argument("--format", choices=("cube", "latlong"), default="cube")
+    r.add_argument("--size", type=int, default=64, help="cube face size")
+    r.add_argument("--bands", choices=("spectral", "rgb"), default=None, help="convert first")
+    r.set_defaults(func=_cmd_sh_prefilter)
