@@ -49,6 +49,7 @@ __all__ = [
     "BRDFTable",
     "brdf_tabulated",
     "read_brdf_table",
+    "tabulable_brdf_names",
     "tabulate_brdf",
     "tabulate_registered_brdf",
     "write_brdf_table",
@@ -177,6 +178,21 @@ def tabulate_brdf(
     return BRDFTable(theta, theta, phi, lam, values, name=label)
 
 
+def tabulable_brdf_names() -> list[str]:
+    """Keys of :data:`reference.brdf.BRDF_METHODS` that :func:`tabulate_registered_brdf` takes.
+
+    The isotropic 3-D BRDFs (``extra["isotropic"]``) and Lambert, in registry order.
+
+    Examples
+    --------
+    >>> "ggx" in tabulable_brdf_names(), "ward_duer" in tabulable_brdf_names()
+    (True, False)
+    """
+    from reference.brdf import BRDF_METHODS
+
+    return [n for n, m in BRDF_METHODS.items() if m.extra.get("isotropic") or n == "lambert"]
+
+
 def tabulate_registered_brdf(
     name: str, theta_step_deg: float = 5.0, phi_step_deg: float = 15.0
 ) -> BRDFTable:
@@ -203,10 +219,10 @@ def tabulate_registered_brdf(
     from reference.brdf import BRDF_METHODS
 
     method = BRDF_METHODS.lookup(name)
+    allowed = tabulable_brdf_names()
     require(
-        method.extra.get("isotropic", False) or name == "lambert",
-        f"brdf {name!r}: not an isotropic 3-D BRDF; allowed: "
-        + ", ".join(m.name for m in BRDF_METHODS.values() if m.extra.get("isotropic")),
+        name in allowed,
+        f"brdf {name!r}: not an isotropic 3-D BRDF; allowed: {', '.join(allowed)}",
     )
     for label, step, span in (
         ("theta step", theta_step_deg, 90.0),

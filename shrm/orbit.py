@@ -28,6 +28,7 @@ from reference.shading import SHADERS, Surface
 
 __all__ = [
     "IsotropicBRDFMaterial",
+    "analytic_isotropic_brdf_names",
     "brdf_params_on_grid",
     "demo_state",
     "orbit_camera",
@@ -55,11 +56,31 @@ class IsotropicBRDFMaterial:
     name: str = "isotropic_brdf"
 
 
+def analytic_isotropic_brdf_names() -> list[str]:
+    """Keys of ``reference.brdf.BRDF_METHODS`` that ``isotropic_brdf`` materials and orbits take.
+
+    The isotropic 3-D BRDFs given by formulas (``extra["isotropic"]``), not the tabulated one,
+    which needs a file.
+
+    Examples
+    --------
+    >>> "ggx" in analytic_isotropic_brdf_names(), "table" in analytic_isotropic_brdf_names()
+    (True, False)
+    """
+    from reference.brdf import BRDF_METHODS
+
+    return [
+        n
+        for n, m in BRDF_METHODS.items()
+        if m.extra.get("isotropic") and "table" not in m.extra.get("params", {})
+    ]
+
+
 def _isotropic_method(brdf: str):
     from reference.brdf import BRDF_METHODS
 
     method = BRDF_METHODS.lookup(brdf)
-    allowed = [n for n, m in BRDF_METHODS.items() if m.extra.get("isotropic") and n != "table"]
+    allowed = analytic_isotropic_brdf_names()
     require(
         brdf in allowed,
         f"must be an analytic isotropic 3-D BRDF; allowed: {', '.join(allowed)}; got {brdf!r}",

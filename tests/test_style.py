@@ -181,3 +181,49 @@ def test_imports_point_one_way():
             for imported in sorted(_imported_packages(path) - allowed):
                 offenders.append(f"{path.relative_to(ROOT)} imports {imported}")
     assert not offenders, "; ".join(offenders)
+
+
+def _cli_actions(parser=None, prefix="specref"):
+    import argparse
+
+    from validation.cli import build_parser
+
+    parser = parser or build_parser()
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for name, subparser in action.choices.items():
+                yield from _cli_actions(subparser, f"{prefix} {name}")
+        else:
+            yield f"{prefix} {'/'.join(action.option_strings) or action.dest}", action
+
+
+CLI_ACTIONS = list(_cli_actions())
+
+
+def test_cli_registry_options_list_their_registry():
+    # Every option that takes a registry key lists the keys from the registry itself.
+    checked = 0
+    for where, action in CLI_ACTIONS:
+        registry = getattr(action, "registry", None)
+        if registry is None:
+            continue
+        checked += 1
+        assert set(action.registry_keys) <= set(registry), where
+        listed = action.help.split(": ", 1)[1].split(" (default")[0].split(", ")
+        assert [key.split("[:")[0] for key in listed] == action.registry_keys, where
+    assert checked >= 10
+
+
+def test_no_cli_option_spells_registry_keys_by_hand():
+    # An option whose help or choices names two or more keys of one registry must read them from
+    # that registry (validation.cli.parser.registry_option).
+    offenders = []
+    for where, action in CLI_ACTIONS:
+        if getattr(action, "registry", None) is not None:
+            continue
+        words = set(re.findall(r"[A-Za-z0-9_]+", f"{action.help or ''} {action.choices or ''}"))
+        for name, registry in REGISTRIES:
+            spelled = words & set(registry)
+            if len(spelled) >= 2:
+                offenders.append(f"{where} spells {sorted(spelled)} of {name}")
+    assert not offenders, "; ".join(offenders)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from validation.cli.parser import Parser
+from validation.cli.parser import Parser, registry_option
 
 
 def _cmd_brdf_tabulate(args) -> int:
@@ -28,10 +28,14 @@ def _cmd_brdf_check(args) -> int:
 
 def add_parser(sub) -> None:
     """Add ``specref brdf`` and its options to the subcommand parsers ``sub``."""
+    from reference.brdf import BRDF_METHODS
+    from reference.brdf_table import tabulable_brdf_names
+
     p = sub.add_parser("brdf", help="tabulate isotropic BRDFs and check BRDF table files")
     brdf = p.add_subparsers(dest="brdf_command", required=True, parser_class=Parser)
     t = brdf.add_parser("tabulate", help="tabulate a registered BRDF (docs/brdf-format.md)")
-    t.add_argument("model", help="a key of reference.brdf.BRDF_METHODS, e.g. ggx")
+    tabulable = tabulable_brdf_names()
+    registry_option(t, "model", BRDF_METHODS, "the BRDF", where=lambda key, _: key in tabulable)
     t.add_argument("-o", "--out", required=True, help="output text file")
     t.add_argument("--theta-step", type=float, default=5.0, help="polar step, degrees")
     t.add_argument("--phi-step", type=float, default=15.0, help="azimuth step, degrees")

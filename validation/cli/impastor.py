@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from validation.cli.parser import Parser
+from validation.cli.parser import Parser, registry_option
 
 
 def _cmd_impastor_table1(args) -> int:
@@ -29,11 +29,14 @@ def _cmd_impastor_render(args) -> int:
 
 def add_parser(sub) -> None:
     """Add ``specref impastor`` and its options to the subcommand parsers ``sub``."""
+    from impastor.multispectral import MULTISPECTRAL_DESIGNS
+    from impastor.painting import PAINTING_LIGHTING_METHODS
+
     p = sub.add_parser("impastor", help="ImpastoR (Ferwerda 2015): Table 1 and the demo painting")
     isub = p.add_subparsers(dest="impastor_command", required=True, parser_class=Parser)
     t = isub.add_parser("table1", help="Table 1: ColorChecker simulation and screen output")
     t.add_argument("--json", metavar="FILE", help="also write the table as JSON")
-    t.add_argument("--design", default="optimized", help="channel design (box, optimized)")
+    registry_option(t, "--design", MULTISPECTRAL_DESIGNS, "channel design", default="optimized")
     t.add_argument("--channels", type=int, default=6, help="channel count (3-10)")
     t.add_argument(
         "--white-luminance", type=float, default=200.0, help="white diffuser luminance, cd/m²"
@@ -43,6 +46,6 @@ def add_parser(sub) -> None:
     r = isub.add_parser("render", help="render the demo painting under a booth light to a PNG")
     r.add_argument("--light", default="D65", help="illuminant key (D65, D50, A, FL2, ...)")
     r.add_argument("--size", type=int, default=512, help="image side in pixels")
-    r.add_argument("--method", default="hybrid", help="median_cut, variance_min, fis, hybrid")
+    registry_option(r, "--method", PAINTING_LIGHTING_METHODS, "specular lighting", default="hybrid")
     r.add_argument("--out", default="impastor.png", help="output PNG")
     r.set_defaults(func=_cmd_impastor_render)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 
-__all__ = ["Parser", "write_json"]
+__all__ = ["Parser", "registry_option", "write_json"]
 
 
 class Parser(argparse.ArgumentParser):
@@ -35,3 +35,59 @@ def write_json(path, result) -> None:
 
     write_text_atomic(path, json.dumps(to_jsonable(result), indent=1))
     print(f"wrote {path}")
+
+
+def registry_option(parser, flag: str, registry, help: str, where=None, **kwargs):
+    """Add an option whose values are the keys of ``registry``; its help lists them from it.
+
+    The CLI never spells a registry key by hand: the help text is built from ``registry`` (keys
+    whose entry takes a parameter, ``extra["param"]``, are shown as ``key[:PARAM]``), and the
+    library checks the value with ``registry.lookup``, so a wrong key gets the library's one-line
+    error (exit 2).
+    ``tests/test_style.py`` checks every such option against its registry.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+    flag : str
+        The option, e.g. ``"--placement"``, or a positional name.
+    registry : Registry or mapping
+        Where the keys come from.
+    help : str
+        What the option chooses; the keys (and the default) are appended.
+    where : callable, optional
+        ``where(key, entry) -> bool``: the keys this option accepts, when it takes a subset.
+    **kwargs
+        Passed to ``add_argument`` (``default``, ``metavar``, ...).
+
+    Returns
+    -------
+    argparse.Action
+        With ``registry`` and ``registry_keys`` attributes.
+
+    Examples
+    --------
+    >>> from reference.registry import Method, Registry
+    >>> shapes = Registry("shape")
+    >>> _ = shapes.register(Method("disc", abs, None, "Eq. (0), nobody"))
+    >>> _ = shapes.register(Method("lobe", abs, None, "Eq. (0), nobody", extra={"param": "S"}))
+    >>> action = registry_option(Parser(prog="x"), "--shape", shapes, "the shape", default="disc")
+    >>> action.help
+    'the shape: disc, lobe[:S] (default disc)'
+    """
+    keys = [key for key in registry if where is None or where(key, _entry(registry, key))]
+    shown = []
+    for key in keys:
+        extra = getattr(_entry(registry, key), "extra", None) or {}
+        shown.append(f"{key}[:{extra['param']}]" if "param" in extra else key)
+    text = f"{help}: {', '.join(shown)}"
+    if kwargs.get("default") is not None:
+        text += f" (default {kwargs['default']})"
+    action = parser.add_argument(flag, help=text, **kwargs)
+    action.registry = registry
+    action.registry_keys = keys
+    return action
+
+
+def _entry(registry, key):
+    return registry.lookup(key) if hasattr(registry, "lookup") else registry[key]

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from validation.cli.parser import write_json
+from validation.cli.parser import registry_option, write_json
 
 
 def _cmd_phong(args) -> int:
@@ -39,11 +39,15 @@ def _cmd_phong(args) -> int:
 
 def add_parser(sub) -> None:
     """Add ``specref phong`` and its options to the subcommand parsers ``sub``."""
+    from phong_table.interpolation import INTERPOLATION_METHODS
+    from phong_table.placement import PLACEMENT_METHODS
+    from phong_table.scenes import VIEWS
+
     p = sub.add_parser(
         "phong",
         help="spectral Phong tables: Table 1 of Wang et al., or one material file",
         description="specref phong table1 [--json FILE] | specref phong --material FILE.toml "
-        "--view far|near --entries M --placement P --interp I [--segments S] [--tolerance T] "
+        "--view V --entries M --placement P --interp I [--segments S] [--tolerance T] "
         "[--json FILE]",
     )
     p.add_argument("action", nargs="?", choices=["table1"], help="reproduce Table 1")
@@ -52,12 +56,12 @@ def add_parser(sub) -> None:
         metavar="FILE.toml",
         help="a material file (docs/scene-format.md, Phong material files)",
     )
-    p.add_argument("--view", default="far", help="far (whole sphere) or near (the highlight)")
-    p.add_argument("--entries", type=int, default=200, help="table entries m (default 200)")
-    p.add_argument("--placement", default="error", help="uniform, importance or error")
-    p.add_argument(
-        "--interp", default="monotone", help="linear, parabolic, parabolic_w or monotone"
+    registry_option(
+        p, "--view", VIEWS, "the view of the sphere (camera field of view)", default="far"
     )
+    p.add_argument("--entries", type=int, default=200, help="table entries m (default 200)")
+    registry_option(p, "--placement", PLACEMENT_METHODS, "node placement", default="error")
+    registry_option(p, "--interp", INTERPOLATION_METHODS, "interpolation", default="monotone")
     p.add_argument("--segments", type=int, help="importance segments p (must divide m)")
     p.add_argument("--tolerance", type=float, help="pick the smallest table with RMS <= T")
     p.add_argument("--resolution", type=int, default=512, help="image size (default 512)")

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from validation.cli.parser import registry_option
+
 
 def _cmd_report(args) -> int:
     from validation.report.runner import run_report
@@ -20,12 +22,16 @@ def _cmd_report(args) -> int:
 
 def add_parser(sub) -> None:
     """Add ``specref report`` and its options to the subcommand parsers ``sub``."""
+    from validation.report.runner import REPORT_SECTIONS
+
     p = sub.add_parser(
         "report", help="run the main job: every section's figures, charts and images"
     )
     p.add_argument("--out", default="report", help="output folder (default: report)")
     p.add_argument("--quick", action="store_true", help="small sizes; under a minute")
-    p.add_argument("--only", nargs="+", metavar="SECTION", help="run only these sections")
+    registry_option(
+        p, "--only", REPORT_SECTIONS, "run only these sections", nargs="+", metavar="SECTION"
+    )
     p.add_argument("--bench", metavar="JSON", help="pytest-benchmark JSON from make bench")
     p.add_argument(
         "--markdown", metavar="MD", help="also write a Markdown rendering (docs/results.md)"

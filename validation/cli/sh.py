@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from validation.cli.parser import Parser
+from validation.cli.parser import Parser, registry_option
 
 
 def _cmd_sh_project(args) -> int:
@@ -27,19 +27,23 @@ def _cmd_sh_prefilter(args) -> int:
 
 def add_parser(sub) -> None:
     """Add ``specref sh`` and its options to the subcommand parsers ``sub``."""
+    from shrm.lobes import PREFILTER_KERNELS
+    from shrm.transform import SH_BACKENDS
+    from shrm.windows import WINDOWS
+
     p = sub.add_parser("sh", help="spherical harmonics: project and prefilter environment maps")
     sh = p.add_subparsers(dest="sh_command", required=True, parser_class=Parser)
     q = sh.add_parser("project", help="SH coefficients of a lat-long map (.npz)")
     q.add_argument("env", help="lat-long map, .hdr or .exr (RGB or spectral)")
     q.add_argument("--order", type=int, required=True, help="SH order L")
-    q.add_argument("--window", default=None, help="none, hanning, lanczos, gaussian[:SIGMA]")
+    registry_option(q, "--window", WINDOWS, "window against ringing")
     q.add_argument("--bands", choices=("spectral", "rgb"), default=None, help="convert first")
-    q.add_argument("--backend", default="ducc0", help="numpy, numba or ducc0")
+    registry_option(q, "--backend", SH_BACKENDS, "SH transform engine", default="ducc0")
     q.add_argument("-o", "--out", required=True, help="output .npz")
     q.set_defaults(func=_cmd_sh_project)
     r = sh.add_parser("prefilter", help="frequency-space prefiltered cube or lat-long map (.exr)")
     r.add_argument("env", help="lat-long map, .hdr or .exr")
-    r.add_argument("--kernel", required=True, help="lambert, phong:S or table:FILE")
+    registry_option(r, "--kernel", PREFILTER_KERNELS, "prefilter kernel", required=True)
     r.add_argument("--out", required=True, help="output .exr")
     r.add_argument("--tol", type=float, default=1e-2, help="adaptive-order tolerance")
     r.add_argument("--format", choices=("cube", "latlong"), default="cube")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from reference.errors import SpecrefError
-from validation.cli.parser import Parser
+from validation.cli.parser import Parser, registry_option
 
 
 def _cmd_shrm_orbit(args) -> int:
@@ -40,13 +40,23 @@ def _cmd_shrm_orbit(args) -> int:
 
 def add_parser(sub) -> None:
     """Add ``specref shrm`` and its options to the subcommand parsers ``sub``."""
+    from reference.brdf import BRDF_METHODS
+    from shrm.orbit import analytic_isotropic_brdf_names
+
     p = sub.add_parser("shrm", help="SH reflection maps (Herbert et al. §5.5-5.6)")
     shrm = p.add_subparsers(dest="shrm_command", required=True, parser_class=Parser)
     o = shrm.add_parser("orbit", help="render a camera orbit; PNG frames and per-stage timings")
     o.add_argument("scene", nargs="?", metavar="SCENE.toml", help="scene file (default: built-in)")
     o.add_argument("--frames", type=int, default=8, help="frames of a full turn (default 8)")
     o.add_argument("-o", "--out", required=True, help="output folder")
-    o.add_argument("--brdf", help="isotropic BRDF of the built-in sphere (effect_pigment)")
+    analytic = analytic_isotropic_brdf_names()
+    registry_option(
+        o,
+        "--brdf",
+        BRDF_METHODS,
+        "isotropic BRDF of the built-in sphere (default effect_pigment)",
+        where=lambda key, _: key in analytic,
+    )
     o.add_argument("--env", help="lat-long environment (.hdr/.exr); default venice_sunset_1k")
     o.add_argument("--quick", action="store_true", help="small maps and images")
     o.add_argument("--tol", type=float, help="order tolerance (default 0.05, an L2 tail)")
