@@ -20,6 +20,7 @@ References
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import re
 import tempfile
@@ -33,6 +34,8 @@ __all__ = [
     "MAX_IMAGE_PIXELS",
     "atomic_write",
     "channel_wavelengths_nm",
+    "check_output_folder",
+    "output_error",
     "read_exr",
     "read_hdr",
     "read_image",
@@ -58,11 +61,65 @@ def _new_file_permissions(tmp) -> None:
     os.chmod(tmp, 0o666 & ~_UMASK)
 
 
+#: Errors of the file system that mean "this output cannot be written here", by errno, with what the
+#: one-line message says about them.
+_WRITE_ERRORS = {
+    errno.EISDIR: "is a folder; give a file name",
+    errno.ENOTDIR: "a part of the path is a file, not a folder",
+    errno.EEXIST: "a part of the path is a file, not a folder",
+    errno.EACCES: "permission denied",
+    errno.EPERM: "permission denied",
+    errno.EROFS: "read-only file system",
+    errno.ENOSPC: "no space left on the device",
+    errno.EDQUOT: "disk quota exceeded",
+    errno.EFBIG: "file too large for the file system",
+}
+
+
+def output_error(path, error: OSError) -> SpecrefError | None:
+    """The one-line :class:`SpecrefError` for an OSError met while writing ``path``, if it is one.
+
+    Every writer (:func:`atomic_write`, :func:`write_exr`) turns the file system's refusals (a
+    folder where a file should be, a file where a folder should be, no permission, a full disk)
+    into this message, so no command shows a traceback for them.
+
+    Returns
+    -------
+    SpecrefError or None
+        None when ``error`` is not a refusal to write (the caller re-raises it).
+
+    Examples
+    --------
+    >>> import errno
+    >>> output_error("out/a.exr", OSError(errno.ENOSPC, "No space left on device"))
+    SpecrefError('out/a.exr: cannot write (no space left on the device)')
+    >>> output_error("a.exr", OSError(errno.EIO, "I/O error")) is None
+    True
+    """
+    reason = _WRITE_ERRORS.get(getattr(error, "errno", None))
+    if reason is None:
+        return None
+    return SpecrefError(f"{path}: cannot write ({reason})")
+
+
+@contextlib.contextmanager
+def _write_errors(path):
+    """Turn the file system's refusals to write ``path`` into one-line SpecrefErrors."""
+    try:
+        yield
+    except OSError as error:
+        translated = output_error(path, error)
+        if translated is None:
+            raise
+        raise translated from None
+
+
 @contextlib.contextmanager
 def atomic_write(path, mode: str = "wb"):
     """Open a temporary file beside ``path``; on success, sync it and rename it to ``path``.
 
-    On an exception the temporary file is removed and ``path`` is untouched.
+    On an exception the temporary file is removed and ``path`` is untouched. When the file system
+    refuses the write (see :func:`output_error`) the error is a one-line :class:`SpecrefError`.
 
     Parameters
     ----------
@@ -87,19 +144,49 @@ def atomic_write(path, mode: str = "wb"):
     'done'
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        _new_file_permissions(tmp)
-        with os.fdopen(fd, mode) as handle:
-            yield handle
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(tmp)
-        raise
+    with _write_errors(path):
+        require(not path.is_dir(), f"{path}: cannot write ({_WRITE_ERRORS[errno.EISDIR]})")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        try:
+            _new_file_permissions(tmp)
+            with os.fdopen(fd, mode) as handle:
+                yield handle
+                handle.flush()
+                os.fsync(handle.fileno())
+            os.replace(tmp, path)
+        except BaseException:
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(tmp)
+            raise
+
+
+def check_output_folder(folder) -> Path:
+    """Create ``folder`` if needed and prove that a file can be written in it; return it.
+
+    Commands that write many files into a folder call this before any work, so an unwritable
+    folder (a file of that name, a read-only file system, a full disk) is refused in one line
+    before the first frame rather than after it.
+
+    Raises
+    ------
+    SpecrefError
+        One line naming the folder and the reason (:func:`output_error`).
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     check_output_folder(os.path.join(d, "frames")).is_dir()
+    True
+    """
+    folder = Path(folder)
+    with _write_errors(folder):
+        require(not folder.is_file(), f"{folder}: cannot write ({_WRITE_ERRORS[errno.ENOTDIR]})")
+        folder.mkdir(parents=True, exist_ok=True)
+    probe = write_bytes_atomic(folder / ".specref-write-probe", b"specref")
+    probe.unlink()
+    return folder
 
 
 def write_bytes_atomic(path, data: bytes) -> Path:
@@ -265,20 +352,44 @@ def write_exr(path, image, channels: list[str] | None = None, half: bool = False
         name: np.ascontiguousarray(image[..., i].astype(dtype)) for i, name in enumerate(channels)
     }
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    # OpenEXR writes by file name, so write a temporary name beside the target and rename it.
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".exr", dir=path.parent)
-    os.close(fd)
-    try:
-        with OpenEXR.File(header, data) as handle:
-            handle.write(tmp)
-        _new_file_permissions(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(tmp)
-        raise
+    with _write_errors(path):
+        require(not path.is_dir(), f"{path}: cannot write ({_WRITE_ERRORS[errno.EISDIR]})")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        # OpenEXR writes by file name, so write a temporary name beside the target and rename it.
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".exr", dir=path.parent)
+        os.close(fd)
+        try:
+            try:
+                with OpenEXR.File(header, data) as handle:
+                    handle.write(tmp)
+            except RuntimeError as error:
+                # OpenEXR reports the file system's refusals as RuntimeError text.
+                text = str(error)
+                full = "No space left" in text
+                reason = _WRITE_ERRORS[errno.ENOSPC] if full else f"OpenEXR: {text}"
+                raise SpecrefError(f"{path}: cannot write ({reason})") from None
+            # OpenEXR may lose a small file's data on a full disk without an error: read it back.
+            _check_exr_written(tmp, path)
+            _new_file_permissions(tmp)
+            os.replace(tmp, path)
+        except BaseException:
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(tmp)
+            raise
     return path
+
+
+def _check_exr_written(tmp, path) -> None:
+    """Raise a one-line SpecrefError for ``path`` unless the EXR at ``tmp`` reads back whole."""
+    try:
+        with open(tmp, "rb") as handle:
+            os.fsync(handle.fileno())
+        read_exr(tmp)
+    except (SpecrefError, OSError):
+        stat = os.statvfs(Path(tmp).parent)
+        full = stat.f_bavail == 0
+        reason = _WRITE_ERRORS[errno.ENOSPC] if full else "the written file does not read back"
+        raise SpecrefError(f"{path}: cannot write ({reason})") from None
 
 
 def read_exr(path) -> tuple[np.ndarray, list[str]]:

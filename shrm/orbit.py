@@ -477,10 +477,12 @@ def render_orbit(session, frames: int, out_dir=None, progress: bool = True):
     from reference.colorimetry import XYZ_to_display_RGB, band_weights, spectra_to_XYZ
     from reference.display import linear_to_display
     from reference.errors import require_positive_int
-    from reference.images import write_png, write_text_atomic
+    from reference.images import check_output_folder, write_png, write_text_atomic
     from reference.spectra import SpectralGrid
 
     frames = require_positive_int(frames, "orbit --frames", 100000)
+    if out_dir is not None:
+        check_output_folder(out_dir)  # before the first frame, not after it
     grid = SpectralGrid(*session.state["config"]["grid"])
     W = band_weights(grid, None)
     white = float(spectra_to_XYZ(np.asarray(session.state["illuminant"]), W)[1])

@@ -1,0 +1,204 @@
+"""Every command that writes a file refuses an unwritable output in one line, with exit code 2.
+
+Four ways an output cannot be written: the path is a folder; a part of its folder is a file; the
+folder is on a read-only file system; the disk is full. The last two are real file systems (a
+small tmpfs, mounted read-only or filled), which needs root; the tests skip without it.
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from reference.errors import SpecrefError
+from reference.images import output_error, write_exr, write_png, write_text_atomic
+from validation.cli import main
+
+ROOT = Path(__file__).resolve().parents[2]
+EXAMPLES = ROOT / "docs" / "examples"
+
+
+def _mount_tmpfs(folder: Path, options: str) -> None:
+    if os.geteuid() != 0 or shutil.which("mount") is None:
+        pytest.skip("mounting a tmpfs needs root and mount(8) (util-linux)")
+    folder.mkdir()
+    done = subprocess.run(
+        ["mount", "-t", "tmpfs", "-o", options, "tmpfs", str(folder)], capture_output=True
+    )
+    if done.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs here: {done.stderr.decode().strip()}")
+
+
+@pytest.fixture
+def full_folder(tmp_path):
+    """A folder on a 64 KiB file system that is already full."""
+    folder = tmp_path / "full"
+    _mount_tmpfs(folder, "size=64k")
+    filler = folder / "filler"
+    with pytest.raises(OSError, match="No space left"):
+        filler.write_bytes(b"\0" * (1 << 20))
+    yield folder
+    subprocess.run(["umount", str(folder)], check=False)
+
+
+@pytest.fixture
+def read_only_folder(tmp_path):
+    """A folder on a read-only file system."""
+    folder = tmp_path / "ro"
+    _mount_tmpfs(folder, "size=64k,ro")
+    yield folder
+    subprocess.run(["umount", str(folder)], check=False)
+
+
+def _outputs(tmp_path: Path, kind: str, request) -> Path:
+    """An output path that cannot be written, of the given kind (for "a folder": create it)."""
+    if kind == "a folder":
+        return tmp_path / "out"
+    if kind == "a file in the path":
+        (tmp_path / "blocker").write_text("x")
+        return tmp_path / "blocker" / "out"
+    folder = request.getfixturevalue("full_folder" if kind == "full disk" else "read_only_folder")
+    return folder / "out"
+
+
+KINDS = ("a folder", "a file in the path", "read-only", "full disk")
+MESSAGES = {
+    "a folder": "is a folder",
+    "a file in the path": "is a file, not a folder",
+    "read-only": "read-only file system",
+    "full disk": "no space left",
+}
+
+
+@pytest.mark.parametrize("kind", KINDS)
+@pytest.mark.parametrize("writer", [write_png, write_exr], ids=["png", "exr"])
+def test_image_writers_refuse_in_one_line(writer, kind, tmp_path, request):
+    path = _outputs(tmp_path, kind, request)
+    if kind == "a folder":
+        path.mkdir()
+    image = np.random.default_rng(1).random((128, 128, 3))
+    with pytest.raises(SpecrefError, match=MESSAGES[kind]) as caught:
+        writer(path, image)
+    assert str(path) in str(caught.value)
+    assert "\n" not in str(caught.value)
+    # No temporary file is left behind.
+    if path.parent.is_dir():
+        assert not [p for p in path.parent.iterdir() if p.name.startswith(f".{path.name}.")]
+
+
+def test_output_error_passes_other_errors_through(tmp_path, monkeypatch):
+    assert output_error("x", OSError(errno.EIO, "I/O error")) is None
+
+    def failing_fsync(fd):
+        raise OSError(errno.EIO, "I/O error")
+
+    monkeypatch.setattr(os, "fsync", failing_fsync)
+    with pytest.raises(OSError, match="I/O error"):
+        write_text_atomic(tmp_path / "a.txt", "x")
+    assert list(tmp_path.iterdir()) == []
+
+
+def _commands(out: Path, tmp_path: Path) -> dict[str, list[str]]:
+    env = tmp_path / "env.exr"
+    if not env.exists():
+        write_exr(env, np.random.default_rng(2).random((8, 16, 3)) + 0.1)
+    material = tmp_path / "m.toml"
+    material.write_text("[material]\nk_d = 0.2\nk_s = 0.5\nn = 3\n")
+    scene = EXAMPLES / "phong-sphere.toml"
+    return {
+        "render -o": ["render", str(scene), "-o", f"{out}.png", "--width", "8"],
+        "render --exr": [
+            "render",
+            str(scene),
+            "-o",
+            str(tmp_path / "ok.png"),
+            "--exr",
+            f"{out}.exr",
+            "--width",
+            "8",
+        ],
+        "sh project -o": ["sh", "project", str(env), "--order", "2", "-o", f"{out}.npz"],
+        "sh prefilter --out": [
+            "sh",
+            "prefilter",
+            str(env),
+            "--kernel",
+            "lambert",
+            "--size",
+            "4",
+            "--out",
+            f"{out}.exr",
+        ],
+        "brdf tabulate -o": [
+            "brdf",
+            "tabulate",
+            "ggx",
+            "--theta-step",
+            "45",
+            "--phi-step",
+            "90",
+            "-o",
+            f"{out}.txt",
+        ],
+        "phong --json": [
+            "phong",
+            "--material",
+            str(material),
+            "--resolution",
+            "8",
+            "--repeats",
+            "1",
+            "--entries",
+            "25",
+            "--json",
+            f"{out}.json",
+        ],
+        "shrm orbit -o": [
+            "shrm",
+            "orbit",
+            "--quick",
+            "--frames",
+            "1",
+            "--no-cache",
+            "-o",
+            str(out),
+        ],
+    }
+
+
+COMMANDS = (
+    "render -o",
+    "render --exr",
+    "sh project -o",
+    "sh prefilter --out",
+    "brdf tabulate -o",
+    "phong --json",
+    "shrm orbit -o",
+)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", KINDS)
+@pytest.mark.parametrize("command", COMMANDS)
+def test_commands_refuse_unwritable_outputs_in_one_line(command, kind, tmp_path, request, capsys):
+    if kind == "a folder" and command == "shrm orbit -o":
+        pytest.skip("shrm orbit -o names a folder: an existing folder is a valid output")
+    out = _outputs(tmp_path, kind, request)
+    argv = _commands(out, tmp_path)[command]
+    if kind == "a folder":
+        # A folder stands where the output file would go.
+        for arg in argv:
+            if arg.startswith(str(out)):
+                Path(arg).mkdir()
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert MESSAGES[kind] in lines[0], lines[0]
