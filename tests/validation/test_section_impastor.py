@@ -122,15 +122,21 @@ def test_compute_returns_every_figure_of_results_json(tiny):
 
 
 def test_present_draws_every_study_from_the_data(tiny, tmp_path):
-    ctx = ReportContext(out_dir=tmp_path, section=SECTION.name)
+    record = {
+        "group": "impastor-specular",
+        "name": "test_bench_specular[fis]",
+        "stats": {"mean": 1},
+    }
+    ctx = ReportContext(out_dir=tmp_path, section=SECTION.name, bench={"benchmarks": [record]})
     blocks = present(ctx, tiny)
     images = sorted(p.name for p in (tmp_path / "images").iterdir())
     assert images == [
         f"impastor-{name}.png"
         for name in ("alpha", "channels", "gloss", "metamers", "painting-A", "painting-D65")
     ] + ["impastor-shadows.png"]
-    frame_table = blocks[-1]
+    frame_table, bench_table = blocks[-2:]
     assert [row[0] for row in frame_table.rows] == frame_methods(every=False)
+    assert bench_table.rows == [["test_bench_specular[fis]", 1]]
 
 
 def test_frame_methods_come_from_the_registry():

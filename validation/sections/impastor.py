@@ -15,14 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from validation.report import (
-    Check,
-    ReportContext,
-    ReportSection,
-    SectionData,
-    Table,
-    Text,
-)
+from validation.report import Check, ReportContext, ReportSection, SectionData, Table, Text
 
 __all__ = [
     "FULL",
@@ -329,16 +322,8 @@ def _channel_rows(results: dict, naive: dict) -> list:
                 target = f"≤ {limit_mean} / ≤ {limit_max}: {'met' if ok else 'MISSED'}"
             rows.append([design, light, s["mean"], s["p90"], s["max"], target])
     for light, dE in naive.items():
-        rows.append(
-            [
-                "naive RGB",
-                light,
-                float(dE.mean()),
-                float(np.percentile(dE, 90)),
-                float(dE.max()),
-                "none",
-            ]
-        )
+        stats = (float(dE.mean()), float(np.percentile(dE, 90)), float(dE.max()))
+        rows.append(["naive RGB", light, *stats, "none"])
     return rows
 
 
