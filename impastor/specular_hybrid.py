@@ -377,9 +377,31 @@ def _example_scene(rng):
     return points, normals, views, alpha, plane, lights
 
 
+# How each method runs on the inputs of ``_example_scene``: ``n_samples`` FIS samples per point
+# (fis, hybrid), ``supersample²`` sub-pixels per light pixel (brute_force); a method ignores the
+# setting it has no use for. Tests use the defaults; the benchmarks ask for more samples.
+
+
+def _call_point_lights(x, backend, n_samples=16, supersample=2):
+    return specular_point_lights(*x[:4], x[5], backend=backend)
+
+
+def _call_fis(x, backend, n_samples=16, supersample=2):
+    return specular_fis(*x[:5], n_samples, backend=backend)
+
+
+def _call_hybrid(x, backend, n_samples=16, supersample=2):
+    return specular_hybrid(*x[:6], n_samples, backend=backend)
+
+
+def _call_brute_force(x, backend, n_samples=16, supersample=2):
+    return specular_brute_force(*x[:5], supersample, backend=backend)
+
+
 #: Specular lighting methods; ``reference`` is the NumPy function (``backend`` selects the numba
 #: twin named by ``kernel``); ``example_inputs(rng)`` returns ``(points, normals, views, alpha,
-#: plane, lights)``; ``extra["call"](method_fn, inputs, backend)`` runs it on those inputs.
+#: plane, lights)``; ``extra["call"](inputs, backend, n_samples=16, supersample=2)`` runs the
+#: method on those inputs.
 SPECULAR_METHODS = Registry("specular lighting")
 SPECULAR_METHODS.register(
     Method(
@@ -388,7 +410,7 @@ SPECULAR_METHODS.register(
         specular_point_lights_kernel,
         "Eq. (2), Ferwerda",
         _example_scene,
-        extra={"call": lambda x, backend: specular_point_lights(*x[:4], x[5], backend=backend)},
+        extra={"call": _call_point_lights},
     )
 )
 SPECULAR_METHODS.register(
@@ -398,7 +420,7 @@ SPECULAR_METHODS.register(
         specular_fis_kernel,
         "Eq. (4), Ferwerda (FIS with the lookup of Eqs. (5)-(8))",
         _example_scene,
-        extra={"call": lambda x, backend: specular_fis(*x[:5], 16, backend=backend)},
+        extra={"call": _call_fis},
     )
 )
 SPECULAR_METHODS.register(
@@ -408,7 +430,7 @@ SPECULAR_METHODS.register(
         None,
         "Eq. (4), Ferwerda",
         _example_scene,
-        extra={"call": lambda x, backend: specular_hybrid(*x[:6], 16, backend=backend)},
+        extra={"call": _call_hybrid},
     )
 )
 SPECULAR_METHODS.register(
@@ -418,6 +440,6 @@ SPECULAR_METHODS.register(
         specular_brute_force_kernel,
         "Eq. (4), Ferwerda",
         _example_scene,
-        extra={"call": lambda x, backend: specular_brute_force(*x[:5], 2, backend=backend)},
+        extra={"call": _call_brute_force},
     )
 )

@@ -140,10 +140,22 @@ def naive_rgb_delta_E(light: str = "A") -> np.ndarray:
     return _lab_delta_E(XYZ, truth, white)
 
 
-def channel_count_errors(
-    designs=("box", "optimized"), counts=range(3, 11), lights=LIGHTS + EXTRA_LIGHTS
-) -> dict:
+def channel_count_errors(designs=None, counts=range(3, 11), lights=LIGHTS + EXTRA_LIGHTS) -> dict:
     """Mean and max ΔE00 on the ColorChecker for each design, channel count and light.
+
+    Parameters
+    ----------
+    designs : sequence of str, optional
+        Keys of :data:`impastor.multispectral.MULTISPECTRAL_DESIGNS`; default all of them.
+    counts : sequence of int
+        Channel counts N (3 … 10).
+    lights : sequence of str
+        Colour-science illuminant keys.
+
+    Returns
+    -------
+    dict
+        ``[design][str(N)][light]``: ΔE00 statistics (mean, std, p90, max).
 
     Examples
     --------
@@ -152,7 +164,7 @@ def channel_count_errors(
     ['max', 'mean', 'p90', 'std']
     """
     out: dict = {}
-    for design in designs:
+    for design in MULTISPECTRAL_DESIGNS.names() if designs is None else designs:
         out[design] = {}
         for n in counts:
             out[design][str(n)] = {

@@ -2,13 +2,20 @@
 
 from __future__ import annotations
 
+from operator import attrgetter
+
 import numpy as np
 import pytest
 
 from impastor.arealights import PlaneLight, booth_light_image
 from impastor.point_lights import point_lights_from_plane
-from impastor.specular_hybrid import sigma_point_lights, specular_hybrid, specular_hybrid_parts
-from impastor.specular_lighting import specular_fis, specular_point_lights
+from impastor.specular_hybrid import (
+    SPECULAR_METHODS,
+    sigma_point_lights,
+    specular_hybrid,
+    specular_hybrid_parts,
+)
+from impastor.specular_lighting import specular_brute_force, specular_fis, specular_point_lights
 
 
 def _plane(kind="fluorescent"):
@@ -125,3 +132,18 @@ def test_hybrid_within_the_two_methods_and_best_at_the_ends():
     assert (hybrid <= 1.05 * np.maximum(pl, fis)).all()
     assert hybrid[0] <= 1.1 * min(pl[0], fis[0])
     assert (hybrid[2:] <= 1.1 * np.minimum(pl[2:], fis[2:])).all()
+
+
+@pytest.mark.parametrize("method", SPECULAR_METHODS.values(), ids=attrgetter("name"))
+def test_registry_calls_pass_the_sample_settings_on(method, rng):
+    # extra["call"] is how tests and benchmarks run a method: its n_samples and supersample
+    # reach the function (the benchmarks ask for 32 FIS samples and one sub-pixel).
+    P, N, V, a, plane, lights = inputs = method.example_inputs(rng)
+    direct = {
+        "point_lights": specular_point_lights(P, N, V, a, lights, backend="numpy"),
+        "fis": specular_fis(P, N, V, a, plane, 32, backend="numpy"),
+        "hybrid": specular_hybrid(P, N, V, a, plane, lights, 32, backend="numpy"),
+        "brute_force": specular_brute_force(P, N, V, a, plane, 1, backend="numpy"),
+    }
+    got = method.extra["call"](inputs, "numpy", n_samples=32, supersample=1)
+    np.testing.assert_array_equal(got, direct[method.name])
