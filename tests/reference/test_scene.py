@@ -12,10 +12,8 @@ from numpy.testing import assert_allclose
 
 from reference.errors import SpecrefError
 from reference.geometry import Plane, Sphere
-from reference.images import spectral_channel_names, write_exr
-from reference.lights import AmbientLight, EnvironmentLight, PointLight
+from reference.lights import AmbientLight, PointLight
 from reference.materials import MATERIAL_TYPES, LambertMaterial, MaterialType, PhongMaterial
-from reference.mesh import TriangleMesh
 from reference.scene import (
     LIGHT_TYPES,
     MAX_RENDER_SAMPLES,
@@ -283,31 +281,6 @@ def test_a_registered_material_type_loads_without_editing_the_loader(monkeypatch
         scene_with('[materials.t]\ntype = "tinted"\nk_d = 0.3\nk_s = 1')
 
 
-def test_environment_light_rgb_and_spectral_exr(tmp_path):
-    rgb = np.full((4, 8, 3), 0.5)
-    write_exr(tmp_path / "rgb.exr", rgb)
-    wl = np.array([380.0, 580.0, 780.0])
-    write_exr(tmp_path / "spec.exr", np.ones((4, 8, 3)), spectral_channel_names(wl))
-    scene = scene_with(
-        '[[lights]]\ntype = "environment"\nfile = "rgb.exr"\nintensity = 2\n'
-        '[[lights]]\ntype = "environment"\nfile = "spec.exr"\n',
-        tmp_path,
-    )
-    first, second = scene.lights
-    assert isinstance(first, EnvironmentLight)
-    assert not first.is_spectral
-    assert_allclose(first.image, rgb)
-    assert first.intensity == 2.0
-    assert second.is_spectral
-    assert_allclose(second.wavelengths_nm, wl)
-
-
-def test_environment_light_reads_shared_hdr(shared_data):
-    path = shared_data / "environments" / "studio_small_03_1k.hdr"
-    scene = scene_with(f'[[lights]]\ntype = "environment"\nfile = "{path}"')
-    assert scene.lights[0].image.shape == (512, 1024, 3)
-
-
 # --- bad input: one line naming the file, the key, what is allowed, what was given ---------------
 
 
@@ -559,81 +532,3 @@ def test_malformed_and_missing_scene_files(tmp_path):
         load_scene(binary)
     with raises(f"{tmp_path}: file not found"):
         load_scene(tmp_path)
-
-
-def test_missing_and_unreadable_images(tmp_path):
-    (tmp_path / "junk.hdr").write_bytes(b"#?RADIANCE\nthis is not an image\n")
-    (tmp_path / "junk.exr").write_bytes(b"v/1\x01 not an exr")
-    (tmp_path / "map.png").write_bytes(b"")
-    env = '[[lights]]\ntype = "environment"\nfile = '
-    with raises("scene.toml: lights[0].file: file not found: "):
-        scene_with(env + '"nope.hdr"', tmp_path)
-    with raises(f"scene.toml: lights[0].file: {tmp_path / 'junk.hdr'}: cannot read Radiance HDR"):
-        scene_with(env + '"junk.hdr"', tmp_path)
-    with raises(f"scene.toml: lights[0].file: {tmp_path / 'junk.exr'}: cannot read OpenEXR image"):
-        scene_with(env + '"junk.exr"', tmp_path)
-    with raises(f"scene.toml: lights[0].file: {tmp_path / 'map.png'}: unsupported environment map"):
-        scene_with(env + '"map.png"', tmp_path)
-
-
-def test_environment_maps_with_bad_values(tmp_path):
-    image = np.ones((4, 8, 3))
-    image[1, 2, 0] = np.nan
-    write_exr(tmp_path / "nan.exr", image)
-    write_exr(tmp_path / "neg.exr", -np.ones((4, 8, 3)))
-    write_exr(tmp_path / "square.exr", np.ones((4, 4, 3)))
-    write_exr(tmp_path / "other.exr", np.ones((4, 8, 2)), ["U", "V"])
-    env = '[[lights]]\ntype = "environment"\nfile = '
-    with raises("scene.toml: lights[0].file: "):
-        scene_with(env + '"nan.exr"', tmp_path)
-    with pytest.raises(SpecrefError, match=r"lights\[0\]\.file: .*radiance must be finite"):
-        scene_with(env + '"nan.exr"', tmp_path)
-    with pytest.raises(SpecrefError, match=r"lights\[0\]\.file: .*radiance must be >= 0"):
-        scene_with(env + '"neg.exr"', tmp_path)
-    with pytest.raises(SpecrefError, match=r"lights\[0\]\.file: .*2:1"):
-        scene_with(env + '"square.exr"', tmp_path)
-    with pytest.raises(SpecrefError, match=r"lights\[0\]\.file: .*channels U, V; an environment"):
-        scene_with(env + '"other.exr"', tmp_path)
-
-
-# --- meshes ---------------------------------------------------------------------------------------
-
-QUAD_OBJ = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvn 0 0 1\nf 1//1 2//1 3//1 4//1\n"
-
-
-def test_mesh_objects_load_and_place(tmp_path):
-    (tmp_path / "quad.obj").write_text(QUAD_OBJ)
-    scene = scene_with(
-        GREY.replace("sphere", "mesh")
-        + 'file = "quad.obj"\nscale = 0.5\ntranslate = [0, 1, -2]\ncull_backfaces = true',
-        tmp_path,
-    )
-    (mesh,) = scene.objects
-    assert isinstance(mesh, TriangleMesh)
-    assert mesh.material == 0
-    assert mesh.cull_backfaces
-    # Source: the OBJ's vertices, scaled by 0.5 and moved by (0, 1, -2).
-    assert_allclose(mesh.vertices[:, :2], [[-0.5, 0.5], [0.5, 0.5], [0.5, 1.5], [-0.5, 1.5]])
-    assert_allclose(mesh.vertices[:, 2], -2.0)
-    assert_allclose(mesh.normals, np.tile([0.0, 0.0, 1.0], (4, 1)))
-
-
-def test_mesh_with_nan_or_inf_vertices_is_refused(tmp_path):
-    (tmp_path / "nan.obj").write_text("v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
-    (tmp_path / "inf.obj").write_text("v 0 0 0\nv inf 0 0\nv 0 1 0\nf 1 2 3\n")
-    for name in ("nan.obj", "inf.obj"):
-        with pytest.raises(
-            SpecrefError,
-            match=rf"^scene\.toml: objects\[0\]\.file: .*{name}.*(finite|not a number)",
-        ):
-            scene_with(GREY.replace("sphere", "mesh") + f'file = "{name}"', tmp_path)
-    with raises("scene.toml: objects[0].file: file not found: "):
-        scene_with(GREY.replace("sphere", "mesh") + 'file = "none.obj"', tmp_path)
-    with raises("scene.toml: objects[0]: missing key 'file'"):
-        scene_with(GREY.replace("sphere", "mesh"), tmp_path)
-    with raises("scene.toml: objects[0].scale: must be > 0, got 0"):
-        scene_with(GREY.replace("sphere", "mesh") + 'file = "nan.obj"\nscale = 0', tmp_path)
-    with raises("scene.toml: objects[0].cull_backfaces: must be true or false, got 1"):
-        scene_with(
-            GREY.replace("sphere", "mesh") + 'file = "nan.obj"\ncull_backfaces = 1', tmp_path
-        )
