@@ -4,8 +4,9 @@ STYLE.md §9: every sampler has a chi-square test, and α is Šidák-corrected a
 tests in the suite. :data:`CHI2_CASES` is the one list of those tests: the test files parametrize
 over it (:func:`cases_for` a module), and :func:`run_chi2_case` divides α among ``len(CHI2_CASES)``
 tests, so the count is never kept by hand. A new sampler is covered by registering a case here;
-``tests/validation/test_stats.py`` checks that no test calls :func:`validation.stats.chi2_test`
-outside this registry and that every module with cases has a test file that runs them.
+``tests/validation/test_chi2_cases.py`` checks that no test calls :func:`validation.stats.chi2_test`
+outside this registry (except the tests of ``chi2_test`` itself, whose samplers must fail) and that
+every module with cases has a test file that runs them.
 
 Cases:
 
