@@ -27,7 +27,7 @@ demo: $(STAMP)
 
 ## make test: install, then run the whole suite (doctests and docs examples included, benchmarks off)
 test: $(STAMP)
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q --durations=15
 
 ## make bench-json: run the pytest-benchmark suite and save bench.json
 bench-json: $(STAMP)

@@ -25,7 +25,7 @@ def _ward_lobe(wi, wo, n, alpha):
     norm = math.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
     cos_h = max((h0 * n[0] + h1 * n[1] + h2 * n[2]) / norm, 1e-300)
     tan2_h = (1.0 - cos_h * cos_h) / (cos_h * cos_h)
-    # Eq. (4), Ferwerda: exp(−tan²θ_h/α²) / (4π α² cos θ_i cos θ_r)
+    # Eq. (4), Ferwerda: exp(−tan²θ_h/α²) / (4π α² cos θ_i cos θ_o)
     return math.exp(-tan2_h / (alpha * alpha)) / (4.0 * math.pi * alpha * alpha * cos_i * cos_o)
 
 

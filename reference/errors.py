@@ -73,14 +73,6 @@ def require(condition: bool, message: str) -> None:
         raise SpecrefError(message)
 
 
-def _describe(values: np.ndarray) -> str:
-    """Say briefly what is wrong with an array: the first bad value and where it is."""
-    flat = values.ravel()
-    if flat.size == 1:
-        return f"{flat[0]!r}"
-    return f"array of shape {values.shape}"
-
-
 def require_finite(values, where: str) -> np.ndarray:
     """Return ``values`` as a float64 array after checking that every entry is finite.
 

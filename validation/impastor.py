@@ -37,14 +37,13 @@ from reference.display_model import (
 )
 from reference.errors import require
 from reference.spectra import resample_spectrum, spectrum_from_dataset
-from validation.metrics import colorchecker_truth as _colorchecker_truth_uncached
-from validation.metrics import delta_E_stats
+from validation.metrics import colorchecker_truth, delta_E_stats
 
 __all__ = [
     "EXTRA_LIGHTS",
     "LIGHTS",
     "channel_count_errors",
-    "colorchecker_truth",
+    "colorchecker_truth_cached",
     "design_delta_E",
     "display_round_trip",
     "metamer_delta_E",
@@ -60,15 +59,15 @@ EXTRA_LIGHTS = ("FL2", "LED-B3")
 
 
 @functools.lru_cache(maxsize=32)
-def colorchecker_truth(light: str):
+def colorchecker_truth_cached(light: str):
     """:func:`validation.metrics.colorchecker_truth`, cached per light (do not modify the result).
 
     Examples
     --------
-    >>> colorchecker_truth("A") is colorchecker_truth("A")
+    >>> colorchecker_truth_cached("A") is colorchecker_truth_cached("A")
     True
     """
-    return _colorchecker_truth_uncached(light)
+    return colorchecker_truth(light)
 
 
 def _lab_delta_E(XYZ, XYZ_true, white) -> np.ndarray:
@@ -111,7 +110,7 @@ def design_delta_E(design: str = "optimized", n_channels: int = 6, light: str = 
     True
     """
     d = MULTISPECTRAL_DESIGNS.lookup(design).reference(n_channels)
-    patches, truth, white = colorchecker_truth(light)
+    patches, truth, white = colorchecker_truth_cached(light)
     R = _cc_on_grid(patches)
     # Fig. 3, Ferwerda: XYZ = M · (R6 ⊙ S6)
     U = spectra_to_channels(R, d) * light_to_channels(spectrum_from_dataset("illuminant", light), d)
@@ -130,8 +129,8 @@ def naive_rgb_delta_E(light: str = "A") -> np.ndarray:
     >>> float(naive_rgb_delta_E("D65").mean()) < 0.5
     True
     """
-    _, truth_d65, _ = colorchecker_truth("D65")
-    _, truth, white = colorchecker_truth(light)
+    _, truth_d65, _ = colorchecker_truth_cached("D65")
+    _, truth, white = colorchecker_truth_cached(light)
     rgb_reflectance = XYZ_to_display_RGB(truth_d65)
     rgb_light = XYZ_to_display_RGB(white)
     from reference.colorimetry import display_RGB_to_XYZ
@@ -221,7 +220,7 @@ def table1(
     d = MULTISPECTRAL_DESIGNS.lookup(design).reference(n_channels)
     rows, per_light = [], {}
     for light in lights:
-        patches, truth, white = colorchecker_truth(light)
+        patches, truth, white = colorchecker_truth_cached(light)
         names = list(patches)
         S6 = light_to_channels(spectrum_from_dataset("illuminant", light), d)
         XYZ_sim = channels_to_XYZ(spectra_to_channels(_cc_on_grid(patches), d) * S6, d)

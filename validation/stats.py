@@ -6,7 +6,9 @@ sampler's pdf, integrated over each cell by composite Gauss–Legendre quadratur
 coordinates. Before any statistics it refuses samples outside the domain, a negative pdf, and pdf
 mass above 1 + 1e-3. Cells expecting fewer than 5 samples are pooled into one bin; the p-value comes
 from ``scipy.stats.chi2.sf`` and is compared with a Šidák-corrected significance level, so that
-the whole suite's chi-square tests together have a false-alarm rate of α = 0.01.
+the whole suite's chi-square tests together have a false-alarm rate of α = 0.01. The family size
+``n_tests`` is an argument: the suite's tests run through ``validation.chi2_cases``, which passes
+the number of registered cases, so no count is kept by hand.
 
 Grid. ``res`` is the number of cell *edges* in cos θ and must be odd; the cos θ range of the domain
 ([0, 1] for ``"hemisphere"``, [−1, 1] for ``"sphere"``) is split into ``res − 1`` equal cells, so on
@@ -30,18 +32,13 @@ import numpy as np
 
 from reference.errors import require, require_choice
 
-__all__ = ["CHI2_TESTS_IN_SUITE", "DOMAINS", "Chi2Result", "chi2_test", "sidak_alpha"]
+__all__ = ["DOMAINS", "Chi2Result", "chi2_test", "sidak_alpha"]
 
 #: Domains of :func:`chi2_test`: the cos θ range each covers.
 DOMAINS = {"hemisphere": (0.0, 1.0), "sphere": (-1.0, 1.0)}
 
-#: How many chi-square tests the whole suite runs; the Šidák correction divides α among them.
-#: Raise it when adding chi-square tests; it counts the tests that are expected to pass
-#: (``tests/reference/test_brdf.py`` runs 4, ``tests/validation/test_stats.py`` 2).
-CHI2_TESTS_IN_SUITE = 16
 
-
-def sidak_alpha(alpha: float = 0.01, n_tests: int = CHI2_TESTS_IN_SUITE) -> float:
+def sidak_alpha(alpha: float, n_tests: int) -> float:
     """Per-test significance level so that ``n_tests`` independent tests have family level α.
 
     ``1 − (1 − α)^(1/n)`` (Šidák 1967).
@@ -149,8 +146,8 @@ def chi2_test(
     *,
     name: str = "sampler",
     out_dir=None,
+    n_tests: int,
     alpha: float = 0.01,
-    n_tests: int = CHI2_TESTS_IN_SUITE,
     quad_order: int = 6,
     quad_sub: int = 4,
 ) -> Chi2Result:
@@ -176,10 +173,11 @@ def chi2_test(
     out_dir : str or Path, optional
         Where to write ``chi2_<name>.npz`` and ``chi2_<name>.png`` on failure (a test's
         ``tmp_path``).
+    n_tests : int
+        Number of chi-square tests in the family (Šidák correction); the suite passes
+        ``len(validation.chi2_cases.CHI2_CASES)``.
     alpha : float
         Family-wise significance level.
-    n_tests : int
-        Number of chi-square tests in the family (Šidák correction).
     quad_order, quad_sub : int
         Gauss–Legendre order and number of sub-intervals per cell and coordinate.
 
@@ -191,7 +189,7 @@ def chi2_test(
     Raises
     ------
     SpecrefError
-        On a bad ``domain``, ``res`` or ``n_samples``.
+        On a bad ``domain``, ``res``, ``n_samples``, ``alpha`` or ``n_tests``.
 
     Examples
     --------
@@ -201,7 +199,7 @@ def chi2_test(
     ...     phi = 2 * np.pi * u[:, 1]
     ...     return np.stack([r * np.cos(phi), r * np.sin(phi), z], -1)
     >>> result = chi2_test(uniform_hemisphere, lambda d: np.full(len(d), 1 / (2 * np.pi)),
-    ...                    "hemisphere", 20000, 9, seed=1)
+    ...                    "hemisphere", 20000, 9, seed=1, n_tests=1)
     >>> result.passed, result.dof
     (True, 127)
     """

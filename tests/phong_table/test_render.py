@@ -5,13 +5,7 @@ import pytest
 from phong_table import SCENES, SpectralPhong, render_sphere
 from phong_table.render import light_geometry, sphere_gbuffer
 from phong_table.scenes import constant_material, highlight_point, spectral_phong_unit_peak
-from reference.camera import Camera
-from reference.gbuffer import render_gbuffer
-from reference.geometry import Sphere
-from reference.lights import PointLight
-from reference.materials import PhongMaterial
-from reference.shading import ShadingContext, shade_gbuffer
-from reference.spectra import DEFAULT_GRID, spectrum_from_dataset
+from reference.spectra import DEFAULT_GRID
 
 
 @pytest.mark.parametrize("scene", ["R1", "R3"])
@@ -40,18 +34,6 @@ def test_exact_render_matches_colour_sd_to_XYZ_per_pixel(scene):
         expected = model.light.intensity * (M @ XYZ)
         got = image.reshape(-1, 3)[pixels[k]]
         np.testing.assert_allclose(got, expected, rtol=1e-9, atol=1e-12)
-
-
-def test_table_shader_through_scene_options_matches_exact():
-    material = PhongMaterial(np.full(41, 0.3), np.full(41, 0.4), np.linspace(10.0, 300.0, 41))
-    light = PointLight((2.0, 3.0, 4.0), spectrum_from_dataset("illuminant", "D65"))
-    g = render_gbuffer([Sphere()], Camera(eye=(0, 0, 4)), 24, 24)
-    exact = shade_gbuffer(g, [material], [light])
-    ctx = ShadingContext(options={"phong": {"method": "table", "entries": 200}})
-    table = shade_gbuffer(g, [material], [light], ctx)
-    assert np.abs(table - exact).max() < 1e-6
-    # the default stays the exact shader
-    assert np.array_equal(shade_gbuffer(g, [material], [light], ShadingContext()), exact)
 
 
 def test_highlight_point_has_t_equal_1():

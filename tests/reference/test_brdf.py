@@ -19,7 +19,7 @@ from reference.brdf import (
     sample_ward_duer_lobe,
 )
 from reference.errors import SpecrefError, SpecrefWarning
-from validation.stats import chi2_test
+from validation.chi2_cases import cases_for, run_chi2_case
 
 Z = np.array([0.0, 0.0, 1.0])
 
@@ -174,23 +174,10 @@ def test_brdf_ward_duer_albedo_bounded_at_grazing_incidence():
     assert albedo <= 1.0
 
 
-CHI2_CASES = [
-    ("lambert", {"rho_d": 0.7}, 30.0),
-    ("ward_duer", {"rho_d": 0.0, "rho_s": 1.0, "alpha": 0.08}, 0.0),
-    ("ward_duer", {"rho_d": 0.0, "rho_s": 1.0, "alpha": 0.3}, 60.0),
-    ("ward_duer", {"rho_d": 0.4, "rho_s": 0.4, "alpha": 0.15}, 45.0),
-]
-
-
-@pytest.mark.parametrize(("name", "params", "theta_deg"), CHI2_CASES)
-def test_brdf_sampler_chi2(name, params, theta_deg, tmp_path):
-    method = BRDF_METHODS.lookup(name)
-    wi = _direction(np.radians(theta_deg))
-    sample = lambda u: method.extra["sample"](np.broadcast_to(wi, (len(u), 3)), Z, u, **params)  # noqa: E731
-    pdf = lambda d: method.extra["pdf"](np.broadcast_to(wi, d.shape), d, Z, **params)  # noqa: E731
-    result = chi2_test(
-        sample, pdf, "sphere", 200_000, 21, seed=5, name=f"{name}_{theta_deg:g}", out_dir=tmp_path
-    )
+@pytest.mark.parametrize("case", cases_for("reference.brdf"), ids=attrgetter("name"))
+def test_brdf_sampler_chi2(case, tmp_path):
+    # Every distinct sampler of BRDF_METHODS (validation/chi2_cases.py), against its own pdf.
+    result = run_chi2_case(case, tmp_path)
     assert result.passed, result.message
 
 

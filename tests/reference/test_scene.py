@@ -5,17 +5,13 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-import colour
-import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
 from reference.errors import SpecrefError
 from reference.geometry import Plane, Sphere
-from reference.images import spectral_channel_names, write_exr
-from reference.lights import AmbientLight, EnvironmentLight, PointLight
+from reference.lights import AmbientLight, PointLight
 from reference.materials import MATERIAL_TYPES, LambertMaterial, MaterialType, PhongMaterial
-from reference.mesh import TriangleMesh
 from reference.scene import (
     LIGHT_TYPES,
     MAX_RENDER_SAMPLES,
@@ -180,84 +176,7 @@ def test_with_render_keeps_the_aspect_ratio():
     assert (r.width, r.height, r.supersample) == (10, 10, 1)
 
 
-# --- spectrum forms -------------------------------------------------------------------------------
-
-
-def _k_d(spectrum: str, tmp_path=None, grid: str = "41") -> np.ndarray:
-    text = f'[spectral]\ngrid = "{grid}"\n[materials.m]\ntype = "lambert"\nk_d = {spectrum}\n'
-    return scene_with(text, tmp_path).materials[0].k_d
-
-
-def test_spectrum_forms_number_and_constant():
-    assert_allclose(_k_d("0.25"), np.full(41, 0.25))
-    assert_allclose(_k_d("{ constant = 0.75 }"), np.full(41, 0.75))
-    assert_allclose(_k_d("1"), np.full(41, 1.0))
-
-
-def test_spectrum_form_colorchecker_matches_colour_science():
-    values = _k_d('{ colorchecker = "dark skin" }')
-    # Source: colour-science's N Ohta data (5 nm), read at the 10 nm grid nodes.
-    sd = colour.SDS_COLOURCHECKERS["ColorChecker N Ohta"]["dark skin"]
-    assert_allclose(values, sd[GRID_41.wavelengths_nm], rtol=1e-12)
-    # BabelColor Average stops at 730 nm: the 41-band grid needs an extrapolation.
-    with raises("scene.toml: materials.m.k_d: covers 380-730 nm but the grid needs 380-780 nm"):
-        _k_d('{ colorchecker = "dark skin", set = "BabelColor Average" }')
-    held = _k_d(
-        '{ colorchecker = "dark skin", set = "BabelColor Average", extrapolation = "constant" }'
-    )
-    babel = colour.SDS_COLOURCHECKERS["BabelColor Average"]["dark skin"]
-    assert_allclose(held[-5:], babel.values[-1], rtol=1e-12)
-
-
-def test_spectrum_form_illuminant_and_light_source():
-    values = _k_d('{ illuminant = "D65" }')
-    # Source: colour-science's CIE D65 table at the grid nodes.
-    assert_allclose(values, colour.SDS_ILLUMINANTS["D65"][GRID_41.wavelengths_nm], rtol=1e-12)
-    values = _k_d('{ light_source = "Natural", extrapolation = "zero" }')
-    natural = colour.SDS_LIGHT_SOURCES["Natural"]
-    inside = (GRID_41.wavelengths_nm >= natural.wavelengths[0]) & (
-        GRID_41.wavelengths_nm <= natural.wavelengths[-1]
-    )
-    assert_allclose(values[inside], natural[GRID_41.wavelengths_nm[inside]], rtol=1e-9)
-    assert_allclose(values[~inside], 0.0)
-
-
-def test_spectrum_form_csv_options(tmp_path):
-    (tmp_path / "long.csv").write_text("nm,a,b\n380,0.1,10\n780,0.3,30\n")
-    assert_allclose(
-        _k_d('{ csv = "long.csv", column = "b", scale = 0.01 }', tmp_path)[[0, -1]], [0.1, 0.3]
-    )
-    assert_allclose(_k_d('{ csv = "long.csv", column = 1 }', tmp_path)[[0, -1]], [0.1, 0.3])
-    (tmp_path / "wide.csv").write_text("380,580,780\n0.1,0.2,0.3\n0.4,0.5,0.6\n")
-    assert_allclose(_k_d('{ csv = "wide.csv", row = 1 }', tmp_path)[[0, 20, 40]], [0.4, 0.5, 0.6])
-    with raises("scene.toml: materials.m.k_d.column: must be a header name"):
-        _k_d('{ csv = "long.csv", column = 1.5 }', tmp_path)
-
-
-def test_spectrum_form_csv_reads_the_shared_measurements(shared_data):
-    path = shared_data / "spectra" / "physicallybased" / "lemon__nix_export.csv"
-    with raises("scene.toml: materials.m.k_d: covers 400-700 nm but the grid needs 380-780 nm"):
-        _k_d(f'{{ csv = "{path}" }}')
-    values = _k_d(f'{{ csv = "{path}", extrapolation = "constant" }}')
-    # Source: the file's own R400 nm ... R700 nm cells, on the 31-band grid.
-    on_31 = _k_d(f'{{ csv = "{path}" }}', grid="31")
-    assert_allclose(values[2:33], on_31, rtol=1e-12)
-    assert_allclose(values[:2], on_31[0])
-    assert_allclose(values[33:], on_31[-1])
-
-
-def test_spectrum_form_inline_arrays_and_interpolation():
-    linear = _k_d("{ wavelengths = [380, 480, 580, 680, 780], values = [0, 1, 0, 1, 0] }")
-    # Source: linear interpolation between the samples (closed form).
-    assert_allclose(linear[:11], np.linspace(0, 1, 11), atol=1e-15)
-    x, y = [380.0, 460, 540, 620, 700, 780], [1.0, 2, 4, 3, 2, 1]
-    sprague = _k_d(f'{{ wavelengths = {x}, values = {y}, interpolation = "sprague" }}')
-    # Source: colour-science's Sprague interpolator on the same samples.
-    from colour.algebra import SpragueInterpolator
-
-    expected = SpragueInterpolator(np.array(x), np.array(y))(GRID_41.wavelengths_nm)
-    assert_allclose(sprague, expected, rtol=1e-12)
-    assert not np.allclose(sprague, np.interp(GRID_41.wavelengths_nm, x, y))
+# --- spectrum forms: tests/reference/test_scene_values.py -----------------------------------------
 
 
 def test_every_spectrum_form_key_is_documented():
@@ -281,31 +200,6 @@ def test_a_registered_material_type_loads_without_editing_the_loader(monkeypatch
     assert_allclose(scene.materials[0].k_d, 0.3)
     with raises("scene.toml: materials.t: unknown key 'k_s'; allowed: k_d, type"):
         scene_with('[materials.t]\ntype = "tinted"\nk_d = 0.3\nk_s = 1')
-
-
-def test_environment_light_rgb_and_spectral_exr(tmp_path):
-    rgb = np.full((4, 8, 3), 0.5)
-    write_exr(tmp_path / "rgb.exr", rgb)
-    wl = np.array([380.0, 580.0, 780.0])
-    write_exr(tmp_path / "spec.exr", np.ones((4, 8, 3)), spectral_channel_names(wl))
-    scene = scene_with(
-        '[[lights]]\ntype = "environment"\nfile = "rgb.exr"\nintensity = 2\n'
-        '[[lights]]\ntype = "environment"\nfile = "spec.exr"\n',
-        tmp_path,
-    )
-    first, second = scene.lights
-    assert isinstance(first, EnvironmentLight)
-    assert not first.is_spectral
-    assert_allclose(first.image, rgb)
-    assert first.intensity == 2.0
-    assert second.is_spectral
-    assert_allclose(second.wavelengths_nm, wl)
-
-
-def test_environment_light_reads_shared_hdr(shared_data):
-    path = shared_data / "environments" / "studio_small_03_1k.hdr"
-    scene = scene_with(f'[[lights]]\ntype = "environment"\nfile = "{path}"')
-    assert scene.lights[0].image.shape == (512, 1024, 3)
 
 
 # --- bad input: one line naming the file, the key, what is allowed, what was given ---------------
@@ -441,88 +335,6 @@ def test_bad_scene_values_are_refused_with_file_and_key(text, message):
         scene_with(text)
 
 
-@pytest.mark.parametrize(
-    ("spectrum", "message"),
-    [
-        ("nan", "scene.toml: materials.m.k_d: must be finite, got nan"),
-        ("inf", "scene.toml: materials.m.k_d: must be finite, got inf"),
-        ("-0.5", "scene.toml: materials.m.k_d: must be >= 0, got -0.5"),
-        ("{ constant = -1 }", "scene.toml: materials.m.k_d.constant: must be >= 0, got -1"),
-        (
-            "{ wavelengths = [380, 780], values = [0.5, nan] }",
-            "scene.toml: materials.m.k_d: values must be finite, got nan at 780 nm",
-        ),
-        (
-            "{ wavelengths = [380, 780], values = [0.5, inf] }",
-            "scene.toml: materials.m.k_d: values must be finite, got inf at 780 nm",
-        ),
-        (
-            "{ wavelengths = [380, 780], values = [-0.5, 0.5] }",
-            "scene.toml: materials.m.k_d: values must be >= 0, got -0.5 at 380 nm",
-        ),
-        (
-            "{ wavelengths = [380, 580, 500, 780], values = [1, 1, 1, 1] }",
-            "scene.toml: materials.m.k_d: wavelengths must increase strictly, got 580.0 then 500.0",
-        ),
-        (
-            "{ wavelengths = [380, 380, 780], values = [1, 1, 1] }",
-            "scene.toml: materials.m.k_d: wavelengths must increase strictly, got 380.0 then 380.0",
-        ),
-        (
-            "{ wavelengths = [380, 780], values = [1, 1, 1] }",
-            "scene.toml: materials.m.k_d: 2 wavelengths but 3 values",
-        ),
-        (
-            "{ wavelengths = [380, 780] }",
-            "scene.toml: materials.m.k_d: inline spectrum needs 'values'",
-        ),
-        (
-            '{ wavelengths = [380, "x"], values = [1, 1] }',
-            "scene.toml: materials.m.k_d.wavelengths[1]: must be a number, got 'x'",
-        ),
-        (
-            '{ constant = 1, extrapolation = "mirror" }',
-            "scene.toml: materials.m.k_d.extrapolation: unknown value 'mirror'; allowed: constant,",
-        ),
-        ('"red"', "scene.toml: materials.m.k_d: must be a number or a spectrum table"),
-    ],
-)
-def test_bad_spectra_are_refused(spectrum, message):
-    with raises(message):
-        _k_d(spectrum)
-
-
-def test_bad_csv_spectra_are_refused(tmp_path):
-    (tmp_path / "nan.csv").write_text("nm,R\n380,0.5\n780,nan\n")
-    (tmp_path / "neg.csv").write_text("nm,R\n380,0.5\n780,-0.1\n")
-    (tmp_path / "back.csv").write_text("nm,R\n380,0.5\n370,0.5\n780,0.5\n")
-    with raises("scene.toml: materials.m.k_d.csv: file not found: "):
-        _k_d('{ csv = "missing.csv" }', tmp_path)
-    with raises(f"scene.toml: materials.m.k_d: {tmp_path / 'nan.csv'}: values must be finite"):
-        _k_d('{ csv = "nan.csv" }', tmp_path)
-    with raises(f"scene.toml: materials.m.k_d: {tmp_path / 'neg.csv'}: values must be >= 0"):
-        _k_d('{ csv = "neg.csv" }', tmp_path)
-    with raises(f"scene.toml: materials.m.k_d: {tmp_path / 'back.csv'}: wavelengths must increase"):
-        _k_d('{ csv = "back.csv" }', tmp_path)
-
-
-def test_bad_light_spectra_are_refused(tmp_path):
-    light = '[[lights]]\ntype = "ambient"\nspectrum = '
-    with raises("scene.toml: lights[0].spectrum: covers 400-700 nm but the grid needs 380-780 nm"):
-        scene_with(light + "{ wavelengths = [400, 700], values = [1, 1] }")
-    with raises("scene.toml: lights[0].spectrum: values must be finite, got nan at 700 nm"):
-        scene_with(light + "{ wavelengths = [400, 700], values = [1, nan] }")
-    # With an extrapolation the light is resampled at 1 nm over the grid, as the scene asked.
-    scene = scene_with(
-        light + '{ wavelengths = [400, 700], values = [1, 1], extrapolation = "zero" }'
-    )
-    spectrum = scene.lights[0].spectrum
-    assert (spectrum.wavelengths_nm[0], spectrum.wavelengths_nm[-1]) == (380.0, 780.0)
-    inside = (spectrum.wavelengths_nm >= 400) & (spectrum.wavelengths_nm <= 700)
-    assert_allclose(spectrum.values[inside], 1.0)
-    assert_allclose(spectrum.values[~inside], 0.0)
-
-
 def test_resolution_limits():
     with raises("scene.toml: render.width: must be an integer in [1, 16384], got 0"):
         scene_with("[render]\nwidth = 0")
@@ -559,81 +371,3 @@ def test_malformed_and_missing_scene_files(tmp_path):
         load_scene(binary)
     with raises(f"{tmp_path}: file not found"):
         load_scene(tmp_path)
-
-
-def test_missing_and_unreadable_images(tmp_path):
-    (tmp_path / "junk.hdr").write_bytes(b"#?RADIANCE\nthis is not an image\n")
-    (tmp_path / "junk.exr").write_bytes(b"v/1\x01 not an exr")
-    (tmp_path / "map.png").write_bytes(b"")
-    env = '[[lights]]\ntype = "environment"\nfile = '
-    with raises("scene.toml: lights[0].file: file not found: "):
-        scene_with(env + '"nope.hdr"', tmp_path)
-    with raises(f"scene.toml: lights[0].file: {tmp_path / 'junk.hdr'}: cannot read Radiance HDR"):
-        scene_with(env + '"junk.hdr"', tmp_path)
-    with raises(f"scene.toml: lights[0].file: {tmp_path / 'junk.exr'}: cannot read OpenEXR image"):
-        scene_with(env + '"junk.exr"', tmp_path)
-    with raises(f"scene.toml: lights[0].file: {tmp_path / 'map.png'}: unsupported environment map"):
-        scene_with(env + '"map.png"', tmp_path)
-
-
-def test_environment_maps_with_bad_values(tmp_path):
-    image = np.ones((4, 8, 3))
-    image[1, 2, 0] = np.nan
-    write_exr(tmp_path / "nan.exr", image)
-    write_exr(tmp_path / "neg.exr", -np.ones((4, 8, 3)))
-    write_exr(tmp_path / "square.exr", np.ones((4, 4, 3)))
-    write_exr(tmp_path / "other.exr", np.ones((4, 8, 2)), ["U", "V"])
-    env = '[[lights]]\ntype = "environment"\nfile = '
-    with raises("scene.toml: lights[0].file: "):
-        scene_with(env + '"nan.exr"', tmp_path)
-    with pytest.raises(SpecrefError, match=r"lights\[0\]\.file: .*radiance must be finite"):
-        scene_with(env + '"nan.exr"', tmp_path)
-    with pytest.raises(SpecrefError, match=r"lights\[0\]\.file: .*radiance must be >= 0"):
-        scene_with(env + '"neg.exr"', tmp_path)
-    with pytest.raises(SpecrefError, match=r"lights\[0\]\.file: .*2:1"):
-        scene_with(env + '"square.exr"', tmp_path)
-    with pytest.raises(SpecrefError, match=r"lights\[0\]\.file: .*channels U, V; an environment"):
-        scene_with(env + '"other.exr"', tmp_path)
-
-
-# --- meshes ---------------------------------------------------------------------------------------
-
-QUAD_OBJ = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvn 0 0 1\nf 1//1 2//1 3//1 4//1\n"
-
-
-def test_mesh_objects_load_and_place(tmp_path):
-    (tmp_path / "quad.obj").write_text(QUAD_OBJ)
-    scene = scene_with(
-        GREY.replace("sphere", "mesh")
-        + 'file = "quad.obj"\nscale = 0.5\ntranslate = [0, 1, -2]\ncull_backfaces = true',
-        tmp_path,
-    )
-    (mesh,) = scene.objects
-    assert isinstance(mesh, TriangleMesh)
-    assert mesh.material == 0
-    assert mesh.cull_backfaces
-    # Source: the OBJ's vertices, scaled by 0.5 and moved by (0, 1, -2).
-    assert_allclose(mesh.vertices[:, :2], [[-0.5, 0.5], [0.5, 0.5], [0.5, 1.5], [-0.5, 1.5]])
-    assert_allclose(mesh.vertices[:, 2], -2.0)
-    assert_allclose(mesh.normals, np.tile([0.0, 0.0, 1.0], (4, 1)))
-
-
-def test_mesh_with_nan_or_inf_vertices_is_refused(tmp_path):
-    (tmp_path / "nan.obj").write_text("v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
-    (tmp_path / "inf.obj").write_text("v 0 0 0\nv inf 0 0\nv 0 1 0\nf 1 2 3\n")
-    for name in ("nan.obj", "inf.obj"):
-        with pytest.raises(
-            SpecrefError,
-            match=rf"^scene\.toml: objects\[0\]\.file: .*{name}.*(finite|not a number)",
-        ):
-            scene_with(GREY.replace("sphere", "mesh") + f'file = "{name}"', tmp_path)
-    with raises("scene.toml: objects[0].file: file not found: "):
-        scene_with(GREY.replace("sphere", "mesh") + 'file = "none.obj"', tmp_path)
-    with raises("scene.toml: objects[0]: missing key 'file'"):
-        scene_with(GREY.replace("sphere", "mesh"), tmp_path)
-    with raises("scene.toml: objects[0].scale: must be > 0, got 0"):
-        scene_with(GREY.replace("sphere", "mesh") + 'file = "nan.obj"\nscale = 0', tmp_path)
-    with raises("scene.toml: objects[0].cull_backfaces: must be true or false, got 1"):
-        scene_with(
-            GREY.replace("sphere", "mesh") + 'file = "nan.obj"\ncull_backfaces = 1', tmp_path
-        )

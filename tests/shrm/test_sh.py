@@ -7,7 +7,6 @@ import numpy as np
 import pytest
 
 from reference.errors import SpecrefError
-from reference.images import read_hdr
 from shrm.sh import (
     PLAIN_ORDER_LIMIT,
     directions_to_theta_phi,
@@ -21,11 +20,7 @@ from shrm.sh import (
     sh_evaluate,
 )
 from shrm.transform import (
-    SH_BACKENDS,
     SH_KERNELS,
-    project_function,
-    project_latlong,
-    synthesize_latlong,
 )
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "sh_basis.json"
@@ -135,45 +130,6 @@ def test_fejer1_exact_for_polynomials():
         assert abs(fejer1_weights(n) @ x**k - 2 / (k + 1)) < 1e-14
 
 
-@pytest.mark.parametrize("backend", SH_BACKENDS.values(), ids=attrgetter("name"))
-def test_round_trip_band_limited_L100(backend, rng):
-    # A band-limited random L = 100 map, synthesized and projected back, returns its coefficients
-    # (Fejér-1 is exact for 2L < H); the bound is RMS ≤ 1e-13 on the map.
-    L, H = 100, 202
-    c = rng.normal(size=(1, (L + 1) ** 2)) / (L + 1)
-    image = synthesize_latlong(c, H, backend=backend.name)
-    back = project_latlong(image, L, backend=backend.name)
-    again = synthesize_latlong(back, H, backend=backend.name)
-    assert np.sqrt(np.mean((again - image) ** 2)) <= 1e-13
-    np.testing.assert_allclose(back, c, atol=1e-13)
-
-
-def test_projection_of_finite_sum_returns_coefficients(rng):
-    L = 12
-    c = rng.normal(size=(3, (L + 1) ** 2))
-    got = project_function(lambda d: sh_evaluate(c, d), L)
-    np.testing.assert_allclose(got, c, atol=1e-13)
-
-
-def test_solid_angle_weights_leave_round_trip_error(rng):
-    # The pixel solid-angle rule is a midpoint rule: its error (5e-4 relative) is why it is not
-    # the default.
-    L = 20
-    c = rng.normal(size=(1, (L + 1) ** 2))
-    image = synthesize_latlong(c, 64)
-    err = np.abs(project_latlong(image, L, weights="solid_angle") - c).max() / np.abs(c).max()
-    assert 1e-5 < err < 1e-2
-
-
-def test_ducc0_agrees_with_numpy_on_real_map(shared_data):
-    # The fast path against its oracle on venice_sunset_1k.hdr (512×1024, RGB), L = 100: ≤ 1e-13
-    # relative to the largest coefficient.
-    image = read_hdr(shared_data / "environments" / "venice_sunset_1k.hdr")
-    a = project_latlong(image, 100, backend="numpy")
-    b = project_latlong(image, 100, backend="ducc0")
-    assert np.abs(a - b).max() / np.abs(a).max() <= 1e-13
-
-
 @pytest.mark.parametrize("method", SH_KERNELS.values(), ids=attrgetter("name"))
 def test_numba_twins_equal_numpy(method, rng):
     args = method.example_inputs(rng)
@@ -227,28 +183,9 @@ def test_directions_on_poles_are_finite():
     assert np.isfinite(sh_basis(50, [[0.0, 1.0, 0.0], [0.0, -1.0, 0.0]])).all()
 
 
-@pytest.mark.parametrize(
-    ("image", "order", "message"),
-    [
-        (np.ones((8, 8, 1)), 2, "2:1"),
-        (np.full((8, 16, 1), np.nan), 2, "finite"),
-        (np.ones((8, 16, 1)), -1, "order"),
-        (np.ones((8, 16, 1)), 8, "order"),
-    ],
-)
-def test_project_bad_input(image, order, message):
-    with pytest.raises(SpecrefError, match=message):
-        project_latlong(image, order)
-
-
 def test_order_above_limit_refused():
     with pytest.raises(SpecrefError, match="3000"):
         legendre_table(3001, [0.5])
-
-
-def test_unknown_backend():
-    with pytest.raises(SpecrefError, match="allowed: ducc0, numba, numpy"):
-        project_latlong(np.ones((4, 8, 1)), 1, backend="fortran")
 
 
 @pytest.mark.xslow
