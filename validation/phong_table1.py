@@ -13,19 +13,20 @@ from __future__ import annotations
 
 import numpy as np
 
+from phong_table.interpolation import INTERPOLATION_METHODS
 from phong_table.model import SpectralPhong
 from phong_table.scenes import SCENES, VIEWS
 from phong_table.table import check_interpolation
 from validation.phong import (
     ENTRY_LADDER,
-    INTERPOLATIONS,
-    NEVER_WORSE_INTERPOLATIONS,
     TABLE1_ENTRIES,
-    TABLE_VARIANTS,
     TIE_8BIT,
     ViewState,
+    never_worse_interpolations,
     shared_frame_time,
+    table1_scenes,
     table_error_row,
+    table_variants,
     time_row,
     time_shading,
     tolerance_search,
@@ -119,9 +120,10 @@ def material_rows(
 
 
 def _table1_variants(entries: int):
-    for placement, segments in TABLE_VARIANTS:
-        for interpolation in INTERPOLATIONS:
-            yield placement, interpolation, entries, segments(entries)
+    # every table variant with every registered interpolation, in registry order
+    for variant in table_variants():
+        for interpolation in INTERPOLATION_METHODS.names():
+            yield variant.placement, interpolation, entries, variant.segments(entries)
 
 
 def _ratio(a: float, b: float) -> float:
@@ -208,9 +210,10 @@ def table1_targets(
             )
         # the error placement against the others, same interpolation, every m of the ladder
         for m in ENTRY_LADDER:
-            for interpolation in NEVER_WORSE_INTERPOLATIONS:
-                for placement, segments in TABLE_VARIANTS:
-                    row = table_error_row(state, placement, interpolation, m, segments(m))
+            for interpolation in never_worse_interpolations():
+                for variant in table_variants():
+                    segments = variant.segments(m)
+                    row = table_error_row(state, variant.placement, interpolation, m, segments)
                     records.append({"scene": scene, "view": view, **row})
                     if interpolation == "monotone":
                         overshoot_max = max(overshoot_max, row["overshoot"])
@@ -269,9 +272,9 @@ def _worst(values, limit, larger_is_worse=True):
 
 def _never_worse(records):
     # error placement minus the best other placement, same view, m and interpolation
-    groups = {}
+    groups, compared = {}, never_worse_interpolations()
     for r in records:
-        if r["interpolation"] in NEVER_WORSE_INTERPOLATIONS:
+        if r["interpolation"] in compared:
             key = (r["scene"], r["view"], r["entries"], r["interpolation"])
             groups.setdefault(key, {})[(r["placement"], r["segments"])] = r["rms"]
     worst, where = None, ""
@@ -400,15 +403,17 @@ def run_table1(
     resolution: int = 512,
     entries: int = TABLE1_ENTRIES,
     repeats: int = 9,
-    scenes=("R1", "R2", "R3"),
-    views=("far", "near"),
+    scenes=None,
+    views=None,
     targets: bool = True,
     progress: bool = False,
 ) -> dict:
     """Table 1 of Wang et al., reproduced and extended, with the issue's target checks.
 
-    Rows: for each scene and view, the exact render (the baseline), then importance (p = m and
-    p = m/10), uniform and error tables at ``entries`` entries with each interpolation.
+    Rows: for each scene and view (default: ``validation.phong.table1_scenes`` and every view of
+    ``phong_table.scenes.VIEWS``), the exact render (the baseline), then each table variant
+    (``validation.phong.table_variants``: importance p = m and p = m/10, uniform, error) at
+    ``entries`` entries with each registered interpolation.
 
     Returns
     -------
@@ -423,6 +428,8 @@ def run_table1(
     """
     from tqdm import tqdm
 
+    scenes = table1_scenes() if scenes is None else scenes
+    views = tuple(VIEWS) if views is None else views
     rows, states = [], {}
     steps = len(scenes) * len(views) * (2 if targets else 1) + (1 if targets else 0)
     bar = tqdm(total=steps, desc="specref phong table1", disable=not progress, leave=False)
