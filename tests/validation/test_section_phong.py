@@ -21,6 +21,18 @@ TARGETS = (
     "shading speed-up",
 )
 
+# A benchmark file for one group: the speed-up comes from it (exact 10 ms / table 0.5 ms = 20×)
+BENCH = {
+    "benchmarks": [
+        {"group": "phong R1 far", "name": "test_exact[R1-far]", "stats": {"min": 0.01}},
+        {
+            "group": "phong R1 far",
+            "name": "test_table[R1-far-error-monotone]",
+            "stats": {"min": 0.0005},
+        },
+    ]
+}
+
 
 def _records(error_rms, uniform_rms, overshoot):
     # one row per placement and interpolation at m = 200 (and the same at m = 25)
@@ -97,43 +109,21 @@ def test_target_checks_without_figures_fail():
 
 @pytest.mark.slow
 def test_report_phong_section_quick(tmp_path):
-    # A benchmark file for one group: the speed-up comes from it (exact 10 ms / table 0.5 ms = 20×)
-    bench = {
-        "benchmarks": [
-            {"group": "phong R1 far", "name": "test_exact[R1-far]", "stats": {"min": 0.01}},
-            {
-                "group": "phong R1 far",
-                "name": "test_table[R1-far-error-monotone]",
-                "stats": {"min": 0.0005},
-            },
-        ]
-    }
     bench_json = tmp_path / "bench.json"
-    bench_json.write_text(json.dumps(bench))
+    bench_json.write_text(json.dumps(BENCH))
     results = run_report(
         tmp_path / "r", quick=True, only=["phong"], bench_json=bench_json, progress=False
     )
-    checks = results["checks"]
-    assert [next(t for t in TARGETS if t in c["name"]) for c in checks] == list(TARGETS)
-    assert all("quick" in c["name"] for c in checks[:-1])
-    assert "benchmark JSON" in checks[-1]["name"]
-    assert checks[-1]["measured"] == 20.0
-    failed = [c["name"] for c in checks if not c["passed"]]
+    found = results["checks"]
+    assert [next(t for t in TARGETS if t in c["name"]) for c in found] == list(TARGETS)
+    assert all("quick" in c["name"] for c in found[:-1])
+    assert "benchmark JSON" in found[-1]["name"]
+    assert found[-1]["measured"] == 20.0
+    failed = [c["name"] for c in found if not c["passed"]]
     assert failed == [], failed
     assert results["sections"]["phong"]["nonfinite"] == 0
 
 
-# A benchmark file for one group: the speed-up comes from it (exact 10 ms / table 0.5 ms = 20×)
-BENCH = {
-    "benchmarks": [
-        {"group": "phong R1 far", "name": "test_exact[R1-far]", "stats": {"min": 0.01}},
-        {
-            "group": "phong R1 far",
-            "name": "test_table[R1-far-error-monotone]",
-            "stats": {"min": 0.0005},
-        },
-    ]
-}
 TINY = PhongStudy(8, False, 1, (25,), ("R1",), ("near",), (10,), (50,), (10,), 64, True)
 
 
