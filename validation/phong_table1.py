@@ -326,6 +326,18 @@ def target_checks(records, picks, failure, speed, speed_source, scope="") -> lis
     [('error/monotone RMS at 200 entries', True), ('error/parabolic RMS at 200 entries', False), \
 ('error/linear RMS at 200 entries', False)]
     """
+    return [
+        *_rms_checks(records, scope),
+        _pick_check(picks, scope),
+        _never_worse_check(records, scope),
+        _overshoot_check(records, scope),
+        *_failure_checks(failure, scope),
+        _speed_check(speed, speed_source),
+    ]
+
+
+def _rms_checks(records, scope: str) -> list[Check]:
+    # the error placement's RMS at 200 entries, worst row, per interpolation
     checks = []
     error_200 = [r for r in records if r["placement"] == "error" and r["entries"] == 200]
     for interpolation, limit in (("monotone", 1e-3), ("parabolic", 1e-3), ("linear", 1e-2)):
@@ -333,40 +345,51 @@ def target_checks(records, picks, failure, speed, speed_source, scope="") -> lis
         measured, passed = _worst(rms, limit)
         name = f"error/{interpolation} RMS at 200 entries, worst of {len(rms)} rows{scope}"
         checks.append(Check(name, f"<= {limit:g}", measured, passed))
+    return checks
+
+
+def _pick_check(picks, scope: str) -> Check:
+    # --tolerance 0.05 picks; an unverified pick counts as not met
     entries = [p["entries"] if p["verified"] else np.inf for p in picks]
     measured, passed = _worst([float(e if e is not None else np.inf) for e in entries], 64)
     name = f"--tolerance 0.05 picks m (verified on the image), largest of {len(picks)}{scope}"
-    checks.append(Check(name, "<= 64", measured, passed))
+    return Check(name, "<= 64", measured, passed)
+
+
+def _never_worse_check(records, scope: str) -> Check:
     margin, where = _never_worse(records)
     measured = "not measured" if margin is None else f"{margin:.3g} ({where})"
-    checks.append(
-        Check(
-            "error placement RMS minus best of uniform/importance (p=m, m/10), same "
-            f"interpolation, worst row and m{scope}",
-            f"<= {TIE_8BIT:g} (tie)",
-            measured,
-            margin is not None and margin <= TIE_8BIT,
-        )
+    return Check(
+        "error placement RMS minus best of uniform/importance (p=m, m/10), same "
+        f"interpolation, worst row and m{scope}",
+        f"<= {TIE_8BIT:g} (tie)",
+        measured,
+        margin is not None and margin <= TIE_8BIT,
     )
+
+
+def _overshoot_check(records, scope: str) -> Check:
     overshoot = [r["overshoot"] for r in records if r["interpolation"] == "monotone"]
     measured, _ = _worst(overshoot, 0.0)
-    checks.append(
-        Check(
-            f"monotone overshoot, largest of {len(overshoot)} tables{scope}",
-            "== 0",
-            measured,
-            bool(overshoot) and max(overshoot) == 0.0,
-        )
+    return Check(
+        f"monotone overshoot, largest of {len(overshoot)} tables{scope}",
+        "== 0",
+        measured,
+        bool(overshoot) and max(overshoot) == 0.0,
     )
+
+
+def _failure_checks(failure: dict, scope: str) -> list[Check]:
+    # the paper's failure modes: n = 2000 overshoot, bimodal 5/500 RMS ratios (t-parabola)
     value = failure.get("n2000_overshoot")
-    checks.append(
+    checks = [
         Check(
             f"n = 2000, importance p = m, t-parabola overshoot at m = 200 (peaks){scope}",
             ">= 1",
             "not measured" if value is None else value,
             value is not None and value >= 1.0,
         )
-    )
+    ]
     for key, name, target, limit in (
         ("importance_rms", "importance p = m, RMS(800)/RMS(200)", ">= 0.5", 0.5),
         ("error_rms", "error placement, RMS(200)/RMS(800)", ">= 30", 30.0),
@@ -386,17 +409,18 @@ def target_checks(records, picks, failure, speed, speed_source, scope="") -> lis
                 value is not None and value >= limit,
             )
         )
-    measured, passed = _worst(speed, 10.0, larger_is_worse=False)
-    checks.append(
-        Check(
-            f"shading speed-up exact / (error + monotone, build included, m = 200), worst of "
-            f"{len(speed)} rows, {speed_source}",
-            ">= 10",
-            measured,
-            passed,
-        )
-    )
     return checks
+
+
+def _speed_check(speed, speed_source: str) -> Check:
+    measured, passed = _worst(speed, 10.0, larger_is_worse=False)
+    return Check(
+        f"shading speed-up exact / (error + monotone, build included, m = 200), worst of "
+        f"{len(speed)} rows, {speed_source}",
+        ">= 10",
+        measured,
+        passed,
+    )
 
 
 def run_table1(
