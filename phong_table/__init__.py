@@ -5,8 +5,8 @@ Users write ``phong_table.SpectralPhong``, ``phong_table.build_table`` and
 method).
 
 - :mod:`phong_table.model`: Eq. (7) diffuse RGB and Eq. (11) specular functions, Wang et al.
-- :mod:`phong_table.placement`: ``PLACEMENT_METHODS`` (uniform, importance, error).
-- :mod:`phong_table.interpolation`: ``INTERPOLATION_METHODS`` (linear, parabolic, parabolic_w,
+- :mod:`phong_table.placement`: ``PLACEMENT_METHODS`` (importance, uniform, error).
+- :mod:`phong_table.interpolation`: ``INTERPOLATION_METHODS`` (parabolic, parabolic_w, linear,
   monotone).
 - :mod:`phong_table.table`: ``build_table`` and ``SpecularTable``.
 - :mod:`phong_table.render`: the exact and table shading paths and ``render_sphere``.

@@ -327,18 +327,13 @@ def _example_inputs(rng):
 
 #: Interpolations by the keys of ``--interp``. ``reference(nodes, values, t, an) -> (..., 3)``; the
 #: compiled twin is the branch ``extra["code"]`` of ``shade_table_kernel``; ``extra["min_entries"]``
-#: is the smallest table it accepts.
+#: is the smallest table it accepts; ``extra["order"]`` its convergence order (error O(h^order) on
+#: smooth data); and
+#: ``extra["coordinate"]`` is the coordinate it interpolates in: ``"t"`` (any node set) or ``"w"``
+#: (``w = ir(t)``, in which only importance nodes with ``p = m`` are uniform). Registration order is
+#: the order of Table 1's columns and of the report: the paper's parabola first, its reading in w,
+#: then the alternatives.
 INTERPOLATION_METHODS = Registry("interpolation")
-INTERPOLATION_METHODS.register(
-    Method(
-        "linear",
-        interpolate_linear,
-        None,
-        "Eq. (11), Wang et al.",
-        _example_inputs,
-        {"code": _kernels.LINEAR, "min_entries": 1, "order": 2},
-    )
-)
 INTERPOLATION_METHODS.register(
     Method(
         "parabolic",
@@ -346,7 +341,7 @@ INTERPOLATION_METHODS.register(
         None,
         "Eq. (11), Wang et al.",
         _example_inputs,
-        {"code": _kernels.PARABOLIC, "min_entries": 3, "order": 3},
+        {"code": _kernels.PARABOLIC, "min_entries": 3, "order": 3, "coordinate": "t"},
     )
 )
 INTERPOLATION_METHODS.register(
@@ -356,7 +351,17 @@ INTERPOLATION_METHODS.register(
         None,
         "Eq. (14), Wang et al.",
         _example_inputs,
-        {"code": _kernels.PARABOLIC_W, "min_entries": 3, "order": 3},
+        {"code": _kernels.PARABOLIC_W, "min_entries": 3, "order": 3, "coordinate": "w"},
+    )
+)
+INTERPOLATION_METHODS.register(
+    Method(
+        "linear",
+        interpolate_linear,
+        None,
+        "Eq. (11), Wang et al.",
+        _example_inputs,
+        {"code": _kernels.LINEAR, "min_entries": 1, "order": 2, "coordinate": "t"},
     )
 )
 INTERPOLATION_METHODS.register(
@@ -366,6 +371,6 @@ INTERPOLATION_METHODS.register(
         None,
         "Eq. (11), Wang et al.",
         _example_inputs,
-        {"code": _kernels.MONOTONE, "min_entries": 1, "order": 3},
+        {"code": _kernels.MONOTONE, "min_entries": 1, "order": 3, "coordinate": "t"},
     )
 )

@@ -509,17 +509,9 @@ def _example_inputs(rng):
 #: ``kernel`` (if any) is the numba twin of its density computation and ``extra["compiled"]`` calls
 #: it with the reference's signature; ``extra["segments"]`` says whether ``segments`` applies and
 #: ``extra["t_range"]`` whether the placement reads the frame's range of ``t`` (``t_range=``).
+#: Registration order is the order of Table 1's rows and of the report: the paper's placement, its
+#: uniform baseline, then ours.
 PLACEMENT_METHODS = Registry("placement")
-PLACEMENT_METHODS.register(
-    Method(
-        "uniform",
-        table_uniform,
-        None,
-        "Eq. (16), Wang et al.",
-        _example_inputs,
-        {"segments": False, "source": "Wang et al. (baseline)"},
-    )
-)
 PLACEMENT_METHODS.register(
     Method(
         "importance",
@@ -528,6 +520,16 @@ PLACEMENT_METHODS.register(
         "Eq. (16), Wang et al.",
         _example_inputs,
         {"segments": True, "source": "Wang et al."},
+    )
+)
+PLACEMENT_METHODS.register(
+    Method(
+        "uniform",
+        table_uniform,
+        None,
+        "Eq. (16), Wang et al.",
+        _example_inputs,
+        {"segments": False, "source": "Wang et al. (baseline)"},
     )
 )
 PLACEMENT_METHODS.register(

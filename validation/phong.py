@@ -31,11 +31,14 @@ a user edits spectra):
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
+from phong_table.interpolation import INTERPOLATION_METHODS
 from phong_table.model import SpectralPhong
+from phong_table.placement import PLACEMENT_METHODS
 from phong_table.render import (
     SphereGeometry,
     compiled_shader,
@@ -52,19 +55,20 @@ from reference.spectra import DEFAULT_GRID
 
 __all__ = [
     "ENTRY_LADDER",
-    "INTERPOLATIONS",
-    "NEVER_WORSE_INTERPOLATIONS",
     "TABLE1_ENTRIES",
-    "TABLE_VARIANTS",
     "TIE_8BIT",
     "TILE_PIXELS",
+    "TableVariant",
     "ViewState",
     "bimodal_material",
     "format_tolerance",
+    "never_worse_interpolations",
     "rms_8bit",
     "scene_state",
     "shared_frame_time",
+    "table1_scenes",
     "table_error_row",
+    "table_variants",
     "time_row",
     "time_shading",
     "tolerance_search",
@@ -75,24 +79,82 @@ __all__ = [
 ENTRY_LADDER = (25, 50, 100, 200, 400, 800)
 #: Entries of Table 1 (the paper's 200).
 TABLE1_ENTRIES = 200
-#: Interpolations in Table 1 order.
-INTERPOLATIONS = ("parabolic", "parabolic_w", "linear", "monotone")
-#: Table variants ``(placement, segments as a function of m)``: importance with p = m (the paper's
-#: setting) and p = m/10, uniform, and the error placement.
-TABLE_VARIANTS = (
-    ("importance", lambda m: m),
-    ("importance", lambda m: max(m // 10, 1) if m % 10 == 0 else 1),
-    ("uniform", lambda m: None),
-    ("error", lambda m: None),
-)
-#: Interpolations of the "never worse" target: the parabola in w is Wang's importance coordinate,
-#: meaningless on other node sets, and is compared in the report only.
-NEVER_WORSE_INTERPOLATIONS = ("linear", "parabolic", "monotone")
 #: Pixels per timing tile.
 TILE_PIXELS = 32768
 #: Two RMS values closer than this (8-bit units, far below the 0.5 of quantization) count as equal
 #: when the error placement is compared with the others (all reach rounding level).
 TIE_8BIT = 1e-6
+
+
+def table1_scenes() -> tuple[str, ...]:
+    """The scenes of Table 1: every registered scene marked ``table1`` (shown in each of ``VIEWS``).
+
+    Examples
+    --------
+    >>> table1_scenes()
+    ('R1', 'R2', 'R3')
+    """
+    return tuple(scene.name for scene in SCENES.values() if scene.table1)
+
+
+@dataclass(frozen=True)
+class TableVariant:
+    """A table of the studies: a placement and its segment count ``p`` as a function of ``m``."""
+
+    name: str
+    placement: str
+    segments: Callable[[int], int | None]
+
+
+def _segments_m(m: int) -> int:
+    return m
+
+
+def _segments_m10(m: int) -> int:
+    return max(m // 10, 1) if m % 10 == 0 else 1
+
+
+def _no_segments(m: int) -> None:
+    return None
+
+
+def table_variants() -> list[TableVariant]:
+    """The tables of Table 1 and the sweeps: every registered placement, in registry order.
+
+    The rule: a placement that takes segments (``extra["segments"]``, the importance placement)
+    is studied at ``p = m`` (the paper's setting, named ``"<placement> p=m"``) and at ``p = m/10``
+    (``"<placement> p=m/10"``; ``p = 1`` where 10 does not divide ``m``); every other placement
+    once, under its key.
+
+    Examples
+    --------
+    >>> [(v.name, v.segments(200)) for v in table_variants()]
+    [('importance p=m', 200), ('importance p=m/10', 20), ('uniform', None), ('error', None)]
+    """
+    variants = []
+    for name, method in PLACEMENT_METHODS.items():
+        if method.extra["segments"]:
+            variants.append(TableVariant(f"{name} p=m", name, _segments_m))
+            variants.append(TableVariant(f"{name} p=m/10", name, _segments_m10))
+        else:
+            variants.append(TableVariant(name, name, _no_segments))
+    return variants
+
+
+def never_worse_interpolations() -> list[str]:
+    """The interpolations of the "never worse" target and the failure sweeps.
+
+    Every registered interpolation in ``t`` (``extra["coordinate"] == "t"``): the parabola in
+    ``w`` is Wang's importance coordinate, meaningless on other node sets, and is compared in the
+    report only. Ordered by convergence order (``extra["order"]``), then registry order.
+
+    Examples
+    --------
+    >>> never_worse_interpolations()
+    ['linear', 'parabolic', 'monotone']
+    """
+    in_t = [m for m in INTERPOLATION_METHODS.values() if m.extra["coordinate"] == "t"]
+    return [m.name for m in sorted(in_t, key=lambda m: m.extra["order"])]
 
 
 def rms_8bit(RGB, RGB_exact, encoding: str = "srgb", exact_encoded=None) -> tuple[float, float]:
@@ -351,7 +413,7 @@ def tolerance_search(
 
         def rms(m, placement=placement, cache=cache):
             if m not in cache:
-                segments = m if placement == "importance" else None
+                segments = m if PLACEMENT_METHODS.lookup(placement).extra["segments"] else None
                 cache[m] = table_error_row(state, placement, interpolation, m, segments)["rms"]
             return cache[m]
 
@@ -376,7 +438,7 @@ def tolerance_search(
         result.update(placement=None, entries=None, rms=None, verified_rms=None, verified=False)
         return result
     entries, placement = min(reached, key=lambda pair: (pair[0], placements.index(pair[1])))
-    segments = entries if placement == "importance" else None
+    segments = entries if PLACEMENT_METHODS.lookup(placement).extra["segments"] else None
     verified = table_error_row(state, placement, interpolation, entries, segments)["rms"]
     result.update(
         placement=placement,

@@ -13,19 +13,20 @@ from __future__ import annotations
 
 import numpy as np
 
+from phong_table.interpolation import INTERPOLATION_METHODS
 from phong_table.model import SpectralPhong
 from phong_table.scenes import SCENES, VIEWS
 from phong_table.table import check_interpolation
 from validation.phong import (
     ENTRY_LADDER,
-    INTERPOLATIONS,
-    NEVER_WORSE_INTERPOLATIONS,
     TABLE1_ENTRIES,
-    TABLE_VARIANTS,
     TIE_8BIT,
     ViewState,
+    never_worse_interpolations,
     shared_frame_time,
+    table1_scenes,
     table_error_row,
+    table_variants,
     time_row,
     time_shading,
     tolerance_search,
@@ -119,9 +120,10 @@ def material_rows(
 
 
 def _table1_variants(entries: int):
-    for placement, segments in TABLE_VARIANTS:
-        for interpolation in INTERPOLATIONS:
-            yield placement, interpolation, entries, segments(entries)
+    # every table variant with every registered interpolation, in registry order
+    for variant in table_variants():
+        for interpolation in INTERPOLATION_METHODS.names():
+            yield variant.placement, interpolation, entries, variant.segments(entries)
 
 
 def _ratio(a: float, b: float) -> float:
@@ -208,9 +210,10 @@ def table1_targets(
             )
         # the error placement against the others, same interpolation, every m of the ladder
         for m in ENTRY_LADDER:
-            for interpolation in NEVER_WORSE_INTERPOLATIONS:
-                for placement, segments in TABLE_VARIANTS:
-                    row = table_error_row(state, placement, interpolation, m, segments(m))
+            for interpolation in never_worse_interpolations():
+                for variant in table_variants():
+                    segments = variant.segments(m)
+                    row = table_error_row(state, variant.placement, interpolation, m, segments)
                     records.append({"scene": scene, "view": view, **row})
                     if interpolation == "monotone":
                         overshoot_max = max(overshoot_max, row["overshoot"])
@@ -269,9 +272,9 @@ def _worst(values, limit, larger_is_worse=True):
 
 def _never_worse(records):
     # error placement minus the best other placement, same view, m and interpolation
-    groups = {}
+    groups, compared = {}, never_worse_interpolations()
     for r in records:
-        if r["interpolation"] in NEVER_WORSE_INTERPOLATIONS:
+        if r["interpolation"] in compared:
             key = (r["scene"], r["view"], r["entries"], r["interpolation"])
             groups.setdefault(key, {})[(r["placement"], r["segments"])] = r["rms"]
     worst, where = None, ""
@@ -323,6 +326,18 @@ def target_checks(records, picks, failure, speed, speed_source, scope="") -> lis
     [('error/monotone RMS at 200 entries', True), ('error/parabolic RMS at 200 entries', False), \
 ('error/linear RMS at 200 entries', False)]
     """
+    return [
+        *_rms_checks(records, scope),
+        _pick_check(picks, scope),
+        _never_worse_check(records, scope),
+        _overshoot_check(records, scope),
+        *_failure_checks(failure, scope),
+        _speed_check(speed, speed_source),
+    ]
+
+
+def _rms_checks(records, scope: str) -> list[Check]:
+    # the error placement's RMS at 200 entries, worst row, per interpolation
     checks = []
     error_200 = [r for r in records if r["placement"] == "error" and r["entries"] == 200]
     for interpolation, limit in (("monotone", 1e-3), ("parabolic", 1e-3), ("linear", 1e-2)):
@@ -330,40 +345,51 @@ def target_checks(records, picks, failure, speed, speed_source, scope="") -> lis
         measured, passed = _worst(rms, limit)
         name = f"error/{interpolation} RMS at 200 entries, worst of {len(rms)} rows{scope}"
         checks.append(Check(name, f"<= {limit:g}", measured, passed))
+    return checks
+
+
+def _pick_check(picks, scope: str) -> Check:
+    # --tolerance 0.05 picks; an unverified pick counts as not met
     entries = [p["entries"] if p["verified"] else np.inf for p in picks]
     measured, passed = _worst([float(e if e is not None else np.inf) for e in entries], 64)
     name = f"--tolerance 0.05 picks m (verified on the image), largest of {len(picks)}{scope}"
-    checks.append(Check(name, "<= 64", measured, passed))
+    return Check(name, "<= 64", measured, passed)
+
+
+def _never_worse_check(records, scope: str) -> Check:
     margin, where = _never_worse(records)
     measured = "not measured" if margin is None else f"{margin:.3g} ({where})"
-    checks.append(
-        Check(
-            "error placement RMS minus best of uniform/importance (p=m, m/10), same "
-            f"interpolation, worst row and m{scope}",
-            f"<= {TIE_8BIT:g} (tie)",
-            measured,
-            margin is not None and margin <= TIE_8BIT,
-        )
+    return Check(
+        "error placement RMS minus best of uniform/importance (p=m, m/10), same "
+        f"interpolation, worst row and m{scope}",
+        f"<= {TIE_8BIT:g} (tie)",
+        measured,
+        margin is not None and margin <= TIE_8BIT,
     )
+
+
+def _overshoot_check(records, scope: str) -> Check:
     overshoot = [r["overshoot"] for r in records if r["interpolation"] == "monotone"]
     measured, _ = _worst(overshoot, 0.0)
-    checks.append(
-        Check(
-            f"monotone overshoot, largest of {len(overshoot)} tables{scope}",
-            "== 0",
-            measured,
-            bool(overshoot) and max(overshoot) == 0.0,
-        )
+    return Check(
+        f"monotone overshoot, largest of {len(overshoot)} tables{scope}",
+        "== 0",
+        measured,
+        bool(overshoot) and max(overshoot) == 0.0,
     )
+
+
+def _failure_checks(failure: dict, scope: str) -> list[Check]:
+    # the paper's failure modes: n = 2000 overshoot, bimodal 5/500 RMS ratios (t-parabola)
     value = failure.get("n2000_overshoot")
-    checks.append(
+    checks = [
         Check(
             f"n = 2000, importance p = m, t-parabola overshoot at m = 200 (peaks){scope}",
             ">= 1",
             "not measured" if value is None else value,
             value is not None and value >= 1.0,
         )
-    )
+    ]
     for key, name, target, limit in (
         ("importance_rms", "importance p = m, RMS(800)/RMS(200)", ">= 0.5", 0.5),
         ("error_rms", "error placement, RMS(200)/RMS(800)", ">= 30", 30.0),
@@ -383,32 +409,35 @@ def target_checks(records, picks, failure, speed, speed_source, scope="") -> lis
                 value is not None and value >= limit,
             )
         )
-    measured, passed = _worst(speed, 10.0, larger_is_worse=False)
-    checks.append(
-        Check(
-            f"shading speed-up exact / (error + monotone, build included, m = 200), worst of "
-            f"{len(speed)} rows, {speed_source}",
-            ">= 10",
-            measured,
-            passed,
-        )
-    )
     return checks
+
+
+def _speed_check(speed, speed_source: str) -> Check:
+    measured, passed = _worst(speed, 10.0, larger_is_worse=False)
+    return Check(
+        f"shading speed-up exact / (error + monotone, build included, m = 200), worst of "
+        f"{len(speed)} rows, {speed_source}",
+        ">= 10",
+        measured,
+        passed,
+    )
 
 
 def run_table1(
     resolution: int = 512,
     entries: int = TABLE1_ENTRIES,
     repeats: int = 9,
-    scenes=("R1", "R2", "R3"),
-    views=("far", "near"),
+    scenes=None,
+    views=None,
     targets: bool = True,
     progress: bool = False,
 ) -> dict:
     """Table 1 of Wang et al., reproduced and extended, with the issue's target checks.
 
-    Rows: for each scene and view, the exact render (the baseline), then importance (p = m and
-    p = m/10), uniform and error tables at ``entries`` entries with each interpolation.
+    Rows: for each scene and view (default: ``validation.phong.table1_scenes`` and every view of
+    ``phong_table.scenes.VIEWS``), the exact render (the baseline), then each table variant
+    (``validation.phong.table_variants``: importance p = m and p = m/10, uniform, error) at
+    ``entries`` entries with each registered interpolation.
 
     Returns
     -------
@@ -423,6 +452,8 @@ def run_table1(
     """
     from tqdm import tqdm
 
+    scenes = table1_scenes() if scenes is None else scenes
+    views = tuple(VIEWS) if views is None else views
     rows, states = [], {}
     steps = len(scenes) * len(views) * (2 if targets else 1) + (1 if targets else 0)
     bar = tqdm(total=steps, desc="specref phong table1", disable=not progress, leave=False)

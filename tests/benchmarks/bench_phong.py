@@ -3,11 +3,12 @@
 import numpy as np
 import pytest
 
-from phong_table import INTERPOLATION_METHODS, PLACEMENT_METHODS, SCENES, build_table
+from phong_table import INTERPOLATION_METHODS, PLACEMENT_METHODS, SCENES, VIEWS, build_table
 from phong_table.interpolation import interval_index
 from phong_table.render import compiled_shader, shading_buffer, sphere_gbuffer
 
-CASES = [(s, v) for s in ("R1", "R2", "R3") for v in ("far", "near")]
+# the rows of Table 1: every scene the registry marks table1, in every view
+CASES = [(s.name, v) for s in SCENES.values() if s.table1 for v in VIEWS]
 
 
 def _setup(scene, view):

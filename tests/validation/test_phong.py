@@ -97,3 +97,40 @@ def test_pixel_weighting_wins_where_the_max_norm_density_lost(shared_data, resol
     rgb = shade_pixels(state.buffer, state.model, "table", unweighted, "linear")
     unweighted_rms = max(rms_8bit(rgb, state.exact, exact_encoded=state.exact_encoded))
     assert weighted < importance < unweighted_rms, (weighted, importance, unweighted_rms)
+
+
+def test_table_variants_follow_the_placement_registry(monkeypatch):
+    # a newly registered placement joins every study at once; one that takes segments is studied
+    # at p = m and p = m/10 (p = 1 where 10 does not divide m)
+    import validation.phong as phong
+    from phong_table.placement import PLACEMENT_METHODS
+    from reference.registry import Method, Registry
+
+    registry = Registry("placement")
+    for method in PLACEMENT_METHODS.values():
+        registry.register(method)
+    registry.register(Method("demo", abs, None, "Eq. (16), Wang et al.", None, {"segments": True}))
+    monkeypatch.setattr(phong, "PLACEMENT_METHODS", registry)
+    variants = phong.table_variants()
+    assert [v.name for v in variants][-2:] == ["demo p=m", "demo p=m/10"]
+    assert [(v.placement, v.segments(200), v.segments(25)) for v in variants[-2:]] == [
+        ("demo", 200, 25),
+        ("demo", 20, 1),
+    ]
+    assert {v.placement for v in variants} == set(registry.names())
+
+
+def test_never_worse_interpolations_are_the_registered_ones_in_t(monkeypatch):
+    import validation.phong as phong
+    from phong_table.interpolation import INTERPOLATION_METHODS
+    from reference.registry import Method, Registry
+
+    registry = Registry("interpolation")
+    for method in INTERPOLATION_METHODS.values():
+        registry.register(method)
+    for name, coordinate, order in (("demo_w", "w", 1), ("demo_t", "t", 1)):
+        extra = {"coordinate": coordinate, "order": order}
+        registry.register(Method(name, abs, None, "Eq. (11), Wang et al.", None, extra))
+    monkeypatch.setattr(phong, "INTERPOLATION_METHODS", registry)
+    # in t only, from the lowest convergence order up
+    assert phong.never_worse_interpolations() == ["demo_t", "linear", "parabolic", "monotone"]

@@ -2,15 +2,24 @@
 
 from __future__ import annotations
 
+import copy
+
+import pytest
+
 import validation.sections.examples as examples
 from validation.report import Image, ReportContext, Table, Text
-from validation.report.runner import REPORT_SECTIONS
 
 
-def test_examples_section_quick(tmp_path):
-    section = REPORT_SECTIONS.lookup("examples")
-    result = section.run(ReportContext(out_dir=tmp_path, quick=True, section="examples"))
-    images = [b for b in result.blocks if isinstance(b, Image)]
+@pytest.fixture(scope="module")
+def small_renders():
+    # every example at 48 pixels wide (supersample 1), the environment scene at 12
+    return examples.example_renders(width=48, env_width=12)
+
+
+def test_example_renders_present_and_check(tmp_path, small_renders):
+    ctx = ReportContext(out_dir=tmp_path, quick=True, section="examples")
+    blocks = examples.present(ctx, small_renders)
+    images = [b for b in blocks if isinstance(b, Image)]
     assert {i.path for i in images} == {
         "images/examples-colorchecker-d65-a.png",
         "images/examples-phong-sphere.png",
@@ -18,15 +27,16 @@ def test_examples_section_quick(tmp_path):
     }
     for image in images:
         assert (tmp_path / image.path).is_file()
-    assert any(isinstance(b, Table) for b in result.blocks)
-    scenes = result.results["scenes"]
+    assert any(isinstance(b, Table) for b in blocks)
+    scenes = small_renders.results["scenes"]
     assert set(scenes) == {
         "colorchecker-d65.toml",
         "colorchecker-a.toml",
         "phong-sphere.toml",
         "env-lambert-sphere.toml",
     }
-    assert all(c.passed for c in result.checks)
+    assert all(scenes[name]["width"] == 48 for name, _ in examples.SCENES)
+    assert all(c.passed for c in examples.checks(small_renders))
     for entry in (scenes[name] for name, _ in examples.SCENES):
         assert entry["seconds"]["total"] > 0
     # The rendered charts reproduce colour-science's E308 XYZ (Y = 1 scale), as the issue asks of
@@ -35,12 +45,29 @@ def test_examples_section_quick(tmp_path):
         assert scenes[name]["accuracy"]["max_abs_dXYZ"] * 100 <= 1e-9
 
 
+def test_example_checks_are_a_pure_function_of_the_data(small_renders):
+    before = examples.checks(small_renders)
+    assert [c.passed for c in before] == [True, True, True]
+    changed = copy.deepcopy(small_renders)
+    changed.results["scenes"]["colorchecker-a.toml"]["accuracy"]["max_abs_dXYZ"] = 1e-6
+    env = changed.results["scenes"][examples.ENV_SCENE]
+    env["max_error_of_peak"] = 2 * env["tolerance"]
+    after = examples.checks(changed)
+    assert [c.passed for c in after] == [True, False, False]
+    assert after[1].measured == pytest.approx(1e-4)  # Y = 100 scale
+    assert after[2].measured == 2 * env["tolerance"]
+    assert [c.name for c in examples.checks(small_renders)] == [c.name for c in before]
+
+
 def test_examples_section_says_when_the_scenes_are_missing(tmp_path, monkeypatch):
     monkeypatch.setattr(examples, "EXAMPLES_DIR", tmp_path / "nowhere")
-    result = examples.run(ReportContext(out_dir=tmp_path, quick=True, section="examples"))
-    assert isinstance(result.blocks[0], Text)
-    assert "missing" in result.blocks[0].text
-    assert result.results["missing"] == [name for name, _ in examples.SCENES]
+    ctx = ReportContext(out_dir=tmp_path, quick=True, section="examples")
+    data = examples.example_renders(ctx)
+    blocks = examples.present(ctx, data)
+    assert isinstance(blocks[0], Text)
+    assert "missing" in blocks[0].text
+    assert data.results["missing"] == [name for name, _ in examples.SCENES]
+    assert examples.checks(data) == []
 
 
 def test_environment_example_frequency_path_agrees_with_the_oracle():

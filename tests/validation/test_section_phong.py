@@ -1,9 +1,12 @@
+import copy
 import json
 
 import pytest
 
 from validation.phong_table1 import target_checks
+from validation.report import Image, ReportContext, Table
 from validation.report.runner import run_report
+from validation.sections.phong import PhongStudy, checks, phong_speed_accuracy, present
 
 TARGETS = (
     "error/monotone RMS at 200",
@@ -17,6 +20,18 @@ TARGETS = (
     "error placement, RMS(200)/RMS(800)",
     "shading speed-up",
 )
+
+# A benchmark file for one group: the speed-up comes from it (exact 10 ms / table 0.5 ms = 20×)
+BENCH = {
+    "benchmarks": [
+        {"group": "phong R1 far", "name": "test_exact[R1-far]", "stats": {"min": 0.01}},
+        {
+            "group": "phong R1 far",
+            "name": "test_table[R1-far-error-monotone]",
+            "stats": {"min": 0.0005},
+        },
+    ]
+}
 
 
 def _records(error_rms, uniform_rms, overshoot):
@@ -94,27 +109,89 @@ def test_target_checks_without_figures_fail():
 
 @pytest.mark.slow
 def test_report_phong_section_quick(tmp_path):
-    # A benchmark file for one group: the speed-up comes from it (exact 10 ms / table 0.5 ms = 20×)
-    bench = {
-        "benchmarks": [
-            {"group": "phong R1 far", "name": "test_exact[R1-far]", "stats": {"min": 0.01}},
-            {
-                "group": "phong R1 far",
-                "name": "test_table[R1-far-error-monotone]",
-                "stats": {"min": 0.0005},
-            },
-        ]
-    }
     bench_json = tmp_path / "bench.json"
-    bench_json.write_text(json.dumps(bench))
+    bench_json.write_text(json.dumps(BENCH))
     results = run_report(
         tmp_path / "r", quick=True, only=["phong"], bench_json=bench_json, progress=False
     )
-    checks = results["checks"]
-    assert [next(t for t in TARGETS if t in c["name"]) for c in checks] == list(TARGETS)
-    assert all("quick" in c["name"] for c in checks[:-1])
-    assert "benchmark JSON" in checks[-1]["name"]
-    assert checks[-1]["measured"] == 20.0
-    failed = [c["name"] for c in checks if not c["passed"]]
+    found = results["checks"]
+    assert [next(t for t in TARGETS if t in c["name"]) for c in found] == list(TARGETS)
+    assert all("quick" in c["name"] for c in found[:-1])
+    assert "benchmark JSON" in found[-1]["name"]
+    assert found[-1]["measured"] == 20.0
+    failed = [c["name"] for c in found if not c["passed"]]
     assert failed == [], failed
     assert results["sections"]["phong"]["nonfinite"] == 0
+
+
+TINY = PhongStudy(8, False, 1, (25,), ("R1",), ("near",), (10,), (50,), (10,), 64, True)
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    ctx = ReportContext(tmp_path_factory.mktemp("phong"), quick=True, bench=BENCH, section="phong")
+    return ctx, phong_speed_accuracy(ctx, TINY)
+
+
+def test_phong_section_compute_present_checks_on_tiny_settings(tiny):
+    ctx, data = tiny
+    assert list(data.results) == [
+        "R1 near",
+        "exponent-scale",
+        "exponent-spread",
+        "segments",
+        "tolerance R1 near",
+        "failure_modes",
+        "nonfinite",
+        "bench",
+        "speedups",
+    ]
+    points = data.results["R1 near"]["points"]
+    assert {p["variant"] for p in points} == {
+        "importance p=m",
+        "importance p=m/10",
+        "uniform",
+        "error",
+    }
+    assert {p["interpolation"] for p in points} == {
+        "parabolic",
+        "parabolic_w",
+        "linear",
+        "monotone",
+    }
+    assert data.results["speedups"]["values"] == [20.0]
+    assert data.results["nonfinite"] == 0
+    found = checks(data)
+    assert [next(t for t in TARGETS if t in c.name) for c in found] == list(TARGETS)
+    assert found[-1].measured == 20.0
+    assert "benchmark JSON" in found[-1].name
+    blocks = present(ctx, data)
+    images = [b.path for b in blocks if isinstance(b, Image)]
+    assert images == [
+        f"images/phong-{name}.png"
+        for name in ("pareto", "exponent-scale", "exponent-spread", "segments")
+    ]
+    assert all((ctx.out_dir / path).stat().st_size > 1000 for path in images)
+    targets = [b for b in blocks if isinstance(b, Table)][-1]
+    assert [row[0] for row in targets.rows] == [c.name for c in found]
+
+
+def test_phong_checks_are_a_pure_function_of_the_data(tiny):
+    _, data = tiny
+    before = checks(data)
+    assert [c.passed for c in checks(data)] == [c.passed for c in before]
+    changed = copy.deepcopy(data)
+    changed.results["failure_modes"]["n2000_overshoot"] = 0.5
+    changed.results["speedups"]["values"] = [5.0]
+    for record in changed.arrays["records"]:
+        if record["placement"] == "error" and record["interpolation"] == "monotone":
+            record["overshoot"] = 0.25
+    after = checks(changed)
+    flipped = [
+        next(t for t in TARGETS if t in c.name)
+        for c, d in zip(before, after, strict=True)
+        if c.passed != d.passed
+    ]
+    assert flipped == ["monotone overshoot", "n = 2000", "shading speed-up"]
+    assert after[-1].measured == 5.0
+    assert after[5].measured == 0.25

@@ -1,5 +1,7 @@
 import json
 
+import numpy as np
+
 from validation.report.runner import run_report
 
 
@@ -39,3 +41,30 @@ def test_report_rasterizer_section_quick(tmp_path):
     assert "Benchmarks (make bench)" in html
     for name in ("convergence", "normals"):
         assert (tmp_path / "r" / "images" / f"rasterizer-{name}.png").stat().st_size > 1000
+
+
+def test_rasterizer_checks_are_a_pure_function_of_the_data():
+    import copy
+
+    from validation.sections.raster import checks, rasterizer_figures
+
+    data = rasterizer_figures(size=32, levels=(4, 8), normals_size=(16, 8))
+    before = checks(data)
+    assert [c.passed for c in before] == [True] * len(before)
+    assert [c.name for c in checks(data)] == [c.name for c in before]  # same data, same checks
+    # a modified figure flips exactly its own check, and shows the modified value
+    changed = copy.deepcopy(data)
+    e = changed.results["tessellation"]["8x16"]
+    e["max"] = 2 * e["bound"]
+    changed.results["closed_mesh"]["front_back_mismatch"] = 3
+    twin = next(iter(changed.results["twin"].values()))
+    twin["max_abs_difference"] = 1e-6
+    after = checks(changed)
+    flipped = [c.name for c, d in zip(before, after, strict=True) if c.passed != d.passed]
+    assert flipped == [
+        "normal error, 224 triangles",
+        "pixel centres with front ≠ back coverage (cracks)",
+        before[-len(changed.results["twin"])].name,
+    ]
+    assert after[1].measured == np.degrees(2 * e["bound"])
+    assert after[4].measured == 3

@@ -4,6 +4,8 @@ The scenes are read from the source tree (``docs/examples``), so the report show
 docs ship. The ColorChecker renders are also checked against colour-science: at each patch centre,
 the rendered XYZ divided by the lamp's closed-form ``f_att cos θ`` must equal
 ``colour.sd_to_XYZ(..., method="ASTM E308")`` for that patch and lamp.
+
+compute → :func:`example_renders`; present → :func:`present`; checks → :func:`checks`.
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ from validation.report import (
     Check,
     ReportContext,
     ReportSection,
-    SectionResult,
+    SectionData,
     Table,
     Text,
 )
@@ -122,93 +124,135 @@ def chart_accuracy(result: RenderResult) -> dict:
     }
 
 
-def run(ctx: ReportContext) -> SectionResult:
-    """Render the example scenes (small with ``--quick``), time them, check the charts."""
-    if not all((EXAMPLES_DIR / name).is_file() for name, _ in SCENES):
-        missing = [name for name, _ in SCENES if not (EXAMPLES_DIR / name).is_file()]
-        text = (
-            f"The docs example scenes are missing from {EXAMPLES_DIR} ({', '.join(missing)}): "
-            "this section reads them from a source checkout, so nothing was rendered."
-        )
-        return SectionResult([Text(text)], {"missing": missing})
+def example_renders(
+    ctx: ReportContext | None = None, width: int | None = None, env_width: int | None = None
+) -> SectionData:
+    """Render the docs example scenes, time them, and check the charts and the environment render.
+
+    Parameters
+    ----------
+    ctx : ReportContext, optional
+        ``ctx.quick``: each scene at its quick width (:data:`SCENES`), supersample 1, and the
+        environment scene at :data:`ENV_WIDTH_QUICK`; otherwise each scene's own ``[render]``
+        size and :data:`ENV_WIDTH`.
+    width, env_width : int, optional
+        Override the width of every scene (supersample 1) and of the environment scene.
+
+    Returns
+    -------
+    SectionData
+        ``results["scenes"]``: per scene, ``width``, ``height``, ``supersample``, ``seconds``
+        (the render's timings), for the two charts ``accuracy`` (:func:`chart_accuracy`), and for
+        :data:`ENV_SCENE` the figures of :func:`environment_oracle_error`; or
+        ``results["missing"]`` (the scene files not found, nothing rendered).
+        ``arrays``: ``encoded`` images by scene, and ``environment`` (frequency and oracle
+        images).
+    """
+    missing = [name for name, _ in SCENES if not (EXAMPLES_DIR / name).is_file()]
+    if missing:
+        return SectionData({"missing": missing})
+    quick = ctx is not None and ctx.quick
     renders: dict[str, RenderResult] = {}
     for name, quick_width in SCENES:
         scene = load_scene(EXAMPLES_DIR / name)
-        size = {"width": quick_width, "supersample": 1} if ctx.quick else {}
+        size = {"width": width or quick_width, "supersample": 1} if quick or width else {}
         renders[name] = render_scene(scene, **size)
     results: dict = {"scenes": {}}
-    rows = []
     for name, result in renders.items():
-        r, t = result.scene.render, result.timings
-        rows.append(
-            [name, f"{r.width}×{r.height}", r.supersample, t["gbuffer"], t["shading"], t["total"]]
-        )
+        r = result.scene.render
         results["scenes"][name] = {
             "width": r.width,
             "height": r.height,
             "supersample": r.supersample,
-            "seconds": dict(t),
+            "seconds": dict(result.timings),
         }
-    d65, a = renders["colorchecker-d65.toml"], renders["colorchecker-a.toml"]
-    gap = np.ones((d65.encoded.shape[0], max(2, d65.encoded.shape[1] // 40), 3))
-    side_by_side = np.concatenate([d65.encoded, gap, a.encoded], axis=1)
-    sphere = renders["phong-sphere.toml"]
-    accuracy_rows, checks = [], []
-    for label, result in (("D65", d65), ("A", a)):
-        accuracy = chart_accuracy(result)
-        results["scenes"][f"colorchecker-{label.lower()}.toml"]["accuracy"] = accuracy
-        accuracy_rows.append(
-            [label, accuracy["max_abs_dXYZ"], accuracy["mean_dE00"], accuracy["max_dE00"]]
-        )
-        checks.append(
-            Check(
-                f"ColorChecker under {label}: rendered patch XYZ vs colour.sd_to_XYZ (ASTM E308), "
-                "Y = 100 scale",
-                f"<= {CHART_DXYZ_TARGET:g}",
-                100 * accuracy["max_abs_dXYZ"],
-                100 * accuracy["max_abs_dXYZ"] <= CHART_DXYZ_TARGET,
-            )
-        )
-    env = environment_oracle_error(
-        EXAMPLES_DIR / ENV_SCENE, ENV_WIDTH_QUICK if ctx.quick else ENV_WIDTH
-    )
+    for label in ("D65", "A"):
+        name = f"colorchecker-{label.lower()}.toml"
+        results["scenes"][name]["accuracy"] = chart_accuracy(renders[name])
+    env_width = env_width or (ENV_WIDTH_QUICK if quick else ENV_WIDTH)
+    env = environment_oracle_error(EXAMPLES_DIR / ENV_SCENE, env_width)
     fast, slow = env.pop("renders")
     results["scenes"][ENV_SCENE] = env
-    checks.append(
-        Check(
-            f"{ENV_SCENE}: SH frequency render vs brute-force oracle, max |ΔY| / peak",
-            f"<= {env['tolerance']:g} (the adaptive-order tolerance)",
-            env["max_error_of_peak"],
-            env["max_error_of_peak"] <= env["tolerance"],
-        )
-    )
-    blocks = [
-        Text(
-            "The scenes in `docs/examples/`, rendered by `reference.render.render_scene` "
-            f"({'small, supersample 1: --quick' if ctx.quick else 'at their own size'}). Render "
-            "them yourself with `specref render docs/examples/<name>.toml -o <name>.png`."
-        ),
+    arrays = {
+        "encoded": {name: result.encoded for name, result in renders.items()},
+        "environment": (fast.encoded, slow.encoded),
+    }
+    return SectionData(results, arrays)
+
+
+_ACCURACY = ("max_abs_dXYZ", "mean_dE00", "max_dE00")
+
+
+def _images(ctx: ReportContext, data: SectionData) -> list:
+    """The charts side by side, the Phong sphere, and the environment render beside its oracle."""
+    scenes, encoded = data.results["scenes"], data.arrays["encoded"]
+    d65, a = encoded["colorchecker-d65.toml"], encoded["colorchecker-a.toml"]
+    gap = np.ones((d65.shape[0], max(2, d65.shape[1] // 40), 3))
+    fast, slow = data.arrays["environment"]
+    env = scenes[ENV_SCENE]
+
+    def seconds(name):
+        return scenes[name]["seconds"]["total"]
+
+    return [
         ctx.image(
             "colorchecker-d65-a",
-            side_by_side,
-            f"ColorChecker (N Ohta) under D65 (left, {d65.timings['total']:.2f} s) and under "
-            f"illuminant A (right, {a.timings['total']:.2f} s), colorimetric sRGB without "
-            "chromatic adaptation",
+            np.concatenate([d65, gap, a], axis=1),
+            f"ColorChecker (N Ohta) under D65 (left, {seconds('colorchecker-d65.toml'):.2f} s) "
+            f"and under illuminant A (right, {seconds('colorchecker-a.toml'):.2f} s), "
+            "colorimetric sRGB without chromatic adaptation",
         ),
         ctx.image(
             "phong-sphere",
-            sphere.encoded,
+            encoded["phong-sphere.toml"],
             f"Spectral Phong sphere, exponent 4 (380 nm) to 800 (780 nm) "
-            f"({sphere.timings['total']:.2f} s)",
+            f"({seconds('phong-sphere.toml'):.2f} s)",
         ),
         ctx.image(
             "env-lambert-sphere",
-            np.concatenate([fast.encoded, np.ones((fast.encoded.shape[0], 2, 3)), slow.encoded], 1),
+            np.concatenate([fast, np.ones((fast.shape[0], 2, 3)), slow], 1),
             f"Measured brick reflectance under st_fagans_interior: SH frequency path (left, "
             f"{env['frequency_s']:.2f} s) and brute-force oracle (right, "
             f"{env['bruteforce_s']:.2f} s); "
             f"max difference {100 * env['max_error_of_peak']:.2f} % of peak",
         ),
+    ]
+
+
+def present(ctx: ReportContext, data: SectionData) -> list:
+    """The renders, their times and the chart accuracy table (or why nothing was rendered)."""
+    if "missing" in data.results:
+        return [
+            Text(
+                f"The docs example scenes are missing from {EXAMPLES_DIR} "
+                f"({', '.join(data.results['missing'])}): this section reads them from a source "
+                "checkout, so nothing was rendered."
+            )
+        ]
+    scenes = data.results["scenes"]
+    rows = [
+        [
+            name,
+            f"{s['width']}×{s['height']}",
+            s["supersample"],
+            s["seconds"]["gbuffer"],
+            s["seconds"]["shading"],
+            s["seconds"]["total"],
+        ]
+        for name, s in scenes.items()
+        if name != ENV_SCENE
+    ]
+    accuracy_rows = [
+        [label, *(scenes[f"colorchecker-{label.lower()}.toml"]["accuracy"][k] for k in _ACCURACY)]
+        for label in ("D65", "A")
+    ]
+    return [
+        Text(
+            "The scenes in `docs/examples/`, rendered by `reference.render.render_scene` "
+            f"({'small, supersample 1: --quick' if ctx.quick else 'at their own size'}). Render "
+            "them yourself with `specref render docs/examples/<name>.toml -o <name>.png`."
+        ),
+        *_images(ctx, data),
         Table(
             ["scene", "size", "supersample", "G-buffer s", "shading s", "total s"],
             rows,
@@ -223,7 +267,35 @@ def run(ctx: ReportContext) -> SectionResult:
             "{:.2e}",
         ),
     ]
-    return SectionResult(blocks, results, checks)
 
 
-SECTION = ReportSection("examples", "Examples", legacy_run=run)
+def checks(data: SectionData) -> list[Check]:
+    """The two charts against colour-science, and the environment render against its oracle."""
+    if "missing" in data.results:
+        return []
+    scenes = data.results["scenes"]
+    found = []
+    for label in ("D65", "A"):
+        accuracy = scenes[f"colorchecker-{label.lower()}.toml"]["accuracy"]
+        found.append(
+            Check(
+                f"ColorChecker under {label}: rendered patch XYZ vs colour.sd_to_XYZ (ASTM E308), "
+                "Y = 100 scale",
+                f"<= {CHART_DXYZ_TARGET:g}",
+                100 * accuracy["max_abs_dXYZ"],
+                100 * accuracy["max_abs_dXYZ"] <= CHART_DXYZ_TARGET,
+            )
+        )
+    env = scenes[ENV_SCENE]
+    found.append(
+        Check(
+            f"{ENV_SCENE}: SH frequency render vs brute-force oracle, max |ΔY| / peak",
+            f"<= {env['tolerance']:g} (the adaptive-order tolerance)",
+            env["max_error_of_peak"],
+            env["max_error_of_peak"] <= env["tolerance"],
+        )
+    )
+    return found
+
+
+SECTION = ReportSection("examples", "Examples", example_renders, present, checks)

@@ -1,5 +1,7 @@
 """Report section "Rasterizer": a tessellated sphere against the exact one, watertightness, speed.
 
+compute → :func:`rasterizer_figures`; present → :func:`present`; checks → :func:`checks`.
+
 The figures: normal error and coverage mismatch of ``uv_sphere_mesh`` tessellations against the
 exact ray-cast sphere as the triangle count grows, with the bound that the tessellation's chord
 error implies; pixel-coverage counts of a closed mesh (each centre exactly once front-facing and
@@ -20,12 +22,12 @@ from validation.report import (
     Check,
     ReportContext,
     ReportSection,
-    SectionResult,
+    SectionData,
     Table,
     Text,
 )
 
-__all__ = ["sphere_tessellation_errors"]
+__all__ = ["rasterizer_figures", "sphere_tessellation_errors"]
 
 CAMERA = Camera(eye=(0.7, 1.1, 3.3), target=(0.0, 0.0, 0.0), fov_deg=40)
 
@@ -97,8 +99,61 @@ def sphere_tessellation_errors(
     }
 
 
-def _normals_image(ctx: ReportContext, size: tuple[int, int]):
-    """Normals of a scene mixing an exact sphere, a smooth mesh sphere and a flat-shaded one."""
+def closed_mesh_coverage(size: int = 64) -> tuple[np.ndarray, np.ndarray]:
+    """Front- and back-facing pixel-centre counts of a closed 360-triangle sphere (culled).
+
+    A watertight mesh covers each pixel centre once front-facing and once back-facing.
+
+    Examples
+    --------
+    >>> front, back = closed_mesh_coverage(16)
+    >>> int(front.max()), int((front != back).sum())
+    (1, 0)
+    """
+    sphere = uv_sphere_mesh(10, 20)
+    front = pixel_coverage(
+        TriangleMesh(sphere.vertices, sphere.faces, cull_backfaces=True), CAMERA, size, size
+    )
+    back = pixel_coverage(
+        TriangleMesh(sphere.vertices, sphere.faces[:, ::-1], cull_backfaces=True),
+        CAMERA,
+        size,
+        size,
+    )
+    return front, back
+
+
+def twin_agreement(width: int = 64, height: int = 48) -> dict:
+    """NumPy reference against numba kernel on a small mesh, for every registered raster method.
+
+    Returns
+    -------
+    dict
+        Per method: ``same_coverage`` and ``max_abs_difference`` (position, normal, uv, depth).
+    """
+    twin = {}
+    for name in RASTER_METHODS.names():
+        mesh = uv_sphere_mesh(12, 24, 0.9, (0.1, 0.0, -0.2))
+        a = rasterize_mesh(mesh, CAMERA, width, height, backend="numpy", method=name)
+        b = rasterize_mesh(mesh, CAMERA, width, height, backend="numba", method=name)
+        same_mask = bool(np.array_equal(a.mask, b.mask))
+        diff = max(
+            float(np.abs(getattr(a, f)[a.mask] - getattr(b, f)[a.mask]).max())
+            for f in ("position", "normal", "uv", "depth")
+        )
+        twin[name] = {"same_coverage": same_mask, "max_abs_difference": diff}
+    return twin
+
+
+def normals_scene(size: tuple[int, int]) -> dict:
+    """Normals ``(n + 1)/2`` of one G-buffer: an exact sphere, a smooth and a flat mesh sphere.
+
+    Returns
+    -------
+    dict
+        ``image`` (shape (H, W, 3), in [0, 1]) and the triangle counts ``smooth_faces``,
+        ``flat_faces`` of the two mesh spheres.
+    """
     W, H = size
     camera = Camera(eye=(0.0, 1.6, 5.2), target=(0.0, 0.0, 0.0), fov_deg=36)
     smooth = uv_sphere_mesh(12, 24, 0.8, (0.0, 0.0, 0.0))
@@ -108,19 +163,27 @@ def _normals_image(ctx: ReportContext, size: tuple[int, int]):
     scene = [Sphere((-1.9, 0.0, 0.0), 0.8), smooth, flat, floor]
     g = render_gbuffer(scene, camera, W, H)
     image = np.where(g.mask[..., None], (np.nan_to_num(g.normal) + 1.0) / 2.0, 0.0)
-    return ctx.image(
-        "normals",
-        image,
-        f"Normals (n + 1)/2 from one G-buffer: an exact ray-cast sphere (left), a "
-        f"{smooth.n_faces}-triangle mesh sphere with interpolated normals (centre), a "
-        f"{flat.n_faces}-triangle mesh with flat face normals (right), and a floor grid mesh",
-    )
+    return {"image": image, "smooth_faces": smooth.n_faces, "flat_faces": flat.n_faces}
 
 
-def _bench_rows(ctx: ReportContext):
-    """Rows ``[group, benchmark, triangles, median ms, ratio to baseline]`` and results."""
+def bench_ratios(bench_groups: dict) -> tuple[list, dict]:
+    """Rows ``[group, benchmark, triangles, median ms, ratio to baseline]`` and their results.
+
+    Parameters
+    ----------
+    bench_groups : dict
+        ``ReportContext.bench_groups("raster")``: benchmark records by group.
+
+    Examples
+    --------
+    >>> records = [{"name": "a", "extra_info": {"role": "baseline"}, "stats": {"median": 0.1}},
+    ...            {"name": "b", "stats": {"median": 0.3}}]
+    >>> rows, results = bench_ratios({"raster-x": records})
+    >>> [round(r[-1], 6) for r in rows], list(results)
+    ([1.0, 3.0], ['raster-x a', 'raster-x b'])
+    """
     rows, results = [], {}
-    for group, records in sorted(ctx.bench_groups("raster").items()):
+    for group, records in sorted(bench_groups.items()):
         base = [r for r in records if r.get("extra_info", {}).get("role") == "baseline"]
         base_median = base[0]["stats"]["median"] if base else float("nan")
         for r in sorted(records, key=lambda r: r["stats"]["median"]):
@@ -136,98 +199,68 @@ def _bench_rows(ctx: ReportContext):
     return rows, results
 
 
-def run(ctx: ReportContext) -> SectionResult:
-    """Tessellated-sphere accuracy, coverage counts, twin agreement, normals image, benchmarks."""
-    import matplotlib.pyplot as plt
+def rasterizer_figures(
+    ctx: ReportContext | None = None,
+    size: int | None = None,
+    levels: tuple[int, ...] | None = None,
+    normals_size: tuple[int, int] | None = None,
+) -> SectionData:
+    """Tessellated-sphere accuracy, closed-mesh coverage, twin agreement and benchmark ratios.
 
-    size = 128 if ctx.quick else 256
-    levels = (4, 8, 16, 32) if ctx.quick else (4, 8, 16, 32, 64, 128)
-    errors = [sphere_tessellation_errors(n, CAMERA, size, size) for n in levels]
-    rows = [
-        [
-            f"{n}×{2 * n}",
-            e["triangles"],
-            np.degrees(e["bound"]),
-            np.degrees(e["max"]),
-            np.degrees(e["mean"]),
-            e["band_pixels"],
-            e["mismatch_pixels"],
-            e["mismatch_outside_band"],
-        ]
-        for n, e in zip(levels, errors, strict=True)
-    ]
+    Parameters
+    ----------
+    ctx : ReportContext, optional
+        ``ctx.quick`` picks the sizes (128 px and up to 32 bands; else 256 px and up to 128);
+        ``ctx.bench`` the benchmark records. Without it: full sizes, no benchmarks.
+    size, levels, normals_size : optional
+        Override the image size, the latitude-band counts and the normals image's (W, H).
+
+    Returns
+    -------
+    SectionData
+        ``results``: ``tessellation`` (per ``"<n>x<2n>"``: :func:`sphere_tessellation_errors`),
+        ``closed_mesh``, ``twin`` (:func:`twin_agreement`) and, with benchmarks, ``benchmarks``;
+        ``arrays``: ``size``, ``coverage`` (front, back), ``normals`` (:func:`normals_scene`),
+        ``bench_rows``.
+
+    Examples
+    --------
+    >>> data = rasterizer_figures(size=32, levels=(4, 8), normals_size=(16, 8))
+    >>> list(data.results["tessellation"]), data.results["closed_mesh"]["front_back_mismatch"]
+    (['4x8', '8x16'], 0)
+    >>> [c.passed for c in checks(data)][:3]
+    [True, True, True]
+    """
+    quick = ctx is not None and ctx.quick
+    size = size or (128 if quick else 256)
+    levels = levels or ((4, 8, 16, 32) if quick else (4, 8, 16, 32, 64, 128))
+    normals_size = normals_size or ((256, 128) if quick else (512, 256))
+    errors = {f"{n}x{2 * n}": sphere_tessellation_errors(n, CAMERA, size, size) for n in levels}
+    front, back = closed_mesh_coverage()
     results: dict = {
-        "tessellation": {f"{n}x{2 * n}": e for n, e in zip(levels, errors, strict=True)}
+        "tessellation": errors,
+        "closed_mesh": {
+            "covered_pixels": int((front > 0).sum()),
+            "max_front_count": int(front.max()),
+            "front_back_mismatch": int((front != back).sum()),
+        },
+        "twin": twin_agreement(),
     }
-    checks = [
-        Check(
-            f"normal error, {e['triangles']} triangles",
-            f"<= chord bound {np.degrees(e['bound']):.3g}°",
-            np.degrees(e["max"]),
-            e["max"] <= e["bound"] + 1e-9,
-        )
-        for e in errors
-    ]
-    checks.append(
-        Check(
-            "coverage differences outside the silhouette band",
-            "0 pixels",
-            sum(e["mismatch_outside_band"] for e in errors),
-            all(e["mismatch_outside_band"] == 0 for e in errors),
-        )
-    )
-
-    # Watertightness: a closed mesh covers each pixel centre once front- and once back-facing.
-    sphere = uv_sphere_mesh(10, 20)
-    front = pixel_coverage(
-        TriangleMesh(sphere.vertices, sphere.faces, cull_backfaces=True), CAMERA, 64, 64
-    )
-    back = pixel_coverage(
-        TriangleMesh(sphere.vertices, sphere.faces[:, ::-1], cull_backfaces=True), CAMERA, 64, 64
-    )
-    results["closed_mesh"] = {
-        "covered_pixels": int((front > 0).sum()),
-        "max_front_count": int(front.max()),
-        "front_back_mismatch": int((front != back).sum()),
+    bench_rows, bench_results = bench_ratios(ctx.bench_groups("raster") if ctx else {})
+    if bench_rows:
+        results["benchmarks"] = bench_results
+    arrays = {
+        "size": size,
+        "coverage": (front, back),
+        "normals": normals_scene(normals_size),
+        "bench_rows": bench_rows,
     }
-    checks.append(
-        Check(
-            "pixel centres covered twice by front faces (closed 360-triangle sphere)",
-            "0",
-            int((front > 1).sum()),
-            int(front.max()) <= 1,
-        )
-    )
-    checks.append(
-        Check(
-            "pixel centres with front ≠ back coverage (cracks)",
-            "0",
-            results["closed_mesh"]["front_back_mismatch"],
-            results["closed_mesh"]["front_back_mismatch"] == 0,
-        )
-    )
+    return SectionData(results, arrays)
 
-    # Twin agreement on a small mesh, every registered method.
-    twin = {}
-    for name in RASTER_METHODS.names():
-        mesh = uv_sphere_mesh(12, 24, 0.9, (0.1, 0.0, -0.2))
-        a = rasterize_mesh(mesh, CAMERA, 64, 48, backend="numpy", method=name)
-        b = rasterize_mesh(mesh, CAMERA, 64, 48, backend="numba", method=name)
-        same_mask = bool(np.array_equal(a.mask, b.mask))
-        diff = max(
-            float(np.abs(getattr(a, f)[a.mask] - getattr(b, f)[a.mask]).max())
-            for f in ("position", "normal", "uv", "depth")
-        )
-        twin[name] = {"same_coverage": same_mask, "max_abs_difference": diff}
-        checks.append(
-            Check(
-                f"NumPy reference vs numba kernel ({name})",
-                "same coverage, <= 1e-12",
-                diff,
-                same_mask and diff <= 1e-12,
-            )
-        )
-    results["twin"] = twin
+
+def _convergence_figure(errors: list[dict], size: int):
+    """Normal error and coverage mismatch against the triangle count, log-log."""
+    import matplotlib.pyplot as plt
 
     fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(9, 3.4))
     triangles = [e["triangles"] for e in errors]
@@ -247,7 +280,26 @@ def run(ctx: ReportContext) -> SectionResult:
     ax1.set_ylabel(f"pixels (of {size}×{size})")
     ax1.legend()
     fig.tight_layout()
+    return fig
 
+
+def present(ctx: ReportContext, data: SectionData) -> list:
+    """The tessellation table and chart, the normals image and the benchmark table."""
+    size, errors = data.arrays["size"], data.results["tessellation"]
+    rows = [
+        [
+            band.replace("x", "×"),
+            e["triangles"],
+            np.degrees(e["bound"]),
+            np.degrees(e["max"]),
+            np.degrees(e["mean"]),
+            e["band_pixels"],
+            e["mismatch_pixels"],
+            e["mismatch_outside_band"],
+        ]
+        for band, e in errors.items()
+    ]
+    normals = data.arrays["normals"]
     blocks = [
         Text(
             "A latitude-longitude tessellation of the unit sphere (exact vertex normals, "
@@ -273,26 +325,85 @@ def run(ctx: ReportContext) -> SectionResult:
             f"Tessellated sphere against the analytic sphere, {size}×{size} pixels",
             "{:.3g}",
         ),
-        ctx.figure("convergence", fig, "Normal error and coverage mismatch against triangle count"),
-        _normals_image(ctx, (256, 128) if ctx.quick else (512, 256)),
+        ctx.figure(
+            "convergence",
+            _convergence_figure(list(errors.values()), size),
+            "Normal error and coverage mismatch against triangle count",
+        ),
+        ctx.image(
+            "normals",
+            normals["image"],
+            f"Normals (n + 1)/2 from one G-buffer: an exact ray-cast sphere (left), a "
+            f"{normals['smooth_faces']}-triangle mesh sphere with interpolated normals (centre), "
+            f"a {normals['flat_faces']}-triangle mesh with flat face normals (right), and a floor "
+            "grid mesh",
+        ),
     ]
-    bench_rows, bench_results = _bench_rows(ctx)
-    if bench_rows:
+    if data.arrays["bench_rows"]:
         blocks.append(
             Table(
                 ["group", "benchmark", "triangles", "median (ms)", "× baseline"],
-                bench_rows,
+                data.arrays["bench_rows"],
                 "Benchmarks (make bench): each group's ratio to its same-run baseline",
                 "{:.3g}",
             )
         )
-        results["benchmarks"] = bench_results
     else:
         blocks.append(
             Text("No benchmark results: run `make bench` for the 100k-triangle G-buffer timings.")
         )
-    return SectionResult(blocks, results, checks)
+    return blocks
 
 
-# pytest's importlib mode may execute this module a second time: register once.
-SECTION = ReportSection("rasterizer", "Rasterizer", legacy_run=run)
+def checks(data: SectionData) -> list[Check]:
+    """Chord bound per tessellation, coverage outside the band, watertightness, twin agreement."""
+    errors = list(data.results["tessellation"].values())
+    found = [
+        Check(
+            f"normal error, {e['triangles']} triangles",
+            f"<= chord bound {np.degrees(e['bound']):.3g}°",
+            np.degrees(e["max"]),
+            e["max"] <= e["bound"] + 1e-9,
+        )
+        for e in errors
+    ]
+    found.append(
+        Check(
+            "coverage differences outside the silhouette band",
+            "0 pixels",
+            sum(e["mismatch_outside_band"] for e in errors),
+            all(e["mismatch_outside_band"] == 0 for e in errors),
+        )
+    )
+    # Watertightness: a closed mesh covers each pixel centre once front- and once back-facing.
+    front, _ = data.arrays["coverage"]
+    closed = data.results["closed_mesh"]
+    found.append(
+        Check(
+            "pixel centres covered twice by front faces (closed 360-triangle sphere)",
+            "0",
+            int((front > 1).sum()),
+            closed["max_front_count"] <= 1,
+        )
+    )
+    found.append(
+        Check(
+            "pixel centres with front ≠ back coverage (cracks)",
+            "0",
+            closed["front_back_mismatch"],
+            closed["front_back_mismatch"] == 0,
+        )
+    )
+    for name, twin in data.results["twin"].items():
+        found.append(
+            Check(
+                f"NumPy reference vs numba kernel ({name})",
+                "same coverage, <= 1e-12",
+                twin["max_abs_difference"],
+                twin["same_coverage"] and twin["max_abs_difference"] <= 1e-12,
+            )
+        )
+    return found
+
+
+SECTION = ReportSection("rasterizer", "Rasterizer", rasterizer_figures, present, checks)
