@@ -45,6 +45,7 @@ __all__ = [
     "SPECTRAL_FORMATS",
     "read_environment_file",
     "read_spectral_tiff",
+    "spectralize_file",
     "write_spectral_blocks",
 ]
 
@@ -253,3 +254,73 @@ def is_spectral(names) -> bool:
     (False, True)
     """
     return channel_wavelengths_nm(names) is not None
+
+
+def spectralize_file(panorama, model, out, rows_per_block: int | None = None) -> dict:
+    """Expand an HDR panorama to a spectral panorama on disk, row block by row block.
+
+    Herbert et al., §4 (the panorama expanded to 41 bands and stored as a float TIFF). The input
+    is read whole (it is 3 channels); the output (``n_bands`` float32 channels) never is: each
+    block of rows is spectralized and written before the next (erratum E43 for the formats).
+
+    Parameters
+    ----------
+    panorama : str or Path
+        ``.hdr`` or RGB ``.exr``, linear camera RGB in the model's camera space.
+    model : SpectralRegression
+    out : str or Path
+        ``.exr`` or ``.tif``/``.tiff``.
+    rows_per_block : int, optional
+        Default :data:`reference.spectral_regression.ROWS_PER_BLOCK`.
+
+    Returns
+    -------
+    dict
+        ``out``, ``height``, ``width``, ``bands``, ``blocks``.
+
+    Raises
+    ------
+    SpecrefError
+        8-bit or unreadable input, not RGB, NaN or negative values, unsupported output type.
+
+    Examples
+    --------
+    >>> spectralize_file("pano.jpg", None, "out.exr")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: pano.jpg: an 8-bit image is not HDR; merge bracketed exposures
+    into a linear Radiance .hdr or OpenEXR .exr (or linearize it, e.g. sRGB decoding, and save as
+    float)
+    """
+    from reference.spectral_regression import ROWS_PER_BLOCK, spectralize_blocks
+
+    image, names = read_environment_file(panorama)
+    require(
+        names[:3] == ["R", "G", "B"],
+        f"{panorama}: channels {', '.join(names[:5])}; spectralize needs an RGB panorama",
+    )
+    suffix = Path(out).suffix.lower()
+    require(
+        suffix in SPECTRAL_FORMATS,
+        f"{out}: unsupported spectral image type {suffix!r}; allowed: .exr, .tif, .tiff",
+    )
+    RGB = image[..., :3]
+    require(np.isfinite(RGB).all(), f"{panorama}: RGB must be finite, found NaN or inf")
+    require((RGB >= 0).all(), f"{panorama}: RGB must be >= 0, found {RGB.min():g}")
+    height, width = RGB.shape[:2]
+    rows = ROWS_PER_BLOCK if rows_per_block is None else int(rows_per_block)
+    count = [0]
+
+    def counted():
+        for item in spectralize_blocks(model, RGB, rows):
+            count[0] += 1
+            yield item
+
+    write_spectral_blocks(out, height, width, model.wavelengths_nm, counted())
+    return {
+        "out": str(out),
+        "height": height,
+        "width": width,
+        "bands": model.n_bands,
+        "blocks": count[0],
+    }

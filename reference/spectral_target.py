@@ -34,7 +34,7 @@ import functools
 
 import numpy as np
 
-from reference.errors import require
+from reference.errors import SpecrefError, require
 from reference.registry import Registry
 from reference.spectra import GRID_41, SpectralGrid
 
@@ -45,6 +45,7 @@ __all__ = [
     "TRAINING_SET",
     "camera_RGB",
     "camera_noise",
+    "read_target",
     "reflectance_set",
 ]
 
@@ -221,3 +222,87 @@ def camera_noise(RGB, rng: np.random.Generator, multiplicative=0.005, additive=0
     RGB = np.asarray(RGB, dtype=np.float64)
     noisy = RGB * (1.0 + multiplicative * rng.standard_normal(RGB.shape))
     return np.maximum(noisy + additive * rng.standard_normal(RGB.shape), 0.0)
+
+
+def _read_csv(path) -> tuple[list[str], list[list[str]]]:
+    import csv
+    from pathlib import Path
+
+    path = Path(path)
+    require(path.is_file(), f"{path}: file not found")
+    with open(path, newline="", encoding="utf-8") as handle:
+        rows = [r for r in csv.reader(handle) if r and not r[0].lstrip().startswith("#")]
+    require(len(rows) >= 2, f"{path}: expected a header row and at least one patch")
+    return [h.strip() for h in rows[0]], rows[1:]
+
+
+def _columns(path, header, rows, names) -> np.ndarray:
+    index = [header.index(n) for n in names]
+    try:
+        return np.array([[float(r[i]) for i in index] for r in rows])
+    except (ValueError, IndexError):
+        raise SpecrefError(f"{path}: non-numeric or missing values in {', '.join(names)}") from None
+
+
+def read_target(path, spectra_path=None, grid: SpectralGrid = GRID_41):
+    r"""Read a measured camera target: RGB of the patches and their reflectances on ``grid``.
+
+    Herbert et al., §4 (a camera target with measured spectra). Format (CSV, ``#`` comments):
+    a header row, then one row per patch. The RGB columns are named ``R``, ``G``, ``B`` (linear
+    camera RGB, white diffuser = 1); the spectral columns are named by their wavelength in nm
+    (``380``, ``385nm``…), reflectance in [0, 1]. Either one file holds both, or ``path`` holds
+    the RGB and ``spectra_path`` the spectra, rows in the same order. The spectra are resampled
+    linearly onto ``grid``, which their wavelengths must cover.
+
+    Returns
+    -------
+    RGB : ndarray, shape (n, 3)
+    spectra : ndarray, shape (n, n_bands)
+
+    Raises
+    ------
+    SpecrefError
+        Missing columns, patch counts that differ, a grid that does not cover ``grid``,
+        negative or NaN RGB.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     path = os.path.join(d, "t.csv")
+    ...     _ = open(path, "w").write("R,G,B,400,700\n0.5,0.5,0.5,0.5,0.5\n")
+    ...     RGB, spectra = read_target(path, grid=SpectralGrid(400.0, 700.0, 100.0))
+    >>> RGB, spectra
+    (array([[0.5, 0.5, 0.5]]), array([[0.5, 0.5, 0.5, 0.5]]))
+    """
+    import re
+
+    header, rows = _read_csv(path)
+    missing = [c for c in "RGB" if c not in header]
+    require(not missing, f"{path}: no column {', '.join(missing)} (expected R, G, B)")
+    RGB = _columns(path, header, rows, list("RGB"))
+    spectra_file = path if spectra_path is None else spectra_path
+    if spectra_path is not None:
+        header, rows = _read_csv(spectra_path)
+    pattern = re.compile(r"^(\d+(?:\.\d+)?)\s*(?:nm)?$")
+    columns = [h for h in header if pattern.match(h)]
+    require(columns, f"{spectra_file}: no spectral columns (named by wavelength in nm: 380, 390nm)")
+    wavelengths = np.array([float(pattern.match(h).group(1)) for h in columns])
+    values = _columns(spectra_file, header, rows, columns)
+    require(
+        len(RGB) == len(values),
+        f"{spectra_file}: {len(values)} spectra for {len(RGB)} RGB patches in {path}",
+    )
+    require(
+        np.isfinite(RGB).all() and (RGB >= 0).all(),
+        f"{path}: RGB must be finite and >= 0 (found NaN, inf or negative values)",
+    )
+    require(
+        (np.diff(wavelengths) > 0).all()
+        and wavelengths[0] <= grid.wavelengths_nm[0]
+        and wavelengths[-1] >= grid.wavelengths_nm[-1],
+        f"{spectra_file}: spectra on {wavelengths[0]:g}-{wavelengths[-1]:g} nm do not cover the "
+        f"scene grid {grid.label}",
+    )
+    spectra = np.stack([np.interp(grid.wavelengths_nm, wavelengths, v) for v in values])
+    return RGB, spectra

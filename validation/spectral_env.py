@@ -51,16 +51,18 @@ def delta_E94_spectra(truth, estimate, illuminant: str) -> np.ndarray:
     return np.asarray(colour.delta_E(Lab_1, Lab_2, method="CIE 1994"))
 
 
-def _stats(truth, estimate) -> dict:
+def _stats(truth, estimate, capture: str = "D65") -> dict:
     found = {"rms": float(np.sqrt(((truth - estimate) ** 2).mean()))}
-    for light in LIGHTS:
+    for light in dict.fromkeys((capture, *LIGHTS)):
         dE = delta_E94_spectra(truth, estimate, light)
         found[f"{light} mean"] = float(dE.mean())
         found[f"{light} max"] = float(dE.max())
     return found
 
 
-def held_out_figures(predict, camera: str = CAMERA, noise: bool = False, sets=HELD_OUT_SETS):
+def held_out_figures(
+    predict, camera: str = CAMERA, noise: bool = False, sets=HELD_OUT_SETS, illuminant="D65"
+):
     """Statistics of ``predict(RGB) -> spectra`` on each held-out set.
 
     Returns
@@ -72,14 +74,21 @@ def held_out_figures(predict, camera: str = CAMERA, noise: bool = False, sets=HE
     found = {}
     for name in sets:
         _, spectra = reflectance_set(name)
-        RGB = camera_RGB(spectra, camera, "D65")
+        RGB = camera_RGB(spectra, camera, illuminant)
         if noise:
             RGB = camera_noise(RGB, rng)
-        found[name] = _stats(spectra[:, ::2], predict(RGB))
+        found[name] = _stats(spectra[:, ::2], predict(RGB), illuminant)
     return found
 
 
-def fit_target(kind: str, degree: int, camera: str = CAMERA, noise: bool = False, ridge=None):
+def fit_target(
+    kind: str,
+    degree: int,
+    camera: str = CAMERA,
+    noise: bool = False,
+    ridge=None,
+    illuminant: str = "D65",
+):
     """Fit on the training set (with camera noise if asked); the model and in-sample figures.
 
     Examples
@@ -89,7 +98,7 @@ def fit_target(kind: str, degree: int, camera: str = CAMERA, noise: bool = False
     0.72
     """
     _, spectra = reflectance_set(TRAINING_SET)
-    RGB = camera_RGB(spectra, camera, "D65")
+    RGB = camera_RGB(spectra, camera, illuminant)
     if noise:
         RGB = camera_noise(RGB, np.random.default_rng(NOISE_SEED))
     model = fit_regression(
@@ -99,11 +108,11 @@ def fit_target(kind: str, degree: int, camera: str = CAMERA, noise: bool = False
         kind,
         degree,
         ridge,
-        "D65",
+        illuminant,
         camera,
         TRAINING_SET,
     )
-    return model, _stats(spectra[:, ::2], model.predict(RGB))
+    return model, _stats(spectra[:, ::2], model.predict(RGB), illuminant)
 
 
 def XYZ_floor(kind: str, degree: int, camera: str = CAMERA, sets=HELD_OUT_SETS) -> dict:
@@ -178,3 +187,67 @@ def recovery_figures(method: str, sets=HELD_OUT_SETS) -> dict:
             estimate.append(sd.copy().align(shape).values)
         found[name] = _stats(spectra, np.array(estimate))
     return found
+
+
+def _format(figures: dict, light: str) -> str:
+    return (
+        f"ΔE94 {light} mean {figures[f'{light} mean']:.2f} max {figures[f'{light} max']:.2f}, "
+        f"A mean {figures['A mean']:.2f}, spectral RMS {figures['rms']:.4f}"
+    )
+
+
+def fit_file(
+    out,
+    target=None,
+    spectra=None,
+    camera: str = CAMERA,
+    illuminant: str = "D65",
+    kind: str = "root_polynomial",
+    degree: int = 4,
+    ridge=None,
+    noise: bool = False,
+) -> dict:
+    """What ``specref env fit`` runs: fit on a target file or the synthetic target, save, report.
+
+    With ``target`` (``reference.spectral_target.read_target``) the figures are in-sample and the
+    cross-validated spectral RMS; without it the synthetic target of ``camera`` under
+    ``illuminant`` is used, and the held-out sets are measured too.
+
+    Returns
+    -------
+    dict
+        ``model``, ``in_sample``, ``held_out`` (None for a file target), ``lines`` (to print).
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     found = fit_file(os.path.join(d, "m.json"), kind="polynomial", degree=9)
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: polynomial degree must be an integer in 1…5, got 9
+    """
+    from reference.spectral_regression import save_regression
+    from reference.spectral_target import read_target
+
+    held_out = None
+    if target is not None:
+        RGB, truth = read_target(target, spectra)
+        model = fit_regression(
+            RGB, truth, GRID_41.wavelengths_nm, kind, degree, ridge, illuminant, "", str(target)
+        )
+        in_sample = _stats(truth, model.predict(RGB), illuminant)
+    else:
+        model, in_sample = fit_target(kind, degree, camera, noise, ridge, illuminant)
+        held_out = held_out_figures(model.predict, camera, noise, HELD_OUT_SETS, illuminant)
+    save_regression(model, out)
+    lines = [
+        f"wrote {out}: {kind} degree {degree}, ridge {model.ridge:.3g}, {model.training_set}",
+        f"in-sample: {_format(in_sample, illuminant)}",
+    ]
+    if model.cv:
+        best = min(model.cv["rms"])
+        lines.append(f"cross-validated ({model.cv['folds']} folds) spectral RMS {best:.4f}")
+    for name, figures in (held_out or {}).items():
+        lines.append(f"held out, {name}: {_format(figures, illuminant)}")
+    return {"model": model, "in_sample": in_sample, "held_out": held_out, "lines": lines}
