@@ -175,23 +175,49 @@ def features_RGB(RGB, kind: str, degree: int) -> np.ndarray:
     array([4., 1., 0., 2., 0., 0.])
     """
     RGB = np.asarray(RGB, dtype=np.float64)
+    X_T = _features_T(RGB.reshape(-1, 3), kind, degree)
+    return X_T.T.reshape(*RGB.shape[:-1], X_T.shape[0])
+
+
+def _features_T(RGB, kind: str, degree: int) -> np.ndarray:
+    """Features of ``(N, 3)`` RGB as an ``(n_features, N)`` array (rows contiguous, for speed).
+
+    Each feature is a product of per-channel powers ``x^f``, computed once per channel and
+    exponent: integer powers by repeated products, 1/2, 1/4, 3/4 by square roots, 1/3 and 2/3 by
+    cube roots, so no feature costs more than two products.
+    """
     E = feature_exponents(kind, degree)
-    out = np.empty((*RGB.shape[:-1], len(E)))
-    if kind == "polynomial":
-        # Eq. (5), Finlayson et al.: products of integer powers, from a table of powers
-        powers = [np.ones_like(RGB), RGB]
-        for _ in range(2, int(degree) + 1):
-            powers.append(powers[-1] * RGB)
-        for f, (a, b, c) in enumerate(E.astype(int)):
-            np.multiply(powers[a][..., 0], powers[b][..., 1], out=out[..., f])
-            out[..., f] *= powers[c][..., 2]
-        return out
-    # Eq. (8), Finlayson et al.: exp(e · log RGB), with log 0 = -inf giving 0
-    with np.errstate(divide="ignore"):
-        log_RGB = np.log(RGB)
-    for f, e in enumerate(E):
-        used = e > 0
-        np.exp((log_RGB[..., used] * e[used]).sum(axis=-1), out=out[..., f])
+    channels = [np.ascontiguousarray(RGB[:, c]) for c in range(3)]
+    table: dict = {}
+
+    def power(c: int, f: Fraction) -> np.ndarray:
+        if (c, f) not in table:
+            x = channels[c]
+            if f == 1:
+                value = x
+            elif f.denominator == 1:
+                value = power(c, f - 1) * x
+            elif f in (Fraction(1, 2), Fraction(1, 4)):
+                value = np.sqrt(power(c, 2 * f))
+            elif f == Fraction(3, 4):
+                value = power(c, Fraction(1, 2)) * power(c, Fraction(1, 4))
+            elif f in (Fraction(1, 3), Fraction(2, 3)):
+                value = np.cbrt(x) if f.numerator == 1 else power(c, Fraction(1, 3)) ** 2
+            else:
+                value = np.power(x, float(f))
+            table[(c, f)] = value
+        return table[(c, f)]
+
+    out = np.empty((len(E), len(RGB)))
+    for i, e in enumerate(E):
+        # Eq. (5) or Eq. (8), Finlayson et al.: the product of the channel powers
+        factors = [power(c, Fraction(x).limit_denominator(12)) for c, x in enumerate(e) if x > 0]
+        if len(factors) == 1:
+            out[i] = factors[0]
+        else:
+            np.multiply(factors[0], factors[1], out=out[i])
+            if len(factors) == 3:
+                out[i] *= factors[2]
     return out
 
 
@@ -257,9 +283,16 @@ class SpectralRegression:
     def predict(self, RGB) -> np.ndarray:
         """Spectra of camera RGB, shape ``(..., n_bands)`` (module docstring: exposure, E41)."""
         RGB = np.asarray(RGB, dtype=np.float64)
-        # Erratum E41: s = max(1, max RGB); S = s · f(RGB / s)
-        s = np.maximum(RGB.max(axis=-1, keepdims=True), 1.0)
-        return features_RGB(RGB / s, self.kind, self.degree) @ self.coefficients * s
+        flat = RGB.reshape(-1, 3)
+        if self.kind == "root_polynomial":
+            # homogeneous of degree 1: the exposure rule of E41 would change nothing
+            S = _features_T(flat, self.kind, self.degree).T @ self.coefficients
+        else:
+            # Erratum E41: s = max(1, max RGB); S = s · f(RGB / s)
+            s = np.maximum(flat.max(axis=-1, keepdims=True), 1.0)
+            S = _features_T(flat / s, self.kind, self.degree).T @ self.coefficients
+            S *= s
+        return S.reshape(*RGB.shape[:-1], self.n_bands)
 
 
 def _check_target(RGB, spectra) -> tuple[np.ndarray, np.ndarray]:

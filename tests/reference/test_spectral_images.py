@@ -63,3 +63,25 @@ def test_integer_and_unlabelled_tiffs_are_refused(tmp_path):
 def test_unknown_suffix(tmp_path):
     with pytest.raises(SpecrefError, match=r"allowed: .exr, .tif, .tiff"):
         write_spectral_blocks(tmp_path / "p.png", 1, 1, WL, [])
+
+
+def test_spectralize_file_memory_is_bounded_by_blocks(tmp_path, rng):
+    # Issue 15: peak extra memory <= 2 × the output; the output itself is never held (memory map).
+    import tracemalloc
+
+    from reference.images import write_exr
+    from reference.spectral_images import spectralize_file
+    from reference.upsampling import default_regression
+
+    pano = write_exr(tmp_path / "pano.exr", rng.uniform(0, 2, (64, 128, 3)))
+    model = default_regression()
+    output_bytes = 64 * 128 * 41 * 4
+    spectralize_file(pano, model, tmp_path / "warm.tif")  # imports and caches outside the trace
+    tracemalloc.start()
+    try:
+        spectralize_file(pano, model, tmp_path / "out.tif", rows_per_block=4)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 2 * output_bytes
+    assert read_environment_file(tmp_path / "out.tif")[0].shape == (64, 128, 41)
