@@ -271,7 +271,7 @@ def spectralize_file(panorama, model, out, rows_per_block: int | None = None) ->
     out : str or Path
         ``.exr`` or ``.tif``/``.tiff``.
     rows_per_block : int, optional
-        Default :data:`reference.spectral_regression.ROWS_PER_BLOCK`.
+        Default: :data:`reference.spectral_regression.PIXELS_PER_BLOCK` pixels' worth of rows.
 
     Returns
     -------
@@ -292,7 +292,7 @@ def spectralize_file(panorama, model, out, rows_per_block: int | None = None) ->
     into a linear Radiance .hdr or OpenEXR .exr (or linearize it, e.g. sRGB decoding, and save as
     float)
     """
-    from reference.spectral_regression import ROWS_PER_BLOCK, spectralize_blocks
+    from reference.spectral_regression import spectralize_blocks
 
     image, names = read_environment_file(panorama)
     require(
@@ -308,7 +308,7 @@ def spectralize_file(panorama, model, out, rows_per_block: int | None = None) ->
     require(np.isfinite(RGB).all(), f"{panorama}: RGB must be finite, found NaN or inf")
     require((RGB >= 0).all(), f"{panorama}: RGB must be >= 0, found {RGB.min():g}")
     height, width = RGB.shape[:2]
-    rows = ROWS_PER_BLOCK if rows_per_block is None else int(rows_per_block)
+    rows = rows_per_block
     count = [0]
 
     def counted():

@@ -35,6 +35,7 @@ References
 
 from __future__ import annotations
 
+import functools
 import itertools
 import json
 from dataclasses import dataclass
@@ -50,6 +51,7 @@ __all__ = [
     "CV_FOLDS",
     "CV_SEED",
     "MAX_RIDGE",
+    "PIXELS_PER_BLOCK",
     "REGRESSION_FEATURES",
     "RIDGE_GRID",
     "SpectralRegression",
@@ -62,9 +64,10 @@ __all__ = [
     "spectralize_blocks",
 ]
 
-#: Rows of a panorama spectralized per block by default (a 12k-wide row of 41 float32 bands is
-#: 2 MB, so a block of 16 rows stays near 32 MB of output and ~3x that of features).
-ROWS_PER_BLOCK = 16
+#: Pixels spectralized per block by default (whole rows, at least one): 2^17 pixels make 21 MB
+#: of float32 output and ~66 MB of float64 features and spectra, large enough for an efficient
+#: matrix product, small beside a panorama (64 rows of a 2k panorama, 10 of a 12k one).
+PIXELS_PER_BLOCK = 1 << 17
 
 #: Cross-validation folds and the seed of their shuffle.
 CV_FOLDS = 5
@@ -179,14 +182,22 @@ def features_RGB(RGB, kind: str, degree: int) -> np.ndarray:
     return X_T.T.reshape(*RGB.shape[:-1], X_T.shape[0])
 
 
-def _features_T(RGB, kind: str, degree: int) -> np.ndarray:
+@functools.lru_cache(maxsize=16)
+def _feature_terms(kind: str, degree: int) -> tuple:
+    """Each feature as ``((channel, exponent as a Fraction), ...)`` over its channels in use."""
+    return tuple(
+        tuple((c, Fraction(x).limit_denominator(12)) for c, x in enumerate(e) if x > 0)
+        for e in feature_exponents(kind, degree)
+    )
+
+
+def _features_T(RGB, kind: str, degree: int, out=None) -> np.ndarray:
     """Features of ``(N, 3)`` RGB as an ``(n_features, N)`` array (rows contiguous, for speed).
 
     Each feature is a product of per-channel powers ``x^f``, computed once per channel and
     exponent: integer powers by repeated products, 1/2, 1/4, 3/4 by square roots, 1/3 and 2/3 by
     cube roots, so no feature costs more than two products.
     """
-    E = feature_exponents(kind, degree)
     channels = [np.ascontiguousarray(RGB[:, c]) for c in range(3)]
     table: dict = {}
 
@@ -208,10 +219,11 @@ def _features_T(RGB, kind: str, degree: int) -> np.ndarray:
             table[(c, f)] = value
         return table[(c, f)]
 
-    out = np.empty((len(E), len(RGB)))
-    for i, e in enumerate(E):
+    terms = _feature_terms(kind, degree)
+    out = np.empty((len(terms), len(RGB))) if out is None else out
+    for i, term in enumerate(terms):
         # Eq. (5) or Eq. (8), Finlayson et al.: the product of the channel powers
-        factors = [power(c, Fraction(x).limit_denominator(12)) for c, x in enumerate(e) if x > 0]
+        factors = [power(c, f) for c, f in term]
         if len(factors) == 1:
             out[i] = factors[0]
         else:
@@ -284,15 +296,21 @@ class SpectralRegression:
         """Spectra of camera RGB, shape ``(..., n_bands)`` (module docstring: exposure, E41)."""
         RGB = np.asarray(RGB, dtype=np.float64)
         flat = RGB.reshape(-1, 3)
+        S = self._predict_flat(flat, np.empty((self.coefficients.shape[0], len(flat))))
+        return S.reshape(*RGB.shape[:-1], self.n_bands)
+
+    def _predict_flat(self, flat, X_T, S=None) -> np.ndarray:
+        """Spectra of ``(N, 3)`` RGB, with the ``(n_features, N)`` buffer ``X_T`` (and ``S``)."""
         if self.kind == "root_polynomial":
             # homogeneous of degree 1: the exposure rule of E41 would change nothing
-            S = _features_T(flat, self.kind, self.degree).T @ self.coefficients
-        else:
-            # Erratum E41: s = max(1, max RGB); S = s · f(RGB / s)
-            s = np.maximum(flat.max(axis=-1, keepdims=True), 1.0)
-            S = _features_T(flat / s, self.kind, self.degree).T @ self.coefficients
-            S *= s
-        return S.reshape(*RGB.shape[:-1], self.n_bands)
+            _features_T(flat, self.kind, self.degree, X_T)
+            return np.matmul(X_T.T, self.coefficients, out=S)
+        # Erratum E41: s = max(1, max RGB); S = s · f(RGB / s)
+        s = np.maximum(flat.max(axis=-1, keepdims=True), 1.0)
+        _features_T(flat / s, self.kind, self.degree, X_T)
+        S = np.matmul(X_T.T, self.coefficients, out=S)
+        S *= s
+        return S
 
 
 def _check_target(RGB, spectra) -> tuple[np.ndarray, np.ndarray]:
@@ -494,7 +512,7 @@ def load_regression(path, wavelengths_nm=None) -> SpectralRegression:
     return model
 
 
-def spectralize_blocks(model: SpectralRegression, RGB, rows_per_block: int = ROWS_PER_BLOCK):
+def spectralize_blocks(model: SpectralRegression, RGB, rows_per_block: int | None = None):
     """Spectralize an image block of rows by block: yields ``(row0, spectra float32)``.
 
     Herbert et al., §4 (the panorama expanded to n bands). Each block is one feature expansion
@@ -506,12 +524,15 @@ def spectralize_blocks(model: SpectralRegression, RGB, rows_per_block: int = ROW
     model : SpectralRegression
     RGB : array_like, shape (H, W, 3)
         Linear camera RGB (white diffuser = 1), finite, >= 0.
-    rows_per_block : int
+    rows_per_block : int, optional
+        Default: as many rows as hold :data:`PIXELS_PER_BLOCK` pixels (at least one).
 
     Yields
     ------
     row0 : int
     spectra : ndarray, shape (rows, W, n_bands), float32
+        A view of a buffer that the next block overwrites: write or copy it before asking for
+        the next block.
 
     Raises
     ------
@@ -522,17 +543,26 @@ def spectralize_blocks(model: SpectralRegression, RGB, rows_per_block: int = ROW
     --------
     >>> model = SpectralRegression("polynomial", 1, np.eye(3), np.array([450.0, 550.0, 650.0]))
     >>> [(row0, block.shape, block.dtype.name) for row0, block in
-    ...  spectralize_blocks(model, np.ones((3, 6, 3)), rows_per_block=2)]
+    ...  spectralize_blocks(model, np.ones((3, 6, 3)), rows_per_block=2)]   # shapes only
     [(0, (2, 6, 3), 'float32'), (2, (1, 6, 3), 'float32')]
     """
     RGB = np.asarray(RGB)
     require(
         RGB.ndim == 3 and RGB.shape[2] == 3, f"spectralize: expected (H, W, 3), got {RGB.shape}"
     )
-    for row0 in range(0, RGB.shape[0], int(rows_per_block)):
-        block = np.asarray(RGB[row0 : row0 + int(rows_per_block)], dtype=np.float64)
+    default = max(1, PIXELS_PER_BLOCK // max(RGB.shape[1], 1))
+    rows = default if rows_per_block is None else int(rows_per_block)
+    # Buffers reused by every block (fresh ones would cost a page fault per page each time)
+    X_T = np.empty((model.coefficients.shape[0], rows * RGB.shape[1]))
+    S = np.empty((rows * RGB.shape[1], model.n_bands))
+    S32 = np.empty((rows * RGB.shape[1], model.n_bands), np.float32)
+    for row0 in range(0, RGB.shape[0], rows):
+        block = np.asarray(RGB[row0 : row0 + rows], dtype=np.float64)
         require(
             np.isfinite(block).all() and (block >= 0).all(),
             f"spectralize: RGB must be finite and >= 0 (rows {row0}-{row0 + len(block) - 1})",
         )
-        yield row0, model.predict(block).astype(np.float32)
+        n = block.shape[0] * block.shape[1]
+        spectra = model._predict_flat(block.reshape(-1, 3), X_T[:, :n], S[:n])
+        np.copyto(S32[:n], spectra, casting="same_kind")
+        yield row0, S32[:n].reshape(*block.shape[:2], model.n_bands)

@@ -123,7 +123,7 @@ def test_fit_bad_input(RGB, spectra, kind, degree, ridge, message):
 def test_spectralize_blocks_equal_predict(rng):
     RGB = rng.uniform(0, 3, (7, 10, 3))
     model = fit_regression(RGB.reshape(-1, 3), RGB.reshape(-1, 3), WL, "polynomial", 3)
-    blocks = list(spectralize_blocks(model, RGB, rows_per_block=3))
+    blocks = [(row0, b.copy()) for row0, b in spectralize_blocks(model, RGB, rows_per_block=3)]
     assert [row0 for row0, _ in blocks] == [0, 3, 6]
     whole = np.concatenate([b for _, b in blocks])
     assert whole.dtype == np.float32
