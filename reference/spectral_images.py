@@ -35,7 +35,6 @@ import numpy as np
 
 from reference.errors import SpecrefError, require
 from reference.images import (
-    channel_wavelengths_nm,
     read_exr,
     read_hdr,
     spectral_channel_names,
@@ -243,17 +242,6 @@ def read_environment_file(path) -> tuple[np.ndarray, list[str]]:
     raise SpecrefError(
         f"{path}: unsupported environment map type {suffix!r}; allowed: .exr, .hdr, .tif"
     )
-
-
-def is_spectral(names) -> bool:
-    """True if every channel name ends in a wavelength (``S0.550,000000nm``, ``550nm``).
-
-    Examples
-    --------
-    >>> is_spectral(["R", "G", "B"]), is_spectral(spectral_channel_names([500.0]))
-    (False, True)
-    """
-    return channel_wavelengths_nm(names) is not None
 
 
 def spectralize_file(panorama, model, out, rows_per_block: int | None = None) -> dict:

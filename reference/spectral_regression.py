@@ -89,7 +89,7 @@ REGRESSION_FEATURES.register(range(1, 5), "root_polynomial")
 def feature_exponents(kind: str, degree: int) -> np.ndarray:
     """Exponents of R, G, B of each feature: ``feature = R^e0 · G^e1 · B^e2``.
 
-    Finlayson et al. 2015, Eq. (5) (polynomial) and Eq. (8) (root-polynomial).
+    Finlayson, Mackiewicz & Hurlbert 2015: the polynomial and the root-polynomial terms.
 
     Parameters
     ----------
@@ -118,7 +118,7 @@ def feature_exponents(kind: str, degree: int) -> np.ndarray:
     for j in range(1, int(degree) + 1):
         for combo in itertools.combinations_with_replacement(range(3), j):
             a = tuple(combo.count(c) for c in range(3))
-            # Eq. (8), Finlayson et al.: the j-th root of a degree-j monomial
+            # Finlayson et al. 2015, root-polynomials: the j-th root of a degree-j monomial
             e = tuple(Fraction(x, j) for x in a) if kind == "root_polynomial" else a
             if e not in seen:
                 seen.append(e)
@@ -157,7 +157,7 @@ def feature_names(kind: str, degree: int) -> list[str]:
 def features_RGB(RGB, kind: str, degree: int) -> np.ndarray:
     """The feature matrix of RGB values: every monomial (or root-monomial) up to ``degree``.
 
-    Finlayson et al. 2015, Eq. (5) (polynomial) and Eq. (8) (root-polynomial).
+    Finlayson, Mackiewicz & Hurlbert 2015: the polynomial and the root-polynomial terms.
 
     Parameters
     ----------
@@ -222,7 +222,7 @@ def _features_T(RGB, kind: str, degree: int, out=None) -> np.ndarray:
     terms = _feature_terms(kind, degree)
     out = np.empty((len(terms), len(RGB))) if out is None else out
     for i, term in enumerate(terms):
-        # Eq. (5) or Eq. (8), Finlayson et al.: the product of the channel powers
+        # Finlayson et al. 2015: a term is the product of the channel powers
         factors = [power(c, f) for c, f in term]
         if len(factors) == 1:
             out[i] = factors[0]

@@ -25,7 +25,7 @@ WL = np.array([450.0, 550.0, 650.0])
 
 
 def test_feature_counts_match_finlayson():
-    # Source: Finlayson, Mackiewicz & Hurlbert 2015, Table 1 (polynomial 2, 3, 4: 9, 19, 34
+    # Source: Finlayson, Mackiewicz & Hurlbert 2015 (polynomial 2, 3, 4: 9, 19, 34
     # terms; root-polynomial 2, 3, 4: 6, 13, 22 terms); degree 5 is C(5 + 3, 3) - 1 = 55.
     assert [len(feature_exponents("polynomial", d)) for d in (2, 3, 4, 5)] == [9, 19, 34, 55]
     assert [len(feature_exponents("root_polynomial", d)) for d in (2, 3, 4)] == [6, 13, 22]
