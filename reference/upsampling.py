@@ -1,7 +1,8 @@
-"""RGB → spectrum upsampling of environment maps (colour-science ``colour.recovery``).
+"""RGB → spectrum upsampling of environment maps (``colour.recovery`` and Herbert et al.'s regression).
 
 Herbert et al. (§4) expand HDR panoramas to 31-41 bands with a fitted polynomial; specref offers
-two published methods from colour-science, by key (:data:`UPSAMPLING_METHODS`):
+that regression and two published methods from colour-science, by key
+(:data:`UPSAMPLING_METHODS`):
 
 - ``mallett2019`` (default): Mallett & Yuksel's spectral primary decomposition for sRGB. A
   spectrum is the linear combination ``R b_r(λ) + G b_g(λ) + B b_b(λ)`` of three non-negative
