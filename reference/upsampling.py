@@ -1,4 +1,4 @@
-"""RGB → spectrum upsampling of environment maps (``colour.recovery`` and Herbert et al.'s regression).
+"""RGB → spectrum upsampling of environment maps (colour.recovery; Herbert et al.'s regression).
 
 Herbert et al. (§4) expand HDR panoramas to 31-41 bands with a fitted polynomial; specref offers
 that regression and two published methods from colour-science, by key
