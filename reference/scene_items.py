@@ -163,9 +163,14 @@ def _parse_environment_light(reader: SceneReader, table: dict, key: str) -> Envi
                     )
         elif suffix in (".hdr", ".rgbe", ".pic"):
             image = read_hdr(path)
+        elif suffix in (".tif", ".tiff"):
+            from reference.spectral_images import read_spectral_tiff
+
+            image, names = read_spectral_tiff(path)
+            wavelengths = channel_wavelengths_nm(names)
         else:
             raise SpecrefError(
-                f"{path}: unsupported environment map type {suffix!r}; allowed: .exr, .hdr"
+                f"{path}: unsupported environment map type {suffix!r}; allowed: .exr, .hdr, .tif"
             )
         return EnvironmentLight(image, wavelengths, colourspace, intensity, name=str(path))
 
@@ -216,6 +221,6 @@ LIGHT_TYPES.register(
         "environment",
         _parse_environment_light,
         ("file", "intensity", "colourspace"),
-        "a lat-long environment map (.hdr, or .exr with RGB or wavelength channels)",
+        "a lat-long environment map (.hdr, .exr with RGB or wavelength channels, spectral .tif)",
     )
 )

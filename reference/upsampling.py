@@ -1,7 +1,8 @@
-"""RGB → spectrum upsampling of environment maps (colour-science ``colour.recovery``).
+"""RGB → spectrum upsampling of environment maps (colour.recovery; Herbert et al.'s regression).
 
 Herbert et al. (§4) expand HDR panoramas to 31-41 bands with a fitted polynomial; specref offers
-two published methods from colour-science, by key (:data:`UPSAMPLING_METHODS`):
+that regression and two published methods from colour-science, by key
+(:data:`UPSAMPLING_METHODS`):
 
 - ``mallett2019`` (default): Mallett & Yuksel's spectral primary decomposition for sRGB. A
   spectrum is the linear combination ``R b_r(λ) + G b_g(λ) + B b_b(λ)`` of three non-negative
@@ -9,6 +10,12 @@ two published methods from colour-science, by key (:data:`UPSAMPLING_METHODS`):
   non-negative for non-negative RGB, and a **white texel (R = G = B = v) becomes the flat spectrum
   v** in every band (to 1e-5, the precision of the published basis). It is the default because it is
   exact on white, linear and fast (one matrix product per map).
+- ``regression``: Herbert et al.'s method (§4): a regression from RGB to the spectra of a camera
+  target (``reference.spectral_regression``). The shipped model (``reference/data/
+  spectral_regression_sRGB.json``, fitted by ``validation/precompute/spectral_regression.py``)
+  takes linear sRGB: Finlayson's root-polynomials of degree 4, fitted on a synthetic target (the
+  sRGB "camera" of the reflectances in ``reference.spectral_target``); it is linear in exposure.
+  ``specref env fit`` fits models for other cameras.
 - ``jakob2019``: Jakob & Hanika's sigmoid-polynomial model, as used by Mitsuba 3 and pbrt-v4, via
   colour-science's coefficient table (``LUT3D_Jakob2019``). The model represents reflectances in
   [0, 1]; HDR texels are scaled by their largest component m, upsampled, and multiplied by m. A
@@ -34,6 +41,7 @@ References
 
 from __future__ import annotations
 
+import functools
 import os
 from pathlib import Path
 
@@ -50,6 +58,8 @@ __all__ = [
     "RGB_to_spectra",
     "RGB_to_spectra_Jakob2019",
     "RGB_to_spectra_Mallett2019",
+    "RGB_to_spectra_regression",
+    "default_regression",
 ]
 
 #: The default RGB → spectrum method.
@@ -169,6 +179,64 @@ def RGB_to_spectra_Jakob2019(RGB, grid: SpectralGrid, lut_size: int | None = Non
     return (0.5 + x / (2.0 * np.sqrt(1.0 + x * x))) * m
 
 
+#: The shipped regression model (linear sRGB → reflectance on the 41-band grid).
+DEFAULT_REGRESSION_MODEL = (
+    Path(__file__).resolve().parent / "data" / "spectral_regression_sRGB.json"
+)
+
+
+@functools.lru_cache(maxsize=1)
+def default_regression():
+    """The shipped :class:`~reference.spectral_regression.SpectralRegression` (linear sRGB input).
+
+    Examples
+    --------
+    >>> model = default_regression()
+    >>> model.kind, model.degree, model.camera, model.n_bands
+    ('root_polynomial', 4, 'sRGB', 41)
+    """
+    from reference.spectral_regression import load_regression
+
+    return load_regression(DEFAULT_REGRESSION_MODEL)
+
+
+def RGB_to_spectra_regression(RGB, grid: SpectralGrid) -> np.ndarray:
+    """Spectra of linear sRGB values by the shipped camera-target regression (Herbert et al., §4).
+
+    Herbert et al., §4: polynomial terms of RGB times fitted coefficients (the shipped model uses
+    Finlayson's root-polynomials, erratum E43), resampled linearly onto ``grid``.
+
+    Parameters
+    ----------
+    RGB : array_like, shape (..., 3)
+        Linear sRGB, >= 0 (any magnitude: the root-polynomials scale with exposure).
+    grid : SpectralGrid
+
+    Returns
+    -------
+    ndarray, shape (..., n_bands)
+
+    Examples
+    --------
+    >>> from reference.colorimetry import band_weights, spectra_to_RGB_matrix
+    >>> from reference.spectra import GRID_41, spectrum_from_dataset
+    >>> S = RGB_to_spectra_regression([[0.2, 0.4, 0.8]], GRID_41)
+    >>> M = spectra_to_RGB_matrix(band_weights(GRID_41, spectrum_from_dataset("illuminant", "D65")))
+    >>> (S @ M).round(2)                                                # the round trip
+    array([[0.2, 0.4, 0.8]])
+    """
+    model = default_regression()
+    S = model.predict(np.asarray(RGB, dtype=np.float64))
+    wl = grid.wavelengths_nm
+    if wl.shape == model.wavelengths_nm.shape and np.array_equal(wl, model.wavelengths_nm):
+        return S
+    index = np.interp(wl, model.wavelengths_nm, np.arange(model.n_bands))
+    lo = np.floor(index).astype(int)
+    hi = np.minimum(lo + 1, model.n_bands - 1)
+    t = index - lo
+    return S[..., lo] * (1.0 - t) + S[..., hi] * t
+
+
 #: RGB → spectrum methods by key.
 UPSAMPLING_METHODS = Registry("RGB upsampling")
 UPSAMPLING_METHODS.register(
@@ -176,6 +244,9 @@ UPSAMPLING_METHODS.register(
 )
 UPSAMPLING_METHODS.register(
     Method("jakob2019", RGB_to_spectra_Jakob2019, None, "Eq. (3), Jakob & Hanika 2019")
+)
+UPSAMPLING_METHODS.register(
+    Method("regression", RGB_to_spectra_regression, None, "§4, Herbert et al.")
 )
 
 

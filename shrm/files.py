@@ -1,8 +1,9 @@
 """File-level SH jobs behind ``specref sh project`` and ``specref sh prefilter``.
 
-Maps are read with ``reference.images`` (``.hdr`` RGBE, ``.exr`` RGB or spectral with one channel
-per band). ``bands="spectral"`` turns an RGB map into spectra on the 41-band grid
-(``reference.upsampling``, Mallett & Yuksel 2019); ``bands="rgb"`` turns a spectral map into linear
+Maps are read with ``reference.spectral_images.read_environment_file`` (``.hdr`` RGBE, ``.exr`` RGB
+or spectral with one channel per band, spectral float ``.tif`` from ``specref env spectralize``).
+``bands="spectral"`` turns an RGB map into spectra on the 41-band grid (``reference.upsampling``,
+Mallett & Yuksel 2019); ``bands="rgb"`` turns a spectral map into linear
 sRGB (equal-energy band weights); the default keeps the map as it is.
 """
 
@@ -14,7 +15,7 @@ import numpy as np
 
 from reference.colorimetry import band_weights, spectra_to_RGB_matrix
 from reference.errors import require, require_choice
-from reference.images import read_exr, read_hdr, spectral_channel_names, write_exr
+from reference.images import spectral_channel_names, write_exr
 from reference.spectra import DEFAULT_GRID
 from reference.upsampling import RGB_to_spectra
 
@@ -37,12 +38,10 @@ def read_environment(path, bands: str | None = None) -> tuple[np.ndarray, list[s
     reference.errors.SpecrefError: /nonexistent.hdr: file not found
     """
     from reference.envmap import check_latlong_shape
+    from reference.spectral_images import read_environment_file
 
     path = Path(path)
-    if path.suffix.lower() == ".exr":
-        image, names = read_exr(path)
-    else:
-        image, names = read_hdr(path), ["R", "G", "B"]
+    image, names = read_environment_file(path)
     check_latlong_shape(image.shape, str(path))
     require(np.isfinite(image).all(), f"{path}: radiance must be finite, found NaN or inf")
     require((image >= 0).all(), f"{path}: radiance must be >= 0, found {image.min():g}")

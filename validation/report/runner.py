@@ -26,7 +26,16 @@ from reference.images import write_text_atomic
 from reference.registry import Registry
 from validation.report.render import render_html, render_markdown
 from validation.report.types import ReportContext, ReportSection, SectionResult, to_jsonable
-from validation.sections import examples, impastor, phong, raster, sh, shrm, spectral
+from validation.sections import (
+    examples,
+    impastor,
+    phong,
+    raster,
+    sh,
+    shrm,
+    spectral,
+    spectral_env,
+)
 
 __all__ = ["REPORT_SECTIONS", "SECTIONS", "run_report"]
 
@@ -37,6 +46,7 @@ SECTIONS: tuple[ReportSection, ...] = (
     examples.SECTION,
     phong.SECTION,
     sh.SECTION,
+    spectral_env.SECTION,
     shrm.SECTION,
     impastor.SECTION,
 )

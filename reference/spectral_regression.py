@@ -1,0 +1,568 @@
+"""Camera RGB → reflectance spectra by polynomial regression on a target (Herbert et al., §4).
+
+Herbert et al. expand an HDR panorama to 31 or more bands with "polynomial equations of the 5th
+order that map RGB plus the higher order terms to the wavelengths of the measured target patches".
+specref implements that regression:
+
+- **Features** (:data:`REGRESSION_FEATURES`): ``polynomial`` — every monomial ``R^a G^b B^c`` with
+  ``1 <= a + b + c <= d``, d = 1…5 (3, 9, 19, 34, 55 terms; no constant, so black stays black);
+  ``root_polynomial`` — Finlayson et al.'s root-polynomials, the ``(a + b + c)``-th root of each
+  monomial of degree ``<= d``, d = 1…4 (3, 6, 13, 22 distinct terms), which scale linearly with
+  exposure.
+- **Ridge least squares**: with the feature columns scaled to unit RMS over the target,
+  ``W = argmin (1/n)·||X W − S||² + λ·||W||²`` for the n target spectra S (one column per band).
+  λ is chosen by k-fold cross-validation (:data:`CV_FOLDS` folds of a shuffle with seed
+  :data:`CV_SEED`) from :data:`RIDGE_GRID` (0 and 10^-12 … 10^0 in half decades), minimizing the
+  held-out spectral RMS; the scale is then folded into ``W``.
+- **Exposure** (erratum E41): HDR texels are brighter than any target patch. A polynomial is
+  applied to ``RGB / s`` and the result multiplied by ``s``, with ``s = max(1, max(R, G, B))``:
+  texels inside the target's range are mapped as fitted, brighter ones keep their chromaticity.
+  Root-polynomials are homogeneous of degree 1, so for them this changes nothing.
+- **Model files** (:func:`save_regression`, :func:`load_regression`): JSON, written atomically.
+  The format is documented in ``docs/spectral-environments.md``.
+
+The spectra are *reflectance-like*: camera RGB is normalized so that the perfect white diffuser
+under the capture illuminant is (1, 1, 1), and the model maps it to the target's reflectance. A
+spectral panorama is relit by multiplying by the chosen illuminant (erratum E42).
+
+References
+----------
+- F. Herbert et al., "Multispectral Virtual Reality", 2004, §4.
+- G. D. Finlayson, M. Mackiewicz, A. Hurlbert, "Color Correction Using Root-Polynomial
+  Regression", IEEE Transactions on Image Processing 24(5), 2015.
+- A. E. Hoerl, R. W. Kennard, "Ridge Regression", Technometrics 12(1), 1970.
+"""
+
+from __future__ import annotations
+
+import functools
+import itertools
+import json
+from dataclasses import dataclass
+from fractions import Fraction
+from pathlib import Path
+
+import numpy as np
+
+from reference.errors import SpecrefError, require
+from reference.registry import Registry
+
+__all__ = [
+    "CV_FOLDS",
+    "CV_SEED",
+    "MAX_RIDGE",
+    "PIXELS_PER_BLOCK",
+    "REGRESSION_FEATURES",
+    "RIDGE_GRID",
+    "SpectralRegression",
+    "feature_exponents",
+    "feature_names",
+    "features_RGB",
+    "fit_regression",
+    "load_regression",
+    "save_regression",
+    "spectralize_blocks",
+]
+
+#: Pixels spectralized per block by default (whole rows, at least one): 2^17 pixels make 21 MB
+#: of float32 output and ~66 MB of float64 features and spectra, large enough for an efficient
+#: matrix product, small beside a panorama (64 rows of a 2k panorama, 10 of a 12k one).
+PIXELS_PER_BLOCK = 1 << 17
+
+#: Cross-validation folds and the seed of their shuffle.
+CV_FOLDS = 5
+CV_SEED = 20040101
+#: Ridge strengths tried by cross-validation (relative to unit-RMS feature columns).
+RIDGE_GRID = (0.0, *(10.0 ** (k / 2.0) for k in range(-24, 1)))
+#: Largest ridge strength accepted from a user.
+MAX_RIDGE = 1.0
+#: Model-file format tag and version.
+FORMAT = "specref-spectral-regression"
+FORMAT_VERSION = 1
+
+#: Feature families by key: the range of degrees each allows.
+REGRESSION_FEATURES = Registry("regression features")
+REGRESSION_FEATURES.register(range(1, 6), "polynomial")
+REGRESSION_FEATURES.register(range(1, 5), "root_polynomial")
+
+
+def feature_exponents(kind: str, degree: int) -> np.ndarray:
+    """Exponents of R, G, B of each feature: ``feature = R^e0 · G^e1 · B^e2``.
+
+    Finlayson, Mackiewicz & Hurlbert 2015: the polynomial and the root-polynomial terms.
+
+    Parameters
+    ----------
+    kind : {"polynomial", "root_polynomial"}
+    degree : int
+        1…5 for polynomials, 1…4 for root-polynomials.
+
+    Returns
+    -------
+    ndarray, shape (n_features, 3)
+        Exponents (fractions for root-polynomials), ordered by degree, then lexicographically.
+
+    Examples
+    --------
+    >>> [len(feature_exponents("polynomial", d)) for d in range(1, 6)]
+    [3, 9, 19, 34, 55]
+    >>> [len(feature_exponents("root_polynomial", d)) for d in range(1, 5)]
+    [3, 6, 13, 22]
+    """
+    degrees = REGRESSION_FEATURES.lookup(kind)
+    require(
+        isinstance(degree, int | np.integer) and degree in degrees,
+        f"{kind} degree must be an integer in {degrees[0]}…{degrees[-1]}, got {degree!r}",
+    )
+    seen: list[tuple] = []
+    for j in range(1, int(degree) + 1):
+        for combo in itertools.combinations_with_replacement(range(3), j):
+            a = tuple(combo.count(c) for c in range(3))
+            # Finlayson et al. 2015, root-polynomials: the j-th root of a degree-j monomial
+            e = tuple(Fraction(x, j) for x in a) if kind == "root_polynomial" else a
+            if e not in seen:
+                seen.append(e)
+    return np.array([[float(x) for x in e] for e in seen])
+
+
+def feature_names(kind: str, degree: int) -> list[str]:
+    """Readable names of the features, e.g. ``R*G^2`` or ``(R*G)^(1/2)``.
+
+    Examples
+    --------
+    >>> feature_names("root_polynomial", 2)
+    ['R', 'G', 'B', '(R*G)^(1/2)', '(R*B)^(1/2)', '(G*B)^(1/2)']
+    """
+    names = []
+    for e in feature_exponents(kind, degree):
+        if kind == "root_polynomial":
+            j = Fraction(1, 1)
+            fractions = [Fraction(x).limit_denominator(12) for x in e]
+            j = max(f.denominator for f in fractions)
+            parts = [
+                c + (f"^{int(f * j)}" if f * j > 1 else "")
+                for c, f in zip("RGB", fractions, strict=True)
+                if f
+            ]
+            body = "*".join(parts)
+            names.append(body if j == 1 else f"({body})^(1/{j})")
+        else:
+            parts = [
+                c + (f"^{int(x)}" if x > 1 else "") for c, x in zip("RGB", e, strict=True) if x
+            ]
+            names.append("*".join(parts))
+    return names
+
+
+def features_RGB(RGB, kind: str, degree: int) -> np.ndarray:
+    """The feature matrix of RGB values: every monomial (or root-monomial) up to ``degree``.
+
+    Finlayson, Mackiewicz & Hurlbert 2015: the polynomial and the root-polynomial terms.
+
+    Parameters
+    ----------
+    RGB : array_like, shape (..., 3)
+        Linear camera RGB, finite and >= 0.
+    kind, degree
+        As in :func:`feature_exponents`.
+
+    Returns
+    -------
+    ndarray, shape (..., n_features)
+
+    Examples
+    --------
+    >>> features_RGB([2.0, 3.0, 1.0], "polynomial", 2)
+    array([2., 3., 1., 4., 6., 2., 9., 3., 1.])
+    >>> features_RGB([4.0, 1.0, 0.0], "root_polynomial", 2)
+    array([4., 1., 0., 2., 0., 0.])
+    """
+    RGB = np.asarray(RGB, dtype=np.float64)
+    X_T = _features_T(RGB.reshape(-1, 3), kind, degree)
+    return X_T.T.reshape(*RGB.shape[:-1], X_T.shape[0])
+
+
+@functools.lru_cache(maxsize=16)
+def _feature_terms(kind: str, degree: int) -> tuple:
+    """Each feature as ``((channel, exponent as a Fraction), ...)`` over its channels in use."""
+    return tuple(
+        tuple((c, Fraction(x).limit_denominator(12)) for c, x in enumerate(e) if x > 0)
+        for e in feature_exponents(kind, degree)
+    )
+
+
+def _features_T(RGB, kind: str, degree: int, out=None) -> np.ndarray:
+    """Features of ``(N, 3)`` RGB as an ``(n_features, N)`` array (rows contiguous, for speed).
+
+    Each feature is a product of per-channel powers ``x^f``, computed once per channel and
+    exponent: integer powers by repeated products, 1/2, 1/4, 3/4 by square roots, 1/3 and 2/3 by
+    cube roots, so no feature costs more than two products.
+    """
+    channels = [np.ascontiguousarray(RGB[:, c]) for c in range(3)]
+    table: dict = {}
+
+    def power(c: int, f: Fraction) -> np.ndarray:
+        if (c, f) not in table:
+            x = channels[c]
+            if f == 1:
+                value = x
+            elif f.denominator == 1:
+                value = power(c, f - 1) * x
+            elif f in (Fraction(1, 2), Fraction(1, 4)):
+                value = np.sqrt(power(c, 2 * f))
+            elif f == Fraction(3, 4):
+                value = power(c, Fraction(1, 2)) * power(c, Fraction(1, 4))
+            elif f in (Fraction(1, 3), Fraction(2, 3)):
+                value = np.cbrt(x) if f.numerator == 1 else power(c, Fraction(1, 3)) ** 2
+            else:
+                value = np.power(x, float(f))
+            table[(c, f)] = value
+        return table[(c, f)]
+
+    terms = _feature_terms(kind, degree)
+    out = np.empty((len(terms), len(RGB))) if out is None else out
+    for i, term in enumerate(terms):
+        # Finlayson et al. 2015: a term is the product of the channel powers
+        factors = [power(c, f) for c, f in term]
+        if len(factors) == 1:
+            out[i] = factors[0]
+        else:
+            np.multiply(factors[0], factors[1], out=out[i])
+            if len(factors) == 3:
+                out[i] *= factors[2]
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class SpectralRegression:
+    """A fitted RGB → spectrum regression: ``S = s · (features(RGB / s) @ coefficients)``.
+
+    Herbert et al., §4 (the 5th-order polynomial from camera RGB to the target's spectra).
+
+    Parameters
+    ----------
+    kind : str
+        A key of :data:`REGRESSION_FEATURES`.
+    degree : int
+    coefficients : ndarray, shape (n_features, n_bands)
+    wavelengths_nm : ndarray, shape (n_bands,)
+    ridge : float
+        The ridge strength used (relative to unit-RMS feature columns).
+    illuminant : str
+        The capture illuminant (the camera's white is the white diffuser under it).
+    camera : str
+        Whose sensitivities made the RGB.
+    training_set : str
+        The target's name.
+    cv : dict
+        ``{"folds": k, "seed": ..., "grid": [...], "rms": [...]}`` (empty when λ was given).
+
+    Examples
+    --------
+    >>> model = SpectralRegression("polynomial", 1, np.eye(3), np.array([450.0, 550.0, 650.0]))
+    >>> model.predict([[0.2, 0.5, 4.0]])                 # B > 1: applied to RGB / 4, times 4
+    array([[0.2, 0.5, 4. ]])
+    """
+
+    kind: str
+    degree: int
+    coefficients: np.ndarray
+    wavelengths_nm: np.ndarray
+    ridge: float = 0.0
+    illuminant: str = "D65"
+    camera: str = ""
+    training_set: str = ""
+    cv: dict | None = None
+
+    def __post_init__(self):
+        n_features = len(feature_exponents(self.kind, self.degree))
+        coefficients = np.asarray(self.coefficients, dtype=np.float64)
+        wavelengths = np.asarray(self.wavelengths_nm, dtype=np.float64)
+        require(
+            coefficients.shape == (n_features, wavelengths.size),
+            f"regression: coefficients must be ({n_features}, {wavelengths.size}), got "
+            f"{coefficients.shape}",
+        )
+        require(np.isfinite(coefficients).all(), "regression: coefficients must be finite")
+        object.__setattr__(self, "coefficients", coefficients)
+        object.__setattr__(self, "wavelengths_nm", wavelengths)
+
+    @property
+    def n_bands(self) -> int:
+        """Number of bands of the spectra."""
+        return self.wavelengths_nm.size
+
+    def predict(self, RGB) -> np.ndarray:
+        """Spectra of camera RGB, shape ``(..., n_bands)`` (module docstring: exposure, E41)."""
+        RGB = np.asarray(RGB, dtype=np.float64)
+        flat = RGB.reshape(-1, 3)
+        S = self._predict_flat(flat, np.empty((self.coefficients.shape[0], len(flat))))
+        return S.reshape(*RGB.shape[:-1], self.n_bands)
+
+    def _predict_flat(self, flat, X_T, S=None) -> np.ndarray:
+        """Spectra of ``(N, 3)`` RGB, with the ``(n_features, N)`` buffer ``X_T`` (and ``S``)."""
+        if self.kind == "root_polynomial":
+            # homogeneous of degree 1: the exposure rule of E41 would change nothing
+            _features_T(flat, self.kind, self.degree, X_T)
+            return np.matmul(X_T.T, self.coefficients, out=S)
+        # Erratum E41: s = max(1, max RGB); S = s · f(RGB / s)
+        s = np.maximum(flat.max(axis=-1, keepdims=True), 1.0)
+        _features_T(flat / s, self.kind, self.degree, X_T)
+        S = np.matmul(X_T.T, self.coefficients, out=S)
+        S *= s
+        return S
+
+
+def _check_target(RGB, spectra) -> tuple[np.ndarray, np.ndarray]:
+    RGB = np.asarray(RGB, dtype=np.float64)
+    spectra = np.asarray(spectra, dtype=np.float64)
+    require(RGB.ndim == 2 and RGB.shape[1] == 3, f"target RGB must be (n, 3), got {RGB.shape}")
+    require(
+        spectra.ndim == 2 and spectra.shape[0] == RGB.shape[0],
+        f"target: {RGB.shape[0]} RGB patches but {spectra.shape[0]} spectra",
+    )
+    require(
+        np.isfinite(RGB).all() and (RGB >= 0).all(),
+        "target RGB must be finite and >= 0 (found NaN, inf or negative values)",
+    )
+    require(np.isfinite(spectra).all(), "target spectra must be finite")
+    return RGB, spectra
+
+
+def _ridge_solutions(X, S, ridges):
+    """Ridge solutions for each λ from one SVD: ``W = V diag(σ / (σ² + nλ)) Uᵀ S``."""
+    U, sigma, Vt = np.linalg.svd(X, full_matrices=False)
+    UtS = U.T @ S
+    n = X.shape[0]
+    for lam in ridges:
+        # Hoerl & Kennard 1970: the ridge solution of (1/n)||XW - S||² + λ||W||²
+        with np.errstate(divide="ignore", invalid="ignore"):
+            d = np.where(sigma > sigma[0] * 1e-13, sigma / (sigma**2 + n * lam), 0.0)
+        yield Vt.T @ (d[:, None] * UtS)
+
+
+def fit_regression(
+    RGB,
+    spectra,
+    wavelengths_nm,
+    kind: str = "polynomial",
+    degree: int = 5,
+    ridge: float | None = None,
+    illuminant: str = "D65",
+    camera: str = "",
+    training_set: str = "",
+) -> SpectralRegression:
+    """Fit the regression of a target's spectra on its camera RGB (ridge, λ by cross-validation).
+
+    Herbert et al., §4; Finlayson et al. 2015 for the root-polynomial features.
+
+    Parameters
+    ----------
+    RGB : array_like, shape (n, 3)
+        Camera RGB of the patches, white diffuser = 1; finite, >= 0.
+    spectra : array_like, shape (n, n_bands)
+        Their reflectances on ``wavelengths_nm``.
+    wavelengths_nm : array_like, shape (n_bands,)
+    kind, degree
+        As in :func:`feature_exponents`.
+    ridge : float, optional
+        A fixed ridge strength in [0, :data:`MAX_RIDGE`]; None chooses it by cross-validation.
+    illuminant, camera, training_set : str
+        Recorded in the model.
+
+    Returns
+    -------
+    SpectralRegression
+
+    Raises
+    ------
+    SpecrefError
+        Patch counts differ, negative or NaN RGB, degree or ridge out of range.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(1)
+    >>> RGB = rng.uniform(0, 1, (40, 3))
+    >>> model = fit_regression(RGB, RGB[:, ::-1], [450.0, 550.0, 650.0], degree=2)
+    >>> model.predict([[0.2, 0.5, 0.9]]).round(3)
+    array([[0.9, 0.5, 0.2]])
+    """
+    RGB, spectra = _check_target(RGB, spectra)
+    wavelengths = np.asarray(wavelengths_nm, dtype=np.float64)
+    require(
+        wavelengths.shape == (spectra.shape[1],),
+        f"target: {spectra.shape[1]} spectral values per patch but {wavelengths.size} wavelengths",
+    )
+    if ridge is not None:
+        require(
+            np.isfinite(ridge) and 0.0 <= ridge <= MAX_RIDGE,
+            f"ridge strength must be in [0, {MAX_RIDGE:g}], got {ridge!r}",
+        )
+    X = features_RGB(RGB, kind, degree)
+    require(
+        RGB.shape[0] >= CV_FOLDS * 2,
+        f"target: at least {CV_FOLDS * 2} patches needed, got {RGB.shape[0]}",
+    )
+    # Feature columns scaled to unit RMS, so that one λ grid suits every degree
+    scale = np.sqrt((X**2).mean(axis=0))
+    scale = np.where(scale > 0, scale, 1.0)
+    X = X / scale
+    cv = None
+    if ridge is None:
+        # k-fold cross-validation over RIDGE_GRID: held-out spectral RMS per λ
+        folds = np.array_split(np.random.default_rng(CV_SEED).permutation(len(X)), CV_FOLDS)
+        sq = np.zeros(len(RIDGE_GRID))
+        for held in folds:
+            train = np.setdiff1d(np.arange(len(X)), held)
+            for i, W in enumerate(_ridge_solutions(X[train], spectra[train], RIDGE_GRID)):
+                sq[i] += ((X[held] @ W - spectra[held]) ** 2).sum()
+        rms = np.sqrt(sq / spectra.size)
+        ridge = float(RIDGE_GRID[int(np.argmin(rms))])
+        cv = {"folds": CV_FOLDS, "seed": CV_SEED, "grid": list(RIDGE_GRID), "rms": rms.tolist()}
+    (W,) = _ridge_solutions(X, spectra, [float(ridge)])
+    return SpectralRegression(
+        kind,
+        int(degree),
+        W / scale[:, None],
+        wavelengths,
+        float(ridge),
+        illuminant,
+        camera,
+        training_set,
+        cv,
+    )
+
+
+def save_regression(model: SpectralRegression, path) -> Path:
+    """Write a model file (JSON, atomically; format in ``docs/spectral-environments.md``).
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> model = SpectralRegression("polynomial", 1, np.eye(3), np.array([450.0, 550.0, 650.0]))
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     back = load_regression(save_regression(model, os.path.join(d, "m.json")))
+    >>> bool(np.array_equal(back.coefficients, model.coefficients))
+    True
+    """
+    from reference.images import write_text_atomic
+
+    document = {
+        "format": FORMAT,
+        "version": FORMAT_VERSION,
+        "features": model.kind,
+        "degree": model.degree,
+        "feature_names": feature_names(model.kind, model.degree),
+        "wavelengths_nm": model.wavelengths_nm.tolist(),
+        "coefficients": model.coefficients.tolist(),
+        "ridge": model.ridge,
+        "cross_validation": model.cv,
+        "illuminant": model.illuminant,
+        "camera": model.camera,
+        "training_set": model.training_set,
+    }
+    return write_text_atomic(path, json.dumps(document, indent=1) + "\n")
+
+
+def load_regression(path, wavelengths_nm=None) -> SpectralRegression:
+    """Read a model file; with ``wavelengths_nm``, require the model's grid to be that grid.
+
+    Raises
+    ------
+    SpecrefError
+        Missing or malformed file, another grid than ``wavelengths_nm``.
+
+    Examples
+    --------
+    >>> load_regression("/nonexistent.json")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: /nonexistent.json: file not found
+    """
+    path = Path(path)
+    require(path.is_file(), f"{path}: file not found")
+    try:
+        document = json.loads(path.read_text(encoding="utf-8"))
+        require(
+            document.get("format") == FORMAT and document.get("version") == FORMAT_VERSION,
+            f"{path}: not a {FORMAT} file of version {FORMAT_VERSION}",
+        )
+        model = SpectralRegression(
+            document["features"],
+            document["degree"],
+            np.array(document["coefficients"], dtype=np.float64),
+            np.array(document["wavelengths_nm"], dtype=np.float64),
+            float(document["ridge"]),
+            str(document["illuminant"]),
+            str(document["camera"]),
+            str(document["training_set"]),
+            document.get("cross_validation"),
+        )
+    except SpecrefError as error:
+        raise SpecrefError(f"{path}: {error}".replace(f"{path}: {path}: ", f"{path}: ")) from None
+    except (ValueError, KeyError, TypeError) as error:
+        raise SpecrefError(f"{path}: malformed model file ({error.__class__.__name__})") from None
+    if wavelengths_nm is not None:
+        wl = np.asarray(wavelengths_nm, dtype=np.float64)
+        require(
+            model.wavelengths_nm.shape == wl.shape and np.allclose(model.wavelengths_nm, wl),
+            f"{path}: model grid {model.wavelengths_nm[0]:g}-{model.wavelengths_nm[-1]:g} nm, "
+            f"{model.n_bands} bands; expected {wl[0]:g}-{wl[-1]:g} nm, {wl.size} bands",
+        )
+    return model
+
+
+def spectralize_blocks(model: SpectralRegression, RGB, rows_per_block: int | None = None):
+    """Spectralize an image block of rows by block: yields ``(row0, spectra float32)``.
+
+    Herbert et al., §4 (the panorama expanded to n bands). Each block is one feature expansion
+    and one matrix product (:meth:`SpectralRegression.predict`), so the memory in use is bounded by
+    a block, never by the whole output; an out-of-core or distributed writer consumes the blocks.
+
+    Parameters
+    ----------
+    model : SpectralRegression
+    RGB : array_like, shape (H, W, 3)
+        Linear camera RGB (white diffuser = 1), finite, >= 0.
+    rows_per_block : int, optional
+        Default: as many rows as hold :data:`PIXELS_PER_BLOCK` pixels (at least one).
+
+    Yields
+    ------
+    row0 : int
+    spectra : ndarray, shape (rows, W, n_bands), float32
+        A view of a buffer that the next block overwrites: write or copy it before asking for
+        the next block.
+
+    Raises
+    ------
+    SpecrefError
+        Not (H, W, 3), NaN, inf or negative RGB.
+
+    Examples
+    --------
+    >>> model = SpectralRegression("polynomial", 1, np.eye(3), np.array([450.0, 550.0, 650.0]))
+    >>> [(row0, block.shape, block.dtype.name) for row0, block in
+    ...  spectralize_blocks(model, np.ones((3, 6, 3)), rows_per_block=2)]   # shapes only
+    [(0, (2, 6, 3), 'float32'), (2, (1, 6, 3), 'float32')]
+    """
+    RGB = np.asarray(RGB)
+    require(
+        RGB.ndim == 3 and RGB.shape[2] == 3, f"spectralize: expected (H, W, 3), got {RGB.shape}"
+    )
+    default = max(1, PIXELS_PER_BLOCK // max(RGB.shape[1], 1))
+    rows = default if rows_per_block is None else int(rows_per_block)
+    # Buffers reused by every block (fresh ones would cost a page fault per page each time)
+    X_T = np.empty((model.coefficients.shape[0], rows * RGB.shape[1]))
+    S = np.empty((rows * RGB.shape[1], model.n_bands))
+    S32 = np.empty((rows * RGB.shape[1], model.n_bands), np.float32)
+    for row0 in range(0, RGB.shape[0], rows):
+        block = np.asarray(RGB[row0 : row0 + rows], dtype=np.float64)
+        require(
+            np.isfinite(block).all() and (block >= 0).all(),
+            f"spectralize: RGB must be finite and >= 0 (rows {row0}-{row0 + len(block) - 1})",
+        )
+        n = block.shape[0] * block.shape[1]
+        spectra = model._predict_flat(block.reshape(-1, 3), X_T[:, :n], S[:n])
+        np.copyto(S32[:n], spectra, casting="same_kind")
+        yield row0, S32[:n].reshape(*block.shape[:2], model.n_bands)

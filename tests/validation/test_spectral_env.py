@@ -1,0 +1,81 @@
+"""The targets of issue 15 on the synthetic Nikon 5100 target (validation/spectral_env.py)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from reference.spectral_target import HELD_OUT_SETS
+from validation.spectral_env import (
+    delta_E94_spectra,
+    fit_target,
+    held_out_figures,
+    recovery_figures,
+)
+
+CC = "ColorChecker N Ohta"
+
+
+@pytest.fixture(scope="module")
+def root4():
+    model, in_sample = fit_target("root_polynomial", 4)
+    return model, in_sample, held_out_figures(model.predict)
+
+
+def test_delta_E94_against_colour_science():
+    # Source: colour-science's sd_to_XYZ (5 nm, CIE 1931) and delta_E CIE 1994, independently.
+    import colour
+
+    sds = list(colour.SDS_COLOURCHECKERS[CC].values())[:2]
+    shape = colour.SpectralShape(380, 780, 10)
+    a, b = (sd.copy().align(shape).values for sd in sds)
+    ill = colour.SDS_ILLUMINANTS["D65"]
+    XYZ = [colour.sd_to_XYZ(sd, illuminant=ill) / 100 for sd in sds]
+    white = colour.XYZ_to_xy(colour.sd_to_XYZ(colour.sd_ones(), illuminant=ill) / 100)
+    expected = colour.delta_E(*(colour.XYZ_to_Lab(x, white) for x in XYZ), method="CIE 1994")
+    assert delta_E94_spectra(a[None], b[None], "D65")[0] == pytest.approx(expected, abs=0.05)
+
+
+def test_in_sample_mean(root4):
+    # Issue 15 target: in-sample mean ΔE94 <= 0.8 (Herbert et al. §4 print 0.77, in-sample).
+    assert root4[1]["D65 mean"] <= 0.8
+
+
+def test_held_out_colorchecker_mean_D65_and_A(root4):
+    # Issue 15 targets: held-out ColorChecker mean ΔE94 <= 0.77 (D65), relit under A <= 1.0.
+    figures = root4[2][CC]
+    assert figures["D65 mean"] <= 0.77
+    assert figures["A mean"] <= 1.0
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="erratum E44: held-out ColorChecker max ΔE94 is 1.83 > 1.5; the direct RGB->XYZ "
+    "floor on the same features is 1.49, so this training set leaves no margin",
+)
+def test_held_out_colorchecker_max(root4):
+    assert root4[2][CC]["D65 max"] <= 1.5
+
+
+@pytest.mark.parametrize("name", HELD_OUT_SETS[1:])
+def test_other_held_out_sets(root4, name):
+    # Our own bound (not the issue's): the sets the design never saw stay below 1 ΔE94 mean.
+    assert root4[2][name]["D65 mean"] <= 1.0
+
+
+def test_noise_hurts_high_degrees_more():
+    # 0.5 % multiplicative + 0.1 % additive noise: the degree-5 polynomial loses more than degree 1.
+    loss = {}
+    for degree in (1, 5):
+        clean = held_out_figures(fit_target("polynomial", degree)[0].predict)[CC]["D65 mean"]
+        model, _ = fit_target("polynomial", degree, noise=True)
+        noisy = held_out_figures(model.predict, noise=True)[CC]["D65 mean"]
+        loss[degree] = noisy - clean
+    assert loss[5] > loss[1]
+
+
+def test_smits_round_trip_is_worse_than_the_regression(root4):
+    # colour.recovery's Smits 1999 is not a round trip on the ColorChecker (ΔE94 ~4 under D65).
+    smits = recovery_figures("Smits 1999", (CC,))[CC]
+    assert smits["D65 mean"] > root4[2][CC]["D65 mean"]
+    assert np.isfinite(smits["A mean"])

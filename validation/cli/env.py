@@ -1,0 +1,68 @@
+"""``specref env``: fit an RGB → spectrum regression and spectralize HDR panoramas (Herbert §4)."""
+
+from __future__ import annotations
+
+from validation.cli.parser import Parser
+
+
+def _cmd_env_fit(args) -> int:
+    from validation.spectral_env import fit_file
+
+    report = fit_file(
+        args.out,
+        args.target,
+        args.spectra,
+        args.camera,
+        args.illuminant,
+        args.features,
+        args.degree,
+        args.ridge,
+        args.noise,
+    )
+    for line in report["lines"]:
+        print(line)
+    return 0
+
+
+def _cmd_env_spectralize(args) -> int:
+    from reference.spectra import DEFAULT_GRID
+    from reference.spectral_images import spectralize_file
+    from reference.spectral_regression import load_regression
+    from reference.upsampling import DEFAULT_REGRESSION_MODEL
+
+    path = DEFAULT_REGRESSION_MODEL if args.model == "default" else args.model
+    model = load_regression(path, DEFAULT_GRID.wavelengths_nm)
+    info = spectralize_file(args.panorama, model, args.out, args.rows)
+    print(
+        f"wrote {info['out']}: {info['height']}x{info['width']}, {info['bands']} bands, "
+        f"{info['blocks']} row blocks"
+    )
+    return 0
+
+
+def add_parser(sub) -> None:
+    """Add ``specref env fit|spectralize`` to the subcommand parsers ``sub``."""
+    from reference.spectral_regression import REGRESSION_FEATURES
+    from reference.spectral_target import CAMERAS
+
+    p = sub.add_parser("env", help="spectral environments: camera-target regression (Herbert §4)")
+    env = p.add_subparsers(dest="env_command", required=True, parser_class=Parser)
+    f = env.add_parser("fit", help="fit and save an RGB -> spectrum model; print its figures")
+    f.add_argument("--target", default=None, help="target CSV (R, G, B and wavelength columns)")
+    f.add_argument("--spectra", default=None, help="spectra CSV when --target holds only RGB")
+    f.add_argument(
+        "--camera", default="Nikon 5100 (NPL)", help=f"synthetic target camera: {CAMERAS.names()}"
+    )
+    f.add_argument("--illuminant", default="D65", help="capture illuminant (colour-science key)")
+    f.add_argument("--features", default="root_polynomial", help=str(REGRESSION_FEATURES.names()))
+    f.add_argument("--degree", type=int, default=4, help="1-5 (polynomial), 1-4 (root)")
+    f.add_argument("--ridge", type=float, default=None, help="fixed ridge strength (default: CV)")
+    f.add_argument("--noise", action="store_true", help="add 0.5 %% + 0.1 %% camera noise")
+    f.add_argument("-o", "--out", required=True, help="output model .json")
+    f.set_defaults(func=_cmd_env_fit)
+    s = env.add_parser("spectralize", help="expand an HDR panorama to a spectral .exr or .tif")
+    s.add_argument("panorama", help="linear HDR panorama, .hdr or RGB .exr")
+    s.add_argument("--model", required=True, help="model .json from `env fit`, or 'default'")
+    s.add_argument("--rows", type=int, default=None, help="rows per block (default: 2^17 pixels)")
+    s.add_argument("-o", "--out", required=True, help="output .exr or .tif")
+    s.set_defaults(func=_cmd_env_spectralize)
