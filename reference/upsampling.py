@@ -237,16 +237,32 @@ def RGB_to_spectra_regression(RGB, grid: SpectralGrid) -> np.ndarray:
     return S[..., lo] * (1.0 - t) + S[..., hi] * t
 
 
-#: RGB → spectrum methods by key.
+#: RGB → spectrum methods by key. ``extra["exact"]``: the spectrum renders back to its RGB by
+#: construction (the fits); the regression is a least-squares model and reproduces RGB only to
+#: within its fit (docs/spectral-environments.md).
 UPSAMPLING_METHODS = Registry("RGB upsampling")
 UPSAMPLING_METHODS.register(
-    Method("mallett2019", RGB_to_spectra_Mallett2019, None, "Eq. (4), Mallett & Yuksel 2019")
+    Method(
+        "mallett2019",
+        RGB_to_spectra_Mallett2019,
+        None,
+        "Eq. (4), Mallett & Yuksel 2019",
+        extra={"exact": True},
+    )
 )
 UPSAMPLING_METHODS.register(
-    Method("jakob2019", RGB_to_spectra_Jakob2019, None, "Eq. (3), Jakob & Hanika 2019")
+    Method(
+        "jakob2019",
+        RGB_to_spectra_Jakob2019,
+        None,
+        "Eq. (3), Jakob & Hanika 2019",
+        extra={"exact": True},
+    )
 )
 UPSAMPLING_METHODS.register(
-    Method("regression", RGB_to_spectra_regression, None, "§4, Herbert et al.")
+    Method(
+        "regression", RGB_to_spectra_regression, None, "§4, Herbert et al.", extra={"exact": False}
+    )
 )
 
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from validation.cli.parser import Parser
+from validation.cli.parser import Parser, registry_option
 
 
 def _cmd_env_fit(args) -> int:
@@ -50,11 +50,11 @@ def add_parser(sub) -> None:
     f = env.add_parser("fit", help="fit and save an RGB -> spectrum model; print its figures")
     f.add_argument("--target", default=None, help="target CSV (R, G, B and wavelength columns)")
     f.add_argument("--spectra", default=None, help="spectra CSV when --target holds only RGB")
-    f.add_argument(
-        "--camera", default="Nikon 5100 (NPL)", help=f"synthetic target camera: {CAMERAS.names()}"
-    )
+    registry_option(f, "--camera", CAMERAS, "synthetic target camera", default="Nikon 5100 (NPL)")
     f.add_argument("--illuminant", default="D65", help="capture illuminant (colour-science key)")
-    f.add_argument("--features", default="root_polynomial", help=str(REGRESSION_FEATURES.names()))
+    registry_option(
+        f, "--features", REGRESSION_FEATURES, "regression features", default="root_polynomial"
+    )
     f.add_argument("--degree", type=int, default=4, help="1-5 (polynomial), 1-4 (root)")
     f.add_argument("--ridge", type=float, default=None, help="fixed ridge strength (default: CV)")
     f.add_argument("--noise", action="store_true", help="add 0.5 %% + 0.1 %% camera noise")
