@@ -1,5 +1,7 @@
-"""The report: data types (:mod:`validation.report.types`), HTML and Markdown
-(:mod:`validation.report.render`) and the runner (:mod:`validation.report.runner`).
+"""The report: data types, HTML and Markdown rendering, and the runner.
+
+:mod:`validation.report.types` (data types), :mod:`validation.report.render` (HTML and Markdown)
+and :mod:`validation.report.runner` (the runner).
 
 Sections import the types from here; only the runner imports the sections, so there is no import
 circle. ``specref report`` calls :func:`validation.report.runner.run_report`.
