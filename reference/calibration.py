@@ -235,9 +235,11 @@ class Calibration:
         """Target luminance (cd/m²) at gray levels ``G`` in [0, 1]."""
         return self.Y_white * curve_target(self.curve, G, self.Y_black / self.Y_white)
 
-    def drives(self, G) -> np.ndarray:
-        """Drives (..., 3) for input levels ``G`` in [0, 1], interpolating the tables linearly."""
-        return _interp_lut(self.lut, np.asarray(G, dtype=np.float64))
+    def drives(self, RGB) -> np.ndarray:
+        """Drives (..., 3) for device values ``RGB`` (..., 3) in [0, 1], through the tables."""
+        RGB = np.asarray(RGB, dtype=np.float64)
+        x = np.linspace(0.0, 1.0, self.lut.shape[1])
+        return np.stack([np.interp(RGB[..., c], x, self.lut[c]) for c in range(3)], axis=-1)
 
 
 @dataclass(frozen=True)

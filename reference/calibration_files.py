@@ -1,0 +1,272 @@
+"""A calibration's outputs and its verification: ``.cal``, ``.cube``, ``.ti3``, a JSON summary.
+
+:func:`write_calibration` writes what a DisplayCAL/ArgyllCMS user expects beside ``CAL``:
+
+- ``CAL.cal``: the per-channel tables (ArgyllCMS CGATS, :func:`reference.cgats.write_cal`);
+- ``CAL.cube``: the same tables as a 1-D ``.cube`` LUT (colour-science's LUT I/O);
+- ``CAL.ti3``: verification measurements through the calibrated display (grays and a 5×5×5
+  grid), which ArgyllCMS's ``colprof`` turns into an ICC profile;
+- ``CAL.json``: the summary: white, curve, points, Δu'v' and luminance error of the gray ramp
+  (Figs. 6 and 7, Herbert et al.) and ΔE00 of the ColorChecker shown through the display.
+
+References
+----------
+- F. Herbert, J. Kirkenaer, O. Unter Ecker, "Achieving a Multi-spectral Virtual Reality", 2004, §6.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from reference.calibration import Calibration, curve_target, verify_calibration
+from reference.cgats import write_cal, write_ti3
+from reference.display_spectral import SpectralDisplay
+from reference.errors import SpecrefError, require
+from reference.images import write_text_atomic
+from reference.instruments import INSTRUMENTS
+
+__all__ = [
+    "calibration_summary",
+    "colorchecker_through_display",
+    "measure_through_calibration",
+    "read_cube",
+    "verification_patches",
+    "write_calibration",
+    "write_cube",
+]
+
+
+def verification_patches(grid: int = 5, grays: int = 17) -> np.ndarray:
+    """Device RGB of the verification set: a gray ramp and a ``grid³`` cube, shape (n, 3).
+
+    Examples
+    --------
+    >>> verification_patches().shape
+    (137, 3)
+    """
+    g = np.linspace(0.0, 1.0, grid)
+    cube = np.stack(np.meshgrid(g, g, g, indexing="ij"), axis=-1).reshape(-1, 3)
+    ramp = np.repeat(np.linspace(0.0, 1.0, grays)[:, None], 3, axis=1)
+    patches = np.concatenate([ramp, cube])
+    _, first = np.unique(patches.round(9), axis=0, return_index=True)
+    return patches[np.sort(first)]
+
+
+def measure_through_calibration(
+    display: SpectralDisplay, calibration: Calibration, RGB, instrument: str = "ideal", seed=2
+) -> np.ndarray:
+    """XYZ (cd/m²) read for device RGB sent through the calibration's tables, shape (n, 3).
+
+    Examples
+    --------
+    >>> from reference.calibration import calibrate_display
+    >>> from reference.display_spectral import spectral_display
+    >>> d = spectral_display(); cal = calibrate_display(d, points=6, instrument="ideal")
+    >>> round(float(measure_through_calibration(d, cal, [[1.0, 1.0, 1.0]])[0, 1]), 1)
+    100.0
+    """
+    drives = calibration.drives(np.asarray(RGB, dtype=np.float64))
+    meter = INSTRUMENTS.lookup(instrument).reference()
+    return meter.measure(display, drives, np.random.default_rng(seed))
+
+
+def colorchecker_through_display(
+    display: SpectralDisplay, calibration: Calibration, instrument: str = "ideal"
+) -> dict:
+    """ΔE00 of the ColorChecker shown through the calibrated display (relative colorimetric).
+
+    The chart's D50 chromaticities (colour-science, 2014 edition) are adapted to the calibrated
+    white (CAT02), scaled to its luminance, converted to device RGB with a matrix/curve profile of
+    the calibrated display (primaries read through the tables, the calibration's curve), shown and
+    read back. Out-of-gamut patches are clipped and counted.
+
+    Returns
+    -------
+    dict
+        ``delta_E00`` (24,), ``mean``, ``max``, ``out_of_gamut`` (count).
+
+    Examples
+    --------
+    >>> from reference.calibration import calibrate_display
+    >>> from reference.display_spectral import spectral_display
+    >>> d = spectral_display(); cal = calibrate_display(d, points=8, instrument="ideal")
+    >>> result = colorchecker_through_display(d, cal)
+    >>> result["delta_E00"].shape, bool(result["mean"] < 1.0)
+    ((24,), True)
+    """
+    import colour
+
+    chart = colour.CCS_COLOURCHECKERS["ColorChecker24 - After November 2014"]
+    XYZ_D50 = colour.xyY_to_XYZ(np.array(list(chart.data.values())))
+    xy = calibration.white_xy
+    white_rel = colour.xy_to_XYZ(xy)
+    XYZ_rel = colour.adaptation.chromatic_adaptation_VonKries(
+        XYZ_D50, colour.xy_to_XYZ(chart.illuminant), white_rel, transform="CAT02"
+    )
+    # the calibrated display's matrix/curve profile, read through the tables
+    measured = measure_through_calibration(
+        display, calibration, np.vstack([np.zeros(3), np.eye(3), np.ones(3)]), instrument
+    )
+    black, primaries, white = measured[0], measured[1:4] - measured[0], measured[4]
+    linear = np.linalg.solve(primaries.T, (XYZ_rel * white[1] - black).T).T
+    in_gamut = ((linear >= -1e-3) & (linear <= 1 + 1e-3)).all(axis=1)
+    linear = np.clip(linear, 0.0, 1.0)
+    RGB = _invert_curve(calibration, linear)
+    shown = measure_through_calibration(display, calibration, RGB, instrument)
+    intended_Lab = colour.XYZ_to_Lab(XYZ_rel, xy)
+    shown_Lab = colour.XYZ_to_Lab(shown / white[1], colour.XYZ_to_xy(white))
+    dE = colour.delta_E(intended_Lab, shown_Lab, method="CIE 2000")
+    return {
+        "delta_E00": dE,
+        "mean": float(dE.mean()),
+        "max": float(dE.max()),
+        "out_of_gamut": int((~in_gamut).sum()),
+    }
+
+
+def _invert_curve(calibration: Calibration, linear) -> np.ndarray:
+    """Device values whose calibrated curve gives ``linear`` (relative to the black-free range)."""
+    G = np.linspace(0.0, 1.0, 4097)
+    black = calibration.Y_black / calibration.Y_white
+    # the channels' share above the black, for the calibrated curve
+    relative = np.maximum(curve_target(calibration.curve, G, black) - black, 0.0) / (1.0 - black)
+    relative = np.maximum.accumulate(relative) + np.linspace(0.0, 1e-12, G.size)
+    return np.interp(linear, relative, G)
+
+
+def write_cube(path, lut, title: str = "specref calibration") -> Path:
+    """Write per-channel tables (3, n) as a 1-D ``.cube`` LUT through colour-science, atomically.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     lut = np.tile(np.linspace(0, 1, 5) ** 2, (3, 1))
+    ...     read_cube(write_cube(os.path.join(d, "x.cube"), lut))[0].round(4)
+    array([0.    , 0.0625, 0.25  , 0.5625, 1.    ])
+    """
+    import colour
+
+    path = Path(path)
+    table = colour.LUT3x1D(np.asarray(lut, dtype=np.float64).T, name=title)
+    handle, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".cube")
+    os.close(handle)
+    try:
+        colour.io.write_LUT(table, tmp)
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return path
+
+
+def read_cube(path) -> np.ndarray:
+    """Read a 1-D ``.cube`` LUT through colour-science: the tables, shape (3, n).
+
+    Examples
+    --------
+    >>> read_cube("/nonexistent.cube")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: /nonexistent.cube: file not found
+    """
+    import colour
+
+    require(Path(path).exists(), f"{path}: file not found")
+    try:
+        table = colour.io.read_LUT(str(path))
+    except Exception as error:  # colour raises several types for a malformed file
+        raise SpecrefError(f"{path}: not a .cube LUT ({error})") from None
+    return np.asarray(table.table, dtype=np.float64).T.copy()
+
+
+def calibration_summary(display: SpectralDisplay, calibration: Calibration) -> dict:
+    """The JSON summary: targets, points and the verification (read by the noise-free instrument).
+
+    Examples
+    --------
+    >>> from reference.calibration import calibrate_display
+    >>> from reference.display_spectral import spectral_display
+    >>> d = spectral_display(); cal = calibrate_display(d, "A", "lstar", 8, "ideal")
+    >>> s = calibration_summary(d, cal)
+    >>> s["white"], s["curve"], bool(s["verification"]["max_duv_above_5pct"] < 0.001)
+    ('A', 'lstar', True)
+    """
+    v = verify_calibration(display, calibration)
+    above_5 = v["Y_target"] > 0.05 * calibration.Y_white
+    above_1 = v["Y_target"] > 0.01 * calibration.Y_white
+    levels = [*range(0, calibration.lut.shape[1], 16), calibration.lut.shape[1] - 1]
+    chart = colorchecker_through_display(display, calibration)
+    return {
+        "display": calibration.display,
+        "white": calibration.white,
+        "white_xy": calibration.white_xy.tolist(),
+        "curve": calibration.curve,
+        "instrument": calibration.instrument,
+        "Y_white_cd_m2": calibration.Y_white,
+        "Y_black_cd_m2": calibration.Y_black,
+        "points": {
+            "G": calibration.points["G"].tolist(),
+            "iterations": calibration.points["iterations"].tolist(),
+        },
+        "verification": {
+            "instrument": "ideal",
+            "max_duv_above_5pct": float(v["duv"][above_5].max()),
+            "max_abs_Y_error_above_1pct": float(np.abs(v["Y_error"][above_1]).max()),
+            "gray": [
+                {
+                    "G": int(i),
+                    "Y_cd_m2": float(v["XYZ"][i, 1]),
+                    "Y_target_cd_m2": float(v["Y_target"][i]),
+                    "x": float(v["xy"][i, 0]),
+                    "y": float(v["xy"][i, 1]),
+                    "duv": float(v["duv"][i]),
+                }
+                for i in levels
+            ],
+            "colorchecker_delta_E00": {
+                "mean": chart["mean"],
+                "max": chart["max"],
+                "out_of_gamut": chart["out_of_gamut"],
+            },
+        },
+    }
+
+
+def write_calibration(
+    path, display: SpectralDisplay, calibration: Calibration, seed: int = 2
+) -> dict:
+    """Write ``.cal``, ``.cube``, ``.ti3`` and ``.json`` for a calibration; return the summary.
+
+    ``path`` names the ``.cal``; the others take its stem. The ``.ti3`` holds the verification
+    patches read by the calibration's own instrument (what a user would profile from).
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> from reference.calibration import calibrate_display
+    >>> from reference.display_spectral import spectral_display
+    >>> d = spectral_display(); cal = calibrate_display(d, points=6, instrument="ideal")
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     s = write_calibration(os.path.join(folder, "d65.cal"), d, cal)
+    ...     sorted(os.listdir(folder))
+    ['d65.cal', 'd65.cube', 'd65.json', 'd65.ti3']
+    """
+    path = Path(path)
+    require(path.suffix == ".cal", f"{path}: the calibration file must end in .cal")
+    description = f"{calibration.white} white, {calibration.curve} curve, {calibration.display}"
+    write_cal(path, calibration.lut, description)
+    write_cube(path.with_suffix(".cube"), calibration.lut, description)
+    RGB = verification_patches()
+    XYZ = measure_through_calibration(display, calibration, RGB, calibration.instrument, seed)
+    white = XYZ[int(np.argmax(RGB.sum(axis=1)))]
+    write_ti3(path.with_suffix(".ti3"), RGB, XYZ, white, description)
+    summary = calibration_summary(display, calibration)
+    summary["files"] = {k: str(path.with_suffix(k)) for k in (".cal", ".cube", ".ti3", ".json")}
+    write_text_atomic(path.with_suffix(".json"), json.dumps(summary, indent=1) + "\n")
+    return summary
