@@ -365,6 +365,7 @@ def calibrate_display(
     def measure(drives):
         return meter.measure(display, drives, rng)
 
+    # Erratum E53: the loop's heuristics (characterisation, placement, tolerances) are ours
     model = _characterize(display, measure)
     # the target white's direction, Y = 1
     XYZ_w1 = np.array([xy[0] / xy[1], 1.0, (1.0 - xy.sum()) / xy[1]])

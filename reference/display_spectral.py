@@ -317,6 +317,7 @@ def spectral_display(
         0.0 <= black_cd_m2 < white_cd_m2,
         f"display: black_cd_m2 must be in [0, white_cd_m2), got {black_cd_m2} and {white_cd_m2}",
     )
+    # Erratum E50: a simulated display (colour-science primaries, our tone responses and black)
     if isinstance(primaries, str):
         w, spectra = DISPLAY_PRIMARIES.lookup(primaries).reference()
     else:

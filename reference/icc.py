@@ -81,6 +81,7 @@ def build_icc_profile(ti3_path, description: str | None = None) -> Path:
     require(ti3_path.suffix == ".ti3", f"{ti3_path}: colprof reads a .ti3 file")
     colprof = _require_tool("colprof")
     stem = ti3_path.with_suffix("")
+    # Erratum E55: a shaper/matrix profile, not the paper's LUT-type profile with the calibration
     command = [colprof, "-qm", "-as", "-D", description or stem.name, str(stem)]
     done = subprocess.run(command, capture_output=True, text=True, check=False)
     icc = ti3_path.with_suffix(".icc")

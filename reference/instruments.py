@@ -89,6 +89,7 @@ class Spectroradiometer:
         bands = spectra @ band_pass.T
         if self.dark_noise > 0 or self.relative_noise > 0:
             require(rng is not None, f"{self.name}: a noisy reading needs a seeded rng")
+            # Erratum E51: our noise model, σ = σ_dark + ρ L(λ) per band
             sigma = self.dark_noise + self.relative_noise * np.abs(bands)
             bands = bands + sigma * rng.standard_normal(bands.shape)
         return spectra_to_absolute_XYZ(bands, centres)
@@ -169,7 +170,7 @@ class Colorimeter:
         spectra = display_drives_to_spectra(display, drives)
         M, unit = self.factory()
         signals = self._signals(spectra, display.wavelengths_nm)
-        # the shadow failure: an uncorrected dark signal and dark noise, per filter
+        # Erratum E52: the shadow failure, an uncorrected dark signal and dark noise per filter
         signals = signals + np.asarray(self.dark_offset) * unit
         if self.dark_noise > 0 or self.relative_noise > 0:
             require(rng is not None, f"{self.name}: a noisy reading needs a seeded rng")
