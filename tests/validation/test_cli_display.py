@@ -85,3 +85,28 @@ def test_bad_display_file(tmp_path, capsys):
     code = main(["display", "calibrate", "--display", str(path), "-o", str(tmp_path / "x.cal")])
     assert code == 2
     assert "ramps.R: must increase with the drive" in capsys.readouterr().err
+
+
+def test_impastor_render_observer_behind_the_screen(tmp_path, capsys):
+    code = main(
+        [
+            "impastor",
+            "render",
+            "--size",
+            "8",
+            "--out",
+            str(tmp_path / "p.png"),
+            "--counts",
+            str(tmp_path / "c.png"),
+            "--observer",
+            "0,0,-1",
+        ]
+    )
+    assert code == 2
+    assert "is behind the screen" in capsys.readouterr().err
+
+
+def test_impastor_render_bad_observer(tmp_path, capsys):
+    code = main(["impastor", "render", "--out", str(tmp_path / "p.png"), "--observer", "1,2"])
+    assert code == 2
+    assert "--observer: must be x,y,z in metres, got '1,2'" in capsys.readouterr().err
