@@ -161,7 +161,7 @@ def image_to_display_counts(
             require(light_position is not None, "light_position: needed with light_XYZ")
             mirror = _off_mirror_deg(geometry, observer, light_position, height, width)
         E = np.zeros(3) if E_XYZ is None else np.asarray(E_XYZ, float)
-        # §3.4.3, Ferwerda: the screen's diffuse and specular reflection of the booth light
+        # §3.4.3, Ferwerda: the screen's diffuse and specular reflection (Erratum E57)
         flare = flare + screen_flare_XYZ(model, np.broadcast_to(E, XYZ.shape), light_XYZ, mirror)
     if compensate:
         # Eq. (1), Ferwerda, inverted per pixel at the observer's (θ, φ), flare subtracted

@@ -87,7 +87,47 @@ def display_calibration(ctx: ReportContext | None = None) -> SectionData:
                 data.arrays[("fig7", instrument)] = (v["G"], v["xy"], cal.white_xy)
                 data.results.setdefault("instruments", {})[instrument] = _bands(cal, v)
     data.results["whites"] = whites
+    data.results["screen"] = screen_compensation()
     return data
+
+
+#: Observers for the screen study: on axis, and off axis to the side and above (metres).
+OBSERVERS = {
+    "on axis": (0.0, 0.0, 0.6),
+    "30° to the side": (0.35, 0.0, 0.6),
+    "above, tilted": (0.0, 0.4, 0.45),
+}
+
+
+def screen_compensation() -> dict:
+    """A mid-gray image through Eq. (1), Ferwerda, per pixel: seen against intended luminance.
+
+    For each observer (:data:`OBSERVERS`; the display tilted 15° for the last), with and without
+    the compensation of §3.4.2–3.4.3 (``L_factor`` and the booth light's diffuse and specular
+    flare, 1000 lx on the screen and a 3000 cd/m² light above): the worst relative error of the
+    seen luminance over the screen.
+    """
+    from reference.display_model import virtual_display
+    from reference.display_pipeline import ScreenGeometry, image_to_display_counts
+
+    display = virtual_display()
+    white = display.white_XYZ / display.white_XYZ[1]
+    image = np.broadcast_to(60.0 * white, (24, 32, 3))
+    light = {"E_XYZ": 1000.0 * white, "light_position": (0.0, 1.2, 0.9), "light_XYZ": 3000 * white}
+    found = {}
+    for name, eye in OBSERVERS.items():
+        geometry = ScreenGeometry(tilt=np.radians(15.0) if "tilted" in name else 0.0)
+        for compensate in (True, False):
+            out = image_to_display_counts(
+                image, display, geometry, eye, compensate=compensate, **light
+            )
+            error = out["seen_XYZ"][..., 1] / image[..., 1] - 1.0
+            found[f"{name}, {'compensated' if compensate else 'not compensated'}"] = {
+                "max_theta_deg": float(np.degrees(out["theta"].max())),
+                "max_abs_Y_error": float(np.abs(error).max()),
+                "mean_Y_error": float(error.mean()),
+            }
+    return found
 
 
 def _bands(cal, v) -> dict:
@@ -197,6 +237,18 @@ def present(ctx: ReportContext, data: SectionData) -> list:
             "Instrument comparison, D65, L*: the colorimeter loses the white in the shadows",
         )
     )
+    rows = [
+        [k, r["max_theta_deg"], r["mean_Y_error"], r["max_abs_Y_error"]]
+        for k, r in data.results["screen"].items()
+    ]
+    blocks.append(
+        Table(
+            ["observer", "max θ (deg)", "mean ΔY/Y", "max |ΔY/Y|"],
+            rows,
+            "ImpastoR's display (Eq. (1), Ferwerda) per pixel: a 60 cd/m² gray seen from three "
+            "positions, with and without the L_factor and screen-flare compensation",
+        )
+    )
     return blocks
 
 
@@ -231,6 +283,17 @@ def checks(data: SectionData) -> list[Check]:
             spectro < colorimeter,
         )
     )
+    for key, r in data.results["screen"].items():
+        if "not compensated" in key:
+            continue
+        found.append(
+            Check(
+                f"seen luminance, compensated, {key.split(',')[0]}",
+                "max |ΔY/Y| <= 0.005",
+                r["max_abs_Y_error"],
+                r["max_abs_Y_error"] <= 0.005,
+            )
+        )
     return found
 
 
