@@ -216,7 +216,8 @@ class Calibration:
     Y_white, Y_black : float
         Calibrated white and the (untouched) black, cd/m², as the instrument read them.
     points : dict
-        ``G`` (n,), ``drives`` (n, 3), ``XYZ`` (n, 3) last readings, ``iterations`` (n,).
+        ``G`` (n,), ``drives`` (n, 3) and ``XYZ`` (n, 3) of the reading kept (the best), and
+        ``iterations`` (n,): which reading that was (1 = the first).
     instrument : str
     display : str
     """

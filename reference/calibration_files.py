@@ -19,6 +19,7 @@ from __future__ import annotations
 import json
 import os
 import tempfile
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -31,8 +32,12 @@ from reference.images import write_text_atomic
 from reference.instruments import INSTRUMENTS
 
 __all__ = [
+    "CalibratedDisplay",
+    "XYZ_to_calibrated_values",
+    "calibrated_values_to_XYZ",
     "calibration_summary",
     "colorchecker_through_display",
+    "load_calibrated_display",
     "measure_through_calibration",
     "read_cube",
     "verification_patches",
@@ -270,3 +275,116 @@ def write_calibration(
     summary["files"] = {k: str(path.with_suffix(k)) for k in (".cal", ".cube", ".ti3", ".json")}
     write_text_atomic(path.with_suffix(".json"), json.dumps(summary, indent=1) + "\n")
     return summary
+
+
+@dataclass(frozen=True)
+class CalibratedDisplay:
+    """A calibrated display as a render sees it: read from ``CAL.cal`` and its ``.ti3``/``.json``.
+
+    Attributes
+    ----------
+    lut : ndarray, shape (3, LUT_SIZE)
+        The video card tables (``CAL.cal``).
+    black_XYZ : ndarray, shape (3,)
+        Black, relative to white Y = 1.
+    P : ndarray, shape (3, 3)
+        Columns: each primary at full device value minus the black, white Y = 1.
+    curve : str
+        The calibration's tone curve (``CAL.json``).
+    Y_white : float
+        cd/m².
+    """
+
+    lut: np.ndarray
+    black_XYZ: np.ndarray
+    P: np.ndarray
+    curve: str
+    Y_white: float
+    path: str = ""
+
+    def share(self, values) -> np.ndarray:
+        """Each channel's share above the black for device values in [0, 1] (the curve)."""
+        black = self.black_XYZ[1]
+        curve = curve_target(self.curve, np.clip(values, 0.0, 1.0), black)
+        return np.maximum(curve - black, 0.0) / (1.0 - black)
+
+
+def load_calibrated_display(cal_path) -> CalibratedDisplay:
+    """Read ``CAL.cal``, ``CAL.ti3`` and ``CAL.json`` (:func:`write_calibration`) for rendering.
+
+    Raises
+    ------
+    SpecrefError
+        A missing file, a ``.ti3`` without the black, primaries and white patches.
+
+    Examples
+    --------
+    >>> load_calibrated_display("/nonexistent/d65.cal")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: /nonexistent/d65.cal: file not found
+    """
+    from reference.cgats import read_cal, read_ti3
+
+    path = Path(cal_path)
+    lut = read_cal(path)
+    summary_path = path.with_suffix(".json")
+    require(summary_path.exists(), f"{summary_path}: file not found (written beside the .cal)")
+    try:
+        summary = json.loads(summary_path.read_text())
+        curve, Y_white = str(summary["curve"]), float(summary["Y_white_cd_m2"])
+    except (ValueError, KeyError, TypeError) as error:
+        raise SpecrefError(f"{summary_path}: not a calibration summary ({error})") from None
+    RGB, XYZ = read_ti3(path.with_suffix(".ti3"))
+    wanted = np.vstack([np.zeros(3), np.eye(3), np.ones(3)])
+    rows = []
+    for patch in wanted:
+        found = np.flatnonzero(np.abs(RGB - patch).max(axis=1) < 1e-6)
+        require(
+            found.size,
+            f"{path.with_suffix('.ti3')}: no patch {patch.tolist()} (need black, "
+            "R, G, B and white)",
+        )
+        rows.append(XYZ[found[0]] / 100.0)
+    black = rows[0] / rows[4][1]
+    P = np.stack([(r - rows[0]) / rows[4][1] for r in rows[1:4]], axis=1)
+    return CalibratedDisplay(lut, black, P, curve, Y_white, str(path))
+
+
+def XYZ_to_calibrated_values(XYZ, display: CalibratedDisplay) -> tuple[np.ndarray, np.ndarray]:
+    """Device values in [0, 1] that show XYZ (relative, white Y = 1) on a calibrated display.
+
+    The inverse of :func:`calibrated_values_to_XYZ`: ``ρ = P⁻¹ (XYZ − XYZ_K)`` (Eq. (1),
+    Ferwerda, on the calibrated display), then each channel through the calibration's curve.
+
+    Returns
+    -------
+    values : ndarray, shape (..., 3)
+        What the application sends (the ``.cal`` is in the video card).
+    in_gamut : ndarray of bool, shape (...,)
+
+    Examples
+    --------
+    >>> d = CalibratedDisplay(np.zeros((3, 2)), np.zeros(3), np.eye(3), "gamma2.2", 100.0)
+    >>> XYZ_to_calibrated_values([0.25, 0.25, 0.25], d)[0].round(4)
+    array([0.5325, 0.5325, 0.5325])
+    """
+    XYZ = np.asarray(XYZ, dtype=np.float64)
+    rho = np.linalg.solve(display.P, (XYZ - display.black_XYZ)[..., None])[..., 0]
+    in_gamut = ((rho >= -1e-3) & (rho <= 1 + 1e-3)).all(axis=-1)
+    G = np.linspace(0.0, 1.0, 4097)
+    share = np.maximum.accumulate(display.share(G)) + np.linspace(0.0, 1e-12, G.size)
+    return np.interp(np.clip(rho, 0.0, 1.0), share, G), in_gamut
+
+
+def calibrated_values_to_XYZ(values, display: CalibratedDisplay) -> np.ndarray:
+    """XYZ (relative, white Y = 1) a calibrated display shows for device values (..., 3).
+
+    Examples
+    --------
+    >>> d = CalibratedDisplay(np.zeros((3, 2)), np.zeros(3), np.eye(3), "gamma2.2", 100.0)
+    >>> calibrated_values_to_XYZ([0.5325, 0.5325, 0.5325], d).round(3)
+    array([0.25, 0.25, 0.25])
+    """
+    # Eq. (1), Ferwerda, on the calibrated display: XYZ = XYZ_K + P · share(values)
+    return display.black_XYZ + display.share(np.asarray(values, float)) @ display.P.T

@@ -61,3 +61,30 @@ def test_counts_to_XYZ_to_counts_round_trip(calibrated):
     XYZ = measure_through_calibration(d, cal, np.repeat(G[:, None], 3, axis=1))
     G_back = np.interp(XYZ[:, 1], cal.target_Y(np.linspace(0, 1, 4097)), np.linspace(0, 1, 4097))
     np.testing.assert_allclose(G_back, G, atol=2e-3)
+
+
+def test_scene_names_a_calibration(tmp_path, calibrated):
+    from reference.calibration_files import calibrated_values_to_XYZ, load_calibrated_display
+    from reference.render import render_scene
+    from reference.scene import loads_scene
+
+    d, cal = calibrated
+    write_calibration(tmp_path / "d50.cal", d, cal)
+    plain = loads_scene("[render]\nbackground = 0.2\n", base_dir=tmp_path)
+    scene = loads_scene(
+        '[render]\nbackground = 0.2\n[display]\ncalibration = "d50.cal"\n', base_dir=tmp_path
+    )
+    a, b = render_scene(plain, 4, 2), render_scene(scene, 4, 2)
+    np.testing.assert_array_equal(a.RGB_linear, b.RGB_linear)
+    assert np.abs(a.encoded - b.encoded).max() > 1e-3
+    # round trip: device values -> what the calibrated display shows -> the intended XYZ
+    shown = calibrated_values_to_XYZ(b.encoded, load_calibrated_display(tmp_path / "d50.cal"))
+    np.testing.assert_allclose(shown, b.XYZ, rtol=1e-6, atol=1e-9)
+
+
+def test_scene_calibration_missing_file(tmp_path):
+    from reference.errors import SpecrefError
+    from reference.scene import loads_scene
+
+    with pytest.raises(SpecrefError, match=r"s.toml: display.calibration: file not found"):
+        loads_scene('[display]\ncalibration = "nope.cal"\n', "s.toml", base_dir=tmp_path)
