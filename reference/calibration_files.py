@@ -117,11 +117,15 @@ def colorchecker_through_display(
     measured = measure_through_calibration(
         display, calibration, np.vstack([np.zeros(3), np.eye(3), np.ones(3)]), instrument
     )
-    black, primaries, white = measured[0], measured[1:4] - measured[0], measured[4]
-    linear = np.linalg.solve(primaries.T, (XYZ_rel * white[1] - black).T).T
-    in_gamut = ((linear >= -1e-3) & (linear <= 1 + 1e-3)).all(axis=1)
-    linear = np.clip(linear, 0.0, 1.0)
-    RGB = _invert_curve(calibration, linear)
+    white = measured[4]
+    profile = CalibratedDisplay(
+        calibration.lut,
+        measured[0] / white[1],
+        (measured[1:4] - measured[0]).T / white[1],
+        calibration.curve,
+        float(white[1]),
+    )
+    RGB, in_gamut = XYZ_to_calibrated_values(XYZ_rel, profile)
     shown = measure_through_calibration(display, calibration, RGB, instrument)
     intended_Lab = colour.XYZ_to_Lab(XYZ_rel, xy)
     shown_Lab = colour.XYZ_to_Lab(shown / white[1], colour.XYZ_to_xy(white))
@@ -132,16 +136,6 @@ def colorchecker_through_display(
         "max": float(dE.max()),
         "out_of_gamut": int((~in_gamut).sum()),
     }
-
-
-def _invert_curve(calibration: Calibration, linear) -> np.ndarray:
-    """Device values whose calibrated curve gives ``linear`` (relative to the black-free range)."""
-    G = np.linspace(0.0, 1.0, 4097)
-    black = calibration.Y_black / calibration.Y_white
-    # the channels' share above the black, for the calibrated curve
-    relative = np.maximum(curve_target(calibration.curve, G, black) - black, 0.0) / (1.0 - black)
-    relative = np.maximum.accumulate(relative) + np.linspace(0.0, 1e-12, G.size)
-    return np.interp(linear, relative, G)
 
 
 def write_cube(path, lut, title: str = "specref calibration") -> Path:
