@@ -284,6 +284,14 @@ def XYZ_to_display(scene: Scene, XYZ) -> tuple[np.ndarray, np.ndarray]:
     # Eq. (5), Wang et al.: [R G B] = [X Y Z] · XYZtoRGB (with the adaptation folded in)
     RGB_linear = np.asarray(XYZ, dtype=np.float64) @ _XYZ_to_RGB(scene).T
     display = scene.display
+    if display.calibration is not None:
+        from reference.calibration_files import XYZ_to_calibrated_values
+
+        # device values for the calibrated display (docs/display.md), relative colorimetric
+        encoded, _ = XYZ_to_calibrated_values(
+            np.asarray(XYZ) * display.exposure, display.calibration
+        )
+        return RGB_linear, encoded
     encoded = linear_to_display(RGB_linear, display.encoding, display.exposure)
     return RGB_linear, encoded
 

@@ -164,6 +164,9 @@ class DisplaySettings:
         None (colorimetric) or a colour-science transform (``"Bradford"``, ``"CAT02"``, ...).
     white : Spectrum or None
         The light whose white diffuser is adapted to display white.
+    calibration : CalibratedDisplay or None
+        ``display.calibration``: the PNG then holds device values for that calibrated display
+        (``reference.calibration_files``, docs/display.md) instead of the encoding.
     """
 
     colourspace: str = "sRGB"
@@ -171,6 +174,7 @@ class DisplaySettings:
     exposure: float = 1.0
     chromatic_adaptation: str | None = None
     white: Spectrum | None = None
+    calibration: object | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -395,7 +399,7 @@ def _parse_display(reader: SceneReader, data: dict, lights: tuple) -> DisplaySet
     table = reader.table(
         data.get(key, {}),
         key,
-        ("colourspace", "encoding", "exposure", "chromatic_adaptation", "white"),
+        ("colourspace", "encoding", "exposure", "chromatic_adaptation", "white", "calibration"),
     )
     colourspace = reader.choice(
         table.get("colourspace", "sRGB"), f"{key}.colourspace", colour.RGB_COLOURSPACES
@@ -419,7 +423,15 @@ def _parse_display(reader: SceneReader, data: dict, lights: tuple) -> DisplaySet
             f"{key}.chromatic_adaptation",
             "needs display.white when the scene has no point or ambient light",
         )
-    return DisplaySettings(colourspace, encoding, exposure, adaptation, white)
+    calibration = None
+    if "calibration" in table:
+        from reference.calibration_files import load_calibrated_display
+
+        path = reader.file_path(table["calibration"], f"{key}.calibration")
+        if path.suffix != ".cal":
+            reader.fail(f"{key}.calibration", f"must name a .cal file, got {path.name}")
+        calibration = load_calibrated_display(path)
+    return DisplaySettings(colourspace, encoding, exposure, adaptation, white, calibration)
 
 
 def _parse_material(reader: SceneReader, table, key: str, name: str):

@@ -20,10 +20,33 @@ def _cmd_impastor_table1(args) -> int:
     return 0
 
 
+def _vector(text: str, option: str) -> tuple:
+    from reference.errors import require
+
+    try:
+        values = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        values = ()
+    require(len(values) == 3, f"{option}: must be x,y,z in metres, got {text!r}")
+    return values
+
+
 def _cmd_impastor_render(args) -> int:
     from validation.impastor_cli import render_for_cli
 
-    print(render_for_cli(args.light, args.size, args.method, args.out))
+    observer = _vector(args.observer, "--observer")
+    print(
+        render_for_cli(
+            args.light,
+            args.size,
+            args.method,
+            args.out,
+            args.counts,
+            observer,
+            args.tilt,
+            args.screen_lux,
+        )
+    )
     return 0
 
 
@@ -48,4 +71,16 @@ def add_parser(sub) -> None:
     r.add_argument("--size", type=int, default=512, help="image side in pixels")
     registry_option(r, "--method", PAINTING_LIGHTING_METHODS, "specular lighting", default="hybrid")
     r.add_argument("--out", default="impastor.png", help="output PNG")
+    r.add_argument(
+        "--counts", metavar="PNG", help="also write the display's 11-bit counts (16-bit PNG)"
+    )
+    r.add_argument(
+        "--observer",
+        default="0,0,0.6",
+        help="eye position x,y,z in metres from the screen centre (default 0,0,0.6)",
+    )
+    r.add_argument("--tilt", type=float, default=0.0, help="display tilt about x, degrees")
+    r.add_argument(
+        "--screen-lux", type=float, default=1000.0, help="booth illuminance on the screen, lux"
+    )
     r.set_defaults(func=_cmd_impastor_render)

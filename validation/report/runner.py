@@ -27,6 +27,7 @@ from reference.registry import Registry
 from validation.report.render import render_html, render_markdown
 from validation.report.types import ReportContext, ReportSection, SectionResult, to_jsonable
 from validation.sections import (
+    display,
     examples,
     impastor,
     phong,
@@ -49,6 +50,7 @@ SECTIONS: tuple[ReportSection, ...] = (
     spectral_env.SECTION,
     shrm.SECTION,
     impastor.SECTION,
+    display.SECTION,
 )
 
 #: Report sections by key (``specref report --only`` takes the keys).
