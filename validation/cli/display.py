@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from validation.cli.parser import Parser, registry_option
+
 
 def _cmd_display_calibrate(args) -> int:
     from reference.calibration import calibrate_display
@@ -55,7 +57,7 @@ def add_parser(sub) -> None:
     from reference.instruments import INSTRUMENTS
 
     p = sub.add_parser("display", help="display calibration (Herbert et al. §6)")
-    dsub = p.add_subparsers(dest="display_command", required=True)
+    dsub = p.add_subparsers(dest="display_command", required=True, parser_class=Parser)
     c = dsub.add_parser(
         "calibrate",
         help="calibrate the simulated display; write .cal, .cube, .ti3 and .json",
@@ -65,17 +67,9 @@ def add_parser(sub) -> None:
     c.add_argument(
         "--white", default="D65", help=f"{', '.join(WHITES)} or x,y chromaticity (default D65)"
     )
-    c.add_argument(
-        "--curve",
-        default="gamma2.2",
-        help=f"tone curve: {', '.join(CALIBRATION_CURVES.names())} (default gamma2.2)",
-    )
+    registry_option(c, "--curve", CALIBRATION_CURVES, "tone curve", default="gamma2.2")
     c.add_argument("--points", type=int, default=15, help="control points, 2..64 (default 15)")
-    c.add_argument(
-        "--instrument",
-        default="spectro",
-        help=f"{', '.join(INSTRUMENTS.names())} (default spectro)",
-    )
+    registry_option(c, "--instrument", INSTRUMENTS, "measuring instrument", default="spectro")
     c.add_argument("--display", metavar="FILE", help="display file (JSON, docs/display.md)")
     c.add_argument("--seed", type=int, default=0, help="seed of the instrument noise")
     c.add_argument(
