@@ -3,7 +3,7 @@ import json
 import pytest
 
 from validation.report.runner import run_report
-from validation.sections.shrm import SUITE, TOLERANCE
+from validation.sections.shrm_study import SUITE, TOLERANCE
 
 
 def test_shrm_section_quick(tmp_path):
@@ -68,7 +68,7 @@ def _normal_frame_errors(env, g, view, F, P, size, fit):
     from shrm.shrm import render_shrm, shrm_create
     from shrm.shrm_oracles import render_bruteforce
     from shrm.transform import project_latlong
-    from validation.sections.shrm import image_error, study_params
+    from validation.sections.shrm_study import image_error, study_params
 
     L = project_latlong(env, F)
     errors = {}
@@ -87,7 +87,7 @@ def test_every_brdf_meets_one_percent_with_P_at_most_10_on_a_small_setting():
     # environment (16×32) and image (20²), normal frame, F 12, P 10, 32² faces. Oracle: the
     # per-pixel brute-force render. The hemisphere fit meets 1 % of the peak for all four BRDFs;
     # R&H 2002's projection over all views (the even continuation below the horizon) does not.
-    from validation.sections.shrm import study_setup
+    from validation.sections.shrm_study import study_setup
 
     env, g, view = study_setup(quick=True)
     hemisphere = _normal_frame_errors(env, g, view, 12, 10, 32, "hemisphere")
@@ -102,7 +102,7 @@ def test_every_brdf_meets_one_percent_with_P_at_most_10_on_a_small_setting():
 def test_full_setting_meets_one_percent_of_peak_with_P_at_most_10():
     # The full study's environment (64×128) and image (48²), normal frame, F 16, P 8, 64² faces
     # (§5.5's default cube size). Oracle: the per-pixel brute-force render.
-    from validation.sections.shrm import study_setup
+    from validation.sections.shrm_study import study_setup
 
     env, g, view = study_setup(quick=False)
     errors = _normal_frame_errors(env, g, view, 16, 8, 64, "hemisphere")
