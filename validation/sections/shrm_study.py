@@ -193,6 +193,15 @@ def study_brdf(name, env, L_env, g, view, plan) -> dict:
         ``truth`` (the brute-force image) and its seconds, ``candidates`` (frame, F, P, S, error,
         error at N·V > 0.2, view fit), the ``choice`` with its measured creation seconds, its
         ``shrm`` and BRDF coefficients ``rho``, and whether it meets :data:`TOLERANCE`.
+
+    Examples
+    --------
+    >>> from shrm.transform import project_latlong
+    >>> env, g, view = study_setup(quick=True, rows=8, size=8)
+    >>> plan = {"P": (2, 4), **{fit: ((4, 8),) for fit in FITS}}
+    >>> st = study_brdf("ggx", env, project_latlong(env, 4), g, view, plan)
+    >>> len(st["candidates"]), st["choice"] in st["candidates"]
+    (6, True)
     """
     from shrm.brdf_sh import shrm_brdf_parts
     from shrm.shrm_oracles import render_bruteforce
