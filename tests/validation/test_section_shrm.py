@@ -99,23 +99,22 @@ def test_cheapest_setting_meets_one_percent_of_peak(full_study, name):
     assert entry["max_error"] <= TOLERANCE
 
 
-def _normal_frame_errors(env, g, view, F, P, size, fit):
-    """Image error of each BRDF of the study (normal frame) against the per-pixel brute force."""
-    from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts
-    from shrm.shrm import render_shrm, shrm_create
-    from shrm.shrm_oracles import render_bruteforce
-    from shrm.transform import project_latlong
-    from validation.sections.shrm_study import image_error, study_params
+def _normal_frame_errors(env, g, view, F, P, size, fits):
+    """Image error per view fit and BRDF at one setting in the normal frame, from the study.
 
-    L = project_latlong(env, F)
-    errors = {}
+    The study's sweep (:func:`study_brdf`) against its oracle, the per-pixel brute-force render.
+    """
+    from shrm.transform import project_latlong
+    from validation.sections.shrm_study import study_brdf
+
+    plan = {"P": (P,)}
+    for frame, fit in FITS:
+        plan[(frame, fit)] = ((F, size),) if frame == "normal" and fit in fits else ()
+    L_env = project_latlong(env, F, backend="ducc0")
+    errors = {fit: {} for fit in fits}
     for name in SUITE:
-        params = study_params(name)
-        brdf, expand, lam, k = shrm_brdf_parts(name, params)
-        rho = brdf_sh_coefficients(brdf, expand, F, P, "normal", view_power=k, view_fit=fit)
-        s = shrm_create(L, rho, "normal", size, "ducc0", k, lam)
-        truth = render_bruteforce(g, env, brdf, params, view)
-        errors[name] = image_error(render_shrm(g, s, view), truth, g.mask)
+        for c in study_brdf(name, env, L_env, g, view, plan)["candidates"]:
+            errors[c[6]][name] = c[4]
     return errors
 
 
@@ -127,8 +126,8 @@ def test_every_brdf_meets_one_percent_with_P_at_most_10_on_a_small_setting():
     from validation.sections.shrm_study import study_setup
 
     env, g, view = study_setup(quick=True)
-    hemisphere = _normal_frame_errors(env, g, view, 12, 10, 32, "hemisphere")
-    sphere = _normal_frame_errors(env, g, view, 12, 10, 32, "sphere")
+    errors = _normal_frame_errors(env, g, view, 12, 10, 32, ("hemisphere", "sphere"))
+    hemisphere, sphere = errors["hemisphere"], errors["sphere"]
     assert max(hemisphere.values()) <= TOLERANCE, hemisphere
     assert max(sphere.values()) > TOLERANCE, sphere
     for name in ("ggx", "effect_pigment"):  # the lobes with a slope at the horizon
@@ -142,5 +141,5 @@ def test_full_setting_meets_one_percent_of_peak_with_P_at_most_10():
     from validation.sections.shrm_study import study_setup
 
     env, g, view = study_setup(quick=False)
-    errors = _normal_frame_errors(env, g, view, 16, 8, 64, "hemisphere")
+    errors = _normal_frame_errors(env, g, view, 16, 8, 64, ("hemisphere",))["hemisphere"]
     assert max(errors.values()) <= TOLERANCE, errors

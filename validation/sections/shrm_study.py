@@ -192,7 +192,8 @@ def study_brdf(name, env, L_env, g, view, plan) -> dict:
     dict
         ``truth`` (the brute-force image) and its seconds, ``candidates`` (frame, F, P, S, error,
         error at N·V > 0.2, view fit), the ``choice`` with its measured creation seconds, its
-        ``shrm`` and BRDF coefficients ``rho``, and whether it meets :data:`TOLERANCE`.
+        ``shrm`` and BRDF coefficients ``rho``, and whether it meets :data:`TOLERANCE`; the best
+        settings with P <= 10 (any fit, and the sphere fit: None when the plan has none).
 
     Examples
     --------
@@ -227,7 +228,7 @@ def study_brdf(name, env, L_env, g, view, plan) -> dict:
         "create_seconds": seconds,
         "best_with_P_at_most_10": min(low, key=lambda c: c[4]),
         "best_sphere_fit_with_P_at_most_10": min(
-            (c for c in low if c[6] == "sphere"), key=lambda c: c[4]
+            (c for c in low if c[6] == "sphere"), key=lambda c: c[4], default=None
         ),
         "lambert_split": lam is not None,
         "grazing_view_power": k,
