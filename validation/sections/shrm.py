@@ -131,16 +131,16 @@ def shrm_study_and_speed(ctx: ReportContext, settings: dict | None = None) -> Se
         data.results[name] = _study_results(st)
     data.arrays.update(plan=plan, studies=studies, env_shape=env.shape, label=s["label"])
     data.arrays["images"] = _shown_images(studies[SHOWN], g, view)
-    # The speed half (validation.sections.shrm_speed)
-    creation = creation_speed(
-        env, L_env, view, {"brdf": SHOWN, **data.results[SHOWN]}, s["angular_texels"]
+    # The speed half (validation.sections.shrm_speed), at the shown BRDF's chosen setting
+    choice = {"brdf": SHOWN, **data.results[SHOWN]}
+    creation = data.results["creation"] = creation_speed(
+        env, L_env, view, choice, s["angular_texels"]
     )
-    data.results["creation"] = creation
     data.results["extraction"], data.results["cache"] = extraction_speed(
         env,
         L_env,
         studies[SHOWN]["rho"],
-        {"brdf": SHOWN, **data.results[SHOWN]},
+        choice,
         s["extraction_size"],
         creation["brdf_projection_seconds"],
     )
