@@ -37,7 +37,7 @@ from shrm.sh import sh_basis
 from shrm.shrm import shrm_create, shrm_extract
 from shrm.shrm_oracles import env_quadrature, reflected_bruteforce, shrm_texels_angular
 from shrm.transform import project_latlong
-from validation.sections.shrm import SUITE, study_params
+from validation.sections.shrm_study import SUITE, study_params
 
 ROOT = Path(__file__).resolve().parents[2]
 #: Normal frame, F 16, P 12: the setting the report's study picked for GGX under 1 % of peak with

@@ -1,19 +1,29 @@
+import copy
 import json
 
 import pytest
 
+from validation.report import ReportContext, SectionData, to_jsonable
 from validation.report.runner import run_report
-from validation.sections.shrm import SUITE, TOLERANCE
+from validation.sections.shrm import SETTINGS, checks, shrm_study_and_speed
+from validation.sections.shrm_study import FITS, SUITE, TOLERANCE
 
 
-def test_shrm_section_quick(tmp_path):
-    report = run_report(tmp_path, quick=True, only=["shrm"], progress=False)
-    results = report["sections"]["shrm"]
+@pytest.fixture(scope="module")
+def tiny():
+    # The whole section on small inputs: 8-row environment, 8² image, P in {2, 4}, F 4, S 8
+    return shrm_study_and_speed(ReportContext("."), SETTINGS["tiny"])
+
+
+def test_compute_on_tiny_settings(tiny):
+    results = tiny.results
     for name in SUITE:
         entry = results[name]
         assert 0 <= entry["max_error"] < 1
         assert entry["frame"] in ("normal", "reflection")
-        assert entry["cheapest_under_tolerance"] == (entry["max_error"] <= TOLERANCE)
+        assert entry["view_fit"] in ("sphere", "hemisphere")
+        assert entry["cheapest_under_tolerance"] == any(c[4] <= TOLERANCE for c in entry["sweep"])
+        assert len(entry["sweep"]) == len(FITS) * 2  # one (F, S) per fit, two P
     creation = results["creation"]
     assert creation["angular_seconds"] > 0
     per_texel = creation["angular_seconds"] / creation["angular_texels"]
@@ -26,30 +36,57 @@ def test_shrm_section_quick(tmp_path):
     names = results["orbit"]["stages"]
     later = {names[k] for row in orbit[1:] for k, t in enumerate(row[:-1]) if t > 0}
     assert later <= {"gbuffer", "extract", "shade"}
-    # Every issue-7 target is a check; quick mode names its reduced versions.
-    checks = [c for c in report["checks"] if c["section"] == "shrm"]
-    assert len(checks) == 2 * len(SUITE) + 3
-    assert all(c["name"].startswith("quick") for c in checks)
+    assert "bench" not in results  # no benchmark file
+    json.dumps(to_jsonable(results))
+
+
+def test_checks_name_every_target(tiny):
+    # Every issue-7 target is a check; reduced runs name their settings.
+    found = checks(tiny)
+    assert len(found) == 2 * len(SUITE) + 3
+    assert all(c.name.startswith("tiny (8-row environment, 8² image): ") for c in found)
     for name in SUITE:
-        entry = results[name]
-        assert entry["view_fit"] in ("sphere", "hemisphere")
-        (check, p10) = [c for c in checks if f", {name} (" in c["name"]]
-        assert check["passed"] == (results[name]["max_error"] <= TOLERANCE)
+        entry = tiny.results[name]
+        (check, p10) = [c for c in found if f", {name} (" in c.name]
+        assert check.measured == entry["max_error"]
+        assert check.passed == (entry["max_error"] <= TOLERANCE)
         # the same target within §5.5's view orders (P <= 10)
-        assert "P <= 10" in p10["name"]
-        assert p10["measured"] == results[name]["best_error_with_P_at_most_10"]
-        assert p10["passed"] == (p10["measured"] <= TOLERANCE)
+        assert "P <= 10" in p10.name
+        assert p10.measured == entry["best_error_with_P_at_most_10"]
+        assert p10.passed == (p10.measured <= TOLERANCE)
+
+
+def test_checks_are_a_pure_function_of_the_data(tiny):
+    before = checks(tiny)
+    assert checks(tiny) == before
+    results = copy.deepcopy(tiny.results)
+    results["ggx"]["max_error"] = 0.5
+    results["ggx"]["best_error_with_P_at_most_10"] = 0.0
+    results["cache"]["ratio"] = 1.0
+    after = {c.name: c for c in checks(SectionData(results, tiny.arrays))}
+    ggx = [c for c in after.values() if ", ggx (" in c.name]
+    assert [(c.measured, c.passed) for c in ggx] == [(0.5, False), (0.0, True)]
+    cache = after["tiny (8-row environment, 8² image): in-run: cache hit vs rebuild"]
+    assert (cache.measured, cache.passed) == (1.0, False)
+
+
+@pytest.mark.slow
+def test_shrm_section_quick(tmp_path):
+    # The section through the report (quick): checks named as reduced, the chart and images.
+    report = run_report(tmp_path, quick=True, only=["shrm"], progress=False)
+    checks_found = [c for c in report["checks"] if c["section"] == "shrm"]
+    assert len(checks_found) == 2 * len(SUITE) + 3
+    assert all(c["name"].startswith("quick") for c in checks_found)
     html = (tmp_path / "index.html").read_text()
     assert "SHRMs" in html
-    assert (tmp_path / "images" / "shrm-error-vs-P.png").is_file()
-    json.dumps(results)
+    for name in ("error-vs-P", "ggx-bruteforce", "ggx-shrm", "ggx-difference", "orbit-stages"):
+        assert (tmp_path / "images" / f"shrm-{name}.png").is_file()
 
 
 @pytest.fixture(scope="module")
 def full_study(tmp_path_factory):
     # The full study of the report (64×128 environment, 48² image; F, P, size and frame swept).
-    folder = tmp_path_factory.mktemp("shrm-full")
-    return run_report(folder, quick=False, only=["shrm"], progress=False)["sections"]["shrm"]
+    return shrm_study_and_speed(ReportContext(tmp_path_factory.mktemp("shrm-full"))).results
 
 
 @pytest.mark.xslow
@@ -62,23 +99,22 @@ def test_cheapest_setting_meets_one_percent_of_peak(full_study, name):
     assert entry["max_error"] <= TOLERANCE
 
 
-def _normal_frame_errors(env, g, view, F, P, size, fit):
-    """Image error of each BRDF of the study (normal frame) against the per-pixel brute force."""
-    from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts
-    from shrm.shrm import render_shrm, shrm_create
-    from shrm.shrm_oracles import render_bruteforce
-    from shrm.transform import project_latlong
-    from validation.sections.shrm import image_error, study_params
+def _normal_frame_errors(env, g, view, F, P, size, fits):
+    """Image error per view fit and BRDF at one setting in the normal frame, from the study.
 
-    L = project_latlong(env, F)
-    errors = {}
+    The study's sweep (:func:`study_brdf`) against its oracle, the per-pixel brute-force render.
+    """
+    from shrm.transform import project_latlong
+    from validation.sections.shrm_study import study_brdf
+
+    plan = {"P": (P,)}
+    for frame, fit in FITS:
+        plan[(frame, fit)] = ((F, size),) if frame == "normal" and fit in fits else ()
+    L_env = project_latlong(env, F, backend="ducc0")
+    errors = {fit: {} for fit in fits}
     for name in SUITE:
-        params = study_params(name)
-        brdf, expand, lam, k = shrm_brdf_parts(name, params)
-        rho = brdf_sh_coefficients(brdf, expand, F, P, "normal", view_power=k, view_fit=fit)
-        s = shrm_create(L, rho, "normal", size, "ducc0", k, lam)
-        truth = render_bruteforce(g, env, brdf, params, view)
-        errors[name] = image_error(render_shrm(g, s, view), truth, g.mask)
+        for c in study_brdf(name, env, L_env, g, view, plan)["candidates"]:
+            errors[c[6]][name] = c[4]
     return errors
 
 
@@ -87,11 +123,11 @@ def test_every_brdf_meets_one_percent_with_P_at_most_10_on_a_small_setting():
     # environment (16×32) and image (20²), normal frame, F 12, P 10, 32² faces. Oracle: the
     # per-pixel brute-force render. The hemisphere fit meets 1 % of the peak for all four BRDFs;
     # R&H 2002's projection over all views (the even continuation below the horizon) does not.
-    from validation.sections.shrm import study_setup
+    from validation.sections.shrm_study import study_setup
 
     env, g, view = study_setup(quick=True)
-    hemisphere = _normal_frame_errors(env, g, view, 12, 10, 32, "hemisphere")
-    sphere = _normal_frame_errors(env, g, view, 12, 10, 32, "sphere")
+    errors = _normal_frame_errors(env, g, view, 12, 10, 32, ("hemisphere", "sphere"))
+    hemisphere, sphere = errors["hemisphere"], errors["sphere"]
     assert max(hemisphere.values()) <= TOLERANCE, hemisphere
     assert max(sphere.values()) > TOLERANCE, sphere
     for name in ("ggx", "effect_pigment"):  # the lobes with a slope at the horizon
@@ -102,8 +138,8 @@ def test_every_brdf_meets_one_percent_with_P_at_most_10_on_a_small_setting():
 def test_full_setting_meets_one_percent_of_peak_with_P_at_most_10():
     # The full study's environment (64×128) and image (48²), normal frame, F 16, P 8, 64² faces
     # (§5.5's default cube size). Oracle: the per-pixel brute-force render.
-    from validation.sections.shrm import study_setup
+    from validation.sections.shrm_study import study_setup
 
     env, g, view = study_setup(quick=False)
-    errors = _normal_frame_errors(env, g, view, 16, 8, 64, "hemisphere")
+    errors = _normal_frame_errors(env, g, view, 16, 8, 64, ("hemisphere",))["hemisphere"]
     assert max(errors.values()) <= TOLERANCE, errors

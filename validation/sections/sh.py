@@ -10,19 +10,31 @@ The figures (issue 5; Herbert et al. §5.3-5.4, §7.1, §7.3):
   per kernel, and the exact Λ_l of the Phong lobe against the Gaussian approximation;
 - speed: the ``sh-*`` groups of ``tests/benchmarks/bench_sh.py`` (``make bench``) as ratios to
   their same-run baselines, projection time against order per path, and memory bandwidth.
+
+compute → :func:`sh_accuracy_and_speed`; present → :func:`present`; checks → :func:`checks`.
+The windows and prefilter kernels studied are read from their registries
+(:data:`shrm.windows.WINDOWS`, :data:`shrm.lobes.PREFILTER_KERNELS`).
 """
 
 from __future__ import annotations
 
 import json
+import os
 import time
 from pathlib import Path
 
 import numpy as np
 
 from reference.display import linear_to_display
-from reference.images import read_hdr
-from shrm.lobes import adaptive_order, parse_kernel, phong_Lambda_gaussian, truncation_tail
+from reference.errors import require
+from reference.images import read_hdr, write_text_atomic
+from shrm.lobes import (
+    PREFILTER_KERNELS,
+    adaptive_order,
+    parse_kernel,
+    phong_Lambda_gaussian,
+    truncation_tail,
+)
 from shrm.prefilter import prefilter_bruteforce, prefilter_coefficients
 from shrm.sh import PLAIN_ORDER_LIMIT, legendre_table, order_of, sh_evaluate
 from shrm.transform import project_latlong, synthesize_latlong
@@ -31,16 +43,127 @@ from validation.report import (
     Check,
     ReportContext,
     ReportSection,
-    SectionResult,
+    SectionData,
     Table,
     Text,
 )
+from validation.sections.sh_speed import benchmark_blocks, benchmark_checks, benchmark_figures
 
-__all__ = ["basis_errors_by_degree", "prefilter_agreement", "ringing_by_order"]
+__all__ = [
+    "SETTINGS",
+    "basis_errors_by_degree",
+    "gaussian_approximation_errors",
+    "kernel_specs",
+    "prefilter_agreement",
+    "ringing_by_order",
+    "sh_accuracy_and_speed",
+    "window_reconstructions",
+]
 
 ROOT = Path(__file__).resolve().parents[2]
 BASIS_DATA = ROOT / "tests" / "data" / "sh_basis.json"
-SHARED = ROOT.parent / "shared" / "data"
+#: Shared data beside the repository (``../shared/data``), or where SPECREF_SHARED_DATA points.
+SHARED = Path(os.environ.get("SPECREF_SHARED_DATA", ROOT.parent / "shared" / "data"))
+ENVIRONMENT = "venice_sunset_1k.hdr"
+IRRADIANCE_ENVIRONMENT = "st_fagans_interior_1k.hdr"
+
+#: The two Legendre recurrences of :func:`shrm.sh.legendre_table` (``"auto"`` switches between
+#: them at :data:`shrm.sh.PLAIN_ORDER_LIMIT`, so it is not a third one).
+RECURRENCES = ("plain", "scaled")
+#: The order of the window images, the prefilter comparison and the Gaussian Λ_l approximation.
+ORDER = 100
+#: The Phong exponents s of the prefilter comparison, the Λ_l chart and the Gaussian approximation.
+PHONG_EXPONENTS = (32, 256)
+
+#: Sizes per mode. ``tiny`` is for tests and the doctest: every figure, on small inputs.
+SETTINGS = {
+    "full": {
+        "max_degree": 2500,
+        "ringing_orders": (10, 25, 50, 75, 100),
+        "ringing_height": 512,
+        "window_height": 128,
+        "prefilter_step": 4,
+        "prefilter_size": 16,
+        "bruteforce_backend": "numba",
+        "gaussian_size": 32,
+    },
+    "quick": {
+        "max_degree": 2500,
+        "ringing_orders": (25, 50, 100),
+        "ringing_height": 128,
+        "window_height": 128,
+        "prefilter_step": 4,
+        "prefilter_size": 8,
+        "bruteforce_backend": "numpy",
+        "gaussian_size": 16,
+    },
+    "tiny": {
+        "max_degree": 10,
+        "ringing_orders": (100,),
+        "ringing_height": 101,
+        "window_height": 101,
+        "prefilter_step": 4,
+        "prefilter_size": 2,
+        "bruteforce_backend": "numpy",
+        "gaussian_size": 2,
+    },
+}
+
+
+def sh_accuracy_and_speed(ctx: ReportContext, settings: dict | None = None) -> SectionData:
+    """Basis accuracy, ringing, prefilter agreement and benchmark ratios (module docstring).
+
+    Parameters
+    ----------
+    ctx : ReportContext
+        ``ctx.quick`` picks the sizes; the tabulated lobe is written to ``ctx.out_dir/images``;
+        ``ctx.bench`` gives the ``sh-*`` benchmark groups.
+    settings : dict, optional
+        One of :data:`SETTINGS` (default ``"quick"`` or ``"full"`` by ``ctx.quick``).
+
+    Returns
+    -------
+    SectionData
+        ``results``: ``basis_error``, ``ringing``, ``prefilter``, ``gaussian_approximation``,
+        ``benchmarks``; ``arrays``: window reconstructions, irradiance maps, Λ_l curves and the
+        benchmark records that the checks read.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     data = sh_accuracy_and_speed(ReportContext(Path(folder)), SETTINGS["tiny"])
+    >>> list(data.results)
+    ['basis_error', 'ringing', 'prefilter', 'gaussian_approximation', 'benchmarks']
+    >>> [c.passed for c in checks(data)]
+    [True, True, True, True, True, True, True]
+    """
+    s = settings or SETTINGS["quick" if ctx.quick else "full"]
+    data = SectionData()
+    # Basis accuracy against mpmath
+    data.results["basis_error"] = basis_errors_by_degree(s["max_degree"])
+    # Ringing of each window on venice_sunset
+    image = read_hdr(SHARED / "environments" / ENVIRONMENT)
+    data.results["ringing"] = ringing_by_order(image, s["ringing_orders"], s["ringing_height"])
+    coeffs = project_latlong(image, ORDER, backend="ducc0")
+    data.arrays["windows"] = window_reconstructions(coeffs, s["window_height"])
+    data.arrays["window_exposure"] = 1.0 / np.percentile(image, 99)
+    # A prefiltered irradiance map of a shared environment (docs/sh.md shows it)
+    data.arrays["irradiance"] = irradiance_maps(SHARED / "environments" / IRRADIANCE_ENVIRONMENT)
+    # Prefiltering: frequency against brute force, and the Gaussian approximation of Λ_l
+    small = np.ascontiguousarray(image[:: s["prefilter_step"], :: s["prefilter_step"], :1])
+    data.arrays["prefilter_input_shape"] = small.shape
+    data.results["prefilter"] = _prefilter_study(ctx, small, s)
+    data.arrays["phong_Lambda"] = {
+        e: (parse_kernel(f"phong:{e}").Lambda(ORDER), phong_Lambda_gaussian(e, ORDER))
+        for e in PHONG_EXPONENTS
+    }
+    data.results["gaussian_approximation"] = gaussian_approximation_errors(
+        coeffs[:1], PHONG_EXPONENTS, s["gaussian_size"]
+    )
+    # Benchmarks (make bench)
+    data.results["benchmarks"], data.arrays["bench"] = benchmark_figures(ctx.bench_groups("sh-"))
+    return data
 
 
 def basis_errors_by_degree(max_degree: int = 2500) -> dict:
@@ -62,7 +185,7 @@ def basis_errors_by_degree(max_degree: int = 2500) -> dict:
     """
     points = np.array(json.loads(BASIS_DATA.read_text())["points"])
     points = points[points[:, 0] <= max_degree]
-    out: dict = {"plain": {}, "scaled": {}}
+    out: dict = {method: {} for method in RECURRENCES}
     for l in sorted({int(r[0]) for r in points}):
         rows = points[points[:, 0] == l]
         thetas = np.unique(rows[:, 2])
@@ -138,36 +261,15 @@ def prefilter_agreement(
         start = time.perf_counter()
         brute = prefilter_bruteforce(image, kernel, d, backend=backend)
         t_brute = time.perf_counter() - start
+        L_adaptive = adaptive_order(kernel)
         out[spec] = {
             "relative_error": float(np.abs(frequency - brute).max() / np.abs(brute).max()),
             "frequency_s": t_frequency,
             "bruteforce_s": t_brute,
-            "adaptive_order": adaptive_order(kernel),
-            "tail_at_adaptive_order": truncation_tail(kernel, adaptive_order(kernel)),
+            "adaptive_order": L_adaptive,
+            "tail_at_adaptive_order": truncation_tail(kernel, L_adaptive),
         }
     return out
-
-
-def irradiance_images(ctx, path) -> list:
-    """The environment and its irradiance / π (Lambert prefilter, adaptive order), as sRGB images.
-
-    Both at the same exposure (0.25 / the mean radiance), so a white Lambertian surface facing
-    n shows the irradiance image's colour at n.
-    """
-    from shrm.prefilter import prefilter_environment
-
-    image = read_hdr(path)
-    result = prefilter_environment(image, "lambert", output="latlong", height=64)
-    exposure = 0.25 / float(image.mean())
-    small = image[:: image.shape[0] // 64, :: image.shape[0] // 64]
-    return [
-        ctx.image("environment", linear_to_display(small, "srgb", exposure), f"{path.name}"),
-        ctx.image(
-            "irradiance",
-            linear_to_display(result.values / np.pi, "srgb", exposure),
-            f"Irradiance / π of {path.name}, Lambert prefilter at order {result.order}",
-        ),
-    ]
 
 
 def gaussian_approximation_errors(coeffs, exponents, size: int = 32) -> dict:
@@ -201,11 +303,188 @@ def gaussian_approximation_errors(coeffs, exponents, size: int = 32) -> dict:
     return out
 
 
+def window_reconstructions(coeffs, height: int) -> dict:
+    """The reconstruction of ``coeffs`` under each registered window, at ``height`` rows.
+
+    Returns
+    -------
+    dict
+        ``{window: ndarray (height, 2 height, C)}`` for every key of :data:`shrm.windows.WINDOWS`.
+
+    Examples
+    --------
+    >>> c = np.zeros((1, 9)); c[0, 0] = 1.0
+    >>> list(window_reconstructions(c, 4)) == WINDOWS.names()
+    True
+    """
+    return {
+        window: synthesize_latlong(apply_window(coeffs, window), height, backend="ducc0")
+        for window in WINDOWS.names()
+    }
+
+
+def irradiance_maps(path) -> dict:
+    """The environment (subsampled to about 64 rows) and its irradiance / π, with one exposure.
+
+    Lambert prefilter at the adaptive order. Both share the exposure 0.25 / the mean radiance, so
+    a white Lambertian surface facing n shows the irradiance image's colour at n.
+
+    Returns
+    -------
+    dict
+        ``environment``, ``irradiance`` (linear RGB), ``order``, ``exposure`` and ``name``.
+    """
+    from shrm.prefilter import prefilter_environment
+
+    image = read_hdr(path)
+    result = prefilter_environment(image, "lambert", output="latlong", height=64)
+    return {
+        "environment": image[:: image.shape[0] // 64, :: image.shape[0] // 64],
+        "irradiance": result.values / np.pi,
+        "order": result.order,
+        "exposure": 0.25 / float(image.mean()),
+        "name": Path(path).name,
+    }
+
+
+def kernel_specs(parameters: dict) -> list[str]:
+    """Every registered prefilter kernel, once per study value of its parameter.
+
+    A kernel of :data:`shrm.lobes.PREFILTER_KERNELS` without a parameter appears as its name; one
+    with a parameter appears as ``name:value`` for each value in ``parameters[name]`` (so a newly
+    registered kernel is studied at once, and one with a parameter must be given its values).
+
+    Raises
+    ------
+    SpecrefError
+        A registered kernel takes a parameter and ``parameters`` has no values for it.
+
+    Examples
+    --------
+    >>> kernel_specs({"phong": (32, 256), "table": ("lobe.csv",)})
+    ['lambert', 'phong:32', 'phong:256', 'table:lobe.csv']
+    """
+    specs = []
+    for name, entry in PREFILTER_KERNELS.items():
+        if "param" not in entry.extra:
+            specs.append(name)
+            continue
+        require(
+            name in parameters,
+            f"validation/sections/sh.py: kernel {name!r} takes {entry.extra['param']}; give its "
+            f"study values (studied: {', '.join(sorted(parameters))})",
+        )
+        specs += [f"{name}:{value}" for value in parameters[name]]
+    return specs
+
+
+def _prefilter_study(ctx, small, s) -> dict:
+    """Frequency path against brute force for every kernel (a tabulated Gaussian lobe included)."""
+    # A tabulated lobe (the 1-D measured-BRDF case): a Gaussian of 0.15 rad sampled every 0.01 rad
+    angles = np.arange(0.0, 0.8, 0.01)
+    lobe = ctx.out_dir / "images" / "sh-gaussian-lobe.csv"
+    rows = "\n".join(f"{a:.2f},{np.exp(-0.5 * (a / 0.15) ** 2):.12g}" for a in angles)
+    write_text_atomic(lobe, "angle_rad,value\n" + rows + "\n")
+    specs = kernel_specs({"phong": PHONG_EXPONENTS, "table": (lobe,)})
+    agreement = prefilter_agreement(
+        small, specs, s["prefilter_size"], ORDER, backend=s["bruteforce_backend"]
+    )
+    return {k.replace(str(lobe.parent) + "/", ""): v for k, v in agreement.items()}
+
+
+def present(ctx: ReportContext, data: SectionData) -> list:
+    """Charts, tables and images of the section (module docstring); draws from ``data`` only."""
+    return [
+        *_basis_blocks(ctx, data.results["basis_error"]),
+        *_ringing_blocks(ctx, data),
+        *_irradiance_blocks(ctx, data.arrays["irradiance"]),
+        *_prefilter_blocks(ctx, data),
+        *benchmark_blocks(ctx, data.arrays["bench"]),
+    ]
+
+
+def _basis_blocks(ctx, errors) -> list:
+    return [
+        Text(
+            "The normalized recurrence in float64 against mpmath at points aimed at the hard "
+            "places (θ within 1e-12 of the poles, sin θ = 1/e, the equator). The plain recurrence "
+            "is exact to rounding until sin^m θ underflows while Y_lm is O(1) (from l ≈ 1930 on; "
+            f"measured failures from l = 2100); above l = {PLAIN_ORDER_LIMIT} specref uses the "
+            "scaled (extended-exponent) recurrence."
+        ),
+        _basis_chart(ctx, errors),
+    ]
+
+
+def _ringing_blocks(ctx, data) -> list:
+    ringing = data.results["ringing"]
+    blocks = [
+        Text("Windows against ringing (§7.3, Herbert et al.), venice_sunset (sun ≈ 6.5e3)."),
+        _ringing_chart(ctx, ringing),
+        Table(
+            ["window", "L", "min / peak", "negative share"],
+            [
+                [w, L, s["undershoot"], s["negative_share"]]
+                for w, st in ringing.items()
+                for L, s in st.items()
+            ],
+            "Ringing of the windowed reconstructions",
+            "{:.3g}",
+        ),
+    ]
+    for window, rec in data.arrays["windows"].items():
+        encoded = linear_to_display(rec, "srgb", data.arrays["window_exposure"])
+        encoded[(rec < 0).any(axis=-1)] = (1.0, 0.0, 1.0)
+        blocks.append(
+            ctx.image(f"window-{window}", encoded, f"L = 100, window {window} (negative: magenta)")
+        )
+    return blocks
+
+
+def _irradiance_blocks(ctx, maps) -> list:
+    exposure, name = maps["exposure"], maps["name"]
+    return [
+        ctx.image("environment", linear_to_display(maps["environment"], "srgb", exposure), name),
+        ctx.image(
+            "irradiance",
+            linear_to_display(maps["irradiance"], "srgb", exposure),
+            f"Irradiance / π of {name}, Lambert prefilter at order {maps['order']}",
+        ),
+    ]
+
+
+def _prefilter_blocks(ctx, data) -> list:
+    agreement, gauss_errors = data.results["prefilter"], data.results["gaussian_approximation"]
+    shape = data.arrays["prefilter_input_shape"]
+    return [
+        Table(
+            ["kernel", "relative error", "frequency s", "brute force s", "adaptive L (tol 1e-2)"],
+            [
+                [k, v["relative_error"], v["frequency_s"], v["bruteforce_s"], v["adaptive_order"]]
+                for k, v in agreement.items()
+            ],
+            f"Frequency path vs brute force at L = 100, input {shape[1]}×{shape[0]}",
+            "{:.3g}",
+        ),
+        _prefilter_chart(ctx, agreement),
+        _lambda_chart(ctx, data.arrays["phong_Lambda"]),
+        Table(
+            ["s", "max relative", "median relative", "max / peak"],
+            [
+                [s, v["max_relative"], v["median_relative"], v["max_over_peak"]]
+                for s, v in gauss_errors.items()
+            ],
+            "Phong prefilter of venice_sunset (R, L = 100) with exp(-l²/2s), not the exact Λ_l",
+            "{:.3g}",
+        ),
+    ]
+
+
 def _basis_chart(ctx, errors):
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(7, 3.4))
-    for method, marker in (("plain", "o"), ("scaled", "s")):
+    for method, marker in zip(RECURRENCES, "os", strict=True):
         ls = sorted(errors[method])
         ax.semilogy(ls, [max(errors[method][l], 1e-18) for l in ls], marker=marker, label=method)
     ax.axvline(PLAIN_ORDER_LIMIT, color="k", ls="--", lw=1)
@@ -263,13 +542,11 @@ def _prefilter_chart(ctx, agreement):
     return ctx.figure("prefilter", fig, "Frequency path against brute force at L = 100, per kernel")
 
 
-def _lambda_chart(ctx, order):
+def _lambda_chart(ctx, curves):
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(7, 3.2))
-    for s in (32, 256):
-        exact = parse_kernel(f"phong:{s}").Lambda(order)
-        approx = phong_Lambda_gaussian(s, order)
+    for s, (exact, approx) in curves.items():
         ax.plot(exact, label=f"exact Λ_l, s = {s}")
         ax.plot(approx, ls="--", label=f"exp(-l²/2s), s = {s}")
     ax.set_xlabel("degree l")
@@ -278,219 +555,34 @@ def _lambda_chart(ctx, order):
     return ctx.figure("phong-lambda", fig, "Normalized Phong lobe: exact Λ_l against exp(-l²/2s)")
 
 
-def _bench(ctx):
-    """Rows for the benchmark table, results, checks and the order chart data."""
-    rows, results, checks, by_order = [], {}, [], {}
-    for group, records in sorted(ctx.bench_groups("sh-").items()):
-        base = [r for r in records if r.get("extra_info", {}).get("role") == "baseline"]
-        base_median = base[0]["stats"]["median"] if base else float("nan")
-        for r in records:
-            info, median = r.get("extra_info", {}), r["stats"]["median"]
-            ratio = median / base_median
-            rows.append([group, r["name"], 1e3 * median, ratio])
-            results[f"{group} {r['name']}"] = {"median_s": median, "ratio_to_baseline": ratio}
-            role = info.get("role")
-            if group == "sh-project-order":
-                by_order.setdefault(role, {})[info["order"]] = median
-            elif group == "sh-project-L100" and role in ("baseline", "numpy"):
-                limit = 5e-3 if role == "baseline" else 25e-3
-                name = "ducc0" if role == "baseline" else "numpy"
-                checks.append(
-                    Check(
-                        f"projection 512×1024 L=100, {name}",
-                        f"<= {limit * 1e3:g} ms",
-                        1e3 * median,
-                        median <= limit,
-                    )
-                )
-            elif group == "sh-project-41band":
-                checks.append(
-                    Check(
-                        "projection 41 bands L=100, ducc0",
-                        "<= 250 ms",
-                        1e3 * median,
-                        median <= 0.25,
-                    )
-                )
-            elif group == "sh-prefilter-cube64" and role != "baseline":
-                limit = 20e-3 if role == "frequency-ducc0" else 1.5
-                checks.append(
-                    Check(
-                        f"prefilter 64²×6, {role}",
-                        f"<= {limit * 1e3:g} ms",
-                        1e3 * median,
-                        median <= limit,
-                    )
-                )
-                if role == "frequency-ducc0":
-                    speedup = base_median / median
-                    checks.append(
-                        Check(
-                            "prefilter speed-up over brute force",
-                            ">= 500×",
-                            speedup,
-                            speedup >= 500,
-                        )
-                    )
-            elif group == "sh-bandwidth" and role != "baseline":
-                base_bw = base[0]["extra_info"]["bytes"] / base_median
-                share = info["bytes"] / median / base_bw
-                limit = 0.25 if role == "latlong_to_cubemap" else 0.5
-                results[f"{group} {r['name']}"]["share_of_copy_bandwidth"] = share
-                checks.append(
-                    Check(f"{role} bandwidth / np.copyto", f">= {limit:g}", share, share >= limit)
-                )
-    return rows, results, checks, by_order
+def checks(data: SectionData) -> list[Check]:
+    """Basis, ringing and prefilter accuracy (issue 5), then the speed targets of ``make bench``."""
+    return _accuracy_checks(data.results) + benchmark_checks(data.arrays["bench"])
 
 
-def _order_chart(ctx, by_order):
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(6, 3.2))
-    for backend, times in sorted(by_order.items()):
-        Ls = sorted(times)
-        ax.loglog(Ls, [1e3 * times[L] for L in Ls], marker="o", label=backend)
-    ax.set_xlabel("order L")
-    ax.set_ylabel("ms, one 512×1024 channel")
-    ax.legend()
-    return ctx.figure("projection-time", fig, "Projection time against order (make bench)")
-
-
-def run(ctx: ReportContext) -> SectionResult:
-    """Basis accuracy, ringing, prefilter agreement and speed (see the module docstring)."""
-    blocks, results, checks = [], {}, []
-    # Basis accuracy against mpmath.
-    errors = basis_errors_by_degree(2500)
-    results["basis_error"] = errors
+def _accuracy_checks(results: dict) -> list[Check]:
+    errors = results["basis_error"]
     worst_100 = max(v for l, v in errors["plain"].items() if l <= 101)
     worst_1000 = max(v for l, v in errors["plain"].items() if l <= 1000)
     worst_scaled = max(errors["scaled"].values())
-    checks += [
+    gauss = results["ringing"]["gaussian"][ORDER]
+    found = [
         Check("basis vs mpmath, l <= 101", "<= 5e-13", worst_100, worst_100 <= 5e-13),
         Check("basis vs mpmath, l <= 1000", "<= 1e-11", worst_1000, worst_1000 <= 1e-11),
         Check("basis vs mpmath, all l (scaled)", "<= 1e-11", worst_scaled, worst_scaled <= 1e-11),
-    ]
-    blocks += [
-        Text(
-            "The normalized recurrence in float64 against mpmath at points aimed at the hard "
-            "places (θ within 1e-12 of the poles, sin θ = 1/e, the equator). The plain recurrence "
-            "is exact to rounding until sin^m θ underflows while Y_lm is O(1) (from l ≈ 1930 on; "
-            f"measured failures from l = 2100); above l = {PLAIN_ORDER_LIMIT} specref uses the "
-            "scaled (extended-exponent) recurrence."
-        ),
-        _basis_chart(ctx, errors),
-    ]
-    # Ringing on venice_sunset.
-    image = read_hdr(SHARED / "environments" / "venice_sunset_1k.hdr")
-    orders = [25, 50, 100] if ctx.quick else [10, 25, 50, 75, 100]
-    ringing = ringing_by_order(image, orders, 128 if ctx.quick else 512)
-    results["ringing"] = ringing
-    gauss = ringing["gaussian"][100]
-    checks.append(
         Check(
             "gaussian σ=π/L, L=100: negative pixels",
             "0",
             gauss["negative_share"],
             gauss["negative_share"] == 0.0,
-        )
-    )
-    blocks += [
-        Text("Windows against ringing (§7.3, Herbert et al.), venice_sunset (sun ≈ 6.5e3)."),
-        _ringing_chart(ctx, ringing),
-        Table(
-            ["window", "L", "min / peak", "negative share"],
-            [
-                [w, L, s["undershoot"], s["negative_share"]]
-                for w, st in ringing.items()
-                for L, s in st.items()
-            ],
-            "Ringing of the windowed reconstructions",
-            "{:.3g}",
         ),
     ]
-    coeffs = project_latlong(image, 100, backend="ducc0")
-    exposure = 1.0 / np.percentile(image, 99)
-    for window in WINDOWS.names():
-        rec = synthesize_latlong(apply_window(coeffs, window), 128, backend="ducc0")
-        encoded = linear_to_display(rec, "srgb", exposure)
-        encoded[(rec < 0).any(axis=-1)] = (1.0, 0.0, 1.0)
-        blocks.append(
-            ctx.image(f"window-{window}", encoded, f"L = 100, window {window} (negative: magenta)")
-        )
-    # A prefiltered irradiance map of a shared environment (docs/sh.md shows it).
-    blocks += irradiance_images(ctx, SHARED / "environments" / "st_fagans_interior_1k.hdr")
-    # Prefiltering: frequency against brute force.
-    step = 4
-    small = np.ascontiguousarray(image[::step, ::step, :1])
-    # A tabulated lobe (the 1-D measured-BRDF case): a Gaussian of 0.15 rad sampled every 0.01 rad.
-    angles = np.arange(0.0, 0.8, 0.01)
-    lobe = ctx.out_dir / "images" / "sh-gaussian-lobe.csv"
-    lobe.parent.mkdir(parents=True, exist_ok=True)
-    rows = "\n".join(f"{a:.2f},{np.exp(-0.5 * (a / 0.15) ** 2):.12g}" for a in angles)
-    lobe.write_text("angle_rad,value\n" + rows + "\n")
-    agreement = prefilter_agreement(
-        small,
-        ["lambert", "phong:32", "phong:256", f"table:{lobe}"],
-        8 if ctx.quick else 16,
-        backend="numpy" if ctx.quick else "numba",
-    )
-    agreement = {k.replace(str(lobe.parent) + "/", ""): v for k, v in agreement.items()}
-    results["prefilter"] = agreement
     for spec, bound in (("phong:32", 1e-11), ("phong:256", 2e-9), ("lambert", 5e-4)):
-        err = agreement[spec]["relative_error"]
-        checks.append(
+        err = results["prefilter"][spec]["relative_error"]
+        found.append(
             Check(f"prefilter {spec} vs brute force, L=100", f"<= {bound:g}", err, err <= bound)
         )
-    blocks += [
-        Table(
-            ["kernel", "relative error", "frequency s", "brute force s", "adaptive L (tol 1e-2)"],
-            [
-                [
-                    k,
-                    v["relative_error"],
-                    v["frequency_s"],
-                    v["bruteforce_s"],
-                    v["adaptive_order"],
-                ]
-                for k, v in agreement.items()
-            ],
-            f"Frequency path vs brute force at L = 100, input {small.shape[1]}×{small.shape[0]}",
-            "{:.3g}",
-        ),
-        _prefilter_chart(ctx, agreement),
-        _lambda_chart(ctx, 100),
-    ]
-    gauss_errors = gaussian_approximation_errors(coeffs[:1], (32, 256), 16 if ctx.quick else 32)
-    results["gaussian_approximation"] = gauss_errors
-    blocks.append(
-        Table(
-            ["s", "max relative", "median relative", "max / peak"],
-            [
-                [s, v["max_relative"], v["median_relative"], v["max_over_peak"]]
-                for s, v in gauss_errors.items()
-            ],
-            "Phong prefilter of venice_sunset (R, L = 100) with exp(-l²/2s), not the exact Λ_l",
-            "{:.3g}",
-        )
-    )
-    # Benchmarks.
-    rows, bench_results, bench_checks, by_order = _bench(ctx)
-    results["benchmarks"] = bench_results
-    checks += bench_checks
-    if rows:
-        blocks.append(
-            Table(
-                ["group", "benchmark", "median ms", "ratio to baseline"],
-                rows,
-                "Benchmarks (make bench)",
-                "{:.4g}",
-            )
-        )
-        if by_order:
-            blocks.append(_order_chart(ctx, by_order))
-    else:
-        blocks.append(Text("No benchmark file: run `make bench` for the speed figures."))
-    return SectionResult(blocks, results, checks)
+    return found
 
 
-SECTION = ReportSection("sh", "Spherical harmonics", legacy_run=run)
+SECTION = ReportSection("sh", "Spherical harmonics", sh_accuracy_and_speed, present, checks)
