@@ -227,3 +227,22 @@ def test_no_cli_option_spells_registry_keys_by_hand():
             if len(spelled) >= 2:
                 offenders.append(f"{where} spells {sorted(spelled)} of {name}")
     assert not offenders, "; ".join(offenders)
+
+
+def test_report_section_functions_stay_short():
+    # Sections read as compute -> present -> checks, in functions a reader can follow (issue 13).
+    long = []
+    for path in sorted((ROOT / "validation" / "sections").glob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.FunctionDef) and node.end_lineno - node.lineno + 1 > 80:
+                long.append(f"{path.name}:{node.name} ({node.end_lineno - node.lineno + 1} lines)")
+    assert not long, "; ".join(long)
+
+
+def test_every_report_section_is_compute_present_checks():
+    from validation.report.runner import SECTIONS
+
+    for section in SECTIONS:
+        assert callable(section.compute), section.name
+        assert callable(section.present), section.name
+        assert callable(section.checks), section.name

@@ -9,7 +9,6 @@ from validation.report import (
     ReportContext,
     ReportSection,
     SectionData,
-    SectionResult,
     Table,
     Text,
     to_jsonable,
@@ -50,18 +49,22 @@ def test_report_refuses_unknown_section_and_bad_bench(tmp_path):
 
 
 def test_registered_section_renders_blocks(tmp_path):
-    def run(ctx):
+    def compute(ctx):
         assert ctx.quick
+        return SectionData({"value": np.float64(2.5), "arr": np.arange(2)})
+
+    def present(ctx, data):
         rows = [["a", 1.23456, float("nan")]]
-        blocks = [
+        return [
             Text("hello `code`"),
             Table(["x", "y", "z"], rows, "T"),
             ctx.image("img", np.ones((2, 2, 3))),
         ]
-        checks = [Check("a", "<= 1", 0.5, True), Check("b", "<= 1", 2.0, False)]
-        return SectionResult(blocks, {"value": np.float64(2.5), "arr": np.arange(2)}, checks)
 
-    section = ReportSection("test-only", "Test only", legacy_run=run)
+    def checks(data):
+        return [Check("a", "<= 1", 0.5, True), Check("b", "<= 1", 2.0, False)]
+
+    section = ReportSection("test-only", "Test only", compute, present, checks)
     results = run_report(
         tmp_path, quick=True, only=["test-only"], progress=False, sections=[section]
     )

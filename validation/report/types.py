@@ -149,13 +149,9 @@ class ReportSection:
     compute: Callable[[ReportContext], SectionData] | None = None
     present: Callable[[ReportContext, SectionData], list] | None = None
     checks: Callable[[SectionData], list] = _no_checks
-    #: Transitional: a section that still computes, presents and checks in one function.
-    legacy_run: Callable[[ReportContext], SectionResult] | None = None
 
     def run(self, ctx: ReportContext) -> SectionResult:
         """Compute, present and check: the section's blocks, results and checks."""
-        if self.legacy_run is not None:
-            return self.legacy_run(ctx)
         data = self.compute(ctx)
         blocks = self.present(ctx, data)
         return SectionResult(blocks, data.results, self.checks(data))

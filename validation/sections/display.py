@@ -149,10 +149,6 @@ def _bands(cal, v) -> dict:
 
 def present(ctx: ReportContext, data: SectionData) -> list:
     """Figs. 6 and 7, the verification table for the four whites, the instrument comparison."""
-    import matplotlib.pyplot as plt
-
-    from reference.calibration import curve_target
-
     blocks = [
         Text(
             f"Herbert et al. §6 on a simulated display ({data.results['display']}; no hardware): "
@@ -160,6 +156,20 @@ def present(ctx: ReportContext, data: SectionData) -> list:
             "black left alone. Read back with the noise-free spectroradiometer unless stated."
         )
     ]
+    blocks += _figures(ctx, data)
+    blocks.append(_whites_table(data))
+    blocks.append(_instrument_table(data))
+    blocks.append(_screen_table(data))
+    return blocks
+
+
+def _figures(ctx: ReportContext, data: SectionData) -> list:
+    """Figs. 6 and 7 of Herbert et al., reproduced."""
+    import matplotlib.pyplot as plt
+
+    from reference.calibration import curve_target
+
+    blocks = []
     fig, ax = plt.subplots(figsize=(5.5, 4))
     for curve in FIG6_CURVES:
         G, Y = data.arrays[("fig6", curve)]
@@ -183,6 +193,11 @@ def present(ctx: ReportContext, data: SectionData) -> list:
     blocks.append(
         ctx.figure("fig7", fig, "Fig. 7 reproduced: x and y of gray against G, D65, L* curve")
     )
+    return blocks
+
+
+def _whites_table(data: SectionData) -> Table:
+    """The verification of the four whites."""
     rows = []
     for white, by_instrument in data.results["whites"].items():
         for instrument, r in by_instrument.items():
@@ -199,23 +214,25 @@ def present(ctx: ReportContext, data: SectionData) -> list:
                     r["points"],
                 ]
             )
-    blocks.append(
-        Table(
-            [
-                "white",
-                "calibrated with",
-                "Y white cd/m²",
-                "x",
-                "y",
-                "max Δu'v' >5 %",
-                "ColorChecker ΔE00 mean",
-                "max",
-                "points",
-            ],
-            rows,
-            "Verification of the four whites (L* curve), read by the noise-free instrument",
-        )
+    return Table(
+        [
+            "white",
+            "calibrated with",
+            "Y white cd/m²",
+            "x",
+            "y",
+            "max Δu'v' >5 %",
+            "ColorChecker ΔE00 mean",
+            "max",
+            "points",
+        ],
+        rows,
+        "Verification of the four whites (L* curve), read by the noise-free instrument",
     )
+
+
+def _instrument_table(data: SectionData) -> Table:
+    """Spectroradiometer against colorimeter, band by band in luminance."""
     names = list(data.results["instruments"])
     band_names = list(data.results["instruments"][names[0]]["bands"])
     rows = [
@@ -226,30 +243,29 @@ def present(ctx: ReportContext, data: SectionData) -> list:
         ]
         for name in names
     ]
-    blocks.append(
-        Table(
-            [
-                "calibrated with",
-                *[f"max Δu'v' {b}" for b in band_names],
-                f"holds Δu'v' <= {HOLD_DUV} down to cd/m²",
-            ],
-            rows,
-            "Instrument comparison, D65, L*: the colorimeter loses the white in the shadows",
-        )
+    return Table(
+        [
+            "calibrated with",
+            *[f"max Δu'v' {b}" for b in band_names],
+            f"holds Δu'v' <= {HOLD_DUV} down to cd/m²",
+        ],
+        rows,
+        "Instrument comparison, D65, L*: the colorimeter loses the white in the shadows",
     )
+
+
+def _screen_table(data: SectionData) -> Table:
+    """A gray seen from three positions, with and without compensation (Eq. (1), Ferwerda)."""
     rows = [
         [k, r["max_theta_deg"], r["mean_Y_error"], r["max_abs_Y_error"]]
         for k, r in data.results["screen"].items()
     ]
-    blocks.append(
-        Table(
-            ["observer", "max θ (deg)", "mean ΔY/Y", "max |ΔY/Y|"],
-            rows,
-            "ImpastoR's display (Eq. (1), Ferwerda) per pixel: a 60 cd/m² gray seen from three "
-            "positions, with and without the L_factor and screen-flare compensation",
-        )
+    return Table(
+        ["observer", "max θ (deg)", "mean ΔY/Y", "max |ΔY/Y|"],
+        rows,
+        "ImpastoR's display (Eq. (1), Ferwerda) per pixel: a 60 cd/m² gray seen from three "
+        "positions, with and without the L_factor and screen-flare compensation",
     )
-    return blocks
 
 
 def checks(data: SectionData) -> list[Check]:

@@ -112,11 +112,6 @@ def _row(kind, degree, noise, data):
 
 def present(ctx: ReportContext, data: SectionData) -> list:
     """The methods table, error against degree, upsamplers, the relit panorama, picked spectra."""
-    import matplotlib.pyplot as plt
-
-    from reference.display import linear_to_display
-    from reference.spectra import GRID_41
-
     blocks = [
         Text(
             "Herbert et al. (§4) map camera RGB to spectra with a 5th-order polynomial fitted on "
@@ -130,6 +125,25 @@ def present(ctx: ReportContext, data: SectionData) -> list:
             "same features: no spectral expansion's XYZ fits the training set better."
         )
     ]
+    blocks += _method_tables(ctx, data)
+    blocks += _degree_chart(ctx, data)
+    if "speed" in data.results:
+        speed = data.results["speed"]
+        blocks.append(
+            Text(
+                "Speed (make bench, 2048×1024 to 41 bands): spectralize "
+                f"{speed['spectralize_s']:.2f} s, the bare matrix product of the same features "
+                f"{speed['matmul_s']:.2f} s "
+                f"(throughput ratio {speed['throughput_ratio']:.2f})."
+            )
+        )
+    blocks += _panorama_blocks(ctx, data)
+    return blocks
+
+
+def _method_tables(ctx: ReportContext, data: SectionData) -> list:
+    """The regression's figures and the colour.recovery upsamplers on the same patches."""
+    blocks = []
     rows = []
     for row in data.results["regression"]:
         cc = row["held_out"][CC]
@@ -183,6 +197,14 @@ def present(ctx: ReportContext, data: SectionData) -> list:
             "{:.3g}",
         )
     )
+    return blocks
+
+
+def _degree_chart(ctx: ReportContext, data: SectionData) -> list:
+    """Held-out error against degree, with and without camera noise."""
+    import matplotlib.pyplot as plt
+
+    blocks = []
     fig, ax = plt.subplots(figsize=(6, 3.4))
     for kind, marker in (("polynomial", "o"), ("root_polynomial", "s")):
         for noise, style in ((False, "-"), (True, "--")):
@@ -203,16 +225,17 @@ def present(ctx: ReportContext, data: SectionData) -> list:
     ax.set_ylabel("held-out ColorChecker mean ΔE94 (D65)")
     ax.legend(fontsize=7)
     blocks.append(ctx.figure("degree", fig, "Error against degree, with and without noise"))
-    if "speed" in data.results:
-        speed = data.results["speed"]
-        blocks.append(
-            Text(
-                "Speed (make bench, 2048×1024 to 41 bands): spectralize "
-                f"{speed['spectralize_s']:.2f} s, the bare matrix product of the same features "
-                f"{speed['matmul_s']:.2f} s "
-                f"(throughput ratio {speed['throughput_ratio']:.2f})."
-            )
-        )
+    return blocks
+
+
+def _panorama_blocks(ctx: ReportContext, data: SectionData) -> list:
+    """The spectral panorama relit under D65, A and FL2, and picked spectra."""
+    import matplotlib.pyplot as plt
+
+    from reference.display import linear_to_display
+    from reference.spectra import GRID_41
+
+    blocks = []
     if "panorama" not in data.arrays:
         blocks.append(Text(f"Panorama left out: {PANORAMA} not found (set SPECREF_SHARED_DATA)."))
     else:
