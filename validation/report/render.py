@@ -1,0 +1,151 @@
+"""The report's HTML and Markdown renderings (``index.html``, ``docs/results.md``)."""
+
+from __future__ import annotations
+
+import html
+import math
+
+import numpy as np
+
+from validation.report.types import Image, ReportSection, SectionResult, Table, Text
+
+__all__ = ["render_html", "render_markdown"]
+
+
+def _cell(value, fmt: str) -> str:
+    if isinstance(value, float | np.floating):
+        return fmt.format(float(value)) if math.isfinite(value) else "—"
+    return str(value)
+
+
+_CSS = " ".join(
+    [
+        "body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;",
+        "line-height:1.45;color:#222}",
+        "table{border-collapse:collapse;margin:.6em 0 1.4em}",
+        "td,th{border:1px solid #ccc;padding:.25em .6em;text-align:right;",
+        "font-variant-numeric:tabular-nums}",
+        "th{background:#f3f3f3} td:first-child,th:first-child{text-align:left}",
+        "caption{caption-side:top;text-align:left;font-weight:600;padding:.3em 0}",
+        "figure{display:inline-block;margin:.5em 1em .5em 0;vertical-align:top}",
+        "figcaption{font-size:.9em;color:#555;max-width:520px} img{max-width:520px}",
+        "code{background:#f5f5f5;padding:0 .2em} .meta{color:#666;font-size:.9em}",
+    ]
+)
+
+
+def render_html(
+    title: str, meta: dict, sections: list[tuple[ReportSection, SectionResult]]
+) -> str:
+    """The report as one HTML page: metadata, contents, the targets, then each section's blocks.
+
+    Examples
+    --------
+    >>> from validation.report.types import Check
+    >>> section = ReportSection("demo", "Demo")
+    >>> page = render_html("t", {"mode": "quick"}, [(section, SectionResult(
+    ...     [Text("a `b`")], {}, [Check("x", "<= 1", 0.5, True)]))])
+    >>> "<code>b</code>" in page, "1 of 1 targets hold." in page
+    (True, True)
+    """
+    esc = html.escape
+    parts = [
+        "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
+        f"<title>{esc(title)}</title>",
+        f"<style>{_CSS}</style></head><body>",
+        f"<h1>{esc(title)}</h1>",
+        "<p class='meta'>" + esc(", ".join(f"{k}: {v}" for k, v in meta.items())) + "</p>",
+        "<nav><ul>",
+    ]
+    for section, _ in sections:
+        parts.append(f"<li><a href='#{esc(section.name)}'>{esc(section.title)}</a></li>")
+    parts.append("</ul></nav>")
+    checks = [(s, c) for s, r in sections for c in r.checks]
+    if checks:
+        failed = sum(not c.passed for _, c in checks)
+        parts.append(
+            f"<h2>Targets</h2><p>{len(checks) - failed} of {len(checks)} targets hold"
+            + (f"; <b>{failed} do not</b>." if failed else ".")
+            + "</p><table><tr><th>section</th><th>check</th><th>target</th><th>measured</th>"
+            "<th>holds</th></tr>"
+        )
+        for section, c in checks:
+            mark = "yes" if c.passed else "<b>NO</b>"
+            parts.append(
+                f"<tr><td>{esc(section.title)}</td><td>{esc(c.name)}</td><td>{esc(c.target)}</td>"
+                f"<td>{esc(_cell(c.measured, '{:.4g}'))}</td><td>{mark}</td></tr>"
+            )
+        parts.append("</table>")
+    for section, result in sections:
+        parts.append(f"<section id='{esc(section.name)}'><h2>{esc(section.title)}</h2>")
+        for block in result.blocks:
+            if isinstance(block, Text):
+                text = esc(block.text)
+                pieces = text.split("`")
+                text = "".join(
+                    p if i % 2 == 0 else f"<code>{p}</code>" for i, p in enumerate(pieces)
+                )
+                parts.append(f"<p>{text}</p>")
+            elif isinstance(block, Table):
+                parts.append(f"<table><caption>{esc(block.caption)}</caption><tr>")
+                parts.extend(f"<th>{esc(str(c))}</th>" for c in block.columns)
+                parts.append("</tr>")
+                for row in block.rows:
+                    cells = "".join(f"<td>{esc(_cell(v, block.fmt))}</td>" for v in row)
+                    parts.append(f"<tr>{cells}</tr>")
+                parts.append("</table>")
+            elif isinstance(block, Image):
+                parts.append(
+                    f"<figure><img src='{esc(block.path)}' alt='{esc(block.caption)}'>"
+                    f"<figcaption>{esc(block.caption)}</figcaption></figure>"
+                )
+        parts.append("</section>")
+    parts.append("</body></html>")
+    return "\n".join(parts)
+
+
+def render_markdown(title: str, meta: dict, sections, image_prefix: str) -> str:
+    """The report as Markdown (``docs/results.md``); image links start with ``image_prefix``.
+
+    Examples
+    --------
+    >>> section = ReportSection("demo", "Demo")
+    >>> text = render_markdown("t", {}, [(section, SectionResult([Image("images/a.png", "A")]))],
+    ...                        "results/")
+    >>> text.splitlines()[-1]
+    '![A](results/images/a.png)'
+    """
+    lines = [
+        f"# {title}",
+        "",
+        "<!-- Generated by `specref report`; do not edit by hand. -->",
+        "",
+        ", ".join(f"{k}: {v}" for k, v in meta.items()),
+        "",
+    ]
+    checks = [(s, c) for s, r in sections for c in r.checks]
+    if checks:
+        failed = sum(not c.passed for _, c in checks)
+        lines += ["## Targets", "", f"{len(checks) - failed} of {len(checks)} targets hold.", ""]
+        lines += ["| section | check | target | measured | holds |", "|---|---|---|---|---|"]
+        for section, c in checks:
+            measured = _cell(c.measured, "{:.4g}")
+            holds = "yes" if c.passed else "**NO**"
+            lines.append(f"| {section.title} | {c.name} | {c.target} | {measured} | {holds} |")
+        lines.append("")
+    for section, result in sections:
+        lines += [f"## {section.title}", ""]
+        for block in result.blocks:
+            if isinstance(block, Text):
+                lines += [block.text, ""]
+            elif isinstance(block, Table):
+                if block.caption:
+                    lines += [f"**{block.caption}**", ""]
+                lines.append("| " + " | ".join(str(c) for c in block.columns) + " |")
+                lines.append("|" + "---|" * len(block.columns))
+                for row in block.rows:
+                    lines.append("| " + " | ".join(_cell(v, block.fmt) for v in row) + " |")
+                lines.append("")
+            elif isinstance(block, Image):
+                lines += [f"![{block.caption}]({image_prefix}{block.path})", ""]
+    return "\n".join(lines)
