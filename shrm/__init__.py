@@ -7,6 +7,14 @@ Importing ``shrm`` registers the environment-light shaders in ``reference.shadin
 from shrm import environment  # noqa: F401  (registers the environment-light shaders)
 from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts, shrm_orders
 from shrm.cache import Cache, cache_key, default_cache_dir
+from shrm.kubelka_munk import (
+    PolymerConstituents,
+    km_invert,
+    km_slab,
+    polymer_constituents,
+    polymer_K_S,
+    slab_measured,
+)
 from shrm.lobes import PREFILTER_KERNELS, adaptive_order, parse_kernel
 from shrm.orbit import render_orbit
 from shrm.prefilter import prefilter_bruteforce, prefilter_coefficients, prefilter_environment
@@ -26,13 +34,18 @@ __all__ = [
     "SH_MAX_ORDER",
     "WINDOWS",
     "Cache",
+    "PolymerConstituents",
     "RenderSession",
     "adaptive_order",
     "apply_window",
     "brdf_sh_coefficients",
     "cache_key",
     "default_cache_dir",
+    "km_invert",
+    "km_slab",
     "parse_kernel",
+    "polymer_K_S",
+    "polymer_constituents",
     "prefilter_bruteforce",
     "prefilter_coefficients",
     "prefilter_environment",
@@ -54,5 +67,6 @@ __all__ = [
     "shrm_create_angular",
     "shrm_extract",
     "shrm_orders",
+    "slab_measured",
     "synthesize_latlong",
 ]

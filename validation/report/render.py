@@ -34,9 +34,7 @@ _CSS = " ".join(
 )
 
 
-def render_html(
-    title: str, meta: dict, sections: list[tuple[ReportSection, SectionResult]]
-) -> str:
+def render_html(title: str, meta: dict, sections: list[tuple[ReportSection, SectionResult]]) -> str:
     """The report as one HTML page: metadata, contents, the targets, then each section's blocks.
 
     Examples
