@@ -7,6 +7,7 @@ Importing ``shrm`` registers the environment-light shaders in ``reference.shadin
 from shrm import environment  # noqa: F401  (registers the environment-light shaders)
 from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts, shrm_orders
 from shrm.cache import Cache, cache_key, default_cache_dir
+from shrm.characterization import characterize_model, read_characterization, write_characterization
 from shrm.kubelka_munk import (
     PolymerConstituents,
     km_invert,
@@ -17,6 +18,7 @@ from shrm.kubelka_munk import (
 )
 from shrm.lobes import PREFILTER_KERNELS, adaptive_order, parse_kernel
 from shrm.orbit import render_orbit
+from shrm.polymer import MIRROR_FACTORS, polymer_look, polymer_maps, polymer_terms
 from shrm.prefilter import prefilter_bruteforce, prefilter_coefficients, prefilter_environment
 from shrm.rotation import rotate_coefficients, rotation_matrix, sh_rotation_blocks
 from shrm.session import HERBERT_STAGES, RenderSession
@@ -28,6 +30,7 @@ from shrm.windows import WINDOWS, apply_window, ringing_statistics
 
 __all__ = [
     "HERBERT_STAGES",
+    "MIRROR_FACTORS",
     "PREFILTER_KERNELS",
     "SHRM",
     "SH_BACKENDS",
@@ -40,17 +43,22 @@ __all__ = [
     "apply_window",
     "brdf_sh_coefficients",
     "cache_key",
+    "characterize_model",
     "default_cache_dir",
     "km_invert",
     "km_slab",
     "parse_kernel",
     "polymer_K_S",
     "polymer_constituents",
+    "polymer_look",
+    "polymer_maps",
+    "polymer_terms",
     "prefilter_bruteforce",
     "prefilter_coefficients",
     "prefilter_environment",
     "project_function",
     "project_latlong",
+    "read_characterization",
     "render_bruteforce",
     "render_orbit",
     "render_shrm",
@@ -69,4 +77,5 @@ __all__ = [
     "shrm_orders",
     "slab_measured",
     "synthesize_latlong",
+    "write_characterization",
 ]
