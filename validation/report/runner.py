@@ -26,7 +26,7 @@ from reference.images import write_text_atomic
 from reference.registry import Registry
 from validation.report.render import render_html, render_markdown
 from validation.report.types import ReportContext, ReportSection, SectionResult, to_jsonable
-from validation.sections import examples, impastor, phong, raster, sh, shrm, spectral
+from validation.sections import examples, impastor, phong, polymer, raster, sh, shrm, spectral
 
 __all__ = ["REPORT_SECTIONS", "SECTIONS", "run_report"]
 
@@ -38,6 +38,7 @@ SECTIONS: tuple[ReportSection, ...] = (
     phong.SECTION,
     sh.SECTION,
     shrm.SECTION,
+    polymer.SECTION,
     impastor.SECTION,
 )
 
