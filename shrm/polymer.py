@@ -52,6 +52,7 @@ from reference.registry import Method, Registry
 from shrm.characterization import Characterization
 from shrm.kubelka_munk import saunderson_constants
 from shrm.prefilter import prefilter_environment
+from shrm.tint import read_tint_library
 
 __all__ = [
     "MIRROR_FACTORS",
@@ -245,6 +246,7 @@ def polymer_look(
     mirror: str = "fresnel",
     unscattered=0.0,
     index=None,
+    tint_library=None,
 ) -> PolymerLook:
     """Look a chip up in the characterization once per frame and build the look of Eqs. (1)–(5).
 
@@ -259,8 +261,8 @@ def polymer_look(
         The chip matrix (``shrm.characterization``).
     thickness_mm, tio2_pct : float
         The chip, inside the matrix.
-    tint : float or array_like, shape (n_bands,)
-        Tint_polymer, in [0, 1].
+    tint : float, array_like, shape (n_bands,), or str
+        Tint_polymer, in [0, 1], or the name of a spot colour in ``tint_library``.
     gloss : float
         In [0, 1].
     mirror : str
@@ -269,6 +271,8 @@ def polymer_look(
         Unscattered fraction of the transmittance, in [0, 1] (E33).
     index : float or array_like, optional
         Refractive index for F_r and k_1; default the characterization's ``index``.
+    tint_library : str or Path, optional
+        A spot-colour library (``shrm.tint``); default the shipped one.
 
     Returns
     -------
@@ -277,8 +281,8 @@ def polymer_look(
     Raises
     ------
     SpecrefError
-        For a chip outside the matrix, gloss or tint outside [0, 1], an unknown mirror factor, an
-        index <= 1.
+        For a chip outside the matrix, gloss or tint outside [0, 1], an unknown tint name (listing
+        the closest names), an unknown mirror factor, an index <= 1.
 
     Examples
     --------
@@ -288,6 +292,13 @@ def polymer_look(
     ((41,), 'fresnel', True)
     """
     MIRROR_FACTORS.lookup(mirror)
+    if isinstance(tint, str):
+        library = read_tint_library(tint_library)
+        require(
+            np.array_equal(library.wavelengths_nm, characterization.wavelengths_nm),
+            f"{library.path}: the tint library's wavelengths differ from the characterization's",
+        )
+        tint = library.tint(tint)
     g = float(require_finite(gloss, "polymer: gloss"))
     require(0.0 <= g <= 1.0, f"polymer: gloss: must be in [0, 1], got {gloss!r}")
     n = characterization.meta.get("index", 1.54) if index is None else index
