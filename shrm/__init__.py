@@ -7,8 +7,18 @@ Importing ``shrm`` registers the environment-light shaders in ``reference.shadin
 from shrm import environment  # noqa: F401  (registers the environment-light shaders)
 from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts, shrm_orders
 from shrm.cache import Cache, cache_key, default_cache_dir
+from shrm.characterization import characterize_model, read_characterization, write_characterization
+from shrm.kubelka_munk import (
+    PolymerConstituents,
+    km_invert,
+    km_slab,
+    polymer_constituents,
+    polymer_K_S,
+    slab_measured,
+)
 from shrm.lobes import PREFILTER_KERNELS, adaptive_order, parse_kernel
 from shrm.orbit import render_orbit
+from shrm.polymer import MIRROR_FACTORS, polymer_look, polymer_maps, polymer_terms
 from shrm.prefilter import prefilter_bruteforce, prefilter_coefficients, prefilter_environment
 from shrm.rotation import rotate_coefficients, rotation_matrix, sh_rotation_blocks
 from shrm.session import HERBERT_STAGES, RenderSession
@@ -20,24 +30,35 @@ from shrm.windows import WINDOWS, apply_window, ringing_statistics
 
 __all__ = [
     "HERBERT_STAGES",
+    "MIRROR_FACTORS",
     "PREFILTER_KERNELS",
     "SHRM",
     "SH_BACKENDS",
     "SH_MAX_ORDER",
     "WINDOWS",
     "Cache",
+    "PolymerConstituents",
     "RenderSession",
     "adaptive_order",
     "apply_window",
     "brdf_sh_coefficients",
     "cache_key",
+    "characterize_model",
     "default_cache_dir",
+    "km_invert",
+    "km_slab",
     "parse_kernel",
+    "polymer_K_S",
+    "polymer_constituents",
+    "polymer_look",
+    "polymer_maps",
+    "polymer_terms",
     "prefilter_bruteforce",
     "prefilter_coefficients",
     "prefilter_environment",
     "project_function",
     "project_latlong",
+    "read_characterization",
     "render_bruteforce",
     "render_orbit",
     "render_shrm",
@@ -54,5 +75,7 @@ __all__ = [
     "shrm_create_angular",
     "shrm_extract",
     "shrm_orders",
+    "slab_measured",
     "synthesize_latlong",
+    "write_characterization",
 ]

@@ -12,13 +12,25 @@ import argparse
 import sys
 
 from reference.errors import SpecrefError
-from validation.cli import brdf, cache, display, env, impastor, phong, render, report, sh, shrm
+from validation.cli import (
+    brdf,
+    cache,
+    display,
+    env,
+    impastor,
+    phong,
+    polymer,
+    render,
+    report,
+    sh,
+    shrm,
+)
 from validation.cli.parser import Parser
 
 __all__ = ["COMMANDS", "build_parser", "main"]
 
 #: The subcommands, in the order ``specref --help`` lists them.
-COMMANDS = (report, render, cache, brdf, shrm, sh, display, env, impastor, phong)
+COMMANDS = (report, render, cache, brdf, shrm, sh, polymer, display, env, impastor, phong)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -31,6 +31,7 @@ from validation.sections import (
     examples,
     impastor,
     phong,
+    polymer,
     raster,
     sh,
     shrm,
@@ -49,6 +50,7 @@ SECTIONS: tuple[ReportSection, ...] = (
     sh.SECTION,
     spectral_env.SECTION,
     shrm.SECTION,
+    polymer.SECTION,
     impastor.SECTION,
     display.SECTION,
 )
