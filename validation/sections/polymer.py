@@ -232,8 +232,6 @@ def _to_srgb(spectra, W, scale: float) -> np.ndarray:
 
 def present(ctx: ReportContext, data: SectionData) -> list:
     """Fig. 2 curves, chip swatches, interpolation table, term images, uniform-sky table."""
-    import matplotlib.pyplot as plt
-
     blocks: list = [
         Text(
             "Herbert et al.'s polymer characterization (§3.1) from specref's Kubelka–Munk chip "
@@ -243,6 +241,46 @@ def present(ctx: ReportContext, data: SectionData) -> list:
             "Herbert's Fig. 2 plots the green channel at D65; this plots CIE L* under D65."
         )
     ]
+    blocks += _chip_figures(ctx, data)
+    rows = []
+    for illuminant, per in data.results["interpolation"].items():
+        for name, stats in per.items():
+            rows.append([illuminant, name, stats["mean"], stats["p90"], stats["max"]])
+    blocks.append(
+        Table(
+            ["illuminant", "measurement", "mean ΔE00", "p90 ΔE00", "max ΔE00"],
+            rows,
+            "Characterization look-up (PCHIP in log thickness, TiO2) against the model at the "
+            "centres of the default grid's cells",
+            "{:.3f}",
+        )
+    )
+    blocks += _term_figures(ctx, data)
+    rows = [[k, v["normal"], v["grazing"]] for k, v in data.results["uniform_sky"].items()]
+    blocks.append(
+        Table(
+            ["chip", "I_result, normal view", "I_result, grazing view"],
+            rows,
+            "The hybrid under a uniform sky of radiance 1 (band mean; a passive surface returns at "
+            "most 1): Eq. (1) as printed is not energy conserving (erratum E34)",
+            "{:.3f}",
+        )
+    )
+    blocks.append(
+        Text(
+            "Not yet in this section (issue 14, later steps): the layered physically based oracle, "
+            "the hybrid's ΔE00 against it per M_s, gloss, thickness and TiO2, and the "
+            "speed–accuracy chart."
+        )
+    )
+    return blocks
+
+
+def _chip_figures(ctx: ReportContext, data: SectionData) -> list:
+    """Fig. 2 reproduced and a row of chips like Fig. 3."""
+    import matplotlib.pyplot as plt
+
+    blocks = []
     fig, axes = plt.subplots(1, 2, figsize=(9, 3.4), sharex=True)
     for d, curve in data.results["fig2"].items():
         axes[0].plot(curve["tio2_pct"], curve["L_over_black"], "o-", label=f"{d} mm")
@@ -268,19 +306,14 @@ def present(ctx: ReportContext, data: SectionData) -> list:
             "(top: over black, bottom: in transmission), sRGB under D65",
         )
     )
-    rows = []
-    for illuminant, per in data.results["interpolation"].items():
-        for name, stats in per.items():
-            rows.append([illuminant, name, stats["mean"], stats["p90"], stats["max"]])
-    blocks.append(
-        Table(
-            ["illuminant", "measurement", "mean ΔE00", "p90 ΔE00", "max ΔE00"],
-            rows,
-            "Characterization look-up (PCHIP in log thickness, TiO2) against the model at the "
-            "centres of the default grid's cells",
-            "{:.3f}",
-        )
-    )
+    return blocks
+
+
+def _term_figures(ctx: ReportContext, data: SectionData) -> list:
+    """The terms of Eq. (1), Herbert et al., on a sphere, one figure per M_s."""
+    import matplotlib.pyplot as plt
+
+    blocks = []
     W_E = band_weights(DEFAULT_GRID, None)
     for mirror in MIRROR_FACTORS.names():
         terms = data.arrays["terms"][mirror]
@@ -301,23 +334,6 @@ def present(ctx: ReportContext, data: SectionData) -> list:
                 "(I_effect is zero: no effect pigment on this material)",
             )
         )
-    rows = [[k, v["normal"], v["grazing"]] for k, v in data.results["uniform_sky"].items()]
-    blocks.append(
-        Table(
-            ["chip", "I_result, normal view", "I_result, grazing view"],
-            rows,
-            "The hybrid under a uniform sky of radiance 1 (band mean; a passive surface returns at "
-            "most 1): Eq. (1) as printed is not energy conserving (erratum E34)",
-            "{:.3f}",
-        )
-    )
-    blocks.append(
-        Text(
-            "Not yet in this section (issue 14, later steps): the layered physically based oracle, "
-            "the hybrid's ΔE00 against it per M_s, gloss, thickness and TiO2, and the "
-            "speed–accuracy chart."
-        )
-    )
     return blocks
 
 
