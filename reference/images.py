@@ -32,9 +32,11 @@ from reference.errors import SpecrefError, require
 
 __all__ = [
     "MAX_IMAGE_PIXELS",
+    "atomic_path",
     "atomic_write",
     "channel_wavelengths_nm",
     "check_output_folder",
+    "exr_write_error",
     "output_error",
     "read_exr",
     "read_hdr",
@@ -154,6 +156,42 @@ def atomic_write(path, mode: str = "wb"):
                 yield handle
                 handle.flush()
                 os.fsync(handle.fileno())
+            os.replace(tmp, path)
+        except BaseException:
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(tmp)
+            raise
+
+
+@contextlib.contextmanager
+def atomic_path(path, suffix: str = ""):
+    """Yield a temporary file name beside ``path``; on success, sync it and rename it to ``path``.
+
+    For writers that take a file name rather than a file object (OpenEXR, tifffile). As in
+    :func:`atomic_write`, an exception removes the temporary file and leaves ``path`` untouched,
+    and the file system's refusals become one-line :class:`SpecrefError` (:func:`output_error`).
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     with atomic_path(os.path.join(d, "a.bin")) as tmp:
+    ...         _ = open(tmp, "wb").write(b"xy")
+    ...     sorted(os.listdir(d))
+    ['a.bin']
+    """
+    path = Path(path)
+    with _write_errors(path):
+        require(not path.is_dir(), f"{path}: cannot write ({_WRITE_ERRORS[errno.EISDIR]})")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
+        os.close(fd)
+        tmp = Path(name)
+        try:
+            yield tmp
+            with open(tmp, "rb+") as handle:
+                os.fsync(handle.fileno())
+            _new_file_permissions(tmp)
             os.replace(tmp, path)
         except BaseException:
             with contextlib.suppress(FileNotFoundError):
@@ -352,31 +390,31 @@ def write_exr(path, image, channels: list[str] | None = None, half: bool = False
         name: np.ascontiguousarray(image[..., i].astype(dtype)) for i, name in enumerate(channels)
     }
     path = Path(path)
-    with _write_errors(path):
-        require(not path.is_dir(), f"{path}: cannot write ({_WRITE_ERRORS[errno.EISDIR]})")
-        path.parent.mkdir(parents=True, exist_ok=True)
-        # OpenEXR writes by file name, so write a temporary name beside the target and rename it.
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".exr", dir=path.parent)
-        os.close(fd)
+    # OpenEXR writes by file name, so write a temporary name beside the target and rename it.
+    with atomic_path(path, ".exr") as tmp:
         try:
-            try:
-                with OpenEXR.File(header, data) as handle:
-                    handle.write(tmp)
-            except RuntimeError as error:
-                # OpenEXR reports the file system's refusals as RuntimeError text.
-                text = str(error)
-                full = "No space left" in text
-                reason = _WRITE_ERRORS[errno.ENOSPC] if full else f"OpenEXR: {text}"
-                raise SpecrefError(f"{path}: cannot write ({reason})") from None
-            # OpenEXR may lose a small file's data on a full disk without an error: read it back.
-            _check_exr_written(tmp, path)
-            _new_file_permissions(tmp)
-            os.replace(tmp, path)
-        except BaseException:
-            with contextlib.suppress(FileNotFoundError):
-                os.unlink(tmp)
-            raise
+            with OpenEXR.File(header, data) as handle:
+                handle.write(str(tmp))
+        except RuntimeError as error:
+            raise exr_write_error(path, error) from None
+        # OpenEXR may lose a small file's data on a full disk without an error: read it back.
+        _check_exr_written(tmp, path)
     return path
+
+
+def exr_write_error(path, error: Exception) -> SpecrefError:
+    """The one-line error for OpenEXR's exception (no errno) while writing ``path``.
+
+    OpenEXR reports the file system's refusals as text ("... No space left on device").
+
+    Examples
+    --------
+    >>> exr_write_error("a.exr", RuntimeError("Failed to write. No space left on device."))
+    SpecrefError('a.exr: cannot write (no space left on the device)')
+    """
+    text = str(error)
+    reason = _WRITE_ERRORS[errno.ENOSPC] if "No space left" in text else f"OpenEXR: {text}"
+    return SpecrefError(f"{path}: cannot write ({reason})")
 
 
 def _check_exr_written(tmp, path) -> None:

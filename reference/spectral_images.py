@@ -24,10 +24,7 @@ References
 
 from __future__ import annotations
 
-import contextlib
 import json
-import os
-import tempfile
 from collections.abc import Iterable
 from pathlib import Path
 
@@ -35,6 +32,8 @@ import numpy as np
 
 from reference.errors import SpecrefError, require
 from reference.images import (
+    atomic_path,
+    exr_write_error,
     read_exr,
     read_hdr,
     spectral_channel_names,
@@ -89,12 +88,6 @@ def _write_tiff_blocks(path: Path, height, width, wavelengths, blocks) -> None:
     del image
 
 
-def _umask() -> int:
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
-
-
 def write_spectral_blocks(
     path, height: int, width: int, wavelengths_nm, blocks: Iterable[tuple[int, np.ndarray]]
 ) -> Path:
@@ -132,23 +125,17 @@ def write_spectral_blocks(
         f"{path}: unsupported spectral image type {suffix!r}; allowed: .exr, .tif, .tiff",
     )
     wavelengths = [float(w) for w in np.asarray(wavelengths_nm, dtype=np.float64)]
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
-    os.close(fd)
-    tmp = Path(name)
-    try:
+    with atomic_path(path, suffix) as tmp:
         if suffix == ".exr":
-            _write_exr_blocks(tmp, height, width, spectral_channel_names(wavelengths), blocks)
+            try:
+                _write_exr_blocks(tmp, height, width, spectral_channel_names(wavelengths), blocks)
+            except (RuntimeError, OSError) as error:
+                # OpenEXR's scanline writer reports a full disk as text, with no errno.
+                if getattr(error, "errno", None) is not None:
+                    raise
+                raise exr_write_error(path, error) from None
         else:
             _write_tiff_blocks(tmp, height, width, wavelengths, blocks)
-        os.chmod(tmp, 0o666 & ~_umask())
-        with open(tmp, "rb+") as handle:
-            os.fsync(handle.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(tmp)
-        raise
     return path
 
 

@@ -76,16 +76,36 @@ MESSAGES = {
 }
 
 
+def _spectral_exr(path, image):
+    from reference.spectral_images import write_spectral_blocks
+
+    blocks = [(0, image.astype(np.float32))]
+    return write_spectral_blocks(Path(f"{path}.exr"), *image.shape[:2], [450, 550, 650], blocks)
+
+
+def _spectral_tiff(path, image):
+    from reference.spectral_images import write_spectral_blocks
+
+    blocks = [(0, image.astype(np.float32))]
+    return write_spectral_blocks(Path(f"{path}.tif"), *image.shape[:2], [450, 550, 650], blocks)
+
+
 @pytest.mark.parametrize("kind", KINDS)
-@pytest.mark.parametrize("writer", [write_png, write_exr], ids=["png", "exr"])
+@pytest.mark.parametrize(
+    "writer",
+    [write_png, write_exr, _spectral_exr, _spectral_tiff],
+    ids=["png", "exr", "spectral-exr", "spectral-tiff"],
+)
 def test_image_writers_refuse_in_one_line(writer, kind, tmp_path, request):
     path = _outputs(tmp_path, kind, request)
     if kind == "a folder":
         path.mkdir()
+        for suffix in (".exr", ".tif"):
+            Path(f"{path}{suffix}").mkdir()
     image = np.random.default_rng(1).random((128, 128, 3))
     with pytest.raises(SpecrefError, match=MESSAGES[kind]) as caught:
         writer(path, image)
-    assert str(path) in str(caught.value)
+    assert str(path.name) in str(caught.value)
     assert "\n" not in str(caught.value)
     # No temporary file is left behind.
     if path.parent.is_dir():
