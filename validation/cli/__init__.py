@@ -12,13 +12,13 @@ import argparse
 import sys
 
 from reference.errors import SpecrefError
-from validation.cli import brdf, cache, impastor, phong, render, report, sh, shrm
+from validation.cli import brdf, cache, equations, impastor, phong, render, report, sh, shrm
 from validation.cli.parser import Parser
 
 __all__ = ["COMMANDS", "build_parser", "main"]
 
 #: The subcommands, in the order ``specref --help`` lists them.
-COMMANDS = (report, render, cache, brdf, shrm, sh, impastor, phong)
+COMMANDS = (report, render, cache, brdf, shrm, sh, impastor, phong, equations)
 
 
 def build_parser() -> argparse.ArgumentParser:

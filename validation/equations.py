@@ -1,0 +1,845 @@
+"""The equation index: each numbered equation of the three papers, the code citing it, its tests.
+
+``docs/equations.md`` is generated from this module (``make equations``, which runs ``specref
+equations -o docs/equations.md``) and checked by ``tests/validation/test_equations.py``. The
+source of truth is :data:`PAPERS`, the numbered equations of each paper read from its text (with the
+section and a one-line description); everything else is found in the code:
+
+- **Citations** in the fixed format of STYLE.md §5, ``Eq. (N), Wang et al.``, ``Eq. (N), Herbert et
+  al.``, ``Eq. (N), Ferwerda`` (also lists, ``Eq. (7) and Eq. (11), Wang et al.``, and ranges,
+  ``Eqs. (5)-(8), Ferwerda``, which are expanded), read with :mod:`ast` and :mod:`tokenize` from
+  docstrings, string constants and comments in every package. A docstring or a comment belongs to
+  its enclosing function or class (a nested function's, or a dunder method's, to the enclosing one).
+  Registry entries' ``cites`` are read from the registries and belong to the entry's ``reference``
+  (or ``cls``) and its ``kernel``.
+- **Tests**: test functions under ``tests/`` whose file imports the function (or its module or
+  package) and whose body names it; then tests parametrized over its registry, or naming the
+  registry and the entry's key.
+- **Errata**: the entries of ``docs/errata.md`` whose bold title cites the equation (an equation
+  without an author takes the paper of the entry's section).
+
+Citations of other sources (``Eq. (7), Ramamoorthi & Hanrahan 2001``) are listed as cited external
+equations, without a check of their numbers. :func:`equation_problems` lists what breaks the index:
+a citation of an equation that the paper does not have, ``Eq. (N)`` without an author, a range or
+list in a comment (STYLE.md §5: comments name one equation each), an equation cited only in ranges
+or lists (a grep for ``Eq. (N), Author`` would miss it), and an indexed function that cannot be
+imported.
+"""
+
+from __future__ import annotations
+
+import ast
+import functools
+import importlib
+import importlib.util
+import io
+import pkgutil
+import re
+import tokenize
+from collections import defaultdict
+from dataclasses import dataclass
+from pathlib import Path
+
+from reference.errors import require
+from reference.registry import Registry
+
+__all__ = [
+    "PACKAGES",
+    "PAPERS",
+    "REGENERATE",
+    "Citation",
+    "Equation",
+    "EquationRow",
+    "IndexedFunction",
+    "Paper",
+    "collect_citations",
+    "equation_index",
+    "equation_problems",
+    "render_equation_index",
+]
+
+#: The repository root (the index reads the sources, ``tests/`` and ``docs/errata.md`` there).
+ROOT = Path(__file__).resolve().parents[1]
+#: The packages whose code is indexed.
+PACKAGES = ("reference", "phong_table", "shrm", "impastor", "validation")
+#: This module: its strings are the index's data, not citations.
+_DATA = "validation/equations.py"
+#: The one command that regenerates ``docs/equations.md``.
+REGENERATE = "make equations"
+
+
+@dataclass(frozen=True)
+class Equation:
+    """One numbered equation of a paper: its number, section and a one-line description."""
+
+    number: int
+    section: str
+    what: str
+    note: str = ""
+
+
+@dataclass(frozen=True)
+class Paper:
+    """A paper: the author string of its citations, its numbered equations, where they come from."""
+
+    author: str
+    title: str
+    numbering: str
+    equations: tuple[Equation, ...]
+
+
+_WANG = (
+    Equation(
+        1,
+        "§3.1",
+        "Phong model: `I = I_a k_a + f_att I_p k_d cos θ + f_att I_p k_s cos^n α`, "
+        "with `f_att = max(1/(c1 + c2 d_L + c3 d_L²), 1)`",
+    ),
+    Equation(
+        2,
+        "§3.1",
+        "Spectral Phong model: `I(λ) = f_att I_p(λ) k_d(λ) cos θ + "
+        "f_att I_p(λ) k_s(λ) cos^{n(λ)} α`",
+    ),
+    Equation(
+        3,
+        "§3.2",
+        "CIE XYZ as integrals `k ∫ φ(λ) x̄(λ) dλ`",
+        "computed as band integrals in the discrete form of Eq. (4) (erratum E7)",
+    ),
+    Equation(4, "§3.2", "Discrete XYZ: `X = k Σ_λ φ(λ) x̄(λ)`"),
+    Equation(5, "§3.2", "RGB from XYZ: `[R G B] = [X Y Z] · XYZtoRGB`"),
+    Equation(
+        6,
+        "§3.2",
+        "XYZ of the spectral Phong model: Eq. (2) summed against the CMFs "
+        "(the exact render of Figure 2)",
+    ),
+    Equation(7, "§3.2", "Eq. (6) with `k f_att cos θ` taken out of the diffuse sum"),
+    Equation(
+        8,
+        "§3.2",
+        "`X_sp, Y_sp, Z_sp`: the specular part of Eq. (7)",
+        "tabulated in XYZ by the scene shader of Eq. (11)",
+    ),
+    Equation(9, "§3.2", "The spectra-to-RGB matrix: CMFs times XYZtoRGB"),
+    Equation(
+        10,
+        "§3.2",
+        "`R_sp, G_sp, B_sp`: the specular spectrum times the spectra-to-RGB matrix",
+        "Eq. (11) at `t = cos α`",
+    ),
+    Equation(11, "§3.2", "The specular functions `[f_rsp f_gsp f_bsp](t)` of `t = cos α`"),
+    Equation(12, "§3.2", "Importance ratio `ir(t₁) = ∫_0^t₁ f^app / ∫_0^1 f^app`"),
+    Equation(13, "§3.2", "The proxy `f^app(t) = t^{an}`, `an` the average exponent"),
+    Equation(14, "§3.2", "`ir(t) = t^{an+1}`, Eq. (12) in closed form"),
+    Equation(15, "§3.2", "Inverse importance ratio `t = w^{1/(an+1)}`"),
+    Equation(16, "§3.2", "Table nodes: `p` segments `S_i`, each of `m/p` equal intervals"),
+)
+_HERBERT = (
+    Equation(
+        1,
+        "§5.1",
+        "Shading sum `I_result = I_d + I_effect + I_r F_r + I_trans (1 − F_r)`",
+        "the hybrid polymer model of §5.1 is not implemented (erratum E5)",
+    ),
+    Equation(
+        2,
+        "§5.1",
+        "Diffuse `I_d = E_d D_polymer Tint_polymer (1 − Mod_effect)`",
+        "implemented as `E_d k_d` (no tint, no effect map)",
+    ),
+    Equation(
+        3,
+        "§5.1",
+        "Effect `I_effect = E_effect Mod_effect`",
+        "not implemented (the hybrid polymer model, erratum E5)",
+    ),
+    Equation(
+        4,
+        "§5.1",
+        "Transmission `I_trans = E_trans Col_trans`",
+        "not implemented (the hybrid polymer model, erratum E5)",
+    ),
+    Equation(
+        5,
+        "§5.1",
+        "Reflection `I_s = (E_s M_s + E_mirror (1 − M_s)) gloss`",
+        "implemented as `E_s k_s` (`M_s = 1`, `gloss = 1`)",
+    ),
+    Equation(6, "§6", "Gamma calibration `Y = (G/255)^Gamma · Y_max`"),
+    Equation(7, "§6", "L*-linear calibration `Y = (((G/255)·100 + 16)/116)³ · Y_max`"),
+)
+_FERWERDA = (
+    Equation(
+        1,
+        "§3.4.1–3.4.2",
+        "Display characterization: `XYZ = L_factor(θ,φ) [XYZ_max − XYZ_K] RGB + XYZ_K(θ,φ)`",
+    ),
+    Equation(
+        2,
+        "§3.5.1",
+        "Illuminance `E = Σ_n L_n (N_surf·I_n)(N_light·I_n) (A/P) / d_n²` "
+        "from 32 median-cut lights",
+    ),
+    Equation(3, "§3.5.1", "Diffuse reflection per channel `L_out,j = ρ_d,j S_j E / π`"),
+    Equation(
+        4, "§3.5.2", "Ward–Dür specular BRDF `ρ_s exp(−tan²θ_h/α²) / (4π α² cos θ_i cos θ_r)`"
+    ),
+    Equation(5, "§3.5.4", "Distance to the light plane `d = ((o_TL − p_surf)·n) / (i_world·n)`"),
+    Equation(6, "§3.5.4", "Light intersection point `p_light = d i_world + p_surf`"),
+    Equation(7, "§3.5.4", "Position on the light `p_relative = p_light − o_TL`"),
+    Equation(8, "§3.5.4", "Unit pixel coordinates `(a, b) = pinv([l_A A, l_B B]) p_relative`"),
+)
+
+#: The numbered equations of each paper: the index's source of truth.
+PAPERS = (
+    Paper(
+        "Wang et al.",
+        "C.-M. Wang, J.-R. Chern, J. Lee, An Efficient Spectral Rendering Technique for Phong "
+        "Illumination Model",
+        'Printed as (1)–(16) at the right of each display; the prose calls them "equation (N)".',
+        _WANG,
+    ),
+    Paper(
+        "Herbert et al.",
+        "F. Herbert, J. Kirkenaer, O. Unter Ecker, Achieving a Multi-spectral Virtual Reality "
+        "(2004)",
+        "Printed as (1)–(7) at the right of each display (§5.1 and §6). The prose of §6 calls "
+        'Eq. (7) "equation 2".',
+        _HERBERT,
+    ),
+    Paper(
+        "Ferwerda",
+        "J. A. Ferwerda, ImpastoR: A realistic surface display system, Vision Research 109 (2015)",
+        "The text specref works from was extracted from the PDF and garbles the equations into "
+        "runs of symbols; its parentheses come out as `ð` and `Þ` (`(θ,φ)` reads `ðh;/Þ`), so the "
+        "numbers survive only as the markers `ð1Þ` … `ð8Þ` after each display, in reading order "
+        'from §3.4.1 to §3.5.4. The prose cites the display characterization as "Eq. (1)" twice. '
+        "specref numbers the equations (1)–(8) by those markers, as errata E11–E17 and "
+        "docs/impastor.md do; the symbols are read as in E11 and E13–E16.",
+        _FERWERDA,
+    ),
+)
+
+
+@dataclass(frozen=True)
+class Citation:
+    """One citation found in the code; ``author`` is None for ``Eq. (N)`` without an author."""
+
+    path: str
+    line: int
+    owner: str
+    kind: str
+    author: str | None
+    number: str
+    grouped: bool = False
+    entry: str = ""
+
+
+@dataclass(frozen=True)
+class IndexedFunction:
+    """A function (or class) citing an equation, its registry entries and the tests naming it."""
+
+    name: str
+    registered: tuple[str, ...] = ()
+    grouped_only: bool = False
+    tests: tuple[str, ...] = ()
+    doctest: bool = False
+
+
+@dataclass(frozen=True)
+class EquationRow:
+    """One row of the index: an equation of a paper and what implements, tests and corrects it."""
+
+    author: str
+    number: int
+    section: str
+    what: str
+    note: str
+    functions: tuple[IndexedFunction, ...] = ()
+    errata: tuple[str, ...] = ()
+
+
+# --- reading citations -----------------------------------------------------------------------
+
+_NUMBER = r"\((\d+(?:\.\d+)?)\)"
+_ONE = rf"Eqs?\.\s*{_NUMBER}(?:\s*[-–]\s*{_NUMBER})?"
+_MORE = r"(?:\s*,\s*and\s+|\s*,\s*|\s+and\s+)(?:Eqs?\.\s*)?\(\d+\)(?:\s*[-–]\s*\(\d+\))?"
+_EXTERNAL = r"[A-Z][\w\-]+(?: (?:&|and) [A-Z][\w\-]+)?(?: et al\.)? \d{4}"
+_PAPER_AUTHORS = "|".join(re.escape(p.author) for p in PAPERS)
+_CHAIN = re.compile(rf"{_ONE}(?:{_MORE})*(?:,\s*(?P<author>{_PAPER_AUTHORS}|{_EXTERNAL}))?")
+_PART = re.compile(r"\((\d+(?:\.\d+)?)\)(?:\s*[-–]\s*\((\d+)\))?")
+
+
+def _parse(text: str) -> list[tuple[str | None, str, bool]]:
+    """``(author, number, grouped)`` for each equation cited in ``text`` (whitespace-normalized).
+
+    ``grouped`` marks an equation cited in a range or a list that shares one author, which a grep
+    for ``Eq. (N), Author`` does not find.
+
+    Examples
+    --------
+    >>> _parse("Eq. (11), Wang et al.; Eqs. (5)-(6), Ferwerda; Eq. (3)")
+    [('Wang et al.', '11', False), ('Ferwerda', '5', True), ('Ferwerda', '6', True),
+     (None, '3', False)]
+    """
+    found = []
+    for match in _CHAIN.finditer(re.sub(r"\s+", " ", text)):
+        author = match.group("author")
+        chain = (
+            match.group(0)[: match.start("author") - match.start()] if author else match.group(0)
+        )
+        numbers = []
+        for part in _PART.finditer(chain):
+            first, last = part.group(1), part.group(2)
+            if last is None or "." in first:
+                numbers.append(first)
+            else:
+                numbers += [str(n) for n in range(int(first), int(last) + 1)]
+        found += [(author, number, len(numbers) > 1) for number in numbers]
+    return found
+
+
+def _without_doctests(doc: str) -> str:
+    """A docstring without its doctest lines (a doctest is code, not a citation)."""
+    return "\n".join(s for s in doc.splitlines() if not s.lstrip().startswith((">>>", "...")))
+
+
+class _Owners(ast.NodeVisitor):
+    """Maps each line to the outermost importable function or class around it (``""``: module)."""
+
+    def __init__(self):
+        self.stack, self.spans, self.texts = [], [], []
+
+    def _scope(self, node):
+        kind = "class" if isinstance(node, ast.ClassDef) else "function"
+        top = self.stack[-1] if self.stack else ("", "module")
+        dunder = node.name.startswith("__") and node.name.endswith("__")
+        if top[1] == "function" or (top[1] == "class" and dunder):  # belongs to the outer scope
+            owner = top[0]
+        else:
+            owner = ".".join([s[0] for s in self.stack[-1:]] + [node.name])
+        self.spans.append((node.lineno, node.end_lineno, owner, len(self.stack)))
+        doc = ast.get_docstring(node)
+        if doc:
+            self.texts.append((node.body[0].lineno, owner, "docstring", doc))
+        self.stack.append((owner, kind))
+        self.generic_visit(node)
+        self.stack.pop()
+
+    visit_FunctionDef = visit_AsyncFunctionDef = visit_ClassDef = _scope
+
+    def visit_Constant(self, node):
+        if isinstance(node.value, str) and "Eq" in node.value:
+            self.texts.append((node.lineno, None, "string", node.value))
+
+    def owner(self, line: int) -> str:
+        """The owner of ``line``: the innermost scope's (``""`` at module level)."""
+        spans = [s for s in self.spans if s[0] <= line <= s[1]]
+        return max(spans, key=lambda s: s[3])[2] if spans else ""
+
+
+def _comment_blocks(source: str) -> list[tuple[int, str]]:
+    """Consecutive comment lines joined into one text each, with the first line's number."""
+    blocks: list[tuple[int, str]] = []
+    last = -2
+    for token in tokenize.generate_tokens(io.StringIO(source).readline):
+        if token.type != tokenize.COMMENT:
+            continue
+        line, text = token.start[0], token.string.lstrip("#").strip()
+        if line == last + 1 and blocks:
+            blocks[-1] = (blocks[-1][0], blocks[-1][1] + " " + text)
+        else:
+            blocks.append((line, text))
+        last = line
+    return blocks
+
+
+def _file_citations(path: Path, root: Path) -> list[Citation]:
+    """The citations in one source file: docstrings, other string constants and comments."""
+    source = path.read_text(encoding="utf-8")
+    tree = ast.parse(source)
+    relative = path.relative_to(root).as_posix()
+    module = relative[:-3].replace("/", ".").removesuffix(".__init__")
+    owners = _Owners()
+    owners.visit(tree)
+    docstrings = {id(n.body[0].value) for n in ast.walk(tree) if _has_docstring(n)}
+    texts = [(t[0], t[1], t[2], _without_doctests(t[3])) for t in owners.texts]
+    texts = [
+        t for t in texts if t[2] == "docstring" or not _is_docstring_at(tree, t[0], docstrings)
+    ]
+    module_doc = ast.get_docstring(tree)
+    if module_doc:
+        texts.append((1, "", "docstring", _without_doctests(module_doc)))
+    texts += [(line, None, "comment", text) for line, text in _comment_blocks(source)]
+    found = []
+    for line, owner, kind, text in texts:
+        owner = owners.owner(line) if owner is None else owner
+        name = f"{module}.{owner}" if owner else module
+        for author, number, grouped in _parse(text):
+            found.append(Citation(relative, line, name, kind, author, number, grouped))
+    return found
+
+
+def _has_docstring(node) -> bool:
+    return (
+        isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef))
+        and ast.get_docstring(node) is not None
+    )
+
+
+def _is_docstring_at(tree, line: int, docstrings: set) -> bool:
+    """Whether the string constant starting at ``line`` is a docstring (already read as one)."""
+    return any(
+        isinstance(n, ast.Constant) and n.lineno == line and id(n) in docstrings
+        for n in ast.walk(tree)
+    )
+
+
+def _modules(packages):
+    for package in packages:
+        module = importlib.import_module(package)
+        yield module
+        for info in pkgutil.walk_packages(module.__path__, prefix=f"{package}."):
+            if not info.name.endswith(".__main__"):
+                yield importlib.import_module(info.name)
+
+
+def _qualified(obj) -> str | None:
+    """``module.qualname`` of a function or class, or None (a lambda, a partial, a local)."""
+    module, qualname = getattr(obj, "__module__", None), getattr(obj, "__qualname__", None)
+    if not module or not qualname or "<" in qualname:
+        return None
+    return f"{module}.{qualname}"
+
+
+def _registry_homes(root: Path, packages) -> dict[str, str]:
+    """``NAME -> module`` for each module-level ``NAME = Registry(...)`` in the sources."""
+    homes = {}
+    for package in packages:
+        for path in sorted((root / package).rglob("*.py")):
+            for node in ast.parse(path.read_text(encoding="utf-8")).body:
+                if (
+                    isinstance(node, ast.Assign)
+                    and isinstance(node.value, ast.Call)
+                    and ast.unparse(node.value.func).endswith("Registry")
+                ):
+                    module = path.relative_to(root).as_posix()[:-3].replace("/", ".")
+                    for target in node.targets:
+                        homes[ast.unparse(target)] = module.removesuffix(".__init__")
+    return homes
+
+
+@functools.lru_cache(maxsize=4)
+def _registry_citations(root: Path, packages) -> tuple[list[Citation], dict[str, set[str]]]:
+    """Citations in registry entries' ``cites``, and ``function -> {registry names}``."""
+    homes = _registry_homes(root, packages)
+    seen, found, registered = set(), [], defaultdict(set)
+    modules = list(_modules(packages))  # all imported first: importing one can register in another
+    for module in modules:
+        for var, registry in vars(module).items():
+            if not isinstance(registry, Registry) or id(registry) in seen:
+                continue
+            if homes.get(var) != module.__name__:
+                continue
+            seen.add(id(registry))
+            for key, entry in registry.items():
+                where = f"{module.__name__}.{var}[{key!r}]"
+                targets = [getattr(entry, a, None) for a in ("reference", "cls", "kernel")]
+                names = [n for n in map(_qualified, targets) if n]
+                for name in names:
+                    registered[name].add(f"{var}[{key!r}]")
+                path = module.__name__.replace(".", "/") + ".py"
+                for author, number, grouped in _parse(getattr(entry, "cites", "") or ""):
+                    for name in names or [where]:
+                        found.append(
+                            Citation(path, 0, name, "registry", author, number, grouped, where)
+                        )
+    return found, registered
+
+
+def collect_citations(root: Path | None = None, packages=PACKAGES) -> list[Citation]:
+    """Every equation citation in the code of ``packages``, sorted by file and line.
+
+    Parameters
+    ----------
+    root : Path, optional
+        The repository root (default: the one this module is in).
+    packages : tuple of str
+        Top-level packages to read.
+
+    Returns
+    -------
+    list of Citation
+        With ``author=None`` for an ``Eq. (N)`` that names no author.
+
+    Examples
+    --------
+    >>> cites = collect_citations(packages=("phong_table",))
+    >>> any(c.owner == "phong_table.placement.importance_ratio_Wang" and c.number == "14"
+    ...     for c in cites)
+    True
+    """
+    root = ROOT if root is None else Path(root)
+    found = []
+    for package in packages:
+        for path in sorted((root / package).rglob("*.py")):
+            if path.relative_to(root).as_posix() != _DATA:  # the index's data, not citations
+                found += _file_citations(path, root)
+    found += _registry_citations(root, packages)[0]
+    return sorted(set(found), key=lambda c: (c.path, c.line, c.owner, c.number))
+
+
+# --- tests and errata --------------------------------------------------------------------------
+
+
+def _names(node) -> set[str]:
+    """The names and attribute names used anywhere in ``node``."""
+    names = {n.id for n in ast.walk(node) if isinstance(n, ast.Name)}
+    return names | {n.attr for n in ast.walk(node) if isinstance(n, ast.Attribute)}
+
+
+@dataclass(frozen=True)
+class _Test:
+    """A test function: names its body and decorators use, its strings, its file's imports."""
+
+    id: str
+    names: frozenset
+    decorators: frozenset
+    strings: frozenset
+    modules: frozenset  # modules the file imports (``import a.b``, ``from a import b`` if a module)
+    imported: tuple  # ``(name, from module)`` of the file's ``from ... import`` statements
+
+
+def _test_names(root: Path) -> list[_Test]:
+    """Every test function under ``tests/``."""
+    tests = []
+    for path in sorted((root / "tests").rglob("test_*.py")):
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        modules, imported = set(), set()
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Import):
+                modules |= {a.name for a in node.names}
+            elif isinstance(node, ast.ImportFrom) and node.module:
+                modules.add(node.module)
+                modules |= {f"{node.module}.{a.name}" for a in node.names}
+                imported |= {(a.name, node.module) for a in node.names}
+        functions = [(n, "") for n in tree.body if isinstance(n, ast.FunctionDef)]
+        for cls in (n for n in tree.body if isinstance(n, ast.ClassDef)):
+            functions += [(n, f"{cls.name}::") for n in cls.body if isinstance(n, ast.FunctionDef)]
+        for node, prefix in functions:
+            if node.name.startswith("test"):
+                strings = {
+                    n.value for n in ast.walk(node) if isinstance(n, ast.Constant) and n.value
+                }
+                tests.append(
+                    _Test(
+                        f"{path.relative_to(root).as_posix()}::{prefix}{node.name}",
+                        frozenset(_names(node)),
+                        frozenset().union(*(_names(d) for d in node.decorator_list)),
+                        frozenset(v for v in strings if isinstance(v, str)),
+                        frozenset(modules),
+                        tuple(sorted(imported)),
+                    )
+                )
+    return tests
+
+
+def _split(name: str) -> tuple[str, str]:
+    """``(module, qualname)`` of a dotted name: the longest prefix that is a module."""
+    parts = name.split(".")
+    for split in range(len(parts) - 1, 0, -1):
+        module = ".".join(parts[:split])
+        try:
+            if importlib.util.find_spec(module) is not None:
+                return module, ".".join(parts[split:])
+        except (ImportError, ValueError):
+            continue
+    return "", name
+
+
+def _names_function(test: _Test, module: str, qualname: str) -> bool:
+    """Whether ``test`` names the function ``module.qualname`` and its file imports it."""
+    first, short = qualname.split(".")[0], qualname.split(".")[-1]
+    if short not in test.names:
+        return False
+    package = module.split(".")[0]
+    return any(m in (module, package) for m in test.modules) or any(
+        name == first and module.startswith(source) for name, source in test.imported
+    )
+
+
+def _tests_of(name: str, registries: set[str], tests: list[_Test]) -> tuple[str, ...]:
+    """Tests naming the function (its module's test file first), then its registry entries' tests.
+
+    An entry's tests are parametrized over the registry, or name the registry and the entry's key.
+    """
+    module, qualname = _split(name)
+    short = qualname.split(".")[-1]
+    mirror = "tests/" + "/".join(module.split(".")[:-1]) + f"/test_{module.split('.')[-1]}.py::"
+    mirror = mirror.replace("test__", "test_")
+    direct = [t.id for t in tests if _names_function(t, module, qualname)]
+    direct.sort(key=lambda t: (not t.startswith(mirror), short not in t, t))
+    entries = [(r.split("[")[0], r.split("[")[1][1:-2]) for r in registries]
+    via = [
+        t.id
+        for t in tests
+        for registry, key in entries
+        if registry in t.decorators or (registry in t.names and key in t.strings)
+    ]
+    return tuple(dict.fromkeys(direct + sorted(via)))
+
+
+def _errata(root: Path) -> dict[tuple[str, str], set[str]]:
+    """``(author, number) -> {"E<k>"}`` from the bold titles of ``docs/errata.md``."""
+    found: dict[tuple[str, str], set[str]] = defaultdict(set)
+    section_author = None
+    for line in (root / "docs" / "errata.md").read_text(encoding="utf-8").splitlines():
+        if line.startswith("## "):
+            section_author = next(
+                (p.author for p in PAPERS if line[3:].startswith(p.author.split()[0])), None
+            )
+        title = re.match(r"- \*\*(E\d+)\. (.*?)\*\*", line)
+        if title:
+            for author, number, _ in _parse(title.group(2)):
+                if author or section_author:
+                    found[(author or section_author, number)].add(title.group(1))
+    return found
+
+
+# --- the index ---------------------------------------------------------------------------------
+
+
+def _is_function(c: Citation) -> bool:
+    """Whether the citation belongs to a function or class (module docstrings are not indexed)."""
+    module = c.path[:-3].replace("/", ".").removesuffix(".__init__")
+    return "[" not in c.owner and c.owner != module
+
+
+def equation_index(root: Path | None = None, citations=None) -> list[EquationRow]:
+    """One row per numbered equation of each paper, in :data:`PAPERS` order.
+
+    Parameters
+    ----------
+    root : Path, optional
+        The repository root (default: the one this module is in).
+    citations : list of Citation, optional
+        Default :func:`collect_citations` (tests pass their own).
+
+    Returns
+    -------
+    list of EquationRow
+        The functions (and classes) citing the equation, each with its registry entries and the
+        tests that name it, and the errata whose title cites the equation.
+
+    Examples
+    --------
+    >>> rows = {(r.author, r.number): r for r in equation_index()}
+    >>> [f.name for f in rows["Wang et al.", 15].functions]
+    ['phong_table.placement.inverse_importance_ratio_Wang',
+     'phong_table.placement.table_importance_Wang']
+    >>> rows["Herbert et al.", 3].functions, rows["Herbert et al.", 3].errata
+    ((), ())
+    """
+    root = ROOT if root is None else Path(root)
+    require((root / "tests").is_dir(), f"equation index: no tests/ folder in {root}")
+    citations = collect_citations(root) if citations is None else citations
+    registered = _registry_citations(root, PACKAGES)[1]
+    tests, errata = _test_names(root), _errata(root)
+    # (author, number) -> {owner: cited only inside ranges}
+    owners: dict[tuple[str, str], dict[str, bool]] = defaultdict(dict)
+    for c in citations:
+        if c.author and _is_function(c):
+            seen = owners[(c.author, c.number)]
+            seen[c.owner] = seen.get(c.owner, True) and c.grouped
+    rows = []
+    for paper in PAPERS:
+        for eq in paper.equations:
+            key = (paper.author, str(eq.number))
+            functions = tuple(
+                IndexedFunction(
+                    name,
+                    tuple(sorted(registered.get(name, ()))),
+                    only_range,
+                    _tests_of(name, registered.get(name, set()), tests),
+                    ">>>" in (getattr(_resolve(name), "__doc__", None) or ""),
+                )
+                for name, only_range in sorted(owners.get(key, {}).items())
+            )
+            found = tuple(sorted(errata.get(key, ()), key=lambda e: int(e[1:])))
+            rows.append(
+                EquationRow(*key[:1], eq.number, eq.section, eq.what, eq.note, functions, found)
+            )
+    return rows
+
+
+def _resolve(name: str):
+    """The object named ``package.module.Qual.name``, or None if it cannot be imported."""
+    module, qualname = _split(name)
+    try:
+        obj = importlib.import_module(module)
+        for attr in qualname.split("."):
+            obj = getattr(obj, attr)
+    except (ImportError, AttributeError, ValueError):
+        return None
+    return obj
+
+
+def equation_problems(citations=None, rows=None) -> list[str]:
+    """What breaks the index, one line each (an empty list when the code and the index agree).
+
+    - a citation of an equation that its paper does not have;
+    - ``Eq. (N)`` without an author (STYLE.md §5: one grep must find each equation);
+    - a range in a comment (STYLE.md §5: comments name one equation each);
+    - an equation that functions cite only inside ranges;
+    - a function in the index that cannot be imported.
+
+    Parameters
+    ----------
+    citations : list of Citation, optional
+        Default :func:`collect_citations`.
+    rows : list of EquationRow, optional
+        Default :func:`equation_index` of ``citations``.
+
+    Examples
+    --------
+    >>> equation_problems([Citation("x.py", 3, "x.f", "comment", "Wang et al.", "17")], rows=[])
+    ['x.py:3: x.f cites Eq. (17), Wang et al., which the paper does not have (it has (1)-(16))']
+    """
+    citations = collect_citations() if citations is None else citations
+    rows = equation_index(citations=citations) if rows is None else rows
+    papers = {p.author: p for p in PAPERS}
+    problems, bare, grouped = [], defaultdict(list), defaultdict(list)
+    for c in citations:
+        where = f"{c.path}:{c.line}: {c.owner}" if c.line else f"{c.path}: {c.entry or c.owner}"
+        numbers = [str(e.number) for e in papers[c.author].equations] if c.author in papers else []
+        if numbers and c.number not in numbers:
+            problems.append(
+                f"{where} cites Eq. ({c.number}), {c.author}, which the paper does not have "
+                f"(it has (1)-({numbers[-1]}))"
+            )
+        if c.author is None:
+            bare[where].append(c.number)
+        elif c.grouped and c.kind == "comment":
+            grouped[where].append(c.number)
+    problems += [
+        f"{where} mentions {_numbers(n)} without an author (write `Eq. (N), Author`)"
+        for where, n in bare.items()
+    ]
+    problems += [
+        f"{where}: a comment cites {_numbers(n)} as a range or list (cite each `Eq. (N), Author`)"
+        for where, n in grouped.items()
+    ]
+    for row in rows:
+        if row.functions and all(f.grouped_only for f in row.functions):
+            problems.append(
+                f"Eq. ({row.number}), {row.author} is cited only in ranges or lists "
+                f"(by {', '.join(f.name for f in row.functions)}); cite it on its own"
+            )
+        problems += [
+            f"Eq. ({row.number}), {row.author}: {f.name} does not exist (not importable)"
+            for f in row.functions
+            if _resolve(f.name) is None
+        ]
+    return sorted(set(problems))
+
+
+def _numbers(numbers: list[str]) -> str:
+    return ", ".join(f"Eq. ({n})" for n in dict.fromkeys(numbers))
+
+
+# --- Markdown ----------------------------------------------------------------------------------
+
+
+def _cell(function: IndexedFunction) -> str:
+    """One function of a row: name, registry entries, the first test naming it."""
+    text = f"`{function.name}`"
+    if function.registered:
+        text += " (" + ", ".join(f"`{r}`" for r in function.registered) + ")"
+    if function.grouped_only:
+        text += ", only in a range or list"
+    if function.tests:
+        more = len(function.tests) - 1
+        text += f"; tested by `{function.tests[0]}`" + (f" and {more} more" if more else "")
+    else:
+        text += "; no test names it" + (" (its doctest runs)" if function.doctest else "")
+    return text
+
+
+def _row_markdown(row: EquationRow) -> list[str]:
+    lines = [f"### Eq. ({row.number}), {row.author}", "", f"{row.section}. {row.what}.", ""]
+    if row.note:
+        lines += [f"*{row.note[0].upper()}{row.note[1:]}.*", ""]
+    if row.functions:
+        lines += [f"- {_cell(f)}" for f in row.functions]
+    else:
+        lines += ["- No function cites it."]
+    if row.errata:
+        lines += [f"- Errata: {', '.join(row.errata)} (docs/errata.md)."]
+    return [*lines, ""]
+
+
+def _external(citations) -> list[str]:
+    """The table of cited external equations: source, equation, functions."""
+    papers = {p.author for p in PAPERS}
+    cited: dict[tuple[str, str], set[str]] = defaultdict(set)
+    for c in citations:
+        if c.author and c.author not in papers and _is_function(c):
+            cited[(c.author, c.number)].add(c.owner)
+    lines = ["| source | equation | functions |", "|---|---|---|"]
+    for (author, number), owners in sorted(
+        cited.items(), key=lambda kv: (kv[0][0], [int(x) for x in kv[0][1].split(".")])
+    ):
+        names = ", ".join(f"`{o}`" for o in sorted(owners))
+        lines.append(f"| {author} | Eq. ({number}) | {names} |")
+    return lines
+
+
+def render_equation_index(root: Path | None = None, citations=None) -> str:
+    """``docs/equations.md``: the summary table, then each paper's equations, then the others.
+
+    Examples
+    --------
+    >>> text = render_equation_index()
+    >>> text.splitlines()[0], "### Eq. (12), Wang et al." in text
+    ('# Equation index', True)
+    """
+    root = ROOT if root is None else Path(root)
+    citations = collect_citations(root) if citations is None else citations
+    rows = equation_index(root, citations)
+    lines = [
+        "# Equation index",
+        "",
+        f"Generated by `{REGENERATE}` (`specref equations -o docs/equations.md`) from",
+        "`validation/equations.py`; do not edit by hand. `tests/validation/test_equations.py`",
+        "fails when this page is out of date, when code cites an equation that a paper does not",
+        "have or cites one without an author, and when a function named here does not exist.",
+        "For each numbered equation of each paper: the functions and classes whose docstring,",
+        "comments or registry entry cite it (`Eq. (N), Author`), the first test that names each",
+        "one, and the errata whose title cites the equation.",
+        "",
+        "| paper | Eq. | § | functions | errata | note |",
+        "|---|---|---|---|---|---|",
+    ]
+    for row in rows:
+        lines.append(
+            f"| {row.author} | ({row.number}) | {row.section} | {len(row.functions) or 'none'} | "
+            f"{', '.join(row.errata)} | {row.note} |"
+        )
+    for paper in PAPERS:
+        lines += ["", f"## {paper.author}: {paper.title}", "", f"Numbering: {paper.numbering}", ""]
+        for row in (r for r in rows if r.author == paper.author):
+            lines += _row_markdown(row)
+    lines += [
+        "## Cited external equations",
+        "",
+        "Equations of other sources that the code cites, with the functions citing them; their",
+        "numbers are not checked.",
+        "",
+        *_external(citations),
+    ]
+    problems = equation_problems(citations, rows)
+    if problems:
+        lines += ["", "## Problems", "", *[f"- {p}" for p in problems]]
+    return "\n".join(lines) + "\n"
