@@ -612,9 +612,13 @@ def _errata(root: Path) -> dict[tuple[str, str], set[str]]:
 
 
 def _is_function(c: Citation) -> bool:
-    """Whether the citation belongs to a function or class (module docstrings are not indexed)."""
+    """Whether the citation is a function's or class's docstring, comment or registry entry.
+
+    Module docstrings and other string constants (labels, ``Method(...)`` arguments, which the
+    registries give) are checked but not indexed.
+    """
     module = c.path[:-3].replace("/", ".").removesuffix(".__init__")
-    return "[" not in c.owner and c.owner != module
+    return c.kind != "string" and "[" not in c.owner and c.owner != module
 
 
 def equation_index(root: Path | None = None, citations=None) -> list[EquationRow]:
