@@ -309,8 +309,8 @@ def _without_doctests(doc: str) -> str:
 class _Owners(ast.NodeVisitor):
     """Maps each line to the outermost importable function or class around it (``""``: module)."""
 
-    def __init__(self):
-        self.stack, self.spans, self.texts = [], [], []
+    def __init__(self, docstrings: set[int]):
+        self.docstrings, self.stack, self.spans, self.texts = docstrings, [], [], []
 
     def _scope(self, node):
         kind = "class" if isinstance(node, ast.ClassDef) else "function"
@@ -331,7 +331,7 @@ class _Owners(ast.NodeVisitor):
     visit_FunctionDef = visit_AsyncFunctionDef = visit_ClassDef = _scope
 
     def visit_Constant(self, node):
-        if isinstance(node.value, str) and "Eq" in node.value:
+        if isinstance(node.value, str) and "Eq" in node.value and id(node) not in self.docstrings:
             self.texts.append((node.lineno, None, "string", node.value))
 
     def owner(self, line: int) -> str:
@@ -362,13 +362,9 @@ def _file_citations(path: Path, root: Path) -> list[Citation]:
     tree = ast.parse(source)
     relative = path.relative_to(root).as_posix()
     module = relative[:-3].replace("/", ".").removesuffix(".__init__")
-    owners = _Owners()
+    owners = _Owners({id(n.body[0].value) for n in ast.walk(tree) if _has_docstring(n)})
     owners.visit(tree)
-    docstrings = {id(n.body[0].value) for n in ast.walk(tree) if _has_docstring(n)}
     texts = [(t[0], t[1], t[2], _without_doctests(t[3])) for t in owners.texts]
-    texts = [
-        t for t in texts if t[2] == "docstring" or not _is_docstring_at(tree, t[0], docstrings)
-    ]
     module_doc = ast.get_docstring(tree)
     if module_doc:
         texts.append((1, "", "docstring", _without_doctests(module_doc)))
@@ -389,14 +385,6 @@ def _has_docstring(node) -> bool:
     )
 
 
-def _is_docstring_at(tree, line: int, docstrings: set) -> bool:
-    """Whether the string constant starting at ``line`` is a docstring (already read as one)."""
-    return any(
-        isinstance(n, ast.Constant) and n.lineno == line and id(n) in docstrings
-        for n in ast.walk(tree)
-    )
-
-
 def _modules(packages):
     for package in packages:
         module = importlib.import_module(package)
@@ -414,9 +402,9 @@ def _qualified(obj) -> str | None:
     return f"{module}.{qualname}"
 
 
-def _registry_homes(root: Path, packages) -> dict[str, str]:
-    """``NAME -> module`` for each module-level ``NAME = Registry(...)`` in the sources."""
-    homes = {}
+def _registry_homes(root: Path, packages) -> dict[str, set[str]]:
+    """``NAME -> {modules}`` for each module-level ``NAME = Registry(...)`` in the sources."""
+    homes = defaultdict(set)
     for package in packages:
         for path in sorted((root / package).rglob("*.py")):
             for node in ast.parse(path.read_text(encoding="utf-8")).body:
@@ -427,7 +415,7 @@ def _registry_homes(root: Path, packages) -> dict[str, str]:
                 ):
                     module = path.relative_to(root).as_posix()[:-3].replace("/", ".")
                     for target in node.targets:
-                        homes[ast.unparse(target)] = module.removesuffix(".__init__")
+                        homes[ast.unparse(target)].add(module.removesuffix(".__init__"))
     return homes
 
 
@@ -441,7 +429,7 @@ def _registry_citations(root: Path, packages) -> tuple[list[Citation], dict[str,
         for var, registry in vars(module).items():
             if not isinstance(registry, Registry) or id(registry) in seen:
                 continue
-            if homes.get(var) != module.__name__:
+            if module.__name__ not in homes.get(var, ()):
                 continue
             seen.add(id(registry))
             for key, entry in registry.items():
