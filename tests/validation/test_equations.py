@@ -118,11 +118,12 @@ def test_ranges_and_lists_are_expanded_and_flagged(tmp_path, monkeypatch):
     assert [p.split(",")[0] for p in only] == ["Eq. (12)", "Eq. (14)"]
 
 
-def test_checker_catches_a_fake_citation_and_an_author_missing(citations, rows):
+def test_checker_catches_a_fake_citation_and_a_missing_or_unknown_author(citations, rows):
     fake = [
         Citation("phong_table/model.py", 7, "phong_table.model.f", "comment", "Wang et al.", "17"),
         Citation("shrm/sh.py", 9, "shrm.sh.g", "docstring", "Herbert et al.", "8"),
         Citation("impastor/horizon.py", 3, "impastor.horizon.h", "comment", None, "4"),
+        Citation("shrm/sh.py", 11, "shrm.sh.k", "comment", "Herbert", "2"),
     ]
     baseline = set(equation_problems(citations, list(rows.values())))
     problems = [p for p in equation_problems([*citations, *fake], list(rows.values()))
@@ -132,6 +133,8 @@ def test_checker_catches_a_fake_citation_and_an_author_missing(citations, rows):
         "(write `Eq. (N), Author`)",
         "phong_table/model.py:7: phong_table.model.f cites Eq. (17), Wang et al., which the paper "
         "does not have (it has (1)-(16))",
+        "shrm/sh.py:11: shrm.sh.k cites Eq. (2), Herbert: not a paper of the index "
+        "(Wang et al., Herbert et al., Ferwerda), nor a source with a year",
         "shrm/sh.py:9: shrm.sh.g cites Eq. (8), Herbert et al., which the paper does not have "
         "(it has (1)-(7))",
     ]
