@@ -110,7 +110,7 @@ _WANG = (
         8,
         "§3.2",
         "`X_sp, Y_sp, Z_sp`: the specular part of Eq. (7)",
-        "tabulated in XYZ by the scene shader of Eq. (11)",
+        "computed as Eq. (11) in XYZ, without `f_att` (erratum E18)",
     ),
     Equation(9, "§3.2", "The spectra-to-RGB matrix: CMFs times XYZtoRGB"),
     Equation(
