@@ -297,7 +297,7 @@ def equation_index(root: Path | None = None, citations=None) -> list[EquationRow
     citations = collect_citations(root) if citations is None else citations
     registered = registry_entries(root)
     tests, errata = read_tests(root), _errata(root)
-    # (author, number) -> {owner: cited only inside ranges}
+    # (author, number) -> {owner: cited only in ranges or lists}
     owners: dict[tuple[str, str], dict[str, bool]] = defaultdict(dict)
     for c in citations:
         if c.author and _is_function(c):
@@ -311,15 +311,15 @@ def equation_index(root: Path | None = None, citations=None) -> list[EquationRow
                 IndexedFunction(
                     name,
                     tuple(sorted(registered.get(name, ()))),
-                    only_range,
+                    grouped_only,
                     naming_tests(name, registered.get(name, set()), tests),
                     ">>>" in (getattr(resolve(name), "__doc__", None) or ""),
                 )
-                for name, only_range in sorted(owners.get(key, {}).items())
+                for name, grouped_only in sorted(owners.get(key, {}).items())
             )
             found = tuple(sorted(errata.get(key, ()), key=lambda e: int(e[1:])))
             rows.append(
-                EquationRow(*key[:1], eq.number, eq.section, eq.what, eq.note, functions, found)
+                EquationRow(paper.author, eq.number, eq.section, eq.what, eq.note, functions, found)
             )
     return rows
 
