@@ -11,7 +11,7 @@ export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 export MPLBACKEND ?= Agg
 
-.PHONY: install demo test bench bench-json results coverage lint clean
+.PHONY: install demo test bench bench-json results equations coverage lint clean
 
 $(STAMP): setup.cfg pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -42,6 +42,10 @@ bench: bench-json
 results: bench-json
 	$(VENV)/bin/specref report --out docs/results --bench bench.json \
 		--markdown docs/results.md --markdown-image-prefix results/
+
+## make equations: regenerate docs/equations.md, the equation index (tests/validation/test_equations.py)
+equations: $(STAMP)
+	$(VENV)/bin/specref equations -o docs/equations.md
 
 ## make coverage: the suite once with the JIT off, so kernel bodies count as Python
 coverage: $(STAMP)

@@ -11,7 +11,7 @@ modules hold the equations (``docs/impastor.md`` walks through the pipeline). Th
 - :mod:`impastor.point_lights`: median cut and variance minimization (``LIGHT_SAMPLING_METHODS``),
   the point lights of Eq. (2), Ferwerda.
 - :mod:`impastor.specular_lighting`: the Ward–Dür lobe (Eq. (4), Ferwerda) lit by point lights,
-  filtered importance sampling (Eqs. (5)-(8)) and the brute-force integral.
+  filtered importance sampling (Eqs. (5)-(8), Ferwerda) and the brute-force integral.
 - :mod:`impastor.specular_hybrid`: the per-pixel hybrid of point lights and FIS
   (``SPECULAR_METHODS``).
 - :mod:`impastor.horizon`: normal maps, horizon maps and ray-marched shadows (``HORIZON_METHODS``).

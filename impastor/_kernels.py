@@ -128,7 +128,7 @@ def specular_fis_kernel(
             ) / denom
             if d <= 0.0:
                 continue
-            # Eq. (6) and Eq. (7), Ferwerda: the hit point relative to o_TL
+            # Eq. (6), Ferwerda, then Eq. (7), Ferwerda: the hit point relative to o_TL
             r0 = d * wi[0] + P[p, 0] - origin[0]
             r1 = d * wi[1] + P[p, 1] - origin[1]
             r2 = d * wi[2] + P[p, 2] - origin[2]

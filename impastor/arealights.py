@@ -11,7 +11,8 @@ Plane lights (Fig. 7, Ferwerda). The rectangle has its top-left corner ``o_TL``,
 ``(j, i)`` of an ``H × W`` image is centred at ``o_TL + (i + ½)/W·l_A A + (j + ½)/H·l_B B``; every
 pixel has area ``A/P = l_A l_B / (H W)``. The light emits from the side of ``n_light = A × B``
 (for a ceiling with A = +x and B = +z this is −y, downwards). Pixel values are luminance (cd/m²)
-or any per-channel radiance ``(H, W, C)``; the light's spectrum is applied separately (Eq. (3)).
+or any per-channel radiance ``(H, W, C)``; the light's spectrum is applied separately (Eq. (3),
+Ferwerda).
 
 Lat-long lights follow ``reference.envmap``'s convention (see ``impastor.point_lights``).
 
@@ -208,7 +209,7 @@ def booth_light_image(kind: str = "fluorescent", width: int = 128, height: int =
     return image
 
 
-# --- Eqs. (5)-(8): where a direction meets the light plane ---------------------------------------
+# --- the light-plane lookup: where a direction meets the light plane ----------------------------
 
 
 def light_plane_uv(light: PlaneLight, points, directions):

@@ -437,7 +437,7 @@ def point_lights_from_latlong(image, method: str = "median_cut", n_lights: int =
     )
 
 
-# --- Eqs. (2)-(3): diffuse illuminance from point lights -----------------------------------------
+# --- diffuse illuminance and reflection from point lights ----------------------------------------
 
 
 def illuminance_point_lights(points, normals, lights: PointLights, visibility=None) -> np.ndarray:

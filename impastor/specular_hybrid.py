@@ -418,7 +418,7 @@ SPECULAR_METHODS.register(
         "fis",
         specular_fis,
         specular_fis_kernel,
-        "Eq. (4), Ferwerda (FIS with the lookup of Eqs. (5)-(8))",
+        "Eq. (4), Ferwerda (FIS with the lookup of Eqs. (5)-(8), Ferwerda)",
         _example_scene,
         extra={"call": _call_fis},
     )

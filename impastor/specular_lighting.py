@@ -310,7 +310,7 @@ def specular_fis(
             wi = 2.0 * v_h[:, None] * h - V
             cos_i = np.einsum("pi,pi->p", wi, N)
             pdf = pdf_ward_duer_lobe(V, wi, N, a)
-            # Eqs. (5)-(8), Ferwerda: where ω_i meets the light, in unit pixel coordinates
+            # The light lookup (light_plane_uv): where ω_i meets the light, in unit pixel coords
             a_uv, b_uv, d = light_plane_uv(light, P, wi)
             hit = (cos_i > 0) & (v_h > 0) & np.isfinite(d)
             hit &= (a_uv >= 0) & (a_uv < 1) & (b_uv >= 0) & (b_uv < 1)

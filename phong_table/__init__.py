@@ -4,7 +4,7 @@ Users write ``phong_table.SpectralPhong``, ``phong_table.build_table`` and
 ``phong_table.render_sphere``; the modules hold the equations (``docs/phong-tables.md`` teaches the
 method).
 
-- :mod:`phong_table.model`: Eq. (7) diffuse RGB and Eq. (11) specular functions, Wang et al.
+- :mod:`phong_table.model`: diffuse RGB and specular functions, Eqs. (7) and (11), Wang et al.
 - :mod:`phong_table.placement`: ``PLACEMENT_METHODS`` (importance, uniform, error).
 - :mod:`phong_table.interpolation`: ``INTERPOLATION_METHODS`` (parabolic, parabolic_w, linear,
   monotone).

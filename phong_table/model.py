@@ -1,4 +1,4 @@
-"""The spectral Phong model in display RGB: Eq. (7) diffuse RGB, Eq. (11) specular functions.
+"""The spectral Phong model in display RGB: diffuse RGB, specular functions (Wang et al.).
 
 Wang et al. render one material under one point light. Everything that does not depend on the pixel
 is folded into a few RGB vectors once per edit (:class:`SpectralPhong`):
@@ -9,16 +9,17 @@ is folded into a few RGB vectors once per edit (:class:`SpectralPhong`):
   ``f_att cos θ``;
 - the specular functions ``[f_rsp(t), f_gsp(t), f_bsp(t)] = Σ_λ I k_s(λ) t^{n(λ)} M(λ, ·)`` of
   Eq. (11), Wang et al., *without* ``f_att`` (Erratum E18: ``f_att`` depends on the pixel's distance
-  to the light, not on ``t``, so a table of Eq. (11) as printed would hold for one distance only);
+  to the light, not on ``t``, so a table of Eq. (11), Wang et al. as printed would hold for one
+  distance only);
 - the ambient RGB ``I_a k_a @ M_a`` of Eq. (1), Wang et al.
 
 A pixel's linear display RGB is then
 
 ``RGB = ambient + f_att (cos θ · D + f_sp(t))``,
 
-which is Eq. (2), Wang et al., integrated against the CMFs (Eq. (4)) and converted to RGB (Eq. (5)).
-Only ``f_sp(t)`` costs one exponentiation per band, which is what the tables of
-``phong_table.placement`` remove.
+which is Eq. (2), Wang et al., integrated against the CMFs (Eq. (4), Wang et al.) and converted to
+RGB (Eq. (5), Wang et al.). Only ``f_sp(t)`` costs one exponentiation per band, which is what the
+tables of ``phong_table.placement`` remove.
 
 References
 ----------
@@ -103,7 +104,7 @@ def specular_RGB_weights(k_s, spectra_to_RGB, intensity: float = 1.0) -> np.ndar
     array([[1., 1., 1.],
            [2., 2., 2.]])
     """
-    # Eq. (11), Wang et al.: k · I_p(λ) k_s(λ) times the row of Eq. (9) for λ
+    # Eq. (11), Wang et al.: k · I_p(λ) k_s(λ) times the row of Eq. (9), Wang et al. for λ
     return np.ascontiguousarray(
         intensity * np.asarray(k_s, dtype=np.float64)[:, None] * spectra_to_RGB
     )

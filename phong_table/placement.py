@@ -128,7 +128,8 @@ def table_uniform(model: SpectralPhong | None, entries: int, segments=None) -> n
 def importance_ratio_Wang(t, an: float) -> np.ndarray:
     """The importance ratio of the proxy ``t^{an}``: ``ir(t) = t^{an+1}``.
 
-    Eq. (14), Wang et al. (the closed form of Eq. (12) for ``f^app = t^{an}`` of Eq. (13)).
+    Eq. (14), Wang et al.: Eq. (12), Wang et al. in closed form for the proxy ``f^app = t^{an}``
+    of Eq. (13), Wang et al.
 
     Parameters
     ----------
@@ -168,7 +169,8 @@ def inverse_importance_ratio_Wang(w, an: float) -> np.ndarray:
 def table_importance_Wang(model: SpectralPhong, entries: int, segments=None) -> np.ndarray:
     """Wang et al.'s importance-driven nodes: ``p`` equal-weight segments of ``m/p`` intervals.
 
-    Eq. (16), Wang et al. (with Eqs. (12)-(15)), with Errata E1, E3 and E4.
+    Eq. (16), Wang et al., on the segment ends of Eqs. (12)-(15), Wang et al., with Errata E1, E3
+    and E4.
 
     Parameters
     ----------

@@ -41,8 +41,9 @@ OPTION_KEYS = {
 def shade_phong_point_table(surface, material, light, ctx) -> np.ndarray:
     """XYZ of a Phong material under a point light through a table of Eq. (11), Wang et al.
 
-    Eq. (11), Wang et al. tabulated in XYZ; ``f_att`` and ``cos θ`` per pixel (Eq. (7), Wang et
-    al.). The table's settings come from ``ctx.options["phong"]`` (module docstring).
+    Eq. (11), Wang et al. tabulated in XYZ (the ``X_sp, Y_sp, Z_sp`` of Eq. (8), Wang et al., as
+    functions of ``t``); ``f_att`` and ``cos θ`` per pixel (Eq. (7), Wang et al.). The table's
+    settings come from ``ctx.options["phong"]`` (module docstring).
 
     Examples
     --------

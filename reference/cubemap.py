@@ -163,7 +163,7 @@ def _fetch(cube: np.ndarray, face, i, j):
 def cubemap_lookup_bilinear(cube, directions, backend: str = "numpy") -> np.ndarray:
     """Seamless bilinear lookup of a cube map in directions ``d``.
 
-    Eq. (1), Herbert et al. shades with such lookups of the prefiltered maps (E_x).
+    §7.1, Herbert et al.; the shading of §5.1 reads the prefiltered maps (E_x) with such lookups.
 
     Texels are point samples at their centres; a tap beyond a face edge is taken from the
     neighbouring face (re-projected), so lookups are continuous across edges.
@@ -248,8 +248,7 @@ def gather_bilinear(image, taps, weights, texel=None) -> np.ndarray:
     """Weighted sum of four taps per output: ``out[texel[j]] = Σ_k w[j, k] image[taps[j, k]]``.
 
     The data movement of §7.1, Herbert et al. (bilinear filtering at memory bandwidth), as used by
-    :func:`latlong_to_cubemap`; the numba twin streams all channels of a texel together. Eq. (1),
-    Herbert et al. shades with the resampled maps.
+    :func:`latlong_to_cubemap`; the numba twin streams all channels of a texel together.
 
     Parameters
     ----------
@@ -358,7 +357,7 @@ CUBEMAP_METHODS.register(
         "gather_bilinear",
         gather_bilinear,
         _k.gather_bilinear_kernel,
-        "Eq. (1), Herbert et al. (§7.1 environment transforms)",
+        "§7.1, Herbert et al. (environment transforms)",
         lambda rng: (
             rng.random((50, 3)),
             rng.integers(0, 50, (20, 4)),
@@ -372,7 +371,7 @@ CUBEMAP_METHODS.register(
         "cubemap_lookup_bilinear",
         cubemap_lookup_bilinear,
         _k.cubemap_lookup_kernel,
-        "Eq. (1), Herbert et al. (§7.1 environment transforms)",
+        "§7.1, Herbert et al. (environment transforms)",
         lambda rng: (rng.random((6, 4, 4, 2)), rng.normal(size=(50, 3))),
     )
 )

@@ -96,8 +96,8 @@ def decode_gamma(encoded, gamma: float = 2.2):
     return np.clip(np.asarray(encoded, dtype=np.float64), 0.0, 1.0) ** gamma
 
 
-# Y/Y_max at G = 0 under Eq. (7): (16/116)^3. The paper's calibration does not reach zero; see
-# docs/errata.md.
+# Y/Y_max at G = 0 under Eq. (7), Herbert et al.: (16/116)^3. The paper's calibration does not
+# reach zero; see docs/errata.md.
 _LSTAR_BLACK = (16.0 / 116.0) ** 3
 
 

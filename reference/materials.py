@@ -8,7 +8,7 @@ and the renderer read the registry.
 - ``lambert``: diffuse reflectance ``k_d(λ)`` (the diffuse term of Eq. (2), Wang et al.).
 - ``phong``: the spectral Phong model of Eq. (2), Wang et al.: ``k_d(λ)``, ``k_s(λ)``, ``n(λ)``, and
 the ambient
-  coefficient ``k_a(λ)`` of Eq. (1).
+  coefficient ``k_a(λ)`` of Eq. (1), Wang et al.
 
 References
 ----------

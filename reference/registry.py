@@ -30,7 +30,7 @@ class Method:
     kernel : callable or None
         The numba twin, or None when the reference is fast enough.
     cites : str
-        The equation, e.g. ``"Eq. (13), Wang et al."``.
+        The equation, in the fixed format ``"Eq. (N), Author"`` (STYLE.md §5).
     example_inputs : callable or None
         ``example_inputs(rng) -> tuple`` of small valid positional inputs for tests and docs.
     extra : dict

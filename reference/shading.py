@@ -199,7 +199,8 @@ def shade_phong_point_exact(
 ) -> np.ndarray:
     """XYZ of a Phong material under a point light, exact spectral evaluation (the speed baseline).
 
-    Eq. (2), Wang et al.; XYZ by Eq. (4), Wang et al. with the light folded into the band weights.
+    Eq. (6), Wang et al.: Eq. (2), Wang et al. summed against the band weights of Eq. (4), Wang et
+    al. (the light folded in).
 
     Examples
     --------
@@ -211,6 +212,7 @@ def shade_phong_point_exact(
     """
     cos_theta, t, f_att = _point_geometry(surface, light)
     spectra = phong_spectral_exact(cos_theta, t, material.k_d, material.k_s, material.n, f_att)
+    # Eq. (6), Wang et al.: XYZ = k Σ_λ I(λ) [x̄ ȳ z̄](λ), with I_p(λ) in the band weights
     return light.intensity * (spectra @ ctx.weights(light.spectrum))
 
 

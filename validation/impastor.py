@@ -225,7 +225,7 @@ def table1(
         S6 = light_to_channels(spectrum_from_dataset("illuminant", light), d)
         XYZ_sim = channels_to_XYZ(spectra_to_channels(_cc_on_grid(patches), d) * S6, d)
         dE_sim = _lab_delta_E(XYZ_sim, truth, white)
-        # Screen output: absolute luminance, flare of the booth light off the screen, Eq. (1).
+        # Screen output: absolute luminance, booth-light flare off the screen, Eq. (1), Ferwerda.
         white_abs = white * white_luminance
         flare = screen_flare_XYZ(display, white * white_luminance * np.pi)
         counts, in_gamut, _ = XYZ_to_display_counts(XYZ_sim * white_luminance, display, 0, 0, flare)
@@ -349,7 +349,7 @@ def metamer_delta_E(design: str = "optimized", n_channels: int = 6, lights=("A",
     return out
 
 
-# --- the display round trip (Eq. (1)) -------------------------------------------------------------
+# --- the display round trip (Eq. (1), Ferwerda) ---------------------------------------------------
 
 
 def display_round_trip(display=None, n: int = 500, seed: int = 0) -> dict:

@@ -17,6 +17,7 @@ from validation.cli import (
     cache,
     display,
     env,
+    equations,
     impastor,
     phong,
     polymer,
@@ -30,7 +31,20 @@ from validation.cli.parser import Parser
 __all__ = ["COMMANDS", "build_parser", "main"]
 
 #: The subcommands, in the order ``specref --help`` lists them.
-COMMANDS = (report, render, cache, brdf, shrm, sh, polymer, display, env, impastor, phong)
+COMMANDS = (
+    report,
+    render,
+    cache,
+    brdf,
+    shrm,
+    sh,
+    polymer,
+    display,
+    env,
+    impastor,
+    phong,
+    equations,
+)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,51 @@
+"""``specref equations``: generate or check the equation index (``docs/equations.md``)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+
+def _cmd_equations(args) -> int:
+    from reference.images import write_text_atomic
+    from validation.equations import (
+        REGENERATE,
+        collect_citations,
+        equation_problems,
+        render_equation_index,
+    )
+
+    citations = collect_citations()
+    text = render_equation_index(citations=citations)
+    if args.check:
+        path = Path(args.out or "docs/equations.md")
+        problems = equation_problems(citations)
+        if not path.is_file() or path.read_text(encoding="utf-8") != text:
+            problems.append(f"{path} is out of date; regenerate it with `{REGENERATE}`")
+        for problem in problems:
+            print(f"specref equations: {problem}", file=sys.stderr)
+        return 1 if problems else 0
+    if args.out:
+        write_text_atomic(args.out, text)
+        print(f"wrote {args.out}")
+    else:
+        sys.stdout.write(text)
+    return 0
+
+
+def add_parser(sub) -> None:
+    """Add ``specref equations`` and its options to the subcommand parsers ``sub``."""
+    p = sub.add_parser(
+        "equations",
+        help="the equation index: each paper's equations, the code citing them, tests, errata",
+    )
+    p.add_argument(
+        "-o", "--out", metavar="FILE", help="write the Markdown to FILE (default: standard output)"
+    )
+    p.add_argument(
+        "--check",
+        action="store_true",
+        help="exit 1 if FILE (default docs/equations.md) differs from a fresh index, or if code "
+        "cites an equation the index lacks",
+    )
+    p.set_defaults(func=_cmd_equations)
