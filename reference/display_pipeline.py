@@ -3,10 +3,10 @@
 ImpastoR compensates the display for the viewing direction and for light reflected by the screen
 (§3.4.2–3.4.3, Ferwerda): for each screen point, the observer's zenith θ from the screen normal and
 azimuth φ along the screen give ``L_factor(θ, φ)``, and the booth light reflected by the front
-surface (diffuse ``ρ E/π`` and a specular lobe around the mirror direction) is subtracted before the
-inverse of Eq. (1). :func:`image_to_display_counts` does this for a whole image and returns the
-counts and what the observer then sees; with ``compensate=False`` it drives the display as if viewed
-on axis in the dark, to show what the compensation buys.
+surface (diffuse ``ρ E/π`` and a specular lobe around the mirror direction) is subtracted before
+the inverse of Eq. (1), Ferwerda. :func:`image_to_display_counts` does this for a whole image and
+returns the counts and what the observer then sees; with ``compensate=False`` it drives the
+display as if viewed on axis in the dark, to show what the compensation buys.
 
 Screen coordinates: the screen's centre is the origin; untilted, the screen lies in the plane
 z = 0 facing +z, x to the right, y up (landscape azimuth φ = 0 along x). ``tilt`` rotates it

@@ -1,12 +1,16 @@
-"""Herbert et al.'s hybrid polymer shading model, Eqs. (1)–(5), spectrally, from prefiltered maps.
+"""Herbert et al.'s hybrid polymer shading model, spectrally, from prefiltered maps.
+
+Eqs. (1)-(5), Herbert et al.
 
 §5.1, Herbert et al. shades "a polymer-with-glossy-finish material" by the sum
 
-    I_result = I_d + I_effect + I_s F_r + I_trans (1 − F_r)       Eq. (1) (I_r read as I_s: E5)
-    I_d      = E_d D_polymer Tint_polymer (1 − Mod_effect)         Eq. (2)
-    I_effect = E_effect Mod_effect                                 Eq. (3)
-    I_trans  = E_trans Col_trans                                   Eq. (4)
-    I_s      = (E_s M_s + E_mirror (1 − M_s)) gloss                Eq. (5)
+    I_result = I_d + I_effect + I_s F_r + I_trans (1 − F_r)   Eq. (1), Herbert et al. (E5)
+    I_d      = E_d D_polymer Tint_polymer (1 − Mod_effect)     Eq. (2), Herbert et al.
+    I_effect = E_effect Mod_effect                             Eq. (3), Herbert et al.
+    I_trans  = E_trans Col_trans                               Eq. (4), Herbert et al.
+    I_s      = (E_s M_s + E_mirror (1 − M_s)) gloss            Eq. (5), Herbert et al.
+
+(E5: the paper's ``I_r`` is read as ``I_s``.)
 
 Every term here is a spectrum on the scene's grid, shape ``(N, n_bands)`` for N pixels, until the
 display step. What specref chose where the paper is silent (errata E30–E35):
@@ -15,8 +19,9 @@ display step. What specref chose where the paper is silent (errata E30–E35):
   Lambert-prefiltered irradiance map looked up at the normal.
 - ``E_s``: the normalized-Phong-prefiltered map (exponent ``phong_exponent``) at the reflected view
   vector ``r``; ``E_mirror``: the environment itself at ``r``, by direct bilinear lookup in the
-  lat-long map (no window). ``gloss`` is the overall factor of Eq. (5) in [0, 1]; the Phong
-  exponent of ``E_s`` is a separate parameter (the paper uses one "gloss" for both: E32).
+  lat-long map (no window). ``gloss`` is the overall factor of Eq. (5), Herbert et al., in
+  [0, 1]; the Phong exponent of ``E_s`` is a separate parameter (the paper uses one "gloss" for
+  both: E32).
 - ``M_s`` (:data:`MIRROR_FACTORS`): the paper's "heuristically-determined mirror reflection
   interpolation factor ... a function of the angle between eye and surface normal" is not given.
   specref's default ``"fresnel"`` reuses the Fresnel LUT: ``M_s = 1 − (F_r − F_0)/(1 − F_0)``, which
@@ -141,7 +146,7 @@ for _name, _function in (
 
 @dataclass(frozen=True)
 class PolymerMaps:
-    """The environment's maps for Eqs. (2), (4), (5), Herbert et al. (per environment and gloss).
+    """The environment's maps for Eq. (2), Eq. (4) and Eq. (5), Herbert et al. (per environment).
 
     Parameters
     ----------
@@ -199,20 +204,20 @@ def polymer_maps(
 
 @dataclass(frozen=True)
 class PolymerLook:
-    """The per-frame spectra and factors of Eqs. (1)–(5), Herbert et al. (no per-pixel work).
+    """The per-frame spectra and factors of Eqs. (1)-(5), Herbert et al. (no per-pixel work).
 
     Parameters
     ----------
     D_polymer : ndarray, shape (n_bands,)
-        Diffuse colour of the polymer (specular excluded), Eq. (2).
+        Diffuse colour of the polymer (specular excluded), Eq. (2), Herbert et al.
     Col_trans : ndarray, shape (n_bands,)
-        Transmissive colour, Eq. (4).
+        Transmissive colour, Eq. (4), Herbert et al.
     unscattered : ndarray, shape (n_bands,)
         Fraction of Col_trans that passes unscattered (E33), in [0, 1].
     Tint_polymer : ndarray, shape (n_bands,)
-        Tint colour, Eq. (2).
+        Tint colour, Eq. (2), Herbert et al.
     gloss : float
-        Overall glossiness factor of Eq. (5), in [0, 1].
+        Overall glossiness factor of Eq. (5), Herbert et al., in [0, 1].
     fresnel : FresnelLUT
         F_r against cos θ.
     mirror : str
@@ -248,7 +253,7 @@ def polymer_look(
     index=None,
     tint_library=None,
 ) -> PolymerLook:
-    """Look a chip up in the characterization once per frame and build the look of Eqs. (1)–(5).
+    """Look a chip up once per frame and build the look of Eqs. (1)-(5), Herbert et al.
 
     §5.1, Herbert et al.: "All function-of parameters are realized through look-up tables, where the
     look-up frequency is per-pixel if the variable is an angle, and per-frame otherwise."

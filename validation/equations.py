@@ -131,31 +131,31 @@ _HERBERT = (
         1,
         "§5.1",
         "Shading sum `I_result = I_d + I_effect + I_r F_r + I_trans (1 − F_r)`",
-        "the hybrid polymer model of §5.1 is not implemented (erratum E5)",
+        "`shrm.polymer` (I_r read as I_s, erratum E5); not energy conserving as printed (E34)",
     ),
     Equation(
         2,
         "§5.1",
         "Diffuse `I_d = E_d D_polymer Tint_polymer (1 − Mod_effect)`",
-        "implemented as `E_d k_d` (no tint, no effect map)",
+        "`shrm.polymer`; the environment shaders' Lambert term is `E_d k_d` (no tint or effect)",
     ),
     Equation(
         3,
         "§5.1",
         "Effect `I_effect = E_effect Mod_effect`",
-        "not implemented (the hybrid polymer model, erratum E5)",
+        "`shrm.polymer` (no effect pigment wired in yet: issue 14)",
     ),
     Equation(
         4,
         "§5.1",
         "Transmission `I_trans = E_trans Col_trans`",
-        "not implemented (the hybrid polymer model, erratum E5)",
+        "`shrm.polymer`; E_trans from behind the surface is ours (erratum E33)",
     ),
     Equation(
         5,
         "§5.1",
         "Reflection `I_s = (E_s M_s + E_mirror (1 − M_s)) gloss`",
-        "implemented as `E_s k_s` (`M_s = 1`, `gloss = 1`)",
+        "`shrm.polymer` (M_s our design, E30); the environment shaders use `E_s k_s` (M_s = 1)",
     ),
     Equation(6, "§6", "Gamma calibration `Y = (G/255)^Gamma · Y_max`"),
     Equation(7, "§6", "L*-linear calibration `Y = (((G/255)·100 + 16)/116)³ · Y_max`"),
@@ -289,8 +289,8 @@ def equation_index(root: Path | None = None, citations=None) -> list[EquationRow
     >>> [f.name for f in rows["Wang et al.", 15].functions]
     ['phong_table.placement.inverse_importance_ratio_Wang',
      'phong_table.placement.table_importance_Wang']
-    >>> rows["Herbert et al.", 3].functions, rows["Herbert et al.", 3].errata
-    ((), ())
+    >>> [f.name for f in rows["Herbert et al.", 3].functions if not f.grouped_only]
+    ['shrm.polymer.polymer_terms']
     """
     root = ROOT if root is None else Path(root)
     require((root / "tests").is_dir(), f"equation index: no tests/ folder in {root}")

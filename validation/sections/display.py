@@ -178,7 +178,11 @@ def _figures(ctx: ReportContext, data: SectionData) -> list:
     ax.set_xlabel("gray value G (0-255)")
     ax.set_ylabel("Y / Y_max")
     ax.legend(frameon=False)
-    blocks.append(ctx.figure("fig6", fig, "Fig. 6 reproduced: Y against G (dotted: Eqs. (6)-(7))"))
+    blocks.append(
+        ctx.figure(
+            "fig6", fig, "Fig. 6 reproduced: Y against G (dotted: Eqs. (6)-(7), Herbert et al.)"
+        )
+    )
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.8), sharex=True)
     for instrument in INSTRUMENTS.names():
         G, xy, white = data.arrays[("fig7", instrument)]

@@ -1,4 +1,6 @@
-"""Report section "Herbert hybrid model": the polymer chips of §3.1 and the terms of Eq. (1).
+"""Report section "Herbert hybrid model": the polymer chips of §3.1 and the hybrid model's terms.
+
+Eq. (1), Herbert et al.: the hybrid model's sum.
 
 compute → :func:`polymer_study`; present → :func:`present`; checks → :func:`checks`.
 
@@ -131,7 +133,9 @@ def synthetic_environment(height: int = 32) -> np.ndarray:
 
 
 def sphere_terms(size: int, mirrors=("fresnel",)) -> dict:
-    """The terms of Eq. (1) on an orthographic sphere under :func:`synthetic_environment`.
+    """The terms of Eq. (1), Herbert et al., on an orthographic sphere.
+
+    Lit by :func:`synthetic_environment`.
 
     The maps are prefiltered once; each M_s of ``mirrors`` only re-shades (the factor is per pixel).
 
@@ -237,7 +241,8 @@ def present(ctx: ReportContext, data: SectionData) -> list:
             "Herbert et al.'s polymer characterization (§3.1) from specref's Kubelka–Munk chip "
             "model (HDPE-like base, rutile TiO2; `shrm/data/polymer_hdpe_tio2.toml`, errata "
             "E35–E36), "
-            "and the hybrid shading model of Eqs. (1)–(5) (`shrm.polymer`, errata E5, E30–E34). "
+            "and the hybrid shading model of Eqs. (1)-(5), Herbert et al. (`shrm.polymer`, "
+            "errata E5, E30–E34). "
             "Herbert's Fig. 2 plots the green channel at D65; this plots CIE L* under D65."
         )
     ]
@@ -262,7 +267,7 @@ def present(ctx: ReportContext, data: SectionData) -> list:
             ["chip", "I_result, normal view", "I_result, grazing view"],
             rows,
             "The hybrid under a uniform sky of radiance 1 (band mean; a passive surface returns at "
-            "most 1): Eq. (1) as printed is not energy conserving (erratum E34)",
+            "most 1): Eq. (1), Herbert et al. as printed is not energy conserving (erratum E34)",
             "{:.3f}",
         )
     )
@@ -328,7 +333,8 @@ def _term_figures(ctx: ReportContext, data: SectionData) -> list:
             ctx.figure(
                 f"terms-{mirror}",
                 fig,
-                f"The terms of Eq. (1) with M_s = {mirror}: a {DEMO['thickness_mm']} mm, "
+                f"The terms of Eq. (1), Herbert et al., with M_s = {mirror}: a "
+                f"{DEMO['thickness_mm']} mm, "
                 f"{DEMO['tio2_pct']} % TiO2 sphere, gloss {DEMO['gloss']}, Phong exponent "
                 f"{DEMO['phong_exponent']:g}, under a synthetic spectral sky with a warm lamp "
                 "(I_effect is zero: no effect pigment on this material)",
