@@ -46,6 +46,7 @@ from reference.images import write_text_atomic
 from reference.registry import Method
 
 __all__ = [
+    "MAX_TABLE_ANGLES",
     "BRDFTable",
     "brdf_tabulated",
     "read_brdf_table",
@@ -54,6 +55,9 @@ __all__ = [
     "tabulate_registered_brdf",
     "write_brdf_table",
 ]
+
+#: Largest tabulated BRDF, in (θ_i, θ_o, Δφ) triples: 91² × 91 at 1° θ and 2° Δφ steps.
+MAX_TABLE_ANGLES = 91 * 91 * 91
 
 #: The first line of a file written by :func:`write_brdf_table`.
 FORMAT_LINE = "# specref-brdf 1: angle-resolved scatter after ASTM E1392"
@@ -230,9 +234,16 @@ def tabulate_registered_brdf(
     ):
         count = span / step if step > 0 else 0.5
         require(
-            step > 0 and abs(count - round(count)) < 1e-9,
+            np.isfinite(step) and step > 0 and count >= 1 and abs(count - round(count)) < 1e-9,
             f"brdf tabulate: {label}: must divide {span:g} degrees, got {step:g}",
         )
+    # Bound the table's size before allocating it: θ_i × θ_o × Δφ angles.
+    angles = (round(90.0 / theta_step_deg) + 1) ** 2 * (round(180.0 / phi_step_deg) + 1)
+    require(
+        angles <= MAX_TABLE_ANGLES,
+        f"brdf tabulate: the steps give {angles:,} angle triples; at most {MAX_TABLE_ANGLES:,} "
+        "(a 1-degree theta step and a 2-degree phi step fit)",
+    )
     params = dict(method.extra["params"])
     theta = np.linspace(0.0, 90.0, round(90.0 / theta_step_deg) + 1)
     phi = np.linspace(0.0, 180.0, round(180.0 / phi_step_deg) + 1)

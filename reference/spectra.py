@@ -573,7 +573,15 @@ def resample_spectrum(
     inside = (target >= wl[0] - tol) & (target <= wl[-1] + tol)
     out = np.empty_like(target)
     # Inside the measured range: interpolate.
-    if interpolation == "sprague" and np.allclose(np.diff(wl), wl[1] - wl[0]) and wl.size >= 6:
+    if interpolation == "sprague":
+        # Sprague's fifth-order scheme needs six uniformly spaced samples (CIE 167): refuse rather
+        # than fall back to linear without saying so.
+        uniform = wl.size >= 2 and np.allclose(np.diff(wl), wl[1] - wl[0])
+        require(
+            wl.size >= 6 and uniform,
+            f"{spectrum.name}: sprague interpolation needs at least 6 uniformly spaced samples, "
+            f'got {wl.size}{"" if uniform else " unevenly spaced"}; use interpolation = "linear"',
+        )
         from colour.algebra import SpragueInterpolator
 
         out[inside] = SpragueInterpolator(wl, v)(np.clip(target[inside], wl[0], wl[-1]))

@@ -111,6 +111,11 @@ def prefilter_file(
     """
     from shrm.prefilter import prefilter_environment
 
+    require(
+        Path(out).suffix.lower() == ".exr",
+        f"--out: the prefiltered map is linear HDR, written as OpenEXR: the name must end in "
+        f".exr, got {str(out)!r}",
+    )
     image, names = read_environment(path, bands)
     result = prefilter_environment(
         image, kernel, tol=tol, output=output, size=size, where=str(path)

@@ -303,6 +303,10 @@ def demo_state(
     grid = grid or SpectralGrid(400.0, 700.0, 20.0)
     default = Path(__file__).resolve().parents[2] / "shared/data/environments/venice_sunset_1k.hdr"
     path = Path(environment_path) if environment_path else default
+    # A missing file the user named is an error; only the missing default falls back to a sky.
+    require(
+        environment_path is None or path.is_file(), f"{path}: environment file not found (--env)"
+    )
     if path.is_file():
         image = read_image(path)
         factor = max(1, image.shape[0] // env_height)

@@ -17,6 +17,7 @@ from phong_table.interpolation import INTERPOLATION_METHODS
 from phong_table.model import SpectralPhong
 from phong_table.scenes import SCENES, VIEWS
 from phong_table.table import check_interpolation
+from reference.errors import require_positive_int
 from validation.phong import (
     ENTRY_LADDER,
     TABLE1_ENTRIES,
@@ -450,6 +451,7 @@ def run_table1(
     >>> len(result["rows"]), result["rows"][0]["placement"]
     (17, 'exact')
     """
+    repeats = require_positive_int(repeats, "--repeats", 1000)
     from tqdm import tqdm
 
     scenes = table1_scenes() if scenes is None else scenes
@@ -542,6 +544,7 @@ def run_material(
     >>> [r["placement"] for r in result["rows"]], result["rows"][1]["rms"] < 0.05
     (['exact', 'error'], True)
     """
+    repeats = require_positive_int(repeats, "--repeats", 1000)
     from phong_table.materialfile import load_material_file
     from phong_table.placement import PLACEMENT_METHODS, check_entries
     from reference.errors import require_choice

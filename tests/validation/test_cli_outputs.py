@@ -222,3 +222,58 @@ def test_commands_refuse_unwritable_outputs_in_one_line(command, kind, tmp_path,
     lines = err.strip().splitlines()
     assert len(lines) == 1, err
     assert MESSAGES[kind] in lines[0], lines[0]
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        # brdf tabulate: a step that would allocate terabytes, and one that is not a divisor.
+        (
+            ["brdf", "tabulate", "ggx", "--theta-step", "1e-4", "-o", "{tmp}/t.txt"],
+            "at most 753,571",
+        ),
+        (
+            ["brdf", "tabulate", "ggx", "--phi-step", "inf", "-o", "{tmp}/t.txt"],
+            "phi step: must divide 180 degrees, got inf",
+        ),
+        # phong: no timing from zero repetitions.
+        (
+            ["phong", "--material", "{tmp}/m.toml", "--resolution", "8", "--repeats", "0"],
+            "--repeats",
+        ),
+        # shrm orbit: a missing environment the user named is not replaced by a built-in sky.
+        (
+            ["shrm", "orbit", "--env", "{tmp}/missing.hdr", "--quick", "-o", "{tmp}/o"],
+            "missing.hdr: environment file not found (--env)",
+        ),
+        # sh prefilter: linear HDR data are not written under a PNG name.
+        (
+            ["sh", "prefilter", "{tmp}/env.exr", "--kernel", "lambert", "--out", "{tmp}/x.png"],
+            "must end in .exr",
+        ),
+    ],
+)
+def test_hostile_arguments_are_refused_in_one_line(argv, message, tmp_path, capsys):
+    # Source: issue 17 §5, the cases found with hostile input.
+    (tmp_path / "m.toml").write_text("[material]\nk_d = 0.2\nk_s = 0.5\nn = 3\n")
+    write_exr(tmp_path / "env.exr", np.random.default_rng(3).random((8, 16, 3)) + 0.1)
+    argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert len(err.strip().splitlines()) == 1, err
+    assert message in err
+    assert not (tmp_path / "t.txt").exists()
+    assert not (tmp_path / "x.png").exists()
+    assert not (tmp_path / "o").exists()
+
+
+def test_sprague_with_too_few_samples_is_refused():
+    from reference.spectra import GRID_41, make_spectrum, resample_spectrum
+
+    three = make_spectrum([380.0, 580.0, 780.0], [0.1, 0.5, 0.2], "three")
+    with pytest.raises(SpecrefError, match="three: sprague interpolation needs at least 6"):
+        resample_spectrum(three, GRID_41, interpolation="sprague")
+    uneven = make_spectrum([380, 400, 450, 500, 600, 700, 780], [0.1] * 7, "uneven")
+    with pytest.raises(SpecrefError, match="unevenly spaced"):
+        resample_spectrum(uneven, GRID_41, interpolation="sprague")

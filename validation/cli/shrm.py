@@ -9,12 +9,10 @@ from validation.cli.parser import Parser, registry_option
 
 
 def _cmd_shrm_orbit(args) -> int:
-    from reference.images import check_output_folder
     from shrm.cache import Cache
     from shrm.orbit import demo_state, render_orbit, scene_state
     from shrm.session import RenderSession
 
-    check_output_folder(args.out)  # an unwritable folder is refused before any work
     quick = {"env_height": 16, "size": 8, "resolution": 48, "F_max": 12, "P_max": 6}
     orders = {k: v for k, v in (("tol", args.tol), ("F", args.F), ("P", args.P)) if v is not None}
     if args.scene is not None:
