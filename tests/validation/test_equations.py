@@ -182,13 +182,19 @@ NUMBER_MARKS = {
 }
 
 
+#: The papers' text files: SPECREF_PAPERS_DIR, else ../shared/papers beside the repository.
+PAPERS_DIR = Path(
+    os.environ.get("SPECREF_PAPERS_DIR", Path(__file__).resolve().parents[3] / "shared" / "papers")
+)
+
+
 @pytest.mark.skipif(
-    not os.environ.get("SPECREF_PAPERS_DIR"),
-    reason="set SPECREF_PAPERS_DIR to the folder of the papers' text files to check the equation "
-    "lists against them",
+    not PAPERS_DIR.is_dir(),
+    reason="the papers' text files are not beside the repository (../shared/papers); set "
+    "SPECREF_PAPERS_DIR to their folder to check the equation lists against them",
 )
 def test_equation_lists_match_the_paper_texts():
-    folder = Path(os.environ["SPECREF_PAPERS_DIR"])
+    folder = PAPERS_DIR
     papers = {p.author: p for p in PAPERS}
     for name, (author, pattern) in NUMBER_MARKS.items():
         text = (folder / name).read_text(encoding="utf-8")
