@@ -567,14 +567,32 @@ def loads_scene(text: str, file: str = "<string>", base_dir=".") -> Scene:
     return scene_from_dict(_parse_toml(text, file), file, base_dir)
 
 
+#: Deepest nesting of arrays and tables that a scene file may have (a scene needs about five).
+MAX_NESTING = 64
+
+
 def _parse_toml(text: str, file: str) -> dict:
     """``tomllib.loads`` with its errors as one-line SpecrefErrors naming the file."""
     if not isinstance(text, str):
         raise SpecrefError(f"{file}: a scene must be TOML text, got {type(text).__name__}")
+    too_deep = (
+        f"{file}: arrays and tables nested deeper than {MAX_NESTING} levels; no scene needs that"
+    )
     try:
-        return tomllib.loads(text)
+        doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
         raise SpecrefError(f"{file}: malformed TOML: {error}") from None
+    except RecursionError:  # tomllib recurses once per level: tens of thousands exhaust the stack
+        raise SpecrefError(too_deep) from None
+    # The parsed document's depth, without recursion (the readers below recurse per level).
+    stack = [(doc, 1)]
+    while stack:
+        value, depth = stack.pop()
+        if depth > MAX_NESTING:
+            raise SpecrefError(too_deep)
+        children = value.values() if isinstance(value, dict) else value
+        stack.extend((v, depth + 1) for v in children if isinstance(v, dict | list))
+    return doc
 
 
 def load_scene(path) -> Scene:

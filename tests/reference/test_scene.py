@@ -371,3 +371,27 @@ def test_malformed_and_missing_scene_files(tmp_path):
         load_scene(binary)
     with raises(f"{tmp_path}: file not found"):
         load_scene(tmp_path)
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "a = " + "[" * 100_000 + "]" * 100_000,  # deeper than tomllib's recursion can parse
+        "a = " + "[" * 100 + "]" * 100,  # parses, but deeper than any scene
+        "x = " + "{a = " * 50_000 + "1" + "}" * 50_000,
+    ],
+    ids=["arrays-100000", "arrays-100", "tables-50000"],
+)
+def test_deeply_nested_scenes_are_refused_in_one_line(text, tmp_path, capsys):
+    # Source: issue 17 §5 (a RecursionError with 3,000 lines of traceback before).
+    from reference.scene import MAX_NESTING
+    from validation.cli import main
+
+    with pytest.raises(SpecrefError, match=f"deep.toml: .*nested deeper than {MAX_NESTING}"):
+        loads_scene(text, "deep.toml")
+    path = tmp_path / "deep.toml"
+    path.write_text(text)
+    assert main(["render", str(path), "-o", str(tmp_path / "x.png")]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1
+    assert "Traceback" not in err
