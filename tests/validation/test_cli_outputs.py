@@ -11,6 +11,7 @@ import errno
 import os
 import shutil
 import subprocess
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -24,22 +25,41 @@ ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "docs" / "examples"
 
 
-def _mount_tmpfs(folder: Path, options: str) -> None:
-    if os.geteuid() != 0 or shutil.which("mount") is None:
-        pytest.skip("mounting a tmpfs needs root and mount(8) (util-linux)")
+def _mount_tmpfs(folder: Path, options: str) -> bool:
+    """Mount a small tmpfs at ``folder``; False without root (the callers then simulate it)."""
     folder.mkdir()
+    if os.geteuid() != 0 or shutil.which("mount") is None:
+        return False
     done = subprocess.run(
         ["mount", "-t", "tmpfs", "-o", options, "tmpfs", str(folder)], capture_output=True
     )
-    if done.returncode != 0:
-        pytest.skip(f"cannot mount a tmpfs here: {done.stderr.decode().strip()}")
+    return done.returncode == 0
+
+
+def _refuse_in(folder: Path, code: int, monkeypatch) -> None:
+    """Without root: every new file in ``folder`` fails with errno ``code``, as the real one does.
+
+    All of specref's writers create their temporary file with ``tempfile.mkstemp`` in the
+    destination folder, which is where a read-only or full file system refuses first.
+    """
+    real = tempfile.mkstemp
+
+    def mkstemp(*args, dir=None, **kwargs):
+        if dir is not None and Path(dir).resolve().is_relative_to(folder.resolve()):
+            raise OSError(code, os.strerror(code))
+        return real(*args, dir=dir, **kwargs)
+
+    monkeypatch.setattr(tempfile, "mkstemp", mkstemp)
 
 
 @pytest.fixture
-def full_folder(tmp_path):
-    """A folder on a 64 KiB file system that is already full."""
+def full_folder(tmp_path, monkeypatch):
+    """A folder on a 64 KiB file system that is already full (simulated without root)."""
     folder = tmp_path / "full"
-    _mount_tmpfs(folder, "size=64k")
+    if not _mount_tmpfs(folder, "size=64k"):
+        _refuse_in(folder, errno.ENOSPC, monkeypatch)
+        yield folder
+        return
     filler = folder / "filler"
     with pytest.raises(OSError, match="No space left"):
         filler.write_bytes(b"\0" * (1 << 20))
@@ -48,10 +68,13 @@ def full_folder(tmp_path):
 
 
 @pytest.fixture
-def read_only_folder(tmp_path):
-    """A folder on a read-only file system."""
+def read_only_folder(tmp_path, monkeypatch):
+    """A folder on a read-only file system (simulated without root)."""
     folder = tmp_path / "ro"
-    _mount_tmpfs(folder, "size=64k,ro")
+    if not _mount_tmpfs(folder, "size=64k,ro"):
+        _refuse_in(folder, errno.EROFS, monkeypatch)
+        yield folder
+        return
     yield folder
     subprocess.run(["umount", str(folder)], check=False)
 
