@@ -202,6 +202,10 @@ def _commands(out: Path, tmp_path: Path) -> dict[str, list[str]]:
             "--json",
             f"{out}.json",
         ],
+        "equations -o": ["equations", "-o", f"{out}.md"],
+        "polymer characterize -o": ["polymer", "characterize", "-o", f"{out}.csv"],
+        "display calibrate -o": ["display", "calibrate", "--points", "4", "-o", f"{out}.cal"],
+        "env fit -o": ["env", "fit", "-o", f"{out}.json"],
         "shrm orbit -o": [
             "shrm",
             "orbit",
@@ -222,6 +226,10 @@ COMMANDS = (
     "sh prefilter --out",
     "brdf tabulate -o",
     "phong --json",
+    "equations -o",
+    "polymer characterize -o",
+    "display calibrate -o",
+    "env fit -o",
     "shrm orbit -o",
 )
 
