@@ -34,9 +34,7 @@ References
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
@@ -417,13 +415,9 @@ def load_display_measurements(path) -> DisplayModel:
     ...     round(float(load_display_measurements(p).white_XYZ[1]), 6)
     320.0
     """
-    path = Path(path)
-    try:
-        doc = json.loads(path.read_text())
-    except FileNotFoundError:
-        raise SpecrefError(f"{path}: file not found") from None
-    except (OSError, ValueError) as error:
-        raise SpecrefError(f"{path}: not a JSON display measurement file ({error})") from None
+    from reference.images import read_json
+
+    doc = read_json(path, "JSON display measurement file")
     return display_from_measurements(doc, str(path))
 
 

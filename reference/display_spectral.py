@@ -28,9 +28,7 @@ References
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
@@ -498,11 +496,7 @@ def load_spectral_display(path) -> SpectralDisplay:
     ...
     reference.errors.SpecrefError: /nonexistent/display.json: file not found
     """
-    path = Path(path)
-    try:
-        doc = json.loads(path.read_text())
-    except FileNotFoundError:
-        raise SpecrefError(f"{path}: file not found") from None
-    except (OSError, ValueError) as error:
-        raise SpecrefError(f"{path}: not a JSON display file ({error})") from None
+    from reference.images import read_json
+
+    doc = read_json(path, "JSON display file")
     return spectral_display_from_doc(doc, str(path))

@@ -41,6 +41,7 @@ __all__ = [
     "read_exr",
     "read_hdr",
     "read_image",
+    "read_json",
     "read_png",
     "spectral_channel_names",
     "write_bytes_atomic",
@@ -197,6 +198,33 @@ def atomic_path(path, suffix: str = ""):
             with contextlib.suppress(FileNotFoundError):
                 os.unlink(tmp)
             raise
+
+
+def read_json(path, kind: str = "JSON"):
+    """Read a JSON file; a missing or malformed one is a one-line :class:`SpecrefError`.
+
+    Parameters
+    ----------
+    path : str or Path
+    kind : str
+        What the file should be, for the message (``"JSON display file"``).
+
+    Examples
+    --------
+    >>> read_json("/nonexistent.json", "JSON display file")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: /nonexistent.json: file not found
+    """
+    import json
+
+    path = Path(path)
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise SpecrefError(f"{path}: file not found") from None
+    except (OSError, ValueError) as error:
+        raise SpecrefError(f"{path}: not a {kind} ({error})") from None
 
 
 def check_output_folder(folder) -> Path:

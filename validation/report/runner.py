@@ -21,8 +21,8 @@ import sys
 import time
 from pathlib import Path
 
-from reference.errors import SpecrefError, require
-from reference.images import write_text_atomic
+from reference.errors import require
+from reference.images import read_json, write_text_atomic
 from reference.registry import Registry
 from validation.report.render import render_html, render_markdown
 from validation.report.types import ReportContext, ReportSection, SectionResult, to_jsonable
@@ -123,14 +123,7 @@ def run_report(
         sections = [s for s in sections if s.name in only]
     bench = None
     if bench_json is not None:
-        try:
-            bench = json.loads(Path(bench_json).read_text())
-        except FileNotFoundError:
-            raise SpecrefError(f"{bench_json}: file not found") from None
-        except (OSError, ValueError) as error:
-            raise SpecrefError(
-                f"{bench_json}: not a pytest-benchmark JSON file ({error})"
-            ) from None
+        bench = read_json(bench_json, "pytest-benchmark JSON file")
         require(isinstance(bench, dict), f"{bench_json}: not a pytest-benchmark JSON file")
     meta = {
         "date": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M UTC"),
