@@ -9,7 +9,7 @@ import shutil
 import pytest
 
 from validation.report.browser import INSTALL_HINT, check_report_page, find_chromium
-from validation.report.runner import SECTIONS, run_report
+from validation.report.runner import PARTS, SECTIONS, run_report
 
 pytestmark = pytest.mark.skipif(
     find_chromium() is None or shutil.which("chromedriver") is None, reason=INSTALL_HINT
@@ -38,6 +38,13 @@ def test_quick_report_reads_in_a_browser(quick_report):
     assert page["first_content"] == "summary"
     assert page["broken_links"] == []
     assert page["links"] >= 2 * len(SECTIONS)
+    # Each part of the summary states figures and links to its sections.
+    html = (out / "index.html").read_text()
+    summary = html[html.index("id='summary'") : html.index("<nav>")]
+    for part in PARTS:
+        block = summary[summary.index(f"id='summary-{part.name}'") :]
+        block = block[: block.index("</div></div>")]
+        assert block.count("<li>") >= 1 + len(part.sections), part.name
 
 
 def test_first_screen_screenshot_is_written(quick_report):
