@@ -66,6 +66,14 @@ def dask_client(scheduler: str | None = None, n_workers: int | None = None, time
     ------
     SpecrefError
         No scheduler answers at the address within ``timeout`` (one line, with the address).
+
+    Examples
+    --------
+    >>> with dask_client("tcp://127.0.0.1:9", timeout=0.5):
+    ...     pass
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: --scheduler tcp://127.0.0.1:9: no Dask scheduler answered ...
     """
     from distributed import Client, LocalCluster
 

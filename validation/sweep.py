@@ -140,6 +140,13 @@ def load_sweep(path) -> tuple[SweepKind, list[dict]]:
     SpecrefError
         Unreadable file, malformed TOML, unknown kind or key, an empty or invalid grid (one line
         naming the file and the key).
+
+    Examples
+    --------
+    >>> load_sweep("/nonexistent/sweep.toml")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: /nonexistent/sweep.toml: file not found
     """
     path = Path(path)
     try:
@@ -180,7 +187,20 @@ def load_sweep(path) -> tuple[SweepKind, list[dict]]:
 
 
 def run_sweep(path, scheduler: str | None = None, progress: bool = True, client=None) -> list[dict]:
-    """Run every cell of a sweep file; rows of the grid keys and the cell's figures, in order."""
+    r"""Run every cell of a sweep file; rows of the grid keys and the cell's figures, in order.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> text = ('kind = "phong"\n[grid]\nmaterials = ["R1"]\nviews = ["near"]\n'
+    ...         'placements = ["error"]\ninterpolations = ["monotone"]\nentries = [32, 64]\n'
+    ...         'resolution = 12\n')
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     _ = open(os.path.join(d, "s.toml"), "w").write(text)
+    ...     rows = run_sweep(os.path.join(d, "s.toml"), scheduler="serial", progress=False)
+    >>> [(r["entries"], r["rms"] < 0.05) for r in rows]
+    [(32, True), (64, True)]
+    """
     kind, cells = load_sweep(path)
     figures = run_tasks(
         kind.run_cell, cells, scheduler=scheduler, client=client, progress=progress, desc="sweep"
@@ -189,7 +209,14 @@ def run_sweep(path, scheduler: str | None = None, progress: bool = True, client=
 
 
 def sweep_csv(rows: list[dict], out=None) -> str:
-    """The rows as CSV text (floats at full precision); written atomically to ``out`` if given."""
+    """The rows as CSV text (floats at full precision); written atomically to ``out`` if given.
+
+    Examples
+    --------
+    >>> print(sweep_csv([{"entries": 25, "rms": 0.5}]), end="")
+    entries,rms
+    25,0.5
+    """
     buffer = io.StringIO()
     writer = csv.DictWriter(buffer, fieldnames=list(rows[0]), lineterminator="\n")
     writer.writeheader()

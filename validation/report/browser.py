@@ -22,13 +22,7 @@ from pathlib import Path
 from reference.errors import SpecrefError, require
 from reference.images import atomic_path
 
-__all__ = [
-    "CHROMIUM_FLAGS",
-    "INSTALL_HINT",
-    "check_report_page",
-    "find_chromium",
-    "screenshot_first_screen",
-]
+__all__ = ["CHROMIUM_FLAGS", "INSTALL_HINT", "find_chromium", "screenshot_first_screen"]
 
 #: How to install what this module needs on Debian.
 INSTALL_HINT = (
@@ -51,7 +45,13 @@ CHROMIUM_FLAGS = (
 
 
 def find_chromium() -> str | None:
-    """The Chromium executable on ``PATH`` (``chromium``, ``chromium-browser``), or None."""
+    """The Chromium executable on ``PATH`` (``chromium``, ``chromium-browser``), or None.
+
+    Examples
+    --------
+    >>> find_chromium() in (None, shutil.which("chromium"), shutil.which("chromium-browser"))
+    True
+    """
     for name in ("chromium", "chromium-browser"):
         path = shutil.which(name)
         if path:
@@ -73,6 +73,15 @@ def screenshot_first_screen(page, out, width: int = 1280, height: int = 900) -> 
     -------
     str
         ``"written"``, or why not (Chromium missing or failing), for ``results.json``.
+
+    Examples
+    --------
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     page = Path(d) / "index.html"
+    ...     _ = page.write_text("<h1>specref</h1>")
+    ...     status = screenshot_first_screen(page, Path(d) / "shot.png", 320, 200)
+    >>> status == "written" or status.startswith("not written")
+    True
     """
     chromium = find_chromium()
     if chromium is None:
