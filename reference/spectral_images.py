@@ -226,8 +226,13 @@ def read_environment_file(path) -> tuple[np.ndarray, list[str]]:
         return read_hdr(path), ["R", "G", "B"]
     if suffix in (".tif", ".tiff"):
         return read_spectral_tiff(path)
+    if suffix == ".zarr":  # a chunked store (reference.zarr_images), read whole here
+        from reference.zarr_images import open_zarr_image
+
+        store = open_zarr_image(path)
+        return store.read(), store.channels
     raise SpecrefError(
-        f"{path}: unsupported environment map type {suffix!r}; allowed: .exr, .hdr, .tif"
+        f"{path}: unsupported environment map type {suffix!r}; allowed: .exr, .hdr, .tif, .zarr"
     )
 
 

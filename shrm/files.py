@@ -78,8 +78,20 @@ def project_file(path, order: int, out, window=None, bands=None, backend: str = 
     from reference.images import write_bytes_atomic
     from shrm.transform import project_latlong
 
-    image, names = read_environment(path, bands)
-    coeffs = project_latlong(image, order, window=window, backend=backend, where=str(path))
+    if Path(path).suffix.lower() == ".zarr" and bands is None:
+        # a chunked store is projected block by block, never read whole (shrm.streamed)
+        from reference.zarr_images import open_zarr_image
+        from shrm.streamed import project_latlong_blocks
+        from shrm.windows import apply_window
+
+        store = open_zarr_image(path)
+        names = store.channels
+        coeffs = project_latlong_blocks(store.row_blocks(), store.shape[0], order, backend)
+        if window is not None and window != "none":
+            coeffs = apply_window(coeffs, window)
+    else:
+        image, names = read_environment(path, bands)
+        coeffs = project_latlong(image, order, window=window, backend=backend, where=str(path))
     buffer = io.BytesIO()
     np.savez(
         buffer,

@@ -76,8 +76,20 @@ def test_registered_section_renders_blocks(tmp_path):
     assert "<td>1.235</td>" in html
     assert "<td>—</td>" in html
     assert (tmp_path / "images" / "test-only-img.png").is_file()
-    assert "1 of 2 targets hold; <b>1 do not</b>" in html
+    assert "1 of 2 targets hold; 1 do not" in html
     assert [c["passed"] for c in results["checks"]] == [True, False]
+    # The failing target is shown open in its section, the rest folded; all targets at the end.
+    section_html = html[html.index("id='test-only'") : html.index("id='targets'")]
+    assert section_html.index("Targets that do not hold") < section_html.index("<details>")
+    assert html.index("id='summary'") < html.index("id='test-only'") < html.index("id='targets'")
+    # A 2×2 render is shown enlarged without smoothing, its true size in the caption.
+    assert "width='256' height='256' class='pixelated'" in html
+    assert "true size 2×2 px, shown ×128" in html
+    # Provenance: commit, cores and run times, in the page and in results.json.
+    meta = results["meta"]
+    assert {"commit", "cores", "total_seconds", "section_seconds"} <= set(meta)
+    assert set(meta["section_seconds"]) == {"test-only"}
+    assert f"cores: {meta['cores']}" in html
 
 
 def test_bench_groups_filters_by_prefix():
@@ -120,3 +132,57 @@ def test_sections_compute_present_check(tmp_path):
 def test_section_registry_is_the_tuple_of_sections():
     assert REPORT_SECTIONS.names() == [s.name for s in SECTIONS]
     assert len(set(REPORT_SECTIONS.names())) == len(SECTIONS)
+
+
+def test_summary_shows_headlines_and_hero(tmp_path):
+    from validation.report import Headline
+
+    def present(ctx, data):
+        return [ctx.image("small", np.zeros((4, 8, 3))), ctx.image("hero", np.ones((300, 400, 3)))]
+
+    section = ReportSection(
+        "with-headlines",
+        "With headlines",
+        lambda ctx: SectionData({"speed": 12.8}),
+        present,
+        lambda data: [Check("speed", ">= 10", data.results["speed"], True)],
+        headlines=lambda data: [
+            Headline(f"table {data.results['speed']:.1f}× faster than exact", "paper: ~10×")
+        ],
+        hero="hero",
+    )
+    md = tmp_path / "results.md"
+    run_report(tmp_path / "r", quick=True, progress=False, sections=[section], markdown=md)
+    html = (tmp_path / "r" / "index.html").read_text()
+    summary = html[html.index("id='summary'") : html.index("<nav>")]
+    assert "table 12.8× faster than exact" in summary
+    assert "(paper: ~10×)" in summary
+    assert "images/with-headlines-hero.png" in summary
+    assert "images/with-headlines-small.png" not in summary
+    assert "1 of 1 targets hold" in summary
+    text = md.read_text()
+    assert text.index("## Summary") < text.index("## With headlines") < text.index("## All targets")
+    assert "- table 12.8× faster than exact (paper: ~10×)" in text
+
+
+def test_default_headlines_are_the_first_checks():
+    section = ReportSection(
+        "d",
+        "D",
+        lambda ctx: SectionData({}),
+        lambda ctx, data: [],
+        lambda data: [Check(f"c{i}", "<= 1", 0.5, True) for i in range(3)],
+    )
+    result = section.run(ReportContext(out_dir="."))
+    assert [h.text for h in result.headlines] == ["c0: 0.5", "c1: 0.5"]
+    assert [h.anchor for h in result.headlines] == ["<= 1", "<= 1"]
+
+
+def test_comparison_layout(tmp_path):
+    ctx = ReportContext(out_dir=tmp_path, section="cmp")
+    rng = np.random.default_rng(7)
+    reference = rng.random((16, 16, 3))
+    image = ctx.comparison("a", reference, reference * 1.1, ("brute force", "SHRM"), "caption")
+    assert (tmp_path / image.path).is_file()
+    assert image.width > 3 * 200
+    assert image.height > 150

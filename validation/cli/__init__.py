@@ -25,6 +25,7 @@ from validation.cli import (
     report,
     sh,
     shrm,
+    sweep,
 )
 from validation.cli.parser import Parser
 
@@ -43,6 +44,7 @@ COMMANDS = (
     env,
     impastor,
     phong,
+    sweep,
     equations,
 )
 

@@ -40,8 +40,20 @@ def _cmd_env_spectralize(args) -> int:
     return 0
 
 
+def _cmd_env_convert(args) -> int:
+    from reference.zarr_images import convert_to_zarr
+
+    info = convert_to_zarr(args.input, args.out, args.rows, args.compression)
+    print(
+        f"wrote {info['out']}: {info['height']}×{info['width']}, {info['channels']} channels, "
+        f"{info['chunks']} chunks of {info['rows_per_chunk']} rows, {info['compression']} "
+        f"({info['ratio']:.2f}× smaller than float32)"
+    )
+    return 0
+
+
 def add_parser(sub) -> None:
-    """Add ``specref env fit|spectralize`` to the subcommand parsers ``sub``."""
+    """Add ``specref env fit|spectralize|convert`` to the subcommand parsers ``sub``."""
     from reference.spectral_regression import REGRESSION_FEATURES
     from reference.spectral_target import CAMERAS
 
@@ -66,3 +78,18 @@ def add_parser(sub) -> None:
     s.add_argument("--rows", type=int, default=None, help="rows per block (default: 2^17 pixels)")
     s.add_argument("-o", "--out", required=True, help="output .exr or .tif")
     s.set_defaults(func=_cmd_env_spectralize)
+    from reference.zarr_images import DEFAULT_ROWS_PER_CHUNK, ZARR_COMPRESSIONS
+
+    c = env.add_parser(
+        "convert", help="convert a panorama (.exr, .hdr, .tif) to a chunked Zarr store"
+    )
+    c.add_argument("input", help="lat-long panorama: .exr, .hdr or spectral .tif")
+    c.add_argument("out", metavar="OUT.zarr", help="the Zarr store to write (docs/scale-out.md)")
+    c.add_argument(
+        "--rows",
+        type=int,
+        default=DEFAULT_ROWS_PER_CHUNK,
+        help="rows per chunk (default %(default)s)",
+    )
+    registry_option(c, "--compression", ZARR_COMPRESSIONS, "chunk compression", default="zstd")
+    c.set_defaults(func=_cmd_env_convert)

@@ -8,15 +8,21 @@ from validation.cli.parser import registry_option
 def _cmd_report(args) -> int:
     from validation.report.runner import run_report
 
-    run_report(
+    results = run_report(
         out_dir=args.out,
         quick=args.quick,
         only=args.only,
         bench_json=args.bench,
         markdown=args.markdown,
         markdown_image_prefix=args.markdown_image_prefix,
+        screenshot=not args.no_screenshot,
     )
     print(f"wrote {args.out}/index.html and {args.out}/results.json")
+    shot = results["meta"].get("screenshot")
+    if shot == "written":
+        print(f"wrote {args.out}/first-screen.png (the first screen in headless Chromium)")
+    elif shot:
+        print(f"first-screen.png {shot}")
     return 0
 
 
@@ -40,5 +46,10 @@ def add_parser(sub) -> None:
         "--markdown-image-prefix",
         default="",
         help="path from the Markdown file to the report folder",
+    )
+    p.add_argument(
+        "--no-screenshot",
+        action="store_true",
+        help="do not write first-screen.png (written with headless Chromium where installed)",
     )
     p.set_defaults(func=_cmd_report)

@@ -9,6 +9,7 @@ circle. ``specref report`` calls :func:`validation.report.runner.run_report`.
 
 from validation.report.types import (
     Check,
+    Headline,
     Image,
     ReportContext,
     ReportSection,
@@ -21,6 +22,7 @@ from validation.report.types import (
 
 __all__ = [
     "Check",
+    "Headline",
     "Image",
     "ReportContext",
     "ReportSection",

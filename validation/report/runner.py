@@ -6,17 +6,21 @@ writes, each atomically:
 - ``DIR/index.html``: the readable report;
 - ``DIR/results.json``: every figure, by section;
 - ``DIR/images/*.png``: images and matplotlib charts;
+- ``DIR/first-screen.png``: the first screen in headless Chromium, where Chromium is installed,
+  so a reviewer can look without a browser;
 - optionally a Markdown rendering (``docs/results.md`` is generated this way, never typed).
 
 A new section is a module in ``validation/sections/`` that defines ``SECTION`` (a
-:class:`~validation.report.types.ReportSection`) and one entry in :data:`SECTIONS`.
+:class:`~validation.report.types.ReportSection`) and one entry in a part of :data:`PARTS`.
 """
 
 from __future__ import annotations
 
 import datetime as _dt
 import json
+import os
 import platform
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -25,7 +29,13 @@ from reference.errors import require
 from reference.images import read_json, write_text_atomic
 from reference.registry import Registry
 from validation.report.render import render_html, render_markdown
-from validation.report.types import ReportContext, ReportSection, SectionResult, to_jsonable
+from validation.report.types import (
+    ReportContext,
+    ReportPart,
+    ReportSection,
+    SectionResult,
+    to_jsonable,
+)
 from validation.sections import (
     display,
     examples,
@@ -39,21 +49,81 @@ from validation.sections import (
     spectral_env,
 )
 
-__all__ = ["REPORT_SECTIONS", "SECTIONS", "run_report"]
+__all__ = ["PARTS", "REPORT_SECTIONS", "SECTIONS", "run_report"]
 
-#: The report's sections, in the order a reader meets them.
-SECTIONS: tuple[ReportSection, ...] = (
-    spectral.SECTION,
-    raster.SECTION,
-    examples.SECTION,
-    phong.SECTION,
-    sh.SECTION,
-    spectral_env.SECTION,
-    shrm.SECTION,
-    polymer.SECTION,
-    impastor.SECTION,
-    display.SECTION,
+#: The report's parts, one per paper and one for the shared core, each with its sections in the
+#: order a reader meets them. The summary shows one block per part.
+PARTS: tuple[ReportPart, ...] = (
+    ReportPart(
+        "core",
+        "The shared spectral core",
+        "Spectra, colorimetry, the rasterizer and the scenes every paper renders with.",
+        (spectral.SECTION, raster.SECTION, examples.SECTION),
+    ),
+    ReportPart(
+        "wang",
+        "Wang, Chern & Lee: spectral Phong tables",
+        "Importance-driven adaptive tables and parabolic interpolation for spectral Phong.",
+        (phong.SECTION,),
+    ),
+    ReportPart(
+        "herbert",
+        "Herbert et al.: SH, SHRMs, the hybrid polymer model, spectral environments, calibration",
+        "SH to order 100, prefiltering, SHRMs, spectral panoramas, display calibration.",
+        (sh.SECTION, spectral_env.SECTION, shrm.SECTION, polymer.SECTION, display.SECTION),
+    ),
+    ReportPart(
+        "ferwerda",
+        "Ferwerda: ImpastoR",
+        "Six-channel multispectral rendering, Ward–Dür gloss, median cut, FIS and horizon shadows.",
+        (impastor.SECTION,),
+    ),
 )
+
+#: The report's sections, in reading order (the parts' sections, one after the other).
+SECTIONS: tuple[ReportSection, ...] = tuple(s for part in PARTS for s in part.sections)
+
+#: One chart style for every section: fonts readable at the size the page shows the charts.
+CHART_STYLE = {
+    "font.size": 11,
+    "axes.titlesize": 12,
+    "axes.labelsize": 11,
+    "xtick.labelsize": 10,
+    "ytick.labelsize": 10,
+    "legend.fontsize": 9,
+    "legend.framealpha": 0.85,
+    "axes.grid": True,
+    "grid.alpha": 0.3,
+}
+
+
+def _commit() -> str:
+    """The git commit of the running code (``+dirty`` with local changes), or ``unknown``."""
+    here = Path(__file__).resolve().parent
+    try:
+        head = subprocess.run(
+            ["git", "-C", str(here), "rev-parse", "--short=12", "HEAD"],
+            capture_output=True,
+            text=True,
+            timeout=10,
+            check=True,
+        ).stdout.strip()
+        dirty = subprocess.run(
+            ["git", "-C", str(here), "status", "--porcelain", "--untracked-files=no"],
+            capture_output=True,
+            text=True,
+            timeout=10,
+            check=True,
+        ).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+    return head + ("+dirty" if dirty else "")
+
+
+def _quiet() -> bool:
+    """Progress bars stay off under CI and when stderr is not a terminal."""
+    return bool(os.environ.get("CI")) or not sys.stderr.isatty()
+
 
 #: Report sections by key (``specref report --only`` takes the keys).
 REPORT_SECTIONS = Registry("report section")
@@ -70,6 +140,7 @@ def run_report(
     markdown_image_prefix: str = "",
     progress: bool = True,
     sections=None,
+    screenshot: bool = False,
 ) -> dict:
     """Run the report sections and write ``index.html`` and ``results.json`` into ``out_dir``.
 
@@ -88,9 +159,12 @@ def run_report(
     markdown_image_prefix : str
         Prefix for image links in the Markdown (the path from the Markdown file to ``out_dir``).
     progress : bool
-        Show tqdm progress on stderr.
+        Show a progress bar per section on stderr (never under CI or without a terminal).
     sections : sequence of ReportSection, optional
         The sections to choose from (default :data:`SECTIONS`).
+    screenshot : bool
+        Also write ``first-screen.png`` with headless Chromium (skipped, with the reason in
+        ``results.json``, where Chromium is not installed).
 
     Returns
     -------
@@ -110,7 +184,7 @@ def run_report(
     >>> round(results["sections"]["spectral-core"]["380-780/10 FL2 point"]["mean"], 1)
     4.0
     """
-    from tqdm import tqdm
+    import matplotlib
 
     out_dir = Path(out_dir)
     sections = list(SECTIONS if sections is None else sections)
@@ -126,32 +200,55 @@ def run_report(
         bench = read_json(bench_json, "pytest-benchmark JSON file")
         require(isinstance(bench, dict), f"{bench_json}: not a pytest-benchmark JSON file")
     meta = {
+        "commit": _commit(),
         "date": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M UTC"),
         "mode": "quick" if quick else "full",
+        "cores": os.cpu_count(),
         "python": platform.python_version(),
         "machine": platform.machine(),
         "benchmarks": str(bench_json) if bench_json else "none (run make bench)",
     }
-    done: list[tuple[ReportSection, SectionResult]] = []
+    started = time.perf_counter()
+    with matplotlib.rc_context(CHART_STYLE):
+        done = _run_sections(sections, out_dir, quick, bench, progress and not _quiet())
+    meta["total_seconds"] = round(time.perf_counter() - started, 1)
+    meta["section_seconds"] = {s.name: round(r.seconds, 1) for s, r in done}
     results: dict = {"meta": meta, "checks": [], "sections": {}}
-    bar = tqdm(
-        sections, desc="specref report", unit="section", file=sys.stderr, disable=not progress
-    )
-    for section in bar:
-        bar.set_postfix_str(section.name)
-        ctx = ReportContext(out_dir=out_dir, quick=quick, bench=bench, section=section.name)
-        start = time.perf_counter()
-        result = section.run(ctx)
-        result.results.setdefault("section_seconds", time.perf_counter() - start)
-        done.append((section, result))
+    for section, result in done:
         results["sections"][section.name] = to_jsonable(result.results)
         for c in result.checks:
             results["checks"].append(to_jsonable({"section": section.name, **c.__dict__}))
+    parts = [p.only(s.name for s, _ in done) for p in PARTS]
+    parts = [p for p in parts if p.sections] or [ReportPart("all", "", "", tuple(sections))]
     title = "specref report"
-    write_text_atomic(out_dir / "index.html", render_html(title, meta, done))
+    write_text_atomic(out_dir / "index.html", render_html(title, meta, done, parts))
     write_text_atomic(out_dir / "results.json", json.dumps(results, indent=1, sort_keys=False))
     if markdown is not None:
-        write_text_atomic(
-            markdown, render_markdown("specref results", meta, done, markdown_image_prefix)
-        )
+        text = render_markdown("specref results", meta, done, markdown_image_prefix, parts)
+        write_text_atomic(markdown, text)
+    if screenshot:
+        from validation.report.browser import screenshot_first_screen
+
+        shot = screenshot_first_screen(out_dir / "index.html", out_dir / "first-screen.png")
+        results["meta"]["screenshot"] = shot
+        write_text_atomic(out_dir / "results.json", json.dumps(results, indent=1, sort_keys=False))
     return results
+
+
+def _run_sections(sections, out_dir, quick, bench, progress) -> list:
+    """Run each section under its own progress bar; returns ``[(section, result), ...]``."""
+    from tqdm import tqdm
+
+    done: list[tuple[ReportSection, SectionResult]] = []
+    width = max((len(s.title) for s in sections), default=0)
+    for i, section in enumerate(sections, 1):
+        desc = f"[{i}/{len(sections)}] {section.title:<{width}}"
+        with tqdm(total=1, desc=desc, file=sys.stderr, disable=not progress, leave=True) as bar:
+            ctx = ReportContext(out_dir=out_dir, quick=quick, bench=bench, section=section.name)
+            start = time.perf_counter()
+            result = section.run(ctx)
+            result.seconds = time.perf_counter() - start
+            result.results.setdefault("section_seconds", result.seconds)
+            bar.update(1)
+        done.append((section, result))
+    return done

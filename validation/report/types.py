@@ -25,8 +25,10 @@ from reference.images import write_png
 
 __all__ = [
     "Check",
+    "Headline",
     "Image",
     "ReportContext",
+    "ReportPart",
     "ReportSection",
     "SectionData",
     "SectionResult",
@@ -55,10 +57,34 @@ class Table:
 
 @dataclass(frozen=True)
 class Image:
-    """An image file written under ``DIR/images`` (path relative to ``DIR``) with a caption."""
+    """An image file written under ``DIR/images`` (path relative to ``DIR``) with a caption.
+
+    ``width`` and ``height`` are the file's true size in pixels (0 when unknown); the HTML shows
+    small images enlarged by a whole factor, without smoothing, and states the true size.
+    """
 
     path: str
     caption: str = ""
+    width: int = 0
+    height: int = 0
+
+
+@dataclass(frozen=True)
+class Headline:
+    """A headline figure for the report's summary: what was measured, and its anchor.
+
+    Parameters
+    ----------
+    text : str
+        The figure as a sentence fragment, computed from the run, e.g.
+        ``"Phong table 12.8× faster than exact at RMS 9e-05"``.
+    anchor : str
+        What it is measured against: the paper's figure or the issue's target, e.g.
+        ``"paper: ~10×"``.
+    """
+
+    text: str
+    anchor: str = ""
 
 
 @dataclass(frozen=True)
@@ -90,6 +116,8 @@ class SectionResult:
     blocks: list = field(default_factory=list)
     results: dict = field(default_factory=dict)
     checks: list = field(default_factory=list)
+    headlines: list = field(default_factory=list)
+    seconds: float = 0.0
 
 
 @dataclass
@@ -113,6 +141,13 @@ def _no_checks(data: SectionData) -> list:
     return []
 
 
+def _format(value) -> str:
+    """A measured value as the report shows it (4 significant digits; non-finite as a dash)."""
+    if isinstance(value, float | np.floating):
+        return f"{float(value):.4g}" if math.isfinite(value) else "—"
+    return str(value)
+
+
 @dataclass(frozen=True)
 class ReportSection:
     """A report section: compute → present → checks.
@@ -129,6 +164,12 @@ class ReportSection:
         ``present(ctx: ReportContext, data: SectionData) -> list`` of blocks.
     checks : callable
         ``checks(data: SectionData) -> list[Check]``.
+    headlines : callable, optional
+        ``headlines(data: SectionData) -> list[Headline]``: the section's figures for the
+        report's summary (by default, the first two checks).
+    hero : str
+        Name of the image (as given to ``ctx.image``/``ctx.figure``) that stands for the
+        section in the summary; empty: the section's first image.
 
     Examples
     --------
@@ -149,12 +190,46 @@ class ReportSection:
     compute: Callable[[ReportContext], SectionData] | None = None
     present: Callable[[ReportContext, SectionData], list] | None = None
     checks: Callable[[SectionData], list] = _no_checks
+    headlines: Callable[[SectionData], list] | None = None
+    hero: str = ""
 
     def run(self, ctx: ReportContext) -> SectionResult:
-        """Compute, present and check: the section's blocks, results and checks."""
+        """Compute, present and check: the section's blocks, results, checks and headlines."""
         data = self.compute(ctx)
         blocks = self.present(ctx, data)
-        return SectionResult(blocks, data.results, self.checks(data))
+        checks = self.checks(data)
+        if self.headlines is not None:
+            headlines = list(self.headlines(data))
+        else:
+            headlines = [Headline(f"{c.name}: {_format(c.measured)}", c.target) for c in checks[:2]]
+        return SectionResult(blocks, data.results, checks, headlines)
+
+
+@dataclass(frozen=True)
+class ReportPart:
+    """A part of the report: one paper (or the shared core) and its sections, in reading order.
+
+    The report's summary shows one block per part: a hero image, the sections' headline figures
+    and the count of targets that hold, linking to the sections.
+
+    Examples
+    --------
+    >>> a, b = ReportSection("a", "A"), ReportSection("b", "B")
+    >>> part = ReportPart("demo", "Demo paper", "What it is about.", (a, b))
+    >>> [s.name for s in part.only(["b"]).sections]
+    ['b']
+    """
+
+    name: str
+    title: str
+    about: str
+    sections: tuple[ReportSection, ...]
+
+    def only(self, names) -> ReportPart:
+        """The same part with only the sections whose keys are in ``names``."""
+        names = set(names)
+        kept = tuple(s for s in self.sections if s.name in names)
+        return ReportPart(self.name, self.title, self.about, kept)
 
 
 @dataclass
@@ -182,13 +257,49 @@ class ReportContext:
         """Write an encoded image (floats in [0, 1] or uint8) as ``images/<section>-<name>.png``."""
         rel = f"images/{self.section}-{name}.png"
         write_png(self.out_dir / rel, encoded)
-        return Image(rel, caption)
+        height, width = np.shape(encoded)[:2]
+        return Image(rel, caption, int(width), int(height))
+
+    def comparison(
+        self, name: str, reference, method, labels=("reference", "method"), caption: str = ""
+    ) -> Image:
+        """Reference | method | difference, the report's one layout for every comparison.
+
+        ``reference`` and ``method`` are linear images of the same shape, ``(H, W)`` or
+        ``(H, W, 3)`` (display RGB; the difference is taken on their luminance-like mean). They
+        are shown with one exposure (the reference's 99th percentile maps to white), the
+        difference ``method − reference`` on a diverging colour scale symmetric about zero,
+        in the reference's units, with its colour bar. Pixels are shown without smoothing.
+        """
+        import matplotlib.pyplot as plt
+
+        ref = np.asarray(reference, dtype=float)
+        got = np.asarray(method, dtype=float)
+        scale = float(np.percentile(ref, 99)) or 1.0
+        diff = got - ref
+        if diff.ndim == 3:
+            diff = diff.mean(axis=-1)
+        limit = float(np.max(np.abs(diff))) or 1.0
+        fig, axes = plt.subplots(1, 3, figsize=(10.5, 3.6), constrained_layout=True)
+        for ax, image, label in zip(axes[:2], (ref, got), labels, strict=True):
+            ax.imshow(np.clip(image / scale, 0, 1) ** (1 / 2.2), interpolation="nearest")
+            ax.set_title(label)
+        shown = axes[2].imshow(
+            diff, cmap="RdBu_r", vmin=-limit, vmax=limit, interpolation="nearest"
+        )
+        axes[2].set_title(f"{labels[1]} − {labels[0]}")
+        fig.colorbar(shown, ax=axes[2], shrink=0.85, label="difference (reference units)")
+        for ax in axes:
+            ax.set_xticks([])
+            ax.set_yticks([])
+        return self.figure(name, fig, caption)
 
     def figure(self, name: str, fig, caption: str = "") -> Image:
         """Save a matplotlib figure as ``images/<section>-<name>.png`` (atomically) and close it."""
         import io
 
         import matplotlib.pyplot as plt
+        from PIL import Image as PILImage
 
         from reference.images import write_bytes_atomic
 
@@ -197,7 +308,9 @@ class ReportContext:
         fig.savefig(buffer, format="png", dpi=110, bbox_inches="tight")
         plt.close(fig)
         write_bytes_atomic(self.out_dir / rel, buffer.getvalue())
-        return Image(rel, caption)
+        buffer.seek(0)
+        width, height = PILImage.open(buffer).size
+        return Image(rel, caption, width, height)
 
     def bench_groups(self, prefix: str) -> dict[str, list[dict]]:
         """Benchmarks whose group starts with ``prefix``, as ``{group: [benchmark records]}``."""

@@ -458,14 +458,6 @@ def present(ctx: ReportContext, data: SectionData) -> list:
                 "{:.3g}",
             )
         )
-    blocks.append(
-        Table(
-            ["target", "limit", "measured", "holds"],
-            [[c.name, c.target, c.measured, "yes" if c.passed else "NO"] for c in checks(data)],
-            "The issue's targets, from this section's figures",
-            "{:.3g}",
-        )
-    )
     return blocks
 
 

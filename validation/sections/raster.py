@@ -20,6 +20,7 @@ from reference.mesh import TriangleMesh, grid_mesh, uv_sphere_mesh
 from reference.raster import RASTER_METHODS, pixel_coverage, rasterize_mesh
 from validation.report import (
     Check,
+    Headline,
     ReportContext,
     ReportSection,
     SectionData,
@@ -406,4 +407,24 @@ def checks(data: SectionData) -> list[Check]:
     return found
 
 
-SECTION = ReportSection("rasterizer", "Rasterizer", rasterizer_figures, present, checks)
+def headlines(data: SectionData) -> list[Headline]:
+    """The summary's figures: shading-normal error at the finest tessellation, watertightness."""
+    finest = max(data.results["tessellation"].values(), key=lambda e: e["triangles"])
+    closed = data.results["closed_mesh"]
+    return [
+        Headline(
+            f"interpolated normals of a {finest['triangles']}-triangle sphere within "
+            f"{np.degrees(finest['max']):.2f}° of the true sphere",
+            f"chord bound {np.degrees(finest['bound']):.2f}°",
+        ),
+        Headline(
+            f"watertight: {closed['front_back_mismatch']} cracks and no pixel centre covered twice "
+            "on a closed mesh",
+            "top-left fill rule",
+        ),
+    ]
+
+
+SECTION = ReportSection(
+    "rasterizer", "Rasterizer", rasterizer_figures, present, checks, headlines=headlines
+)

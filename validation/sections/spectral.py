@@ -11,6 +11,7 @@ from reference.spectra import GRID_31, GRID_41
 from validation.metrics import COLORCHECKER, colorchecker_delta_E, delta_E_stats
 from validation.report import (
     Check,
+    Headline,
     ReportContext,
     ReportSection,
     SectionData,
@@ -106,6 +107,30 @@ def checks(data: SectionData) -> list[Check]:
     return found
 
 
+def headlines(data: SectionData) -> list[Headline]:
+    """The summary's figures: the 41-band ColorChecker under D65 and FL2, and point sampling."""
+    r = data.results
+    d65, fl2 = (r[f"{GRID_41.label} {light} astm_e308"]["mean"] for light in ("D65", "FL2"))
+    point = r[f"{GRID_41.label} FL2 point"]["mean"]
+    return [
+        Headline(
+            f"41-band ColorChecker renders match the 5 nm truth: mean ΔE00 {d65:.3f} under D65, "
+            f"{fl2:.3f} under FL2",
+            f"targets ≤ {TARGETS['D65'][0]} and ≤ {TARGETS['FL2'][0]}",
+        ),
+        Headline(
+            f"point-sampled bands miss FL2's mercury lines: mean ΔE00 {point:.2f}, "
+            f"{point / fl2:.0f}× the band weights' error",
+            "why specref folds the light into ASTM E308 weights",
+        ),
+    ]
+
+
 SECTION = ReportSection(
-    "spectral-core", "Spectral core", colorchecker_band_weights, present, checks
+    "spectral-core",
+    "Spectral core",
+    colorchecker_band_weights,
+    present,
+    checks,
+    headlines=headlines,
 )

@@ -1,0 +1,167 @@
+"""Independent jobs on a Dask cluster: local by default, or a remote scheduler.
+
+One way to run a list of independent tasks (a sweep's cells, a study's renders): a
+``dask.distributed`` client on a ``LocalCluster`` of worker processes sized to the machine, or on
+the scheduler that ``--scheduler ADDRESS`` or the ``SPECREF_SCHEDULER`` environment variable names
+(``tcp://host:8786``, as ``dask scheduler`` prints it). ``"serial"`` runs the tasks in this process,
+one after another: the baseline every distributed run must reproduce.
+
+Results come back in task order, whatever order the workers finish in, so reductions over them
+are order-independent; each task carries its own seed. A worker killed mid-sweep loses only its
+running tasks, which the scheduler runs again elsewhere (``retries``), so the results are the same.
+
+specref writes no scheduler of its own: this module only wraps Dask's (``distributed.Client``,
+``LocalCluster``, ``as_completed``), with one-line errors and a progress bar.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+import sys
+from collections.abc import Callable, Sequence
+
+from reference.errors import SpecrefError, require
+
+__all__ = ["SCHEDULER_ENV", "SERIAL", "dask_client", "run_tasks", "scheduler_address"]
+
+#: The environment variable that names a remote scheduler.
+SCHEDULER_ENV = "SPECREF_SCHEDULER"
+
+#: The scheduler name that runs tasks in this process, one after another.
+SERIAL = "serial"
+
+
+def scheduler_address(scheduler: str | None = None) -> str | None:
+    """The scheduler to use: ``scheduler``, else ``$SPECREF_SCHEDULER``, else None (local).
+
+    Examples
+    --------
+    >>> scheduler_address("tcp://127.0.0.1:8786")
+    'tcp://127.0.0.1:8786'
+    >>> scheduler_address("serial")
+    'serial'
+    """
+    if scheduler:
+        return str(scheduler)
+    return os.environ.get(SCHEDULER_ENV) or None
+
+
+@contextlib.contextmanager
+def dask_client(scheduler: str | None = None, n_workers: int | None = None, timeout: float = 10.0):
+    """A ``distributed.Client``: on ``scheduler`` if given, else on a new local cluster.
+
+    Parameters
+    ----------
+    scheduler : str, optional
+        Address of a running scheduler (``tcp://host:port``); default ``$SPECREF_SCHEDULER``,
+        else a ``LocalCluster`` of ``n_workers`` single-threaded processes on 127.0.0.1.
+    n_workers : int, optional
+        Local workers (default: the machine's cores).
+    timeout : float
+        Seconds to wait for a remote scheduler.
+
+    Raises
+    ------
+    SpecrefError
+        No scheduler answers at the address within ``timeout`` (one line, with the address).
+
+    Examples
+    --------
+    >>> with dask_client("tcp://127.0.0.1:9", timeout=0.5):
+    ...     pass
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: --scheduler tcp://127.0.0.1:9: no Dask scheduler answered ...
+    """
+    from distributed import Client, LocalCluster
+
+    address = scheduler_address(scheduler)
+    require(address != SERIAL, "dask_client: 'serial' runs without a client")
+    if address:
+        try:
+            client = Client(address, timeout=timeout)
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise SpecrefError(
+                f"--scheduler {address}: no Dask scheduler answered within {timeout:g} s "
+                f"({type(exc).__name__}); start one with `dask scheduler` or omit --scheduler "
+                "for a local cluster"
+            ) from None
+        try:
+            yield client
+        finally:
+            client.close()
+        return
+    workers = n_workers or os.cpu_count() or 1
+    with (
+        LocalCluster(
+            n_workers=workers,
+            threads_per_worker=1,
+            processes=True,
+            host="127.0.0.1",
+            dashboard_address=None,
+            silence_logs=logging.ERROR,
+        ) as cluster,
+        Client(cluster) as client,
+    ):
+        yield client
+
+
+def run_tasks(
+    function: Callable,
+    tasks: Sequence,
+    scheduler: str | None = None,
+    client=None,
+    progress: bool = True,
+    desc: str = "tasks",
+    retries: int = 3,
+) -> list:
+    """``[function(task) for task in tasks]``, on a Dask cluster or serially, in task order.
+
+    Parameters
+    ----------
+    function : callable
+        A module-level function (workers import it by name), deterministic given its task.
+    tasks : sequence
+        One argument per call (picklable).
+    scheduler : str, optional
+        ``"serial"``, a scheduler address, or None: ``$SPECREF_SCHEDULER``, else a local cluster.
+    client : distributed.Client, optional
+        Use this client (and leave it open) instead of making one.
+    progress : bool
+        A progress bar on stderr (never under CI or without a terminal).
+    retries : int
+        Times a task is run again after its worker died.
+
+    Returns
+    -------
+    list
+        The results, in the order of ``tasks``.
+
+    Examples
+    --------
+    >>> run_tasks(abs, [-1, 2, -3], scheduler="serial", progress=False)
+    [1, 2, 3]
+    """
+    from tqdm import tqdm
+
+    tasks = list(tasks)
+    show = progress and not os.environ.get("CI") and sys.stderr.isatty()
+    if client is None and scheduler_address(scheduler) == SERIAL:
+        return [function(task) for task in tqdm(tasks, desc=desc, disable=not show, leave=False)]
+    with contextlib.ExitStack() as stack:
+        if client is None:
+            client = stack.enter_context(dask_client(scheduler))
+        return _gather(client, function, tasks, show, desc, retries)
+
+
+def _gather(client, function, tasks, show, desc, retries) -> list:
+    from distributed import as_completed
+    from tqdm import tqdm
+
+    futures = client.map(function, tasks, pure=False, retries=retries)
+    with tqdm(total=len(futures), desc=desc, disable=not show, leave=False) as bar:
+        for _ in as_completed(futures):
+            bar.update()
+    return client.gather(futures)

@@ -1,0 +1,37 @@
+"""``specref sweep``: a user-defined grid of methods × materials as tasks (local or remote Dask)."""
+
+from __future__ import annotations
+
+
+def _cmd_sweep(args) -> int:
+    from validation.sweep import run_sweep, sweep_csv
+
+    rows = run_sweep(args.file, scheduler=args.scheduler)
+    text = sweep_csv(rows, args.out)
+    if args.out:
+        print(f"wrote {len(rows)} rows to {args.out}")
+    else:
+        print(text, end="")
+    return 0
+
+
+def add_parser(sub) -> None:
+    """Add ``specref sweep`` and its options to the subcommand parsers ``sub``."""
+    from validation.sweep import SWEEP_KINDS
+
+    p = sub.add_parser(
+        "sweep",
+        help="run a sweep file's grid as Dask tasks; a tidy CSV, one row per cell",
+    )
+    kinds = ", ".join(SWEEP_KINDS.names())
+    p.add_argument(
+        "file", metavar="SWEEP.toml", help=f"the sweep file; kind: {kinds} (docs/scale-out.md)"
+    )
+    p.add_argument("-o", "--out", metavar="CSV", help="write the table here (default: stdout)")
+    p.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="a running Dask scheduler (tcp://host:8786), or 'serial'; default $SPECREF_SCHEDULER, "
+        "else a local cluster of one worker process per core",
+    )
+    p.set_defaults(func=_cmd_sweep)
