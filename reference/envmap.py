@@ -12,7 +12,9 @@ Pixel ``(j, i)`` (row j, column i) of an ``H × W`` map has its centre at ``u = 
 ``v = (j + ½)/H``. The row centres ``θ_j = (j + ½)π/H`` are the nodes of Fejér's first quadrature
 rule, which the SH engine relies on. Mitsuba 3 itself puts row centres at ``v = j/(H − 1)`` (row 0
 on the pole), which differs by up to half a row near the poles (0.18° for 1024×512); see
-``docs/conventions.md``. OpenEXR's ``envmap = LATLONG`` attribute uses the same orientation as
+``docs/conventions.md``. :data:`TEXEL_PLACEMENTS` lets a map be read under Mitsuba's placement
+(``"mitsuba"``, for like-for-like comparisons with it; the default is specref's ``"centred"``):
+:func:`latlong_rows_mitsuba_to_centred` resamples it onto specref's rows. OpenEXR's ``envmap = LATLONG`` attribute uses the same orientation as
 Mitsuba 3.
 
 References
@@ -26,13 +28,18 @@ from __future__ import annotations
 import numpy as np
 
 from reference.errors import require
+from reference.registry import Method, Registry
 
 __all__ = [
+    "DEFAULT_TEXEL_PLACEMENT",
+    "TEXEL_PLACEMENTS",
     "check_latlong_shape",
     "direction_to_latlong_uv",
     "latlong_lookup_bilinear",
     "latlong_pixel_directions",
     "latlong_pixel_solid_angles",
+    "latlong_rows_centred",
+    "latlong_rows_mitsuba_to_centred",
     "latlong_uv_to_direction",
 ]
 
@@ -194,3 +201,79 @@ def latlong_lookup_bilinear(image, d) -> np.ndarray:
     top = image[y0, x0] * (1 - fx) + image[y0, x1] * fx
     bottom = image[y1, x0] * (1 - fx) + image[y1, x1] * fx
     return top * (1 - fy) + bottom * fy
+
+
+def latlong_rows_centred(image) -> np.ndarray:
+    """specref's own texel placement: rows at ``v = (j + ½)/H`` already; the map unchanged.
+
+    Fejér's first rule (module docstring): row j is the sample at ``θ_j = (j + ½)π/H``.
+
+    Examples
+    --------
+    >>> latlong_rows_centred(np.ones((2, 4, 1))).shape
+    (2, 4, 1)
+    """
+    return np.asarray(image, dtype=np.float64)
+
+
+def latlong_rows_mitsuba_to_centred(image) -> np.ndarray:
+    """A map whose rows sit at Mitsuba 3's ``v = j/(H − 1)``, resampled onto specref's rows.
+
+    Mitsuba 3 (``src/emitters/envmap.cpp``, ``eval_spectrum``) reads texel ``(j, i)`` of an
+    ``H × W`` map as the sample at ``u = (i + ½)/W``, ``v = j/(H − 1)`` (rows on the poles) and
+    interpolates linearly between rows. Its radiance at specref's row centre ``v = (j + ½)/H`` is
+    therefore the linear interpolation at row coordinate ``y = (j + ½)(H − 1)/H``; columns already
+    agree. (Mitsuba interpolates the upsampled spectrum's shape and its scale separately and
+    multiplies them; applied after upsampling, this interpolates their product, a difference of
+    second order in the row spacing.)
+
+    Parameters
+    ----------
+    image : array_like, shape (H, W, C)
+        The map as Mitsuba 3 reads it, H >= 2.
+
+    Returns
+    -------
+    ndarray, shape (H, W, C)
+        The same radiance function sampled at specref's rows.
+
+    Examples
+    --------
+    >>> ramp = np.arange(4.0)[:, None, None] * np.ones((4, 8, 1))   # row j holds j: linear in v
+    >>> latlong_rows_mitsuba_to_centred(ramp)[:, 0, 0]              # (j + 1/2)(H - 1)/H
+    array([0.375, 1.125, 1.875, 2.625])
+    """
+    image = np.asarray(image, dtype=np.float64)
+    H = image.shape[0]
+    require(H >= 2, f"Mitsuba texel placement: needs at least 2 rows, got {H}")
+    # Row coordinate of specref's centre v = (j + ½)/H in Mitsuba's rows v = j/(H − 1)
+    y = (np.arange(H) + 0.5) * (H - 1) / H
+    j0 = np.minimum(np.floor(y).astype(np.int64), H - 2)
+    t = (y - j0).reshape(-1, *([1] * (image.ndim - 1)))
+    return image[j0] * (1.0 - t) + image[j0 + 1] * t
+
+
+#: The default texel placement of lat-long maps: specref's pixel-centred rows.
+DEFAULT_TEXEL_PLACEMENT = "centred"
+
+#: Lat-long texel placements (scene key ``texel_placement`` of environment lights, ``specref render
+#: --texel-placement``): each entry turns a map read under that placement into specref's rows.
+TEXEL_PLACEMENTS = Registry("texel placement")
+TEXEL_PLACEMENTS.register(
+    Method(
+        "centred",
+        latlong_rows_centred,
+        None,
+        "Fejér's first rule: rows at v = (j + 1/2)/H",
+        extra={"rows": "v = (j + 1/2)/H", "columns": "u = (i + 1/2)/W"},
+    )
+)
+TEXEL_PLACEMENTS.register(
+    Method(
+        "mitsuba",
+        latlong_rows_mitsuba_to_centred,
+        None,
+        "Mitsuba 3, src/emitters/envmap.cpp: rows at v = j/(H - 1)",
+        extra={"rows": "v = j/(H - 1)", "columns": "u = (i + 1/2)/W"},
+    )
+)
