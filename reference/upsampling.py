@@ -21,7 +21,8 @@ that regression and two published methods from colour-science, by key
   (Mitsuba 3 ``src/emitters/envmap.cpp``, pbrt-v4 ``RGBIlluminantSpectrum``: ``scale = 2 * max``),
   a texel is divided by **twice** its largest component m, so the shape is fitted to a colour whose
   largest component is ½ (a smoother spectrum than at 1), and the spectrum is multiplied by 2m
-  (erratum E80). A white texel becomes exactly the flat spectrum (½ is the sigmoid at 0). The
+  (erratum E80). A white texel becomes a flat spectrum to 0.1 % (½ is the sigmoid at 0; the sRGB
+  white and D65 integrated at 5 nm differ slightly). The
   coefficients come from a 64³ table per largest component, Mitsuba's and pbrt's resolution
   (``reference.jakob2019``: generated once, one to four minutes, and cached), interpolated by
   colour-science's ``LUT3D_Jakob2019``, so a 1k map takes seconds; ``lut_size=None`` fits each colour
