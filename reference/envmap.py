@@ -14,8 +14,8 @@ rule, which the SH engine relies on. Mitsuba 3 itself puts row centres at ``v = 
 on the pole), which differs by up to half a row near the poles (0.18° for 1024×512); see
 ``docs/conventions.md``. :data:`TEXEL_PLACEMENTS` lets a map be read under Mitsuba's placement
 (``"mitsuba"``, for like-for-like comparisons with it; the default is specref's ``"centred"``):
-:func:`latlong_rows_mitsuba_to_centred` resamples it onto specref's rows. OpenEXR's ``envmap = LATLONG`` attribute uses the same orientation as
-Mitsuba 3.
+:func:`latlong_rows_mitsuba_to_centred` resamples it onto specref's rows. OpenEXR's
+``envmap = LATLONG`` attribute uses the same orientation as Mitsuba 3.
 
 References
 ----------
@@ -204,7 +204,7 @@ def latlong_lookup_bilinear(image, d) -> np.ndarray:
 
 
 def latlong_rows_centred(image) -> np.ndarray:
-    """specref's own texel placement: rows at ``v = (j + ½)/H`` already; the map unchanged.
+    """Specref's own texel placement: rows at ``v = (j + ½)/H`` already; the map unchanged.
 
     Fejér's first rule (module docstring): row j is the sample at ``θ_j = (j + ½)π/H``.
 

@@ -1,4 +1,4 @@
-"""Jakob & Hanika's coefficient table: many colours fitted at once, cached, looked up by colour-science.
+"""Jakob & Hanika's coefficient table: colours fitted in batches, cached, looked up by colour-science.
 
 Jakob & Hanika (2019) represent a reflectance by a sigmoid of a quadratic in wavelength,
 ``R(λ) = S(c0 λ² + c1 λ + c2)`` with ``S(x) = ½ + x / (2 sqrt(1 + x²))`` (Eq. (3), Jakob & Hanika
@@ -15,7 +15,7 @@ look-up (``colour.recovery.LUT3D_Jakob2019``: three blocks by largest component,
 Gauss-Newton on the three Lab residuals (three equations, three unknowns), with step halving,
 on colour-science's objective exactly (its 360-780 nm, 5 nm grid in normalized wavelength, CIE 1931
 2°, D65, Lab relative to the illuminant's white). :func:`generate_table_Jakob2019` fills
-colour-science's table the way ``rgb2spec_opt`` does: every chromaticity of a block at once, starting
+colour-science's table as ``rgb2spec_opt`` does: every chromaticity of a block at once, starting
 in the middle of the brightness scale and stepping up and down it, each step started from the
 previous one (64³ in seconds). :func:`table_Jakob2019` loads it from specref's cache folder, or
 generates and writes it there atomically; an unusable cache folder gives a warning and an in-memory
@@ -227,7 +227,7 @@ def generate_table_Jakob2019(size: int = DEFAULT_TABLE_SIZE) -> tuple[np.ndarray
 
 
 def _cache_folder() -> Path:
-    """specref's cache folder, as ``shrm.cache.default_cache_dir`` finds it."""
+    """Specref's cache folder, as ``shrm.cache.default_cache_dir`` finds it."""
     explicit = os.environ.get("SPECREF_CACHE_DIR")
     if explicit:
         return Path(explicit)

@@ -17,10 +17,10 @@ from dataclasses import dataclass
 import numpy as np
 
 import reference.raster  # noqa: F401  (registers the TriangleMesh G-buffer writer)
+from reference.envmap import DEFAULT_TEXEL_PLACEMENT, TEXEL_PLACEMENTS
 from reference.errors import SpecrefError, format_allowed
 from reference.geometry import Plane, Sphere
 from reference.images import channel_wavelengths_nm, read_exr, read_hdr
-from reference.envmap import DEFAULT_TEXEL_PLACEMENT, TEXEL_PLACEMENTS
 from reference.lights import AmbientLight, EnvironmentLight, PointLight
 from reference.mesh import TriangleMesh, mesh_from_obj
 from reference.registry import Registry

@@ -25,8 +25,8 @@ that regression and two published methods from colour-science, by key
   white and D65 integrated at 5 nm differ slightly). The
   coefficients come from a 64³ table per largest component, Mitsuba's and pbrt's resolution
   (``reference.jakob2019``: generated once, one to four minutes, and cached), interpolated by
-  colour-science's ``LUT3D_Jakob2019``, so a 1k map takes seconds; ``lut_size=None`` fits each colour
-  with colour-science instead (about 0.5 s each, for a few colours).
+  colour-science's ``LUT3D_Jakob2019``, so a 1k map takes seconds; ``lut_size=None`` fits each
+  colour with colour-science instead (about 0.5 s each, for a few colours).
 
 The RGB is linear in the map's colourspace (sRGB primaries for both methods). Both methods recover
 *reflectance-like* spectra: R = G = B maps to a flat spectrum, whose colour under the equal-energy
