@@ -1,4 +1,4 @@
-"""Jakob & Hanika's coefficient table: colours fitted in batches, cached, looked up by colour-science.
+"""Jakob & Hanika's coefficient table: colours fitted in batches, cached, read by colour-science.
 
 Jakob & Hanika (2019) represent a reflectance by a sigmoid of a quadratic in wavelength,
 ``R(λ) = S(c0 λ² + c1 λ + c2)`` with ``S(x) = ½ + x / (2 sqrt(1 + x²))`` (Eq. (3), Jakob & Hanika

@@ -27,6 +27,7 @@ from reference.registry import Registry
 from validation.report.render import render_html, render_markdown
 from validation.report.types import ReportContext, ReportSection, SectionResult, to_jsonable
 from validation.sections import (
+    crosscheck,
     display,
     examples,
     impastor,
@@ -53,6 +54,7 @@ SECTIONS: tuple[ReportSection, ...] = (
     polymer.SECTION,
     impastor.SECTION,
     display.SECTION,
+    crosscheck.SECTION,
 )
 
 #: Report sections by key (``specref report --only`` takes the keys).
