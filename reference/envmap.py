@@ -217,15 +217,17 @@ def latlong_rows_centred(image) -> np.ndarray:
 
 
 def latlong_rows_mitsuba_to_centred(image) -> np.ndarray:
-    """A map whose rows sit at Mitsuba 3's ``v = j/(H − 1)``, resampled onto specref's rows.
+    """A map whose rows sit at Mitsuba 3's ``v = j/(H − 1)``, averaged onto specref's rows.
 
     Mitsuba 3 (``src/emitters/envmap.cpp``, ``eval_spectrum``) reads texel ``(j, i)`` of an
     ``H × W`` map as the sample at ``u = (i + ½)/W``, ``v = j/(H − 1)`` (rows on the poles) and
-    interpolates linearly between rows. Its radiance at specref's row centre ``v = (j + ½)/H`` is
-    therefore the linear interpolation at row coordinate ``y = (j + ½)(H − 1)/H``; columns already
-    agree. (Mitsuba interpolates the upsampled spectrum's shape and its scale separately and
-    multiplies them; applied after upsampling, this interpolates their product, a difference of
-    second order in the row spacing.)
+    interpolates linearly between rows and columns. Columns already agree with specref's. Row j of
+    specref spans ``v ∈ [j/H, (j + 1)/H]``, i.e. Mitsuba row coordinates ``y ∈ [j, j + 1](H − 1)/H``;
+    it receives the mean of Mitsuba's piecewise-linear radiance over that span (its exact integral,
+    divided by the span), so a light one texel wide keeps its power: a point sample at the row
+    centre would alias it by up to ±2/H. A map linear in v is reproduced exactly. (Mitsuba
+    interpolates the upsampled spectrum's shape and its scale separately and multiplies them;
+    applied after upsampling, this interpolates their product, erratum E81.)
 
     Parameters
     ----------
@@ -235,22 +237,34 @@ def latlong_rows_mitsuba_to_centred(image) -> np.ndarray:
     Returns
     -------
     ndarray, shape (H, W, C)
-        The same radiance function sampled at specref's rows.
+        Its radiance averaged over specref's rows.
 
     Examples
     --------
     >>> ramp = np.arange(4.0)[:, None, None] * np.ones((4, 8, 1))   # row j holds j: linear in v
     >>> latlong_rows_mitsuba_to_centred(ramp)[:, 0, 0]              # (j + 1/2)(H - 1)/H
     array([0.375, 1.125, 1.875, 2.625])
+    >>> spike = np.zeros((4, 8, 1)); spike[1] = 1.0                 # one bright row
+    >>> float(latlong_rows_mitsuba_to_centred(spike)[:, 0, 0].sum() / 4 * 3)   # power kept
+    1.0
     """
     image = np.asarray(image, dtype=np.float64)
     H = image.shape[0]
     require(H >= 2, f"Mitsuba texel placement: needs at least 2 rows, got {H}")
-    # Row coordinate of specref's centre v = (j + ½)/H in Mitsuba's rows v = j/(H − 1)
-    y = (np.arange(H) + 0.5) * (H - 1) / H
-    j0 = np.minimum(np.floor(y).astype(np.int64), H - 2)
-    t = (y - j0).reshape(-1, *([1] * (image.ndim - 1)))
-    return image[j0] * (1.0 - t) + image[j0 + 1] * t
+    # Integral F(y) of the piecewise-linear rows: trapezoids between integer nodes
+    F_nodes = np.concatenate(
+        [np.zeros_like(image[:1]), np.cumsum(0.5 * (image[1:] + image[:-1]), axis=0)]
+    )
+
+    def F(y):
+        n = np.minimum(np.floor(y).astype(np.int64), H - 2)
+        t = (y - n).reshape(-1, *([1] * (image.ndim - 1)))
+        return F_nodes[n] + image[n] * t + 0.5 * (image[n + 1] - image[n]) * t * t
+
+    # Specref row j spans y in [j, j + 1] (H - 1)/H: mean of Mitsuba's radiance over it
+    edges = np.arange(H + 1) * (H - 1) / H
+    F_edges = F(edges)
+    return (F_edges[1:] - F_edges[:-1]) / ((H - 1) / H)
 
 
 #: The default texel placement of lat-long maps: specref's pixel-centred rows.

@@ -104,3 +104,13 @@ def test_unknown_texel_placement_is_refused():
 
     with pytest.raises(SpecrefError, match="unknown texel placement 'pbrt'; allowed: centred"):
         EnvironmentLight(np.ones((4, 8, 3)), texel_placement="pbrt")
+
+
+def test_mitsuba_rows_keep_the_integral_over_v(rng):
+    # Source: the trapezoid rule, which is the exact integral of Mitsuba's piecewise-linear rows
+    # over v in [0, 1]; specref's rows (width 1/H) are its averages, so their sum keeps it.
+    from reference.envmap import latlong_rows_mitsuba_to_centred
+
+    image = rng.random((7, 14, 2))
+    exact = np.trapezoid(image, dx=1.0 / 6.0, axis=0)
+    np.testing.assert_allclose(latlong_rows_mitsuba_to_centred(image).sum(axis=0) / 7, exact)
