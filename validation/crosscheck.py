@@ -79,7 +79,7 @@ class CrosscheckSettings:
 #: ``specref crosscheck`` and the report (a few minutes in all).
 FULL = CrosscheckSettings()
 #: Tests.
-QUICK = CrosscheckSettings(size=8, spp=64, seeds=6, env_height=16, supersample=2)
+QUICK = CrosscheckSettings(size=8, spp=64, seeds=6, env_height=32, supersample=2)
 
 
 def mitsuba_missing() -> str | None:

@@ -11,10 +11,11 @@ import numpy as np
 
 from validation.report.types import Check, ReportSection, SectionData, Table, Text
 
-#: Agreement target: the RMS z of a case is within this factor of Student's t expectation, and its
-#: mean relative difference in Y is below MEAN_REL_Y_TARGET (specref's systematic differences:
-#: band grid, Jakob tables, interpolation, errata E81-E82).
-RMS_Z_FACTOR = 1.5
+#: Agreement targets (erratum E83): the RMS z of a case within this factor of Student's t
+#: expectation, and its mean relative difference in Y below MEAN_REL_Y_TARGET. Both allow for the
+#: documented systematic differences (band grid, Jakob tables, Mitsuba's separate interpolation of
+#: spectral shape and scale between texels; errata E81-E82), which grow in z with the samples.
+RMS_Z_FACTOR = 2.0
 MEAN_REL_Y_TARGET = 0.02
 
 
