@@ -70,3 +70,10 @@ def test_without_mitsuba_the_section_and_cli_say_how_to_install(monkeypatch, tmp
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1
     assert "pip install" in err[0]
+
+
+def test_json_output_into_a_folder_is_refused_before_rendering(tmp_path, capsys):
+    code = main(["crosscheck", "--quick", "--json", str(tmp_path)])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert "is a folder" in err or "pip install" in err

@@ -14,6 +14,15 @@ def _cmd_crosscheck(args) -> int:
         run_crosscheck,
     )
 
+    if args.json:  # refuse an unusable output before minutes of rendering
+        from pathlib import Path
+
+        from reference.errors import require
+        from reference.images import check_output_folder
+
+        json_path = Path(args.json)
+        require(not json_path.is_dir(), f"--json: {json_path} is a folder; give a file name")
+        check_output_folder(json_path.parent)
     settings = QUICK if args.quick else FULL
     data = args.data or SHARED_DATA
     result = run_crosscheck(
