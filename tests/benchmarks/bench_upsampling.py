@@ -5,7 +5,7 @@ Group ``upsampling-1k`` (issue 17 §3: a 1k map upsamples in seconds): ``studio_
 through :func:`reference.upsampling.RGB_to_radiance_spectra`, what rendering a scene runs. The
 baseline is ``mallett2019`` (one matrix product). ``jakob2019`` looks its coefficients up in the
 cached 64³ table (generated before timing, as a user's second render would find it); the
-per-colour fit it replaced took 0.5-2 s per distinct colour, tens of thousands on this map.
+per-colour fit it replaced took 0.5-2 s per distinct colour, thousands of them on this map.
 """
 
 from operator import attrgetter
