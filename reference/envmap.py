@@ -12,8 +12,10 @@ Pixel ``(j, i)`` (row j, column i) of an ``H × W`` map has its centre at ``u = 
 ``v = (j + ½)/H``. The row centres ``θ_j = (j + ½)π/H`` are the nodes of Fejér's first quadrature
 rule, which the SH engine relies on. Mitsuba 3 itself puts row centres at ``v = j/(H − 1)`` (row 0
 on the pole), which differs by up to half a row near the poles (0.18° for 1024×512); see
-``docs/conventions.md``. OpenEXR's ``envmap = LATLONG`` attribute uses the same orientation as
-Mitsuba 3.
+``docs/conventions.md``. :data:`TEXEL_PLACEMENTS` lets a map be read under Mitsuba's placement
+(``"mitsuba"``, for like-for-like comparisons with it; the default is specref's ``"centred"``):
+:func:`latlong_rows_mitsuba_to_centred` resamples it onto specref's rows. OpenEXR's
+``envmap = LATLONG`` attribute uses the same orientation as Mitsuba 3.
 
 References
 ----------
@@ -26,13 +28,18 @@ from __future__ import annotations
 import numpy as np
 
 from reference.errors import require
+from reference.registry import Method, Registry
 
 __all__ = [
+    "DEFAULT_TEXEL_PLACEMENT",
+    "TEXEL_PLACEMENTS",
     "check_latlong_shape",
     "direction_to_latlong_uv",
     "latlong_lookup_bilinear",
     "latlong_pixel_directions",
     "latlong_pixel_solid_angles",
+    "latlong_rows_centred",
+    "latlong_rows_mitsuba_to_centred",
     "latlong_uv_to_direction",
 ]
 
@@ -194,3 +201,93 @@ def latlong_lookup_bilinear(image, d) -> np.ndarray:
     top = image[y0, x0] * (1 - fx) + image[y0, x1] * fx
     bottom = image[y1, x0] * (1 - fx) + image[y1, x1] * fx
     return top * (1 - fy) + bottom * fy
+
+
+def latlong_rows_centred(image) -> np.ndarray:
+    """Specref's own texel placement: rows at ``v = (j + ½)/H`` already; the map unchanged.
+
+    Fejér's first rule (module docstring): row j is the sample at ``θ_j = (j + ½)π/H``.
+
+    Examples
+    --------
+    >>> latlong_rows_centred(np.ones((2, 4, 1))).shape
+    (2, 4, 1)
+    """
+    return np.asarray(image, dtype=np.float64)
+
+
+def latlong_rows_mitsuba_to_centred(image) -> np.ndarray:
+    """A map whose rows sit at Mitsuba 3's ``v = j/(H − 1)``, averaged onto specref's rows.
+
+    Mitsuba 3 (``src/emitters/envmap.cpp``, ``eval_spectrum``) reads texel ``(j, i)`` of an
+    ``H × W`` map as the sample at ``u = (i + ½)/W``, ``v = j/(H − 1)`` (rows on the poles) and
+    interpolates linearly between rows and columns. Columns already agree with specref's. Row j of
+    specref spans ``v ∈ [j/H, (j + 1)/H]``, Mitsuba row coordinates ``y ∈ [j, j + 1](H − 1)/H``;
+    it receives the mean of Mitsuba's piecewise-linear radiance over that span (its exact integral,
+    divided by the span), so a light one texel wide keeps its power: a point sample at the row
+    centre would alias it by up to ±2/H. A map linear in v is reproduced exactly. (Mitsuba
+    interpolates the upsampled spectrum's shape and its scale separately and multiplies them;
+    applied after upsampling, this interpolates their product, erratum E81.)
+
+    Parameters
+    ----------
+    image : array_like, shape (H, W, C)
+        The map as Mitsuba 3 reads it, H >= 2.
+
+    Returns
+    -------
+    ndarray, shape (H, W, C)
+        Its radiance averaged over specref's rows.
+
+    Examples
+    --------
+    >>> ramp = np.arange(4.0)[:, None, None] * np.ones((4, 8, 1))   # row j holds j: linear in v
+    >>> latlong_rows_mitsuba_to_centred(ramp)[:, 0, 0]              # (j + 1/2)(H - 1)/H
+    array([0.375, 1.125, 1.875, 2.625])
+    >>> spike = np.zeros((4, 8, 1)); spike[1] = 1.0                 # one bright row
+    >>> float(latlong_rows_mitsuba_to_centred(spike)[:, 0, 0].sum() / 4 * 3)   # power kept
+    1.0
+    """
+    image = np.asarray(image, dtype=np.float64)
+    H = image.shape[0]
+    require(H >= 2, f"Mitsuba texel placement: needs at least 2 rows, got {H}")
+    # Integral F(y) of the piecewise-linear rows: trapezoids between integer nodes
+    F_nodes = np.concatenate(
+        [np.zeros_like(image[:1]), np.cumsum(0.5 * (image[1:] + image[:-1]), axis=0)]
+    )
+
+    def F(y):
+        n = np.minimum(np.floor(y).astype(np.int64), H - 2)
+        t = (y - n).reshape(-1, *([1] * (image.ndim - 1)))
+        return F_nodes[n] + image[n] * t + 0.5 * (image[n + 1] - image[n]) * t * t
+
+    # Specref row j spans y in [j, j + 1] (H - 1)/H: mean of Mitsuba's radiance over it
+    edges = np.arange(H + 1) * (H - 1) / H
+    F_edges = F(edges)
+    return (F_edges[1:] - F_edges[:-1]) / ((H - 1) / H)
+
+
+#: The default texel placement of lat-long maps: specref's pixel-centred rows.
+DEFAULT_TEXEL_PLACEMENT = "centred"
+
+#: Lat-long texel placements (scene key ``texel_placement`` of environment lights, ``specref render
+#: --texel-placement``): each entry turns a map read under that placement into specref's rows.
+TEXEL_PLACEMENTS = Registry("texel placement")
+TEXEL_PLACEMENTS.register(
+    Method(
+        "centred",
+        latlong_rows_centred,
+        None,
+        "Fejér's first rule: rows at v = (j + 1/2)/H",
+        extra={"rows": "v = (j + 1/2)/H", "columns": "u = (i + 1/2)/W"},
+    )
+)
+TEXEL_PLACEMENTS.register(
+    Method(
+        "mitsuba",
+        latlong_rows_mitsuba_to_centred,
+        None,
+        "Mitsuba 3, src/emitters/envmap.cpp: rows at v = j/(H - 1)",
+        extra={"rows": "v = j/(H - 1)", "columns": "u = (i + 1/2)/W"},
+    )
+)

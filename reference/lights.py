@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from reference.envmap import check_latlong_shape
+from reference.envmap import DEFAULT_TEXEL_PLACEMENT, TEXEL_PLACEMENTS, check_latlong_shape
 from reference.errors import require, require_finite
 from reference.spectra import Spectrum, spectrum_from_dataset
 
@@ -195,6 +195,11 @@ class EnvironmentLight:
         Scale, >= 0.
     name : str
         Where it came from (the file), for messages and cache keys.
+    texel_placement : str
+        Where the texels sit on the sphere, a key of ``reference.envmap.TEXEL_PLACEMENTS``:
+        ``"centred"`` (specref's rows at ``v = (j + ½)/H``, default) or ``"mitsuba"`` (Mitsuba 3's
+        rows at ``v = j/(H − 1)``, for like-for-like comparisons). :meth:`centred_image` is the map
+        on specref's rows.
 
     Examples
     --------
@@ -208,8 +213,10 @@ class EnvironmentLight:
     colourspace: str = "sRGB"
     intensity: float = 1.0
     name: str = "environment"
+    texel_placement: str = DEFAULT_TEXEL_PLACEMENT
 
     def __post_init__(self):
+        TEXEL_PLACEMENTS.lookup(self.texel_placement)
         image = np.asarray(self.image, dtype=np.float64)
         require(
             image.ndim == 3, f"{self.name}: environment image must be (H, W, C), got {image.shape}"
@@ -243,3 +250,15 @@ class EnvironmentLight:
     def is_spectral(self) -> bool:
         """True for a map with one channel per wavelength."""
         return self.wavelengths_nm is not None
+
+    def centred_image(self, image=None) -> np.ndarray:
+        """``image`` (default the map, or any per-texel data of it) on specref's centred rows.
+
+        Examples
+        --------
+        >>> ramp = np.arange(4.0)[:, None, None] * np.ones((4, 8, 3))
+        >>> EnvironmentLight(ramp, texel_placement="mitsuba").centred_image()[:, 0, 0]
+        array([0.375, 1.125, 1.875, 2.625])
+        """
+        data = self.image if image is None else image
+        return TEXEL_PLACEMENTS.lookup(self.texel_placement).reference(data)

@@ -195,7 +195,7 @@ def background_XYZ(scene: Scene, directions) -> np.ndarray:
         XYZ = np.linalg.solve(_XYZ_to_RGB(scene), np.asarray(background, dtype=np.float64))
         return np.broadcast_to(XYZ, directions.shape).copy()
     env = next(light for light in scene.lights if isinstance(light, EnvironmentLight))
-    values = latlong_lookup_bilinear(env.image, directions) * env.intensity
+    values = latlong_lookup_bilinear(env.centred_image(), directions) * env.intensity
     if not env.is_spectral:
         return display_RGB_to_XYZ(values, env.colourspace)
     # A spectral map: linear interpolation onto the grid is a matrix (resample each unit channel).
@@ -445,6 +445,7 @@ def render_scene_file(
     height: int | None = None,
     supersample: int | None = None,
     oracle: bool = False,
+    texel_placement: str | None = None,
 ) -> RenderResult:
     """Load a scene file, render it and write the outputs: what ``specref render`` does.
 
@@ -459,6 +460,9 @@ def render_scene_file(
     oracle : bool
         Set ``ShadingContext.options["environment"] = "bruteforce"``: environment lights are
         integrated by brute force (the SH engine's oracle path) instead of the fast method.
+    texel_placement : str, optional
+        Override every environment light's ``texel_placement`` (``reference.envmap.
+        TEXEL_PLACEMENTS``: ``"mitsuba"`` reads the maps as Mitsuba 3 does).
 
     Returns
     -------
@@ -489,6 +493,8 @@ def render_scene_file(
     scene = load_scene(scene_path)
     if width is not None or height is not None or supersample is not None:
         scene = scene.with_render(width, height, supersample, where="command line: render")
+    if texel_placement is not None:
+        scene = scene.with_texel_placement(texel_placement)
     options = {"environment": "bruteforce"} if oracle else None
     result = render_scene(scene, options=options)
     write_render(result, png, exr)

@@ -271,6 +271,22 @@ class Scene:
         render = dataclasses.replace(r, width=width, height=height, supersample=supersample)
         return dataclasses.replace(self, render=render)
 
+    def with_texel_placement(self, placement: str) -> Scene:
+        """The scene with every environment light read under ``placement`` (``TEXEL_PLACEMENTS``).
+
+        Examples
+        --------
+        >>> loads_scene("").with_texel_placement("mitsuba").lights
+        ()
+        """
+        lights = tuple(
+            dataclasses.replace(light, texel_placement=placement)
+            if isinstance(light, EnvironmentLight)
+            else light
+            for light in self.lights
+        )
+        return dataclasses.replace(self, lights=lights)
+
     def material_index(self, name: str) -> int:
         """Index of the material called ``name``."""
         if name not in self.material_names:

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 import reference.raster  # noqa: F401  (registers the TriangleMesh G-buffer writer)
+from reference.envmap import DEFAULT_TEXEL_PLACEMENT, TEXEL_PLACEMENTS
 from reference.errors import SpecrefError, format_allowed
 from reference.geometry import Plane, Sphere
 from reference.images import channel_wavelengths_nm, read_exr, read_hdr
@@ -141,8 +142,15 @@ def _parse_ambient_light(reader: SceneReader, table: dict, key: str) -> AmbientL
 def _parse_environment_light(reader: SceneReader, table: dict, key: str) -> EnvironmentLight:
     import colour
 
-    reader.table(table, key, ("type", "file", "intensity", "colourspace"), ("file",))
+    reader.table(
+        table, key, ("type", "file", "intensity", "colourspace", "texel_placement"), ("file",)
+    )
     path = reader.file_path(table["file"], f"{key}.file")
+    placement = reader.choice(
+        table.get("texel_placement", DEFAULT_TEXEL_PLACEMENT),
+        f"{key}.texel_placement",
+        TEXEL_PLACEMENTS.names(),
+    )
     intensity = reader.number(table.get("intensity", 1.0), f"{key}.intensity", minimum=0)
     colourspace = reader.choice(
         table.get("colourspace", "sRGB"), f"{key}.colourspace", colour.RGB_COLOURSPACES
@@ -172,7 +180,9 @@ def _parse_environment_light(reader: SceneReader, table: dict, key: str) -> Envi
             raise SpecrefError(
                 f"{path}: unsupported environment map type {suffix!r}; allowed: .exr, .hdr, .tif"
             )
-        return EnvironmentLight(image, wavelengths, colourspace, intensity, name=str(path))
+        return EnvironmentLight(
+            image, wavelengths, colourspace, intensity, name=str(path), texel_placement=placement
+        )
 
 
 #: Object types of scene files (``[[objects]] type = ...``).
@@ -220,7 +230,7 @@ LIGHT_TYPES.register(
     SceneItemType(
         "environment",
         _parse_environment_light,
-        ("file", "intensity", "colourspace"),
+        ("file", "intensity", "colourspace", "texel_placement"),
         "a lat-long environment map (.hdr, .exr with RGB or wavelength channels, spectral .tif)",
     )
 )

@@ -16,12 +16,17 @@ that regression and two published methods from colour-science, by key
   takes linear sRGB: Finlayson's root-polynomials of degree 4, fitted on a synthetic target (the
   sRGB "camera" of the reflectances in ``reference.spectral_target``); it is linear in exposure.
   ``specref env fit`` fits models for other cameras.
-- ``jakob2019``: Jakob & Hanika's sigmoid-polynomial model, as used by Mitsuba 3 and pbrt-v4, via
-  colour-science's coefficient table (``LUT3D_Jakob2019``). The model represents reflectances in
-  [0, 1]; HDR texels are scaled by their largest component m, upsampled, and multiplied by m. A
-  white texel becomes a near-flat spectrum (within 1 % of flat: the sigmoid approaches 1 without
-  reaching it). Colours are fitted one by one (0.3 s each, for small maps), or looked up in
-  colour-science's coefficient table, generated once (minutes) and cached in the user cache folder.
+- ``jakob2019``: Jakob & Hanika's sigmoid-polynomial model, as Mitsuba 3 and pbrt-v4 use it for RGB
+  emitters and environment maps. The model represents reflectances in [0, 1]; like those renderers
+  (Mitsuba 3 ``src/emitters/envmap.cpp``, pbrt-v4 ``RGBIlluminantSpectrum``: ``scale = 2 * max``),
+  a texel is divided by **twice** its largest component m, so the shape is fitted to a colour whose
+  largest component is ½ (a smoother spectrum than at 1), and the spectrum is multiplied by 2m
+  (erratum E80). A white texel becomes a flat spectrum to 0.1 % (½ is the sigmoid at 0; the sRGB
+  white and D65 integrated at 5 nm differ slightly). The
+  coefficients come from a 64³ table per largest component, Mitsuba's and pbrt's resolution
+  (``reference.jakob2019``: generated once, one to four minutes, and cached), interpolated by
+  colour-science's ``LUT3D_Jakob2019``, so a 1k map takes seconds; ``lut_size=None`` fits each
+  colour with colour-science instead (about 0.5 s each, for a few colours).
 
 The RGB is linear in the map's colourspace (sRGB primaries for both methods). Both methods recover
 *reflectance-like* spectra: R = G = B maps to a flat spectrum, whose colour under the equal-energy
@@ -42,12 +47,12 @@ References
 from __future__ import annotations
 
 import functools
-import os
 from pathlib import Path
 
 import numpy as np
 
 from reference.errors import require
+from reference.jakob2019 import DEFAULT_TABLE_SIZE, table_Jakob2019
 from reference.registry import Method, Registry
 from reference.spectra import SpectralGrid
 
@@ -103,46 +108,25 @@ def RGB_to_spectra_Mallett2019(RGB, grid: SpectralGrid) -> np.ndarray:
     return RGB @ _mallett_basis(grid)
 
 
-_JAKOB_LUTS: dict = {}
+def RGB_to_spectra_Jakob2019(
+    RGB, grid: SpectralGrid, lut_size: int | None = DEFAULT_TABLE_SIZE
+) -> np.ndarray:
+    """Spectra of linear sRGB values by Jakob & Hanika's sigmoid polynomials, scaled as Mitsuba 3.
 
-
-def _jakob_lut(size: int):
-    import colour
-    from colour.recovery import LUT3D_Jakob2019
-
-    if size in _JAKOB_LUTS:
-        return _JAKOB_LUTS[size]
-    folder = Path(os.environ.get("SPECREF_CACHE", Path.home() / ".cache" / "specref"))
-    path = folder / f"jakob2019-sRGB-{size}.coeff"
-    lut = LUT3D_Jakob2019()
-    if path.is_file():
-        lut.read(str(path))
-    else:
-        lut.generate(colour.RGB_COLOURSPACES["sRGB"], size=size)
-        folder.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_suffix(".tmp")
-        lut.write(str(tmp))
-        os.replace(tmp, path)
-    _JAKOB_LUTS[size] = lut
-    return lut
-
-
-def RGB_to_spectra_Jakob2019(RGB, grid: SpectralGrid, lut_size: int | None = None) -> np.ndarray:
-    """Spectra of linear sRGB values by Jakob & Hanika's sigmoid polynomials (colour-science).
-
-    Eq. (3), Jakob & Hanika 2019: ``S(λ) = sigmoid(c0 λ² + c1 λ + c2)``. HDR values are scaled by
-    their largest component m, fitted in [0, 1] and multiplied by m (module docstring).
+    Eq. (3), Jakob & Hanika 2019: ``S(λ) = sigmoid(c0 λ² + c1 λ + c2)``. A texel is divided by
+    ``2m`` (m its largest component), its shape fitted there, and multiplied by ``2m``, as Mitsuba 3
+    and pbrt-v4 do (module docstring; erratum E80).
 
     Parameters
     ----------
     RGB : array_like, shape (..., 3)
         Linear sRGB, >= 0.
     grid : SpectralGrid
-    lut_size : int, optional
-        None: fit each distinct colour (chromaticity quantized to 1/64 of the largest component)
-        with ``colour.recovery.find_coefficients_Jakob2019`` (about 0.3 s each; for small maps).
-        An int: colour-science's ``lut_size³`` coefficient table, generated once (minutes) and
-        cached in ``$SPECREF_CACHE`` or ``~/.cache/specref``.
+    lut_size : int or None
+        The coefficient table's resolution (``reference.jakob2019.table_Jakob2019``, default 64, as
+        Mitsuba 3 and pbrt-v4; generated once and cached). None: fit each distinct colour
+        (chromaticity quantized to 1/64 of the largest component) with
+        ``colour.recovery.find_coefficients_Jakob2019`` (about 0.5 s each; for a few colours).
 
     Returns
     -------
@@ -151,21 +135,23 @@ def RGB_to_spectra_Jakob2019(RGB, grid: SpectralGrid, lut_size: int | None = Non
     Examples
     --------
     >>> from reference.spectra import GRID_41
-    >>> S = RGB_to_spectra_Jakob2019([[2.0, 2.0, 2.0]], GRID_41)      # white: nearly flat
-    >>> round(float(S.min()), 3), round(float(S.max()), 3)
-    (1.999, 1.999)
+    >>> S = RGB_to_spectra_Jakob2019([[2.0, 2.0, 2.0]], GRID_41, lut_size=None)   # white: flat
+    >>> round(float(S.min()), 6), round(float(S.max()), 6)
+    (2.0, 2.0)
     """
     import colour
 
     RGB = np.asarray(RGB, dtype=np.float64)
-    m = RGB.max(axis=-1, keepdims=True)
-    unit = RGB / np.where(m > 0, m, 1.0)
+    # Erratum E80: scale by twice the largest component (Mitsuba 3, pbrt-v4)
+    scale = 2.0 * RGB.max(axis=-1, keepdims=True)
+    half = RGB / np.where(scale > 0, scale, 1.0)
     if lut_size is not None:
-        coefficients = _jakob_lut(int(lut_size)).RGB_to_coefficients(unit)
+        coefficients = table_Jakob2019(int(lut_size)).RGB_to_coefficients(half.reshape(-1, 3))
+        coefficients = coefficients.reshape(*RGB.shape[:-1], 3)
     else:
         from colour.recovery import find_coefficients_Jakob2019
 
-        quantized = np.round(unit * 64.0) / 64.0
+        quantized = np.round(half * 128.0) / 128.0
         flat = quantized.reshape(-1, 3)
         unique, inverse = np.unique(flat, axis=0, return_inverse=True)
         space = colour.RGB_COLOURSPACES["sRGB"]
@@ -176,7 +162,7 @@ def RGB_to_spectra_Jakob2019(RGB, grid: SpectralGrid, lut_size: int | None = Non
     lam = grid.wavelengths_nm
     # Eq. (3), Jakob & Hanika 2019: x = c0 λ² + c1 λ + c2, S = ½ + x / (2 sqrt(1 + x²))
     x = (coefficients[..., 0:1] * lam + coefficients[..., 1:2]) * lam + coefficients[..., 2:3]
-    return (0.5 + x / (2.0 * np.sqrt(1.0 + x * x))) * m
+    return (0.5 + x / (2.0 * np.sqrt(1.0 + x * x))) * scale
 
 
 #: The shipped regression model (linear sRGB → reflectance on the 41-band grid).

@@ -62,7 +62,8 @@ def environment_spectral_radiance(
     """The environment's spectral radiance on ``grid``: ``(H, W, n_bands)``, times its intensity.
 
     Spectral maps are interpolated linearly between their wavelengths (constant beyond them); RGB
-    maps are upsampled (Eq. (4), Mallett & Yuksel 2019 by default).
+    maps are upsampled (Eq. (4), Mallett & Yuksel 2019 by default). A map with another texel
+    placement (``light.texel_placement``) is then resampled onto specref's rows.
 
     Examples
     --------
@@ -80,7 +81,8 @@ def environment_spectral_radiance(
         spectra = image @ M
     else:
         spectra = RGB_to_radiance_spectra(image, grid, upsampling, light.colourspace)
-    return light.intensity * spectra
+    # The texels on specref's rows (light.texel_placement: "mitsuba" resamples Mitsuba 3's rows)
+    return light.intensity * light.centred_image(spectra)
 
 
 def _state(light: EnvironmentLight, ctx) -> dict:

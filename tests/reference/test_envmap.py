@@ -80,3 +80,37 @@ def test_check_latlong_shape():
     for shape in [(512, 512, 3), (100, 201), (0, 0)]:
         with pytest.raises(SpecrefError, match="must be 2:1"):
             check_latlong_shape(shape, "map.hdr")
+
+
+def test_mitsuba_rows_resample_a_linear_ramp_exactly(rng):
+    # Source: Mitsuba 3 envmap.cpp (rows at v = j/(H-1), linear between rows). A map linear in
+    # Mitsuba's v is the function a + b v; resampled, specref's row j holds it at v = (j + 1/2)/H.
+    from reference.envmap import TEXEL_PLACEMENTS, latlong_rows_mitsuba_to_centred
+
+    H, a, b = 9, rng.random(3), rng.random(3)
+    v_mitsuba = np.arange(H) / (H - 1)
+    image = np.broadcast_to((a + b * v_mitsuba[:, None])[:, None, :], (H, 2 * H, 3))
+    v_centred = (np.arange(H) + 0.5) / H
+    expected = a + b * v_centred[:, None]
+    got = latlong_rows_mitsuba_to_centred(image)
+    np.testing.assert_allclose(got[:, 3], expected, rtol=1e-13)
+    np.testing.assert_array_equal(TEXEL_PLACEMENTS.lookup("centred").reference(image), image)
+    with pytest.raises(SpecrefError, match="at least 2 rows"):
+        latlong_rows_mitsuba_to_centred(np.ones((1, 2, 3)))
+
+
+def test_unknown_texel_placement_is_refused():
+    from reference.lights import EnvironmentLight
+
+    with pytest.raises(SpecrefError, match="unknown texel placement 'pbrt'; allowed: centred"):
+        EnvironmentLight(np.ones((4, 8, 3)), texel_placement="pbrt")
+
+
+def test_mitsuba_rows_keep_the_integral_over_v(rng):
+    # Source: the trapezoid rule, which is the exact integral of Mitsuba's piecewise-linear rows
+    # over v in [0, 1]; specref's rows (width 1/H) are its averages, so their sum keeps it.
+    from reference.envmap import latlong_rows_mitsuba_to_centred
+
+    image = rng.random((7, 14, 2))
+    exact = np.trapezoid(image, dx=1.0 / 6.0, axis=0)
+    np.testing.assert_allclose(latlong_rows_mitsuba_to_centred(image).sum(axis=0) / 7, exact)

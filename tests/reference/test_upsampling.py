@@ -33,16 +33,18 @@ def test_mallett2019_matches_colour_science():
 
 def test_jakob2019_matches_colour_science():
     # Source: colour.recovery.XYZ_to_sd_Jakob2019 (colour-science's own evaluation of the fitted
-    # sigmoid polynomial) of the sRGB colour's XYZ. Our fit quantizes chromaticity to 1/64 of the
-    # largest component, which (1, 1/4, 1/8) is exactly; HDR scaling by 2 multiplies the spectrum.
+    # sigmoid polynomial) of the sRGB colour's XYZ. The texel is divided by twice its largest
+    # component (erratum E80: Mitsuba 3, pbrt-v4), so the shape is fitted at (1/2, 1/8, 1/16),
+    # which the per-colour fit's 1/64-of-the-largest quantization holds exactly; the spectrum is
+    # multiplied back by 2 max = 4 for the texel (2, 1/2, 1/4).
     import colour
 
-    RGB = np.array([1.0, 0.25, 0.125])
+    RGB = np.array([0.5, 0.125, 0.0625])
     XYZ = colour.RGB_to_XYZ(RGB, colour.RGB_COLOURSPACES["sRGB"])
     sd = colour.recovery.XYZ_to_sd_Jakob2019(XYZ)
     expected = np.interp(GRID_41.wavelengths_nm, sd.wavelengths, sd.values)
-    got = RGB_to_spectra_Jakob2019(2.0 * RGB, GRID_41)
-    np.testing.assert_allclose(got, 2.0 * expected, rtol=1e-6)
+    got = RGB_to_spectra_Jakob2019(4.0 * RGB, GRID_41, lut_size=None)
+    np.testing.assert_allclose(got, 4.0 * expected, rtol=1e-6)
 
 
 def test_upsampling_white_is_flat_and_renders_white():

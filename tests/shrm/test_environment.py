@@ -135,3 +135,28 @@ def test_environment_shading_bad_input():
         shade_lambert_environment(flat, LambertMaterial(np.ones(41)), env, ShadingContext())
     with pytest.raises(SpecrefError, match="unknown RGB upsampling 'smits'"):
         environment_spectral_radiance(env, GRID_41, "smits")
+
+
+@pytest.mark.parametrize(("placement", "H"), [("centred", 32), ("mitsuba", 32), ("mitsuba", 48)])
+def test_texel_placement_changes_irradiance_as_predicted(placement, H):
+    # Source: closed forms. Row j of a grey map holds theta_j = j pi/(H - 1). Read as Mitsuba 3
+    # reads it (rows at v = j/(H-1), linear between them) the radiance is L(theta) = theta exactly;
+    # read with specref's centred rows (theta = (j + 1/2) pi/H) it is (H theta - pi/2)/(H - 1).
+    # Irradiance of L = theta: pi^2/4 at the +y normal, 3 pi^2/4 at -y (2 pi int theta |cos| sin);
+    # of L = 1: pi. The two readings differ by (H - 2)/(H - 1) at +y. Brute force integrates the
+    # map with exact pixel solid angles at centres (midpoint rule, error ~ (pi/H)^2/24 ~ 4e-4).
+    theta = np.arange(H) * np.pi / (H - 1)
+    image = np.broadcast_to(theta[:, None, None], (H, 2 * H, 3)).copy()
+    light = EnvironmentLight(image, texel_placement=placement)
+    normals = np.array([[0.0, 1.0, 0.0], [0.0, -1.0, 0.0]])
+    surface = Surface(np.zeros((2, 3)), normals, normals.copy(), np.zeros((2, 2)))
+    ctx = ShadingContext(options={"environment": "bruteforce"})
+    Y = shade_lambert_environment(surface, LambertMaterial(np.ones(41)), light, ctx)[:, 1]
+    E_theta = np.array([np.pi**2 / 4, 3 * np.pi**2 / 4])
+    if placement == "mitsuba":
+        expected = E_theta / np.pi  # Y = E/pi for a white Lambertian, radiance Y = L
+    else:
+        expected = (H * E_theta - np.pi / 2 * np.pi) / (H - 1) / np.pi
+    np.testing.assert_allclose(Y, expected, rtol=2e-3)
+    ratio_up = (H - 2) / (H - 1)  # centred over mitsuba at +y: 3 % at H = 32, well above 2e-3
+    assert abs(ratio_up - 1) > 10 * 2e-3

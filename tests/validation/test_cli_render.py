@@ -188,3 +188,49 @@ def test_oracle_flag_reaches_the_shading_options(tmp_path, monkeypatch):
         == 0
     )
     assert seen == {"environment": "bruteforce"}
+
+
+ENV_SCENE = """
+[render]
+width = 6
+height = 6
+[camera]
+eye = [0, 0, 4]
+target = [0, 0, 0]
+fov_deg = 20
+[materials.m]
+type = "lambert"
+k_d = 0.5
+[[objects]]
+type = "sphere"
+material = "m"
+[[lights]]
+type = "environment"
+file = "sky.exr"
+{placement}
+"""
+
+
+def test_texel_placement_scene_key_and_flag_agree(tmp_path):
+    # The scene key and the CLI flag change the render the same way; the two placements differ
+    # (a map with a bright top row: Mitsuba's rows put it on the pole, specref's half a row below).
+    from reference.images import write_exr
+
+    sky = np.full((8, 16, 3), 0.1)
+    sky[0] = 5.0
+    write_exr(tmp_path / "sky.exr", sky)
+    (tmp_path / "c.toml").write_text(ENV_SCENE.format(placement=""))
+    (tmp_path / "m.toml").write_text(ENV_SCENE.format(placement='texel_placement = "mitsuba"'))
+    runs = {
+        "centred": ["c.toml"],
+        "key": ["m.toml"],
+        "flag": ["c.toml", "--texel-placement", "mitsuba"],
+    }
+    images = {}
+    for name, (scene, *flags) in runs.items():
+        exr = tmp_path / f"{name}.exr"
+        args = ["render", str(tmp_path / scene), "-o", str(tmp_path / f"{name}.png")]
+        assert main([*args, "--exr", str(exr), "--oracle", *flags]) == 0
+        images[name] = read_exr(exr)[0]
+    np.testing.assert_array_equal(images["key"], images["flag"])
+    assert np.abs(images["key"] - images["centred"]).max() > 1e-3

@@ -15,6 +15,7 @@ from reference.errors import SpecrefError
 from validation.cli import (
     brdf,
     cache,
+    crosscheck,
     display,
     env,
     equations,
@@ -46,6 +47,7 @@ COMMANDS = (
     phong,
     sweep,
     equations,
+    crosscheck,
 )
 
 

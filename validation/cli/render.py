@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+from reference.envmap import TEXEL_PLACEMENTS
+from validation.cli.parser import registry_option
+
 
 def _cmd_render(args) -> int:
     import phong_table  # noqa: F401  (registers its shaders, if any)
@@ -16,6 +19,7 @@ def _cmd_render(args) -> int:
         height=args.height,
         supersample=args.supersample,
         oracle=args.oracle,
+        texel_placement=args.texel_placement,
     )
     r = result.scene.render
     outputs = " and ".join(str(p) for p in (args.output, args.exr) if p is not None)
@@ -49,5 +53,12 @@ def add_parser(sub) -> None:
         action="store_true",
         help='brute-force environment lighting (ShadingContext.options["environment"] = '
         '"bruteforce"), the reference the SH engine is checked against; slow',
+    )
+    registry_option(
+        p,
+        "--texel-placement",
+        TEXEL_PLACEMENTS,
+        "read every environment map with this lat-long texel placement (overrides the scene's "
+        "texel_placement; mitsuba puts rows at v = j/(H-1), as Mitsuba 3 does)",
     )
     p.set_defaults(func=_cmd_render)

@@ -37,6 +37,7 @@ from validation.report.types import (
     to_jsonable,
 )
 from validation.sections import (
+    crosscheck,
     display,
     examples,
     impastor,
@@ -57,8 +58,8 @@ PARTS: tuple[ReportPart, ...] = (
     ReportPart(
         "core",
         "The shared spectral core",
-        "Spectra, colorimetry, the rasterizer and the scenes every paper renders with.",
-        (spectral.SECTION, raster.SECTION, examples.SECTION),
+        "Spectra, colorimetry, the rasterizer, the scenes all papers render with; a cross-check.",
+        (spectral.SECTION, raster.SECTION, examples.SECTION, crosscheck.SECTION),
     ),
     ReportPart(
         "wang",
