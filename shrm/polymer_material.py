@@ -53,6 +53,8 @@ __all__ = [
     "POLYMER_DEFAULTS",
     "PolymerMaterial",
     "modulation_at",
+    "polymer_pixel_parts",
+    "polymer_shade_parts",
     "polymer_characterization",
     "polymer_environment_maps",
     "polymer_material_look",
@@ -277,6 +279,119 @@ def polymer_environment_maps(light: EnvironmentLight, ctx, gloss_exponent: float
     # The normalized Phong lobe of E_s (shrm.polymer.polymer_maps), unlike the Phong material's
     E_s = _frequency_map(light, ctx, f"normalized-phong:{s:g}", L_s, phong.Lambda(L_s))
     return PolymerMaps(E, E_s, _state(light, ctx)["radiance"], s)
+
+
+def polymer_pixel_parts(normal, view, maps: PolymerMaps, fresnel, mirror="fresnel", E_effect=None):
+    """The per-pixel parts of Eq. (1), Herbert et al. that depend on angles and maps only.
+
+    §5.1, Herbert et al.: "the look-up frequency is per-pixel if the variable is an angle, and
+    per-frame otherwise". These parts change with the viewpoint, the maps (environment, gloss
+    exponent) and the Fresnel table (index), never with the dynamic parameters (thickness, TiO2,
+    tint, transparency, gloss factor, Mod_effect), which :func:`polymer_shade_parts` applies per
+    frame. Together they give :func:`shrm.polymer.polymer_terms`'s ``I_result``.
+
+    Parameters
+    ----------
+    normal, view : ndarray, shape (N, 3)
+        Unit normals and unit vectors towards the eye.
+    maps : shrm.polymer.PolymerMaps
+    fresnel : reference.fresnel.FresnelLUT
+    mirror : str
+        Key of ``shrm.polymer.MIRROR_FACTORS``.
+    E_effect : ndarray, shape (N, n_bands), optional
+        The effect pigment's radiance; None is zero.
+
+    Returns
+    -------
+    dict of str to ndarray, shape (N, n_bands)
+        ``E_d`` (E(N)/π), ``S`` (``I_s F_r / gloss``), ``B`` (``E(−N)/π (1 − F_r)``), ``L``
+        (``L(−V) (1 − F_r)``), ``E_effect``.
+
+    Examples
+    --------
+    >>> from reference.fresnel import fresnel_lut
+    >>> from shrm.polymer import polymer_maps
+    >>> maps = polymer_maps(np.ones((16, 32, 2)), 8.0, size=4)
+    >>> up = np.array([[0.0, 1.0, 0.0]])
+    >>> parts = polymer_pixel_parts(up, up, maps, fresnel_lut(1.5))
+    >>> print(parts["S"].round(3), parts["B"].round(3))
+    [[0.04 0.04]] [[0.96 0.96]]
+    """
+    from reference.cubemap import cubemap_lookup_bilinear
+    from reference.envmap import latlong_lookup_bilinear
+
+    N = np.asarray(normal, dtype=np.float64)
+    V = np.asarray(view, dtype=np.float64)
+    cos_theta = np.clip(np.einsum("ij,ij->i", N, V), 0.0, 1.0)
+    # Eq. (1), Herbert et al.: F_r from the cos θ LUT, per pixel
+    F_r = fresnel.lookup(cos_theta)
+    F_r = F_r[:, None] if F_r.ndim == 1 else F_r
+    F_0 = fresnel.lookup(1.0)
+    # Eq. (2), Herbert et al.: E_d = E(N)/π
+    E_d = cubemap_lookup_bilinear(maps.irradiance, N, backend="numba") / np.pi
+    # Eq. (5), Herbert et al.: I_s / gloss = E_s M_s + E_mirror (1 − M_s), at r = 2 (N·V) N − V
+    r = 2.0 * cos_theta[:, None] * N - V
+    E_s = cubemap_lookup_bilinear(maps.specular, r, backend="numba")
+    E_mirror = latlong_lookup_bilinear(maps.radiance, r)
+    M_s = MIRROR_FACTORS.lookup(mirror).reference(cos_theta, F_r, F_0)
+    S = (E_s * M_s + E_mirror * (1.0 - M_s)) * F_r
+    # Eq. (4), Herbert et al.: the two parts of E_trans (E33), times 1 − F_r of Eq. (1)
+    B = cubemap_lookup_bilinear(maps.irradiance, -N, backend="numba") / np.pi * (1.0 - F_r)
+    L = latlong_lookup_bilinear(maps.radiance, -V) * (1.0 - F_r)
+    effect = np.zeros_like(E_d) if E_effect is None else np.asarray(E_effect, dtype=np.float64)
+    return {"E_d": E_d, "S": S, "B": B, "L": L, "E_effect": effect}
+
+
+def polymer_shade_parts(parts: dict, look: PolymerLook, Mod_effect=0.0) -> np.ndarray:
+    """Eq. (1), Herbert et al. from the per-pixel parts and the per-frame look: (N, n_bands).
+
+    ``I_result = E_d D Tint (1 − Mod) + E_effect Mod + gloss S + Col_trans ((1 − u) B + u L)``
+    with the parts of :func:`polymer_pixel_parts`; a few multiply-adds per pixel and band.
+
+    Parameters
+    ----------
+    parts : dict
+        From :func:`polymer_pixel_parts`.
+    look : shrm.polymer.PolymerLook
+        Its ``fresnel`` and ``mirror`` are not read (they are in the parts).
+    Mod_effect : float or ndarray, shape (N,)
+        In [0, 1].
+
+    Returns
+    -------
+    ndarray, shape (N, n_bands)
+
+    Examples
+    --------
+    >>> from shrm.characterization import characterize_model
+    >>> from shrm.polymer import polymer_look, polymer_maps, polymer_terms
+    >>> look = polymer_look(characterize_model(), 1.0, 0.3, unscattered=0.2)
+    >>> maps = polymer_maps(np.ones((16, 32, 41)), 8.0, size=4)
+    >>> n, v = np.array([[0.0, 1.0, 0.0]]), np.array([[0.6, 0.8, 0.0]])
+    >>> I = polymer_shade_parts(polymer_pixel_parts(n, v, maps, look.fresnel), look)
+    >>> bool(np.allclose(I, polymer_terms(n, v, look, maps)["I_result"], rtol=1e-12))
+    True
+    """
+    Mod = np.asarray(Mod_effect, dtype=np.float64)
+    require(
+        bool(np.all((Mod >= 0) & (Mod <= 1))), "polymer: Mod_effect: must be in [0, 1], not NaN"
+    )
+    u = look.unscattered
+    # Eq. (2), Herbert et al.: E_d D_polymer Tint_polymer (1 − Mod_effect)
+    if Mod.ndim == 0:
+        out = parts["E_d"] * (look.D_polymer * look.Tint_polymer * (1.0 - float(Mod)))
+    else:
+        out = parts["E_d"] * (look.D_polymer * look.Tint_polymer) * (1.0 - Mod[:, None])
+    scratch = np.empty_like(out)
+    # Eq. (1), Herbert et al.: + I_s F_r + I_trans (1 − F_r), I_s = gloss (E_s M_s + ...)
+    out += np.multiply(parts["S"], look.gloss, out=scratch)
+    out += np.multiply(parts["B"], look.Col_trans * (1.0 - u), out=scratch)
+    if np.any(u > 0):
+        out += np.multiply(parts["L"], look.Col_trans * u, out=scratch)
+    # Eq. (3), Herbert et al.: + E_effect Mod_effect
+    if np.any(Mod > 0):
+        out += parts["E_effect"] * (Mod if Mod.ndim == 0 else Mod[:, None])
+    return out
 
 
 def _effect_radiance(surface: Surface, effect: IsotropicBRDFMaterial, light, ctx) -> np.ndarray:
