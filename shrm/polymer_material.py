@@ -53,11 +53,11 @@ __all__ = [
     "POLYMER_DEFAULTS",
     "PolymerMaterial",
     "modulation_at",
-    "polymer_pixel_parts",
-    "polymer_shade_parts",
     "polymer_characterization",
     "polymer_environment_maps",
     "polymer_material_look",
+    "polymer_pixel_parts",
+    "polymer_shade_parts",
     "shade_polymer_environment",
 ]
 
