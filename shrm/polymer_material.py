@@ -52,6 +52,7 @@ from shrm.polymer import MIRROR_FACTORS, PolymerLook, PolymerMaps, polymer_look,
 __all__ = [
     "POLYMER_DEFAULTS",
     "PolymerMaterial",
+    "chip_lookup",
     "modulation_at",
     "polymer_characterization",
     "polymer_environment_maps",
@@ -142,6 +143,59 @@ def _file_on_grid(path: str, mtime_ns: int, grid: SpectralGrid) -> Characterizat
         over_white=resample(ch.over_white),
         transmittance=resample(ch.transmittance),
     )
+
+
+#: Interpolators per characterization, by id (the object is kept, so the id stays its own).
+_INTERPOLATORS: dict = {}
+
+
+def _stacked_interpolator(ch: Characterization):
+    from scipy.interpolate import RegularGridInterpolator
+
+    from shrm.characterization import MEASUREMENTS
+
+    if id(ch) not in _INTERPOLATORS:
+        if len(_INTERPOLATORS) >= 16:
+            _INTERPOLATORS.clear()
+        axes = (np.log(ch.thickness_mm), ch.tio2_pct)
+        method = "pchip" if min(len(a) for a in axes) >= 4 else "linear"
+        table = np.concatenate([getattr(ch, name) for name in MEASUREMENTS], axis=-1)
+        _INTERPOLATORS[id(ch)] = (ch, RegularGridInterpolator(axes, table, method=method))
+    return _INTERPOLATORS[id(ch)][1]
+
+
+def chip_lookup(ch: Characterization, thickness_mm: float, tio2_pct: float) -> dict:
+    """``ch.lookup`` for one chip, with the three tables interpolated in one call (per frame).
+
+    The same interpolation as :meth:`shrm.characterization.Characterization.lookup` (PCHIP in log
+    thickness and TiO2, E37), on the three measurements stacked, with the interpolator kept per
+    characterization.
+
+    Examples
+    --------
+    >>> from reference.spectra import SpectralGrid
+    >>> ch = polymer_characterization(None, SpectralGrid(400.0, 700.0, 20.0))
+    >>> a, b = chip_lookup(ch, 0.9, 0.3), ch.lookup(0.9, 0.3)
+    >>> all(np.allclose(a[k], b[k], rtol=1e-12, atol=1e-15) for k in b)
+    True
+    """
+    from shrm.characterization import MEASUREMENTS
+
+    for name, value, axis in (
+        ("thickness_mm", thickness_mm, ch.thickness_mm),
+        ("tio2_pct", tio2_pct, ch.tio2_pct),
+    ):
+        require(
+            bool(axis[0] <= value <= axis[-1]),
+            f"characterization: {name}: must be in [{axis[0]:g}, {axis[-1]:g}] (the grid), "
+            f"got {value!r}",
+        )
+    values = _stacked_interpolator(ch)([[np.log(thickness_mm), tio2_pct]])[0]
+    nb = ch.wavelengths_nm.size
+    return {
+        name: np.clip(values[i * nb : (i + 1) * nb], 0.0, 1.0)
+        for i, name in enumerate(MEASUREMENTS)
+    }
 
 
 def polymer_characterization(path, grid: SpectralGrid) -> Characterization:

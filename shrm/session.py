@@ -543,7 +543,12 @@ def _polymer_tint(tint, grid) -> np.ndarray:
 def _stage_polymer_shade(state, inputs):
     from reference.spectra import SpectralGrid
     from shrm.polymer import PolymerLook, _spectrum01
-    from shrm.polymer_material import modulation_at, polymer_characterization, polymer_shade_parts
+    from shrm.polymer_material import (
+        chip_lookup,
+        modulation_at,
+        polymer_characterization,
+        polymer_shade_parts,
+    )
 
     c = _config(state)
     d = {
@@ -559,9 +564,8 @@ def _stage_polymer_shade(state, inputs):
     pixels = inputs["polymer_pixels"]
     fresnel = inputs["fresnel_lut"]
     # Set dynamic parameters into shaders (§5.2, Herbert et al.): the chip, once per frame
-    chip = polymer_characterization(c.get("characterization"), grid).lookup(
-        d["thickness"], d["tio2"]
-    )
+    ch = polymer_characterization(c.get("characterization"), grid)
+    chip = chip_lookup(ch, d["thickness"], d["tio2"])
     nb = grid.n_bands
     gloss = _spectrum01(d["gloss"], 1, "polymer: gloss")[0]
     look = PolymerLook(
@@ -576,15 +580,16 @@ def _stage_polymer_shade(state, inputs):
     Mod = d["Mod_effect"]
     if np.ndim(Mod) == 2:
         Mod = modulation_at(Mod, pixels["uv"])
-    sel = pixels["mask"]
-    image = np.zeros((*sel.shape, nb))
-    image[sel] = polymer_shade_parts(pixels["parts"], look, Mod)
-    return {"radiance": image, "mask": sel}
+    # The radiance of the covered pixels only (N, n_bands), in the order of g.normal[mask]: no
+    # image is scattered per frame (the display step reads the pixels it needs)
+    return {"pixels": polymer_shade_parts(pixels["parts"], look, Mod), "mask": pixels["mask"]}
 
 
 #: The render loop of §5.2, Herbert et al., for the hybrid polymer of Eqs. (1)-(5) (module
 #: docstring). ``config`` adds ``grid`` (required), ``characterization`` (a file, default the
-#: model) and ``mirror`` (default ``"fresnel"``).
+#: model) and ``mirror`` (default ``"fresnel"``). Its ``shade`` result is ``pixels``, the radiance
+#: spectra (N, n_bands) of the covered pixels in the order of ``gbuffer.normal[mask]``, and
+#: ``mask``.
 POLYMER_STAGES = (
     Stage("color_manage", ("illuminant", "environment"), (), _stage_color_manage),
     Stage("sh_project", ("config",), ("color_manage",), _stage_sh_project, persistent=True),

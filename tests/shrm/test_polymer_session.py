@@ -80,12 +80,12 @@ def test_every_polymer_parameter_is_classified():
 
 def test_each_change_runs_exactly_its_stages(rng):
     session = RenderSession(polymer_state(rng), POLYMER_STAGES)
-    first = session.render()["shade"]["radiance"]
+    first = session.render()["shade"]["pixels"]
     assert all(count == 1 for count in session.executions.values())
     for parameter in EXPECTED:
         before = dict(session.executions)
         session.update(**changed(session.state, parameter))
-        image = session.render()["shade"]["radiance"]
+        image = session.render()["shade"]["pixels"]
         ran = [s for s in session.executions if session.executions[s] > before[s]]
         assert ran == EXPECTED[parameter], parameter
         assert sorted(session.frame_times[-1]) == sorted(EXPECTED[parameter]), parameter
@@ -123,7 +123,7 @@ def test_session_frame_is_the_readable_model(rng):
     )
     E_effect = out["polymer_pixels"]["parts"]["E_effect"]
     expected = polymer_terms(n, v, look, maps, 0.25, E_effect)["I_result"]
-    np.testing.assert_allclose(out["shade"]["radiance"][sel], expected, rtol=1e-12, atol=1e-14)
+    np.testing.assert_allclose(out["shade"]["pixels"], expected, rtol=1e-12, atol=1e-14)
 
 
 def test_bad_dynamic_values_are_refused(rng):
