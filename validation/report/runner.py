@@ -32,6 +32,7 @@ from validation.sections import (
     impastor,
     phong,
     polymer,
+    polymer_scene,
     raster,
     sh,
     shrm,
@@ -51,6 +52,7 @@ SECTIONS: tuple[ReportSection, ...] = (
     spectral_env.SECTION,
     shrm.SECTION,
     polymer.SECTION,
+    polymer_scene.SECTION,
     impastor.SECTION,
     display.SECTION,
 )
