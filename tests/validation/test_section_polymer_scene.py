@@ -18,7 +18,7 @@ def test_full_bottle_has_100k_triangles_in_three_groups(tmp_path):
     # Source: the construction: two triangles per quad between profile rings, a fan per disc
     expected = 2 * s["around"] * (s["profile"] - 1) + 2 * s["around"]
     assert expected >= polymer_scene.TRIANGLES_TARGET
-    r, y, group = bottle_profile(s["profile"])
+    _, _, group = bottle_profile(s["profile"])
     assert sorted(set(group.tolist())) == [0, 1, 2]
     path = tmp_path / "b.obj"
     assert bottle_obj(path, 16, 13) == 2 * 16 * 12 + 2 * 16
