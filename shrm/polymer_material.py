@@ -389,7 +389,7 @@ def polymer_pixel_parts(normal, view, maps: PolymerMaps, fresnel, mirror="fresne
     E_mirror = latlong_lookup_bilinear(maps.radiance, r)
     M_s = MIRROR_FACTORS.lookup(mirror).reference(cos_theta, F_r, F_0)
     S = (E_s * M_s + E_mirror * (1.0 - M_s)) * F_r
-    # Eq. (4), Herbert et al.: the two parts of E_trans (E33), times 1 − F_r of Eq. (1)
+    # Eq. (4), Herbert et al.: the two parts of E_trans (E33), times the transmitted 1 − F_r
     B = cubemap_lookup_bilinear(maps.irradiance, -N, backend="numba") / np.pi * (1.0 - F_r)
     L = latlong_lookup_bilinear(maps.radiance, -V) * (1.0 - F_r)
     effect = np.zeros_like(E_d) if E_effect is None else np.asarray(E_effect, dtype=np.float64)

@@ -25,7 +25,7 @@ scene, is served from the cache without running the stage. Every execution, cach
 time is counted (:attr:`RenderSession.executions`, :attr:`RenderSession.hits`,
 :attr:`RenderSession.frame_times`).
 
-:data:`POLYMER_STAGES` is the same loop for Herbert et al.'s hybrid polymer (Eqs. (1)-(5),
+:data:`POLYMER_STAGES` is the same loop for the hybrid polymer (Eq. (1), Herbert et al.;
 ``shrm.polymer_material``): the Lambert and Phong maps, a Fresnel table for the ``index``, the
 effect pigment's SHRM for the ``brdf`` (None: no effect pigment), the per-pixel angle look-ups
 (``polymer_pixels``) and the per-frame shading with the dynamic parameters. Which state key each
@@ -464,11 +464,12 @@ HERBERT_STAGES = (
 )
 
 
-# --- the polymer of Eqs. (1)-(5), Herbert et al. ----------------------------------------------
+# --- the hybrid polymer, Eq. (1), Herbert et al. ----------------------------------------------
 
 #: Where each polymer parameter lives in the session state (§5.2, §8, Herbert et al.: "changes to
 #: dynamic parameters (such as material thickness, color, TiO2 load) ... incur no speed penalty").
-#: ``gloss`` is the factor of Eq. (5); ``gloss_exponent`` selects the specular prefilter (E32).
+#: ``gloss`` is the factor of Eq. (5), Herbert et al.; ``gloss_exponent`` selects the specular
+#: prefilter (E32).
 POLYMER_PARAMETERS = {
     "thickness": "dynamic",
     "tio2": "dynamic",
@@ -585,7 +586,7 @@ def _stage_polymer_shade(state, inputs):
     return {"pixels": polymer_shade_parts(pixels["parts"], look, Mod), "mask": pixels["mask"]}
 
 
-#: The render loop of §5.2, Herbert et al., for the hybrid polymer of Eqs. (1)-(5) (module
+#: The render loop of §5.2, Herbert et al., for the hybrid polymer, Eq. (1), Herbert et al. (module
 #: docstring). ``config`` adds ``grid`` (required), ``characterization`` (a file, default the
 #: model) and ``mirror`` (default ``"fresnel"``). Its ``shade`` result is ``pixels``, the radiance
 #: spectra (N, n_bands) of the covered pixels in the order of ``gbuffer.normal[mask]``, and
