@@ -110,14 +110,15 @@ def test_effect_term_is_the_effect_pigment_through_its_shrm():
     # terms, which do not depend on Mod_effect; E_effect alone is what the isotropic_brdf shader
     # (shrm.orbit, its own SHRM) renders for the same BRDF.
     rng = np.random.default_rng(5)
-    ctx = ShadingContext(GRID, options={"environment_size": 8})
+    grid = SpectralGrid(440.0, 680.0, 80.0)  # 4 bands: the SHRM's cost is per band
+    ctx = ShadingContext(grid, options={"environment_size": 8})
     light = EnvironmentLight(rng.uniform(0.2, 2.0, (16, 32, 3)))
     n = rng.normal(size=(6, 3))
     n[:, 2] = np.abs(n[:, 2]) + 1.0
     n /= np.linalg.norm(n, axis=1, keepdims=True)
     v = np.tile([0.0, 0.0, 1.0], (6, 1))
     surface = Surface(n * 0, n, v, np.zeros((6, 2)))
-    effect = IsotropicBRDFMaterial("ggx", brdf_params_on_grid("ggx", GRID))
+    effect = IsotropicBRDFMaterial("ggx", brdf_params_on_grid("ggx", grid))
     with_effect = PolymerMaterial(tint=0.0, effect=effect, modulation=1.0)
     without = PolymerMaterial(tint=0.0, effect=effect, modulation=0.0)
     difference = shade_polymer_environment(surface, with_effect, light, ctx) - (
