@@ -215,3 +215,33 @@ def test_oracle_option_is_refused_in_one_line(sky):
     scene = load(sky, "")
     with pytest.raises(SpecrefError, match="polymer materials have no brute-force environment"):
         render_scene(scene, options={"environment": "bruteforce"})
+
+
+def test_obj_groups_render_with_their_own_polymers(sky, tmp_path):
+    # Source: the closed form of Eq. (1) under a uniform sky at normal view (as above), per group:
+    # two unit squares facing the camera, usemtl thin (left) and thick (right)
+    (tmp_path / "two.obj").write_text(
+        "v -2 -1 0\nv 0 -1 0\nv 0 1 0\nv -2 1 0\nv 2 -1 0\nv 2 1 0\n"
+        "usemtl thin\nf 1 2 3 4\nusemtl thick\nf 2 5 6 3\n"
+    )
+    text = (
+        scene_text(sky, "thickness = 0.762\ntio2 = 0.1")
+        .replace(
+            '[[objects]]\ntype = "sphere"\nmaterial = "p"',
+            '[materials.thick]\ntype = "polymer"\nthickness = 3.048\ntio2 = 2.0\n'
+            '[[objects]]\ntype = "mesh"\nfile = "two.obj"\n'
+            'groups = { thin = "p", thick = "thick" }',
+        )
+        .replace("extent = 2.4", "extent = 2.0")
+        .replace("width = 16\nheight = 16", "width = 8\nheight = 4")
+    )
+    scene = loads_scene(text, "s.toml", tmp_path)
+    result = render_scene(scene, supersample=1)
+    np.testing.assert_array_equal(result.gbuffer.material_id[1], [0] * 4 + [1] * 4)
+    S = environment_spectral_radiance(scene.lights[0], GRID)[0, 0]
+    W = scene.shading_context().weights(None)
+    for column, material in ((1, scene.materials[0]), (6, scene.materials[1])):
+        look = polymer_material_look(material, GRID)
+        F = look.fresnel.lookup(1.0)
+        expected = S * (look.D_polymer * look.Tint_polymer + F + look.Col_trans * (1 - F))
+        np.testing.assert_allclose(result.XYZ[1, column], expected @ W, rtol=1e-6)
