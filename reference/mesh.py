@@ -77,6 +77,9 @@ class TriangleMesh:
         normals as given.
     source : str
         Where the mesh came from (a file name), used in error messages.
+    face_materials : array_like of int, shape (F,), optional
+        A material index per face (material groups, e.g. an OBJ file's ``usemtl``); overrides
+        ``material`` where given.
 
     Raises
     ------
@@ -102,6 +105,7 @@ class TriangleMesh:
     material: int = 0
     cull_backfaces: bool = False
     source: str = "mesh"
+    face_materials: np.ndarray | None = None
 
     def __post_init__(self):
         src = self.source
@@ -146,6 +150,18 @@ class TriangleMesh:
             isinstance(self.material, int | np.integer) and self.material >= 0,
             f"{src}: material: must be an integer >= 0, got {self.material!r}",
         )
+        if self.face_materials is not None:
+            groups = np.asarray(self.face_materials)
+            require(
+                np.issubdtype(groups.dtype, np.integer)
+                and groups.shape == (faces.shape[0],)
+                and bool(np.all(groups >= 0)),
+                f"{src}: face_materials: must be {faces.shape[0]} integers >= 0 (one per face), "
+                f"got shape {groups.shape}",
+            )
+            groups = groups.astype(np.int32)
+            groups.setflags(write=False)
+            object.__setattr__(self, "face_materials", groups)
         object.__setattr__(self, "vertices", vertices)
         object.__setattr__(self, "faces", faces)
         object.__setattr__(self, "material", int(self.material))
@@ -208,7 +224,9 @@ def _obj_index(token: str, count: int, kind: str, where: str) -> int:
     return resolved
 
 
-def mesh_from_obj(path, material: int = 0, cull_backfaces: bool = False) -> TriangleMesh:
+def mesh_from_obj(
+    path, material: int = 0, cull_backfaces: bool = False, groups=None
+) -> TriangleMesh:
     r"""Read a Wavefront OBJ file into a :class:`TriangleMesh`.
 
     Supported: ``v x y z [w]`` (extra numbers such as vertex colours are ignored), ``vt u [v [w]]``,
@@ -226,15 +244,22 @@ def mesh_from_obj(path, material: int = 0, cull_backfaces: bool = False) -> Tria
     ----------
     path : str or Path
         The OBJ file (UTF-8 or ASCII text).
-    material : int
-        Material index of the mesh.
+    material : int or None
+        Material index of the mesh (with ``groups``: of faces before the first ``usemtl``; None
+        refuses such faces).
     cull_backfaces : bool
         Passed to :class:`TriangleMesh`.
+    groups : mapping of str to int, optional
+        Material groups: each ``usemtl`` name to a material index. Given, every face takes the
+        index of the ``usemtl`` above it (``material`` before the first one) and the mesh carries
+        ``face_materials``; a ``usemtl`` name that ``groups`` lacks is an error naming the file,
+        the line and the group. None (the default) skips ``usemtl``: one material for the mesh.
 
     Returns
     -------
     TriangleMesh
-        With ``normals`` if every corner names a ``vn``, ``uvs`` if every corner names a ``vt``.
+        With ``normals`` if every corner names a ``vn``, ``uvs`` if every corner names a ``vt``,
+        ``face_materials`` if ``groups`` is given.
 
     Raises
     ------
@@ -271,6 +296,8 @@ def mesh_from_obj(path, material: int = 0, cull_backfaces: bool = False) -> Tria
     texcoords: list[list[float]] = []
     normals: list[list[float]] = []
     corners: list[tuple[int, int, int]] = []  # (v, vt, vn), -1 where absent
+    face_materials: list[int] = []  # per triangle, when groups are read
+    current = material
     has_vt: bool | None = None
     has_vn: bool | None = None
     lines = text.replace("\\\n", " ").splitlines()
@@ -281,6 +308,15 @@ def mesh_from_obj(path, material: int = 0, cull_backfaces: bool = False) -> Tria
         parts = line.split()
         keyword = parts[0]
         where = f"{name}: line {number}"
+        if keyword == "usemtl" and groups is not None:
+            group = " ".join(parts[1:])
+            if group not in groups:
+                raise SpecrefError(
+                    f"{where}: usemtl group {group!r} has no scene material; allowed: "
+                    f"{', '.join(sorted(groups)) or 'none defined'}"
+                )
+            current = int(groups[group])
+            continue
         if keyword in OBJ_IGNORED:
             continue
         if keyword not in _OBJ_READ:
@@ -328,8 +364,13 @@ def mesh_from_obj(path, material: int = 0, cull_backfaces: bool = False) -> Tria
                 has_vt, has_vn = vt >= 0, vn >= 0
                 face.append((v, vt, vn))
             # Fan triangulation from the first corner: (0, k, k + 1).
+            require(
+                current is not None,
+                f"{where}: face before any usemtl, and no material for ungrouped faces",
+            )
             for k in range(1, len(face) - 1):
                 corners.extend((face[0], face[k], face[k + 1]))
+                face_materials.append(current)
     require(len(corners) > 0, f"{name}: no faces ('f' statements) found")
 
     # One mesh vertex per distinct (v, vt, vn) corner.
@@ -339,7 +380,17 @@ def mesh_from_obj(path, material: int = 0, cull_backfaces: bool = False) -> Tria
     vertices = np.asarray(positions, dtype=np.float64)[unique[:, 0]]
     uvs = np.asarray(texcoords, dtype=np.float64)[unique[:, 1]] if has_vt else None
     vn = np.asarray(normals, dtype=np.float64)[unique[:, 2]] if has_vn else None
-    return TriangleMesh(vertices, faces, vn, uvs, material, cull_backfaces, source=name)
+    per_face = None if groups is None else np.asarray(face_materials, dtype=np.int32)
+    return TriangleMesh(
+        vertices,
+        faces,
+        vn,
+        uvs,
+        material or 0,
+        cull_backfaces,
+        source=name,
+        face_materials=per_face,
+    )
 
 
 def mesh_to_obj(mesh: TriangleMesh, path) -> Path:

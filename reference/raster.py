@@ -455,7 +455,10 @@ def gbuffer_from_raster(
     g.uv.reshape(-1, 2)[pixel] = uv
     g.depth.reshape(-1)[pixel] = depth.ravel()[pixel]
     g.view.reshape(-1, 3)[pixel] = view
-    g.material_id.reshape(-1)[pixel] = mesh.material
+    if mesh.face_materials is None:
+        g.material_id.reshape(-1)[pixel] = mesh.material
+    else:  # material groups: the material of each pixel's face
+        g.material_id.reshape(-1)[pixel] = mesh.face_materials[setup.face[tri]]
     g.object_id.reshape(-1)[pixel] = object_id
     g.mask.reshape(-1)[pixel] = True
     return g

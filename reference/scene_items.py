@@ -92,16 +92,37 @@ def _plane_parser(rectangle: bool):
     return parse
 
 
+def _mesh_groups(reader: SceneReader, table: dict, key: str, materials: Mapping):
+    """``groups``: false (usemtl ignored), true (same names) or a table of group → material."""
+    value = table.get("groups", False)
+    if isinstance(value, bool):
+        return dict(materials) if value else None
+    reader.table(value, f"{key}.groups")
+    groups = {}
+    for group, name in value.items():
+        if not isinstance(name, str) or name not in materials:
+            reader.fail(
+                f"{key}.groups.{group}",
+                f"unknown material {name!r}; allowed: "
+                f"{format_allowed(materials) or 'none defined'}",
+            )
+        groups[group] = materials[name]
+    return groups
+
+
 def _parse_mesh(reader: SceneReader, table: dict, key: str, materials: Mapping) -> TriangleMesh:
-    keys = ("type", "material", "file", "scale", "translate", "cull_backfaces")
-    reader.table(table, key, keys, ("material", "file"))
+    keys = ("type", "material", "file", "scale", "translate", "cull_backfaces", "groups")
+    groups = _mesh_groups(reader, table, key, materials)
+    reader.table(table, key, keys, ("file",) if groups is not None else ("material", "file"))
     path = reader.file_path(table["file"], f"{key}.file")
     scale = reader.number(table.get("scale", 1.0), f"{key}.scale", 0, exclusive_minimum=True)
     translate = np.array(reader.vector(table.get("translate", [0.0, 0.0, 0.0]), f"{key}.translate"))
     cull = reader.boolean(table.get("cull_backfaces", False), f"{key}.cull_backfaces")
-    material = _material_ref(reader, table, key, materials)
+    material = None
+    if groups is None or "material" in table:
+        material = _material_ref(reader, table, key, materials)
     with reader.context(f"{key}.file"):
-        mesh = mesh_from_obj(path, material, cull)
+        mesh = mesh_from_obj(path, material, cull, groups)
         if scale == 1.0 and not translate.any():
             return mesh
         # A uniform scale and a translation keep the shading normals as they are.
@@ -206,7 +227,7 @@ OBJECT_TYPES.register(
     SceneItemType(
         "mesh",
         _parse_mesh,
-        ("material", "file", "scale", "translate", "cull_backfaces"),
+        ("material", "file", "scale", "translate", "cull_backfaces", "groups"),
         "a triangle mesh from a Wavefront OBJ file, rasterized",
     )
 )

@@ -19,6 +19,7 @@ from shrm.kubelka_munk import (
 from shrm.lobes import PREFILTER_KERNELS, adaptive_order, parse_kernel
 from shrm.orbit import render_orbit
 from shrm.polymer import MIRROR_FACTORS, polymer_look, polymer_maps, polymer_terms
+from shrm.polymer_material import PolymerMaterial
 from shrm.prefilter import prefilter_bruteforce, prefilter_coefficients, prefilter_environment
 from shrm.rotation import rotate_coefficients, rotation_matrix, sh_rotation_blocks
 from shrm.session import HERBERT_STAGES, RenderSession
@@ -38,6 +39,7 @@ __all__ = [
     "WINDOWS",
     "Cache",
     "PolymerConstituents",
+    "PolymerMaterial",
     "RenderSession",
     "adaptive_order",
     "apply_window",

@@ -25,7 +25,24 @@ scene, is served from the cache without running the stage. Every execution, cach
 time is counted (:attr:`RenderSession.executions`, :attr:`RenderSession.hits`,
 :attr:`RenderSession.frame_times`).
 
-Which stages run for each kind of change (tested):
+:data:`POLYMER_STAGES` is the same loop for the hybrid polymer (Eq. (1), Herbert et al.;
+``shrm.polymer_material``): the Lambert and Phong maps, a Fresnel table for the ``index``, the
+effect pigment's SHRM for the ``brdf`` (None: no effect pigment), the per-pixel angle look-ups
+(``polymer_pixels``) and the per-frame shading with the dynamic parameters. Which state key each
+polymer parameter lives in is :data:`POLYMER_PARAMETERS`; its stages are
+``stages_depending_on(POLYMER_STAGES, key)`` (tested):
+
+=======================================================  ==========================================
+polymer parameter                                        stages that run
+=======================================================  ==========================================
+thickness, tio2, tint, transparency, Mod_effect, gloss   shade
+gloss_exponent (state ``gloss``)                         specular_map, polymer_pixels, shade
+index                                                    fresnel_lut, polymer_pixels, shade
+effect (state ``brdf``)                                  brdf_coeffs, shrm_create, extract,
+                                                         polymer_pixels, shade
+=======================================================  ==========================================
+
+Which stages of :data:`HERBERT_STAGES` run for each kind of change (tested):
 
 =====================  ========================================================================
 change                 stages that run
@@ -58,6 +75,8 @@ from shrm.cache import Cache, cache_key, hash_inputs
 
 __all__ = [
     "HERBERT_STAGES",
+    "POLYMER_PARAMETERS",
+    "POLYMER_STAGES",
     "STATE_KEYS",
     "RenderSession",
     "Stage",
@@ -73,6 +92,8 @@ STATE_KEYS = (
     "brdf",
     "dynamic",
     "config",
+    # The polymer's refractive index (POLYMER_STAGES): it changes only the Fresnel table
+    "index",
 )
 
 
@@ -439,5 +460,173 @@ HERBERT_STAGES = (
         ("dynamic", "viewpoint", "config"),
         ("diffuse_map", "specular_map", "shrm_create", "extract", "gbuffer"),
         _stage_shade,
+    ),
+)
+
+
+# --- the hybrid polymer, Eq. (1), Herbert et al. ----------------------------------------------
+
+#: Where each polymer parameter lives in the session state (§5.2, §8, Herbert et al.: "changes to
+#: dynamic parameters (such as material thickness, color, TiO2 load) ... incur no speed penalty").
+#: ``gloss`` is the factor of Eq. (5), Herbert et al.; ``gloss_exponent`` selects the specular
+#: prefilter (E32).
+POLYMER_PARAMETERS = {
+    "thickness": "dynamic",
+    "tio2": "dynamic",
+    "tint": "dynamic",
+    "transparency": "dynamic",
+    "Mod_effect": "dynamic",
+    "gloss": "dynamic",
+    "gloss_exponent": "gloss",
+    "index": "index",
+    "effect": "brdf",
+}
+
+
+def _stage_fresnel_lut(state, inputs):
+    from reference.fresnel import fresnel_lut
+    from shrm.kubelka_munk import saunderson_constants
+
+    n = np.asarray(state["index"], dtype=np.float64)
+    # Eq. (1), Herbert et al.: the F_r table, and the chip surface's k_1 of D_polymer (E31)
+    return {"lut": fresnel_lut(n), "k_1": np.asarray(saunderson_constants(n).k_1)}
+
+
+def _effect_stage(stage):
+    """A stage of the effect pigment's SHRM that does nothing when the state has no ``brdf``."""
+
+    def run(state, inputs):
+        if state.get("brdf") is None:
+            return {"none": np.zeros(0)}
+        return stage(state, inputs)
+
+    return run
+
+
+def _stage_polymer_pixels(state, inputs):
+    from shrm.polymer import PolymerMaps
+    from shrm.polymer_material import polymer_pixel_parts
+    from shrm.shrm import shade_shrm
+
+    c = _config(state)
+    g = inputs["gbuffer"]["gbuffer"]
+    sel = g.mask
+    n = g.normal[sel]
+    v = _view_of(state["viewpoint"])
+    radiance = inputs["color_manage"]["radiance"]
+    maps = PolymerMaps(
+        inputs["diffuse_map"]["cube"],
+        inputs["specular_map"]["cube"],
+        radiance,
+        float(state["gloss"]),
+    )
+    E_effect = None
+    if state.get("brdf") is not None:
+        s = _shrm_of(state, inputs["shrm_create"])
+        E_effect = shade_shrm(s, inputs["extract"]["map"], n, v)
+    # §5.1, Herbert et al.: the per-pixel (angle) look-ups, once per viewpoint and maps
+    V = np.broadcast_to(v, n.shape)
+    lut, mirror = inputs["fresnel_lut"]["lut"], c.get("mirror", "fresnel")
+    parts = polymer_pixel_parts(n, V, maps, lut, mirror, E_effect)
+    return {"parts": parts, "mask": sel, "uv": g.uv[sel]}
+
+
+def _polymer_tint(tint, grid) -> np.ndarray:
+    """Tint_polymer on the grid: a number, a spectrum on the grid, or a spot-colour name."""
+    if isinstance(tint, str):
+        from shrm.tint import read_tint_library
+
+        library = read_tint_library()
+        return np.interp(grid.wavelengths_nm, library.wavelengths_nm, library.tint(tint))
+    return np.asarray(tint, dtype=np.float64)
+
+
+def _stage_polymer_shade(state, inputs):
+    from reference.spectra import SpectralGrid
+    from shrm.polymer import PolymerLook, _spectrum01
+    from shrm.polymer_material import (
+        chip_lookup,
+        modulation_at,
+        polymer_characterization,
+        polymer_shade_parts,
+    )
+
+    c = _config(state)
+    d = {
+        "thickness": 1.524,
+        "tio2": 0.5,
+        "tint": 1.0,
+        "transparency": 0.0,
+        "Mod_effect": 0.0,
+        "gloss": 1.0,
+        **state["dynamic"],
+    }
+    grid = SpectralGrid(*c["grid"])
+    pixels = inputs["polymer_pixels"]
+    fresnel = inputs["fresnel_lut"]
+    # Set dynamic parameters into shaders (§5.2, Herbert et al.): the chip, once per frame
+    ch = polymer_characterization(c.get("characterization"), grid)
+    chip = chip_lookup(ch, d["thickness"], d["tio2"])
+    nb = grid.n_bands
+    gloss = _spectrum01(d["gloss"], 1, "polymer: gloss")[0]
+    look = PolymerLook(
+        np.clip(chip["over_black"] - fresnel["k_1"], 0.0, 1.0),  # Erratum E31: D_polymer
+        chip["transmittance"],
+        _spectrum01(d["transparency"], nb, "polymer: transparency"),
+        _spectrum01(_polymer_tint(d["tint"], grid), nb, "polymer: tint"),
+        float(gloss),
+        fresnel["lut"],
+        c.get("mirror", "fresnel"),
+    )
+    Mod = d["Mod_effect"]
+    if np.ndim(Mod) == 2:
+        Mod = modulation_at(Mod, pixels["uv"])
+    # The radiance of the covered pixels only (N, n_bands), in the order of g.normal[mask]: no
+    # image is scattered per frame (the display step reads the pixels it needs)
+    return {"pixels": polymer_shade_parts(pixels["parts"], look, Mod), "mask": pixels["mask"]}
+
+
+#: The render loop of §5.2, Herbert et al., for the hybrid polymer, Eq. (1), Herbert et al. (module
+#: docstring). ``config`` adds ``grid`` (required), ``characterization`` (a file, default the
+#: model) and ``mirror`` (default ``"fresnel"``). Its ``shade`` result is ``pixels``, the radiance
+#: spectra (N, n_bands) of the covered pixels in the order of ``gbuffer.normal[mask]``, and
+#: ``mask``.
+POLYMER_STAGES = (
+    Stage("color_manage", ("illuminant", "environment"), (), _stage_color_manage),
+    Stage("sh_project", ("config",), ("color_manage",), _stage_sh_project, persistent=True),
+    Stage("diffuse_map", ("config",), ("sh_project",), _stage_diffuse_map, persistent=True),
+    Stage(
+        "specular_map", ("gloss", "config"), ("sh_project",), _stage_specular_map, persistent=True
+    ),
+    Stage("fresnel_lut", ("index",), (), _stage_fresnel_lut),
+    Stage("brdf_coeffs", ("brdf", "config"), (), _effect_stage(_stage_brdf_coeffs), "3"),
+    Stage(
+        "shrm_create",
+        ("config",),
+        ("sh_project", "brdf_coeffs"),
+        _effect_stage(_stage_shrm_create),
+        "2",
+    ),
+    Stage("gbuffer", ("viewpoint", "config"), (), _stage_gbuffer),
+    Stage("extract", ("viewpoint", "config"), ("shrm_create",), _effect_stage(_stage_extract)),
+    Stage(
+        "polymer_pixels",
+        ("viewpoint", "config"),
+        (
+            "color_manage",
+            "diffuse_map",
+            "specular_map",
+            "fresnel_lut",
+            "shrm_create",
+            "extract",
+            "gbuffer",
+        ),
+        _stage_polymer_pixels,
+    ),
+    Stage(
+        "shade",
+        ("dynamic", "config"),
+        ("fresnel_lut", "polymer_pixels"),
+        _stage_polymer_shade,
     ),
 )

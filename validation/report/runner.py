@@ -43,6 +43,7 @@ from validation.sections import (
     impastor,
     phong,
     polymer,
+    polymer_scene,
     raster,
     sh,
     shrm,
@@ -71,7 +72,14 @@ PARTS: tuple[ReportPart, ...] = (
         "herbert",
         "Herbert et al.: SH, SHRMs, the hybrid polymer model, spectral environments, calibration",
         "SH to order 100, prefiltering, SHRMs, spectral panoramas, display calibration.",
-        (sh.SECTION, spectral_env.SECTION, shrm.SECTION, polymer.SECTION, display.SECTION),
+        (
+            sh.SECTION,
+            spectral_env.SECTION,
+            shrm.SECTION,
+            polymer.SECTION,
+            polymer_scene.SECTION,
+            display.SECTION,
+        ),
     ),
     ReportPart(
         "ferwerda",

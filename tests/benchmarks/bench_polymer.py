@@ -1,0 +1,139 @@
+"""Dynamic polymer parameters at no prefilter cost (§5.2, §8, Herbert et al.), as ratios in one run.
+
+A 512×512 frame of a polymer sphere (``shrm.session.POLYMER_STAGES``) under venice_sunset (64 rows,
+its luminance on the 16-band 400-700/20 nm grid of the session demo), cube faces 32², no effect
+pigment. "Re-shade" is a dynamic change (a new thickness every round, so no result is reused), the
+session's frame and the radiance of the covered pixels to XYZ: what a user pays per frame while
+dragging a thickness, TiO2, tint, transparency or Mod_effect slider. Groups (report section
+"Polymer scenes", targets of issue 14):
+
+- ``polymer-dynamic-cold``: the re-shade against a cold render of the same frame by a new session
+  without a persistent cache (baseline: environment projection, Lambert and Phong maps, Fresnel
+  table, G-buffer, per-pixel look-ups, shading); target baseline / re-shade >= 20;
+- ``polymer-dynamic-lambert``: the re-shade against re-shading a plain Lambert material of the same
+  pixels from its cached irradiance map (baseline: ``shrm.environment.shade_lambert_environment``
+  with a new ``k_d``, which also ends in XYZ); target re-shade / baseline <= 3.
+"""
+
+import itertools
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from reference.camera import Camera, downsample_box
+from reference.colorimetry import band_weights
+from reference.geometry import Sphere
+from reference.images import read_image
+from reference.lights import EnvironmentLight
+from reference.materials import LambertMaterial
+from reference.shading import ShadingContext, surface_of
+from reference.spectra import SpectralGrid
+from shrm.environment import shade_lambert_environment
+from shrm.session import POLYMER_STAGES, RenderSession
+
+ROOT = Path(__file__).resolve().parents[2]
+SHARED = Path(os.environ.get("SPECREF_SHARED_DATA", ROOT.parent / "shared" / "data"))
+GRID = SpectralGrid(400.0, 700.0, 20.0)
+SIZE = 512
+_THICKNESS = itertools.count()
+
+
+@pytest.fixture(scope="module")
+def image():
+    hdr = read_image(SHARED / "environments/venice_sunset_1k.hdr")
+    return downsample_box(hdr, hdr.shape[0] // 64)
+
+
+@pytest.fixture(scope="module")
+def state(image):
+    luminance = image @ np.array([0.2126, 0.7152, 0.0722])
+    return {
+        "illuminant": np.ones(GRID.n_bands),
+        "environment": np.repeat(luminance[..., None], GRID.n_bands, axis=-1),
+        "viewpoint": Camera(eye=(0.0, 1.0, 5.0), projection="orthographic", extent=2.4),
+        "gloss": 64.0,
+        "brdf": None,
+        "index": 1.54,
+        "dynamic": {"thickness": 1.524, "tio2": 0.5},
+        "config": {
+            "size": 32,
+            "width": SIZE,
+            "height": SIZE,
+            "objects": [Sphere((0.0, 0.0, 0.0), 1.0)],
+            "grid": [GRID.start_nm, GRID.end_nm, GRID.step_nm],
+        },
+    }
+
+
+@pytest.fixture(scope="module")
+def warm(state):
+    """A session that has rendered the frame once (maps built, JIT compiled)."""
+    session = RenderSession(state, POLYMER_STAGES)
+    session.render()
+    return session
+
+
+def _cold(state, W):
+    out = RenderSession(state, POLYMER_STAGES).render()
+    return out["shade"]["pixels"] @ W
+
+
+def _reshade(session, W):
+    # A new thickness every round: the shading stage runs, nothing is reused
+    thickness = 1.0 + 1e-6 * next(_THICKNESS)
+    session.update(dynamic={**session.state["dynamic"], "thickness": thickness})
+    out = session.render()
+    assert list(session.frame_times[-1]) == ["shade"]
+    return out["shade"]["pixels"] @ W
+
+
+def _info(benchmark, role, session):
+    benchmark.extra_info.update(
+        {"role": role, "pixels": int(session.render()["shade"]["mask"].sum()), "bands": 16}
+    )
+
+
+@pytest.mark.benchmark(group="polymer-dynamic-cold")
+def test_cold_render_baseline(benchmark, state, warm):
+    W = band_weights(GRID, None)
+    _info(benchmark, "baseline", warm)
+    benchmark.pedantic(_cold, (state, W), rounds=3, iterations=1)
+
+
+@pytest.mark.benchmark(group="polymer-dynamic-cold")
+def test_reshade_after_dynamic_change(benchmark, warm):
+    W = band_weights(GRID, None)
+    _info(benchmark, "reshade", warm)
+    benchmark(_reshade, warm, W)
+
+
+@pytest.fixture(scope="module")
+def lambert(image, warm):
+    g = warm.render()["gbuffer"]["gbuffer"]
+    surface = surface_of(g, g.mask)
+    light = EnvironmentLight(image)
+    ctx = ShadingContext(GRID, options={"environment_size": 32})
+    shade_lambert_environment(surface, LambertMaterial(np.full(GRID.n_bands, 0.5)), light, ctx)
+    return surface, light, ctx
+
+
+@pytest.mark.benchmark(group="polymer-dynamic-lambert")
+def test_lambert_reshade_baseline(benchmark, lambert, warm):
+    surface, light, ctx = lambert
+    k_d = itertools.count()
+    _info(benchmark, "baseline", warm)
+
+    def reshade():
+        material = LambertMaterial(np.full(GRID.n_bands, 0.5 + 1e-6 * next(k_d)))
+        return shade_lambert_environment(surface, material, light, ctx)
+
+    benchmark(reshade)
+
+
+@pytest.mark.benchmark(group="polymer-dynamic-lambert")
+def test_polymer_reshade_against_lambert(benchmark, warm):
+    W = band_weights(GRID, None)
+    _info(benchmark, "reshade", warm)
+    benchmark(_reshade, warm, W)
