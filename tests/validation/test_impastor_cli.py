@@ -177,3 +177,22 @@ def test_render_light_bad_input(tmp_path, capsys, option, value, message):
     assert len(err) == 1
     assert message in err[0]
     assert not (tmp_path / "p.png").exists()
+
+
+def test_render_light_options_reach_the_counts(tmp_path, capsys, monkeypatch):
+    # --light-position and --light-luminance change the counts written, through the real CLI
+    # (the painting replaced by a uniform gray, so the test does not render).
+    import impastor.painting
+
+    gray = {"XYZ": np.full((6, 6, 3), 40.0), "sRGB": np.full((6, 6, 3), 0.5), "seconds": {}}
+    monkeypatch.setattr(impastor.painting, "render_painting", lambda *a, **k: gray)
+    counts = {}
+    for luminance in ("0", "2000"):
+        out = tmp_path / f"c{luminance}.png"
+        argv = ["impastor", "render", "--size", "6", "--out", str(tmp_path / "p.png")]
+        argv += ["--counts", str(out), "--tilt", "15", "--light-position", "0,0.5,1.0"]
+        assert main([*argv, "--light-luminance", luminance]) == 0
+        assert "specular up to" in capsys.readouterr().out
+        counts[luminance] = read_png(out)
+    assert (counts["2000"] <= counts["0"]).all()
+    assert (counts["2000"] < counts["0"]).any()
