@@ -404,8 +404,28 @@ def _parse_render(reader: SceneReader, data: dict, lights: tuple) -> RenderSetti
             f'must be a number, a list of 3 linear RGB values or "environment", got '
             f"{background!r:.60}",
         )
-    options = reader.table(table.get("options", {}), f"{key}.options")
-    return RenderSettings(width, height, supersample, background, dict(options))
+    options = dict(reader.table(table.get("options", {}), f"{key}.options"))
+    _parse_upsampling(reader, options, f"{key}.options")
+    return RenderSettings(width, height, supersample, background, options)
+
+
+def _parse_upsampling(reader: SceneReader, options: dict, key: str) -> None:
+    """Check ``upsampling`` (a key of UPSAMPLING_METHODS) and ``upsampling_model`` (a model file).
+
+    The model file's path is stored resolved, so shaders find it wherever they run.
+    """
+    from reference.upsampling import UPSAMPLING_METHODS, load_upsampling_model
+
+    if "upsampling" in options:
+        reader.choice(options["upsampling"], f"{key}.upsampling", UPSAMPLING_METHODS)
+    if "upsampling_model" not in options:
+        return
+    if options.get("upsampling") != "regression":
+        reader.fail(f"{key}.upsampling_model", 'needs upsampling = "regression"')
+    path = reader.file_path(options["upsampling_model"], f"{key}.upsampling_model")
+    with reader.context(f"{key}.upsampling_model"):
+        load_upsampling_model(path, reader.grid)
+    options["upsampling_model"] = str(path.resolve())
 
 
 def _parse_display(reader: SceneReader, data: dict, lights: tuple) -> DisplaySettings:

@@ -41,6 +41,8 @@ from reference.images import (
 
 __all__ = [
     "SPECTRAL_FORMATS",
+    "PanoramaRows",
+    "open_panorama_rows",
     "read_environment_file",
     "read_spectral_tiff",
     "spectralize_file",
@@ -236,12 +238,244 @@ def read_environment_file(path) -> tuple[np.ndarray, list[str]]:
     )
 
 
+class PanoramaRows:
+    """A panorama opened for reading by row windows: ``read(row0, row1)``, ``(rows, W, C)`` float64.
+
+    What :func:`open_panorama_rows` returns; ``height``, ``width``, ``names`` (channel names as
+    :func:`read_environment_file` gives them), ``streamed`` (False when the file's layout forces a
+    whole read: compressed TIFF, old-style RLE or rotated Radiance files). Use it as a context
+    manager, so the file is closed.
+    """
+
+    def __init__(self, path, height, width, names, read, close=None, streamed=True):
+        self.path, self.height, self.width, self.names = Path(path), height, width, names
+        self.streamed = streamed
+        self._read, self._close = read, close
+
+    def read(self, row0: int, row1: int) -> np.ndarray:
+        """Rows ``row0 <= y < row1`` (top to bottom), ``(row1 - row0, W, C)`` float64."""
+        require(
+            0 <= row0 < row1 <= self.height,
+            f"{self.path}: rows {row0}-{row1} outside 0-{self.height}",
+        )
+        return self._read(row0, row1)
+
+    def close(self) -> None:
+        """Close the file."""
+        if self._close is not None:
+            self._close()
+            self._close = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+def _whole(path, image, names) -> PanoramaRows:
+    return PanoramaRows(
+        path, image.shape[0], image.shape[1], names, lambda a, b: image[a:b], streamed=False
+    )
+
+
+def _open_exr_rows(path: Path) -> PanoramaRows:
+    """OpenEXR by scanline windows (``InputFile.channel(name, FLOAT, y0, y1)``)."""
+    import Imath
+    import OpenEXR
+
+    from reference.images import _WAVELENGTH_CHANNEL
+
+    require(path.is_file(), f"{path}: file not found")
+    try:
+        # the header through the current bindings (the legacy InputFile.header() crashes on
+        # some attributes, e.g. previews), the scanline windows through the legacy reader
+        with OpenEXR.File(str(path), header_only=True) as opened:
+            header = opened.header()
+            (x0, y0), (x1, y1) = (np.asarray(v, int) for v in header["dataWindow"])
+            names = [channel.name for channel in header["channels"]]
+        handle = OpenEXR.InputFile(str(path))
+    except Exception as error:  # the bindings raise OSError, RuntimeError and others
+        raise SpecrefError(
+            f"{path}: cannot read OpenEXR image ({error.__class__.__name__})"
+        ) from None
+    require(names, f"{path}: OpenEXR file has no channels")
+    width, height = int(x1 - x0 + 1), int(y1 - y0 + 1)
+    spectral = {n: _WAVELENGTH_CHANNEL.search(n) for n in names}
+    if names and all(spectral.values()):
+        names.sort(key=lambda n: float(spectral[n].group(1).replace(",", ".")))
+    else:
+        order = {"R": 0, "G": 1, "B": 2, "A": 3}
+        position = {n: i for i, n in enumerate(names)}
+        names.sort(key=lambda n: (order.get(n, 4), position[n]))
+    FLOAT = Imath.PixelType(Imath.PixelType.FLOAT)
+
+    def read(row0, row1):
+        out = np.empty((row1 - row0, width, len(names)))
+        try:
+            for c, name in enumerate(names):
+                data = handle.channel(name, FLOAT, int(y0) + row0, int(y0) + row1 - 1)
+                data = np.frombuffer(data, np.float32)
+                out[..., c] = data.reshape(row1 - row0, width)
+        except Exception as error:  # truncated or corrupt scanlines
+            raise SpecrefError(
+                f"{path}: cannot read OpenEXR rows {row0}-{row1 - 1} ({error.__class__.__name__})"
+            ) from None
+        return out
+
+    return PanoramaRows(path, height, width, names, read, handle.close)
+
+
+def _hdr_scanline_end(buffer, p: int, width: int) -> int | None:
+    """End of the Radiance scanline starting at ``p`` (flat or new-style RLE), None if old RLE."""
+    if 8 <= width < 0x8000 and buffer[p] == 2 and buffer[p + 1] == 2 and buffer[p + 2] < 128:
+        p += 4
+        # new-style RLE: four channels of runs, count > 128 is a run of one byte
+        for _channel in range(4):
+            x = 0
+            while x < width:
+                count = buffer[p]
+                if count > 128:
+                    x, p = x + count - 128, p + 2
+                else:
+                    x, p = x + count, p + 1 + count
+        return p
+    if buffer[p] == 1 and buffer[p + 1] == 1 and buffer[p + 2] == 1:
+        return None
+    return p + 4 * width
+
+
+def _open_hdr_rows(path: Path) -> PanoramaRows:
+    """Radiance RGBE by scanlines: find each block's bytes, decode them with imagecodecs."""
+    import imagecodecs
+
+    require(path.is_file(), f"{path}: file not found")
+    handle = open(path, "rb")  # noqa: SIM115 (closed by PanoramaRows.close)
+    header = b""
+    while not header.endswith(b"\n\n"):
+        line = handle.readline(4096)
+        if not line or len(header) > 65536:
+            handle.close()
+            raise SpecrefError(f"{path}: cannot read Radiance HDR image (no header end)")
+        header += line
+    resolution = handle.readline(256).split()
+    if len(resolution) != 4 or resolution[0] != b"-Y" or resolution[2] != b"+X":
+        handle.close()  # a rotated or flipped file: decoded whole
+        return _whole(path, read_hdr(path), ["R", "G", "B"])
+    try:
+        height, width = int(resolution[1]), int(resolution[3])
+    except ValueError:
+        handle.close()
+        raise SpecrefError(f"{path}: cannot read Radiance HDR image (resolution)") from None
+    state = {"buffer": b"", "row": 0}
+    worst = 4 + 4 * width + 4 * (width // 128 + 1)  # a scanline's most bytes (RLE or flat)
+
+    def read(row0, row1):
+        require(row0 == state["row"], f"{path}: Radiance rows are read in order, from row 0")
+        buffer, p = state["buffer"], 0
+        for row in range(row0, row1):
+            if len(buffer) - p < worst:  # keep at least one whole scanline ahead
+                buffer += handle.read(max(1 << 18, worst))
+            end = _hdr_scanline_end(buffer, p, width) if len(buffer) - p >= 4 else p + worst
+            if end is None:
+                raise SpecrefError(f"{path}: old-style RLE scanlines; re-save it (e.g. pfstools)")
+            require(end <= len(buffer), f"{path}: truncated Radiance HDR image (row {row})")
+            p = end
+        block = header + f"-Y {row1 - row0} +X {width}\n".encode() + buffer[:p]
+        state["buffer"], state["row"] = buffer[p:], row1
+        try:
+            image = imagecodecs.rgbe_decode(block)
+        except Exception as error:  # imagecodecs.RgbeError and others
+            raise SpecrefError(
+                f"{path}: cannot read Radiance HDR rows {row0}-{row1 - 1} "
+                f"({error.__class__.__name__})"
+            ) from None
+        return np.asarray(image, dtype=np.float64).reshape(row1 - row0, width, 3)
+
+    return PanoramaRows(path, height, width, ["R", "G", "B"], read, handle.close)
+
+
+def _open_tiff_rows(path: Path) -> PanoramaRows:
+    """A float TIFF by rows through a memory map (uncompressed), else read whole."""
+    import tifffile
+
+    require(path.is_file(), f"{path}: file not found")
+    try:
+        image = tifffile.memmap(str(path), mode="r")
+        with tifffile.TiffFile(str(path)) as tif:
+            description = tif.pages[0].description
+    except ValueError:  # compressed or tiled: no memory map
+        image, names = read_spectral_tiff(path)
+        return _whole(path, image, names)
+    except Exception as error:  # tifffile raises TiffFileError and others
+        raise SpecrefError(f"{path}: cannot read TIFF image ({error.__class__.__name__})") from None
+    require(
+        image.dtype.kind == "f",
+        f"{path}: {image.dtype.itemsize * 8}-bit integer TIFF, not HDR; linearize it and save "
+        "as float (.hdr, .exr or a float TIFF)",
+    )
+    image = image[..., None] if image.ndim == 2 else image
+    try:
+        names = spectral_channel_names(json.loads(description)["wavelengths_nm"])
+    except (ValueError, KeyError, TypeError):
+        require(
+            image.shape[2] == 3,
+            f"{path}: no wavelengths in the TIFF ImageDescription and not RGB "
+            f"({image.shape[2]} samples)",
+        )
+        names = ["R", "G", "B"]
+    require(
+        image.shape[2] == len(names),
+        f"{path}: {image.shape[2]} samples per pixel but {len(names)} wavelengths",
+    )
+    return PanoramaRows(
+        path, image.shape[0], image.shape[1], names, lambda a, b: np.array(image[a:b], float)
+    )
+
+
+def open_panorama_rows(path) -> PanoramaRows:
+    """Open a panorama for reading by row windows, never holding it whole (where the file allows).
+
+    ``.exr``: OpenEXR scanline windows; ``.hdr``: Radiance scanlines found one by one (flat or
+    new-style RLE) and decoded a block at a time by imagecodecs, bit for bit as
+    :func:`reference.images.read_hdr` (rows in order); ``.tif``: a memory map of an uncompressed
+    float TIFF (RGB without a description, or spectral as :func:`write_spectral_blocks` writes).
+    Rotated Radiance files and compressed TIFFs are read whole (``streamed`` is False).
+
+    Raises
+    ------
+    SpecrefError
+        Unknown type, 8-bit images, missing or unreadable files.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> from reference.images import write_exr
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     path = write_exr(os.path.join(d, "p.exr"), np.ones((4, 8, 3)))
+    ...     with open_panorama_rows(path) as rows:
+    ...         (rows.height, rows.width, rows.names), rows.read(1, 3).shape
+    ((4, 8, ['R', 'G', 'B']), (2, 8, 3))
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".exr":
+        return _open_exr_rows(path)
+    if suffix in (".hdr", ".rgbe", ".pic"):
+        return _open_hdr_rows(path)
+    if suffix in (".tif", ".tiff"):
+        return _open_tiff_rows(path)
+    read_environment_file(path)  # the one-line refusals of 8-bit and unknown types
+    raise AssertionError("unreachable")  # pragma: no cover
+
+
 def spectralize_file(panorama, model, out, rows_per_block: int | None = None) -> dict:
     """Expand an HDR panorama to a spectral panorama on disk, row block by row block.
 
-    Herbert et al., §4 (the panorama expanded to 41 bands and stored as a float TIFF). The input
-    is read whole (it is 3 channels); the output (``n_bands`` float32 channels) never is: each
-    block of rows is spectralized and written before the next (erratum E43 for the formats).
+    Herbert et al., §4 (the panorama expanded to 41 bands and stored as a float TIFF). Neither
+    the input nor the output is held whole: each block of rows is read from the panorama
+    (:func:`open_panorama_rows`), spectralized and written before the next (erratum E43 for the
+    formats). A NaN, inf or negative value stops the command and leaves no output.
 
     Parameters
     ----------
@@ -256,7 +490,8 @@ def spectralize_file(panorama, model, out, rows_per_block: int | None = None) ->
     Returns
     -------
     dict
-        ``out``, ``height``, ``width``, ``bands``, ``blocks``.
+        ``out``, ``height``, ``width``, ``bands``, ``blocks``, ``streamed`` (False when the
+        input's layout forced a whole read, :func:`open_panorama_rows`).
 
     Raises
     ------
@@ -272,35 +507,34 @@ def spectralize_file(panorama, model, out, rows_per_block: int | None = None) ->
     into a linear Radiance .hdr or OpenEXR .exr (or linearize it, e.g. sRGB decoding, and save as
     float)
     """
-    from reference.spectral_regression import spectralize_blocks
+    from reference.spectral_regression import spectralize_rows
 
-    image, names = read_environment_file(panorama)
-    require(
-        names[:3] == ["R", "G", "B"],
-        f"{panorama}: channels {', '.join(names[:5])}; spectralize needs an RGB panorama",
-    )
     suffix = Path(out).suffix.lower()
-    require(
-        suffix in SPECTRAL_FORMATS,
-        f"{out}: unsupported spectral image type {suffix!r}; allowed: .exr, .tif, .tiff",
-    )
-    RGB = image[..., :3]
-    require(np.isfinite(RGB).all(), f"{panorama}: RGB must be finite, found NaN or inf")
-    require((RGB >= 0).all(), f"{panorama}: RGB must be >= 0, found {RGB.min():g}")
-    height, width = RGB.shape[:2]
-    rows = rows_per_block
-    count = [0]
+    with open_panorama_rows(panorama) as rows:
+        require(
+            rows.names[:3] == ["R", "G", "B"],
+            f"{panorama}: channels {', '.join(rows.names[:5])}; spectralize needs an RGB panorama",
+        )
+        require(
+            suffix in SPECTRAL_FORMATS,
+            f"{out}: unsupported spectral image type {suffix!r}; allowed: .exr, .tif, .tiff",
+        )
+        count = [0]
 
-    def counted():
-        for item in spectralize_blocks(model, RGB, rows):
-            count[0] += 1
-            yield item
+        def counted():
+            blocks = spectralize_rows(
+                model, rows.read, rows.height, rows.width, rows_per_block, panorama
+            )
+            for item in blocks:
+                count[0] += 1
+                yield item
 
-    write_spectral_blocks(out, height, width, model.wavelengths_nm, counted())
+        write_spectral_blocks(out, rows.height, rows.width, model.wavelengths_nm, counted())
     return {
         "out": str(out),
-        "height": height,
-        "width": width,
+        "height": rows.height,
+        "width": rows.width,
         "bands": model.n_bands,
         "blocks": count[0],
+        "streamed": rows.streamed,
     }

@@ -65,6 +65,7 @@ __all__ = [
     "RGB_to_spectra_Mallett2019",
     "RGB_to_spectra_regression",
     "default_regression",
+    "load_upsampling_model",
 ]
 
 #: The default RGB → spectrum method.
@@ -186,7 +187,44 @@ def default_regression():
     return load_regression(DEFAULT_REGRESSION_MODEL)
 
 
-def RGB_to_spectra_regression(RGB, grid: SpectralGrid) -> np.ndarray:
+def load_upsampling_model(path, grid: SpectralGrid):
+    """A regression model file for upsampling onto ``grid`` (cached by path and modification time).
+
+    Herbert et al., §4. The model's wavelengths must cover the grid's range (the spectra are
+    resampled linearly onto it, :func:`RGB_to_spectra_regression`).
+
+    Raises
+    ------
+    SpecrefError
+        Missing or malformed file; a model of another grid: ``<file>: model grid 450-650 nm, 3
+        bands; does not cover the scene grid 380-780 nm``.
+
+    Examples
+    --------
+    >>> from reference.spectra import GRID_31
+    >>> load_upsampling_model(DEFAULT_REGRESSION_MODEL, GRID_31).n_bands
+    41
+    """
+    path = Path(path)
+    require(path.is_file(), f"{path}: file not found")
+    model = _load_model(str(path.resolve()), path.stat().st_mtime_ns)
+    wl = model.wavelengths_nm
+    require(
+        wl[0] <= grid.start_nm + 1e-9 and wl[-1] >= grid.end_nm - 1e-9,
+        f"{path}: model grid {wl[0]:g}-{wl[-1]:g} nm, {wl.size} bands; does not cover the scene "
+        f"grid {grid.start_nm:g}-{grid.end_nm:g} nm",
+    )
+    return model
+
+
+@functools.lru_cache(maxsize=8)
+def _load_model(path: str, mtime_ns: int):
+    from reference.spectral_regression import load_regression
+
+    return load_regression(path)
+
+
+def RGB_to_spectra_regression(RGB, grid: SpectralGrid, model=None) -> np.ndarray:
     """Spectra of linear sRGB values by the shipped camera-target regression (Herbert et al., §4).
 
     Herbert et al., §4: polynomial terms of RGB times fitted coefficients (the shipped model uses
@@ -197,6 +235,9 @@ def RGB_to_spectra_regression(RGB, grid: SpectralGrid) -> np.ndarray:
     RGB : array_like, shape (..., 3)
         Linear sRGB, >= 0 (any magnitude: the root-polynomials scale with exposure).
     grid : SpectralGrid
+    model : SpectralRegression or path, optional
+        Another model (a file of ``specref env fit``, :func:`load_upsampling_model`); default the
+        shipped one.
 
     Returns
     -------
@@ -211,7 +252,10 @@ def RGB_to_spectra_regression(RGB, grid: SpectralGrid) -> np.ndarray:
     >>> (S @ M).round(2)                                                # the round trip
     array([[0.2, 0.4, 0.8]])
     """
-    model = default_regression()
+    if model is None:
+        model = default_regression()
+    elif not hasattr(model, "predict"):
+        model = load_upsampling_model(model, grid)
     S = model.predict(np.asarray(RGB, dtype=np.float64))
     wl = grid.wavelengths_nm
     if wl.shape == model.wavelengths_nm.shape and np.array_equal(wl, model.wavelengths_nm):
@@ -252,15 +296,18 @@ UPSAMPLING_METHODS.register(
 )
 
 
-def RGB_to_spectra(RGB, grid: SpectralGrid, method: str = DEFAULT_UPSAMPLING) -> np.ndarray:
+def RGB_to_spectra(
+    RGB, grid: SpectralGrid, method: str = DEFAULT_UPSAMPLING, model=None
+) -> np.ndarray:
     """Spectra of linear sRGB values by a registered method (default ``mallett2019``).
 
-    Eq. (4), Mallett & Yuksel 2019 by default.
+    Eq. (4), Mallett & Yuksel 2019 by default. ``model`` (a regression model or its file) is for
+    ``method="regression"`` only.
 
     Raises
     ------
     SpecrefError
-        Unknown method, negative or non-finite RGB.
+        Unknown method, negative or non-finite RGB, a model for another method.
 
     Examples
     --------
@@ -272,11 +319,20 @@ def RGB_to_spectra(RGB, grid: SpectralGrid, method: str = DEFAULT_UPSAMPLING) ->
     RGB = np.asarray(RGB, dtype=np.float64)
     require(RGB.shape[-1:] == (3,), f"RGB_to_spectra: expected (..., 3), got {RGB.shape}")
     require(np.isfinite(RGB).all() and (RGB >= 0).all(), "RGB_to_spectra: RGB must be finite, >= 0")
-    return entry.reference(RGB, grid)
+    if model is None:
+        return entry.reference(RGB, grid)
+    require(
+        method == "regression", f"RGB_to_spectra: a model file is for 'regression', not {method!r}"
+    )
+    return entry.reference(RGB, grid, model)
 
 
 def RGB_to_radiance_spectra(
-    RGB, grid: SpectralGrid, method: str = DEFAULT_UPSAMPLING, colourspace: str = "sRGB"
+    RGB,
+    grid: SpectralGrid,
+    method: str = DEFAULT_UPSAMPLING,
+    colourspace: str = "sRGB",
+    model=None,
 ) -> np.ndarray:
     """Spectral radiance of linear RGB radiance: the upsampled spectrum times the white illuminant.
 
@@ -300,4 +356,4 @@ def RGB_to_radiance_spectra(
     illuminant = spectrum_from_dataset("illuminant", space.whitepoint_name)
     D = resample_spectrum(illuminant, grid, extrapolation="constant")
     D = D / (D @ band_weights(grid, None)[:, 1])
-    return RGB_to_spectra(RGB, grid, method) * D
+    return RGB_to_spectra(RGB, grid, method, model) * D

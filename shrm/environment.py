@@ -19,12 +19,13 @@ pixel integrates the whole map instead (:func:`shrm.prefilter.prefilter_brutefor
 A spectral environment (one channel per band) is resampled linearly onto the scene's grid; an RGB
 one is upsampled with ``reference.upsampling.RGB_to_radiance_spectra`` (Mallett & Yuksel 2019 by
 default, times the colourspace's white illuminant, so a white texel becomes a D65-shaped spectrum
-and renders white; option ``ctx.options["upsampling"]``). XYZ uses the equal-energy band weights:
+and renders white; options ``ctx.options["upsampling"]`` and, for ``"regression"``,
+``ctx.options["upsampling_model"]``, a model file). XYZ uses the equal-energy band weights:
 radiance spectra carry no light to fold in.
 
 Options read from ``ctx.options``: ``environment`` (``"frequency"`` default, or ``"bruteforce"``),
 ``environment_tol`` (default :data:`shrm.lobes.DEFAULT_TOL`), ``environment_size`` (cube
-face, default 64), ``upsampling``.
+face, default 64), ``upsampling``, ``upsampling_model``.
 """
 
 from __future__ import annotations
@@ -57,7 +58,10 @@ _CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def environment_spectral_radiance(
-    light: EnvironmentLight, grid: SpectralGrid, upsampling: str = DEFAULT_UPSAMPLING
+    light: EnvironmentLight,
+    grid: SpectralGrid,
+    upsampling: str = DEFAULT_UPSAMPLING,
+    upsampling_model=None,
 ) -> np.ndarray:
     """The environment's spectral radiance on ``grid``: ``(H, W, n_bands)``, times its intensity.
 
@@ -80,17 +84,24 @@ def environment_spectral_radiance(
         M = np.stack([np.interp(target, wl, np.eye(wl.size)[i]) for i in range(wl.size)])
         spectra = image @ M
     else:
-        spectra = RGB_to_radiance_spectra(image, grid, upsampling, light.colourspace)
+        spectra = RGB_to_radiance_spectra(
+            image, grid, upsampling, light.colourspace, upsampling_model
+        )
     # The texels on specref's rows (light.texel_placement: "mitsuba" resamples Mitsuba 3's rows)
     return light.intensity * light.centred_image(spectra)
 
 
 def _state(light: EnvironmentLight, ctx) -> dict:
-    key = (ctx.grid, ctx.options.get("upsampling", DEFAULT_UPSAMPLING))
+    key = (
+        ctx.grid,
+        ctx.options.get("upsampling", DEFAULT_UPSAMPLING),
+        ctx.options.get("upsampling_model"),
+    )
     per_light = _CACHE.setdefault(light, {})
     if key not in per_light:
         per_light.clear()
-        per_light[key] = {"radiance": environment_spectral_radiance(light, ctx.grid, key[1])}
+        radiance = environment_spectral_radiance(light, ctx.grid, key[1], key[2])
+        per_light[key] = {"radiance": radiance}
     return per_light[key]
 
 

@@ -168,6 +168,71 @@ def regression_table(camera: str = CAMERA, sets=HELD_OUT_SETS) -> list[dict]:
     return rows
 
 
+#: Erratum E44's study: ridge strengths λ and smoothness strengths μ tried by cross-validation.
+SMOOTH_RIDGES = (0.0, *(10.0**k for k in range(-10, 0)))
+SMOOTH_STRENGTHS = (0.0, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2)
+
+
+def _fit_smooth(X, S, ridge: float, smoothness: float) -> np.ndarray:
+    """``argmin (1/n)‖XW − S‖² + λ‖W‖² + μ‖W D₂ᵀ‖²`` (D₂: second differences across bands).
+
+    Hoerl & Kennard 1970 with a Tikhonov smoothness term; the normal equations
+    ``(XᵀX + nλ I) W + W (nμ D₂ᵀD₂) = XᵀS`` are a Sylvester equation.
+    """
+    import scipy.linalg
+
+    n = len(X)
+    D2 = np.diff(np.eye(S.shape[1]), 2, axis=0)
+    A = X.T @ X + n * ridge * np.eye(X.shape[1])
+    return scipy.linalg.solve_sylvester(A, n * smoothness * (D2.T @ D2), X.T @ S)
+
+
+def smoothness_study(kind: str, degree: int, criterion: str = "dE94", camera: str = CAMERA):
+    """Erratum E44: a smoothness prior, (λ, μ) chosen by 5-fold CV on the training set only.
+
+    ``criterion`` is the cross-validated quantity minimized: ``"dE94"`` (mean ΔE94, D65) or
+    ``"rms"`` (spectral RMS). Features scaled to unit RMS, as :func:`fit_regression` does.
+
+    Returns
+    -------
+    dict
+        ``ridge``, ``smoothness``, ``held_out`` (:func:`held_out_figures`) and ``clipped`` (the
+        same with the predicted spectra clipped at 0).
+    """
+    from reference.spectral_regression import CV_FOLDS, CV_SEED
+
+    _, spectra = reflectance_set(TRAINING_SET)
+    S = spectra[:, ::2]
+    X = features_RGB(camera_RGB(spectra, camera, "D65"), kind, degree)
+    scale = np.sqrt((X**2).mean(axis=0))
+    X = X / scale
+    folds = np.array_split(np.random.default_rng(CV_SEED).permutation(len(X)), CV_FOLDS)
+    scores = {}
+    for ridge in SMOOTH_RIDGES:
+        for smoothness in SMOOTH_STRENGTHS:
+            errors = []
+            for held in folds:
+                train = np.setdiff1d(np.arange(len(X)), held)
+                P = X[held] @ _fit_smooth(X[train], S[train], ridge, smoothness)
+                if criterion == "dE94":
+                    errors.append(delta_E94_spectra(S[held], P, "D65"))
+                else:
+                    errors.append(((P - S[held]) ** 2).mean(axis=1))
+            scores[(ridge, smoothness)] = float(np.concatenate(errors).mean())
+    ridge, smoothness = min(scores, key=scores.get)
+    W = _fit_smooth(X, S, ridge, smoothness) / scale[:, None]
+
+    def predict(RGB):
+        return features_RGB(RGB, kind, degree) @ W
+
+    return {
+        "ridge": ridge,
+        "smoothness": smoothness,
+        "held_out": held_out_figures(predict, camera),
+        "clipped": held_out_figures(lambda RGB: np.clip(predict(RGB), 0.0, None), camera),
+    }
+
+
 def recovery_figures(method: str, sets=HELD_OUT_SETS) -> dict:
     """A colour.recovery upsampler on the held-out patches: XYZ (D65) → spectrum → figures.
 

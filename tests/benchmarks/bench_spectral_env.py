@@ -4,8 +4,9 @@ Group ``spectral-env-2k`` (target of issue 15: spectralize throughput >= 50 % of
 
 - ``baseline``: ``np.matmul`` of the panorama's precomputed feature matrix (shipped model:
   root-polynomial degree 4, 22 features, float64) by the coefficients, into a preallocated output;
-- ``spectralize``: :func:`reference.spectral_regression.spectralize_blocks` (feature expansion,
-  exposure rule, product, float32 cast) by blocks of 16 rows into a preallocated float32 panorama.
+- ``spectralize``: :func:`reference.spectral_regression.spectralize_blocks` (RGB checks, feature
+  expansion and product in float32, erratum E45) by its default blocks (2^17 pixels, 64 rows) into
+  a preallocated float32 panorama.
 """
 
 import numpy as np

@@ -134,3 +134,27 @@ def test_spectralize_refuses_negative():
     model = SpectralRegression("polynomial", 1, np.eye(3), WL)
     with pytest.raises(SpecrefError, match=r"finite and >= 0 \(rows 0-1\)"):
         list(spectralize_blocks(model, -np.ones((2, 4, 3))))
+
+
+@pytest.mark.parametrize(("kind", "degree"), [("root_polynomial", 4), ("polynomial", 5)])
+def test_spectralize_float32_within_the_rounding_bound(rng, kind, degree):
+    # Erratum E45: spectralize_blocks computes features and product in float32. Source of the
+    # bound: Higham, "Accuracy and Stability of Numerical Algorithms", §3.1: a dot product of K
+    # terms errs by at most γ_K Σ|x_i c_i| (γ_K ≈ K·u, u = 2^-24), plus a few ulps per feature
+    # (roots and up to four products), plus the rounding of the coefficients and of RGB to
+    # float32, and the output's own rounding: (K + 7)·u·Σ|x_i c_i| (times s for the exposure
+    # rule), with RGB up to 1e4 (a sun).
+    from reference.upsampling import default_regression
+
+    shipped = default_regression()
+    K = len(feature_exponents(kind, degree))
+    C = rng.normal(0.0, 3.0, (K, shipped.n_bands))
+    model = SpectralRegression(kind, degree, C, shipped.wavelengths_nm)
+    RGB = rng.uniform(0, 1, (16, 32, 3)) * 10.0 ** rng.uniform(-3, 4, (16, 32, 1))
+    fast = np.concatenate([b.copy() for _, b in spectralize_blocks(model, RGB, rows_per_block=5)])
+    flat = RGB.reshape(-1, 3)
+    s = np.maximum(flat.max(axis=-1, keepdims=True), 1.0) if kind == "polynomial" else 1.0
+    magnitude = s * (np.abs(features_RGB(flat / s, kind, degree)) @ np.abs(C))
+    bound = (K + 7) * 2.0**-24 * magnitude.reshape(fast.shape)
+    error = np.abs(fast - model.predict(RGB))
+    assert (error <= bound).all()

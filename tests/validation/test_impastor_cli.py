@@ -115,3 +115,84 @@ def test_cli_render(tmp_path, capsys, monkeypatch):
         == 0
     )
     assert read_png(out).shape[:2] == (24, 24)
+
+
+def _tilted_booth():
+    # The screen tilted 15° (its mirror of an on-axis view turns 30° up) and the booth light 3.5°
+    # off that mirror direction: inside the specular lobe (§3.4.3, Ferwerda: 1.1 % at the
+    # mirror angle, negligible beyond 10°).
+    from reference.display_pipeline import ScreenGeometry
+
+    geometry = ScreenGeometry(tilt=np.radians(15.0))
+    flare = {"screen_lux": 1000.0, "position": (0.0, 0.5, 1.0), "luminance": 2000.0}
+    return geometry, (0.0, 0.0, 0.6), flare
+
+
+def test_specular_flare_is_subtracted():
+    # Issue 16 (g): with the specular flare subtracted, what the observer sees (emission at their
+    # angle plus the diffuse and the specular flare) is the intended painting; compensating the
+    # diffuse flare alone (what the CLI did before) leaves the specular flare on the screen.
+    from reference.display_model import screen_flare_XYZ, virtual_display
+    from reference.display_pipeline import _off_mirror_deg
+    from validation.impastor_cli import painting_on_display
+
+    geometry, eye, flare = _tilted_booth()
+    white = virtual_display().white_XYZ / virtual_display().white_XYZ[1]
+    XYZ = np.random.default_rng(16).uniform(20.0, 60.0, (12, 16, 1)) * white  # grays, cd/m²
+    both = painting_on_display(XYZ, geometry, eye, flare)
+    assert both["in_gamut"].all()
+    assert np.abs(both["seen_XYZ"][..., 1] / XYZ[..., 1] - 1).max() < 5e-3
+    diffuse_only = painting_on_display(XYZ, geometry, eye, {**flare, "luminance": 0.0})
+    mirror = _off_mirror_deg(geometry, eye, flare["position"], 12, 16)
+    specular = screen_flare_XYZ(virtual_display(), np.zeros(3), flare["luminance"] * white, mirror)
+    seen = diffuse_only["seen_XYZ"] + specular  # the light is there all the same
+    assert specular[..., 1].max() > 5.0  # cd/m²: a visible veil
+    assert np.abs(seen[..., 1] / XYZ[..., 1] - 1).max() > 0.1
+    assert (both["counts"] <= diffuse_only["counts"]).all()
+
+
+def test_write_counts_reports_both_flares(tmp_path):
+    from validation.impastor_cli import _write_counts
+
+    geometry, eye, flare = _tilted_booth()
+    XYZ = np.full((8, 8, 3), 40.0)
+    line = _write_counts(XYZ, tmp_path / "c.png", geometry, eye, flare)
+    assert re.search(r"diffuse 0\.64 cd/m², specular up to \d+\.\d\d cd/m²", line)
+    assert read_png(tmp_path / "c.png").shape[:2] == (8, 8)
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "message"),
+    [
+        ("--light-position", "0,0,-1", "--light-position: (0, 0, -1) m must be x,y,z in front"),
+        ("--light-position", "0,1", "--light-position: must be x,y,z in metres, got '0,1'"),
+        ("--light-luminance", "-5", "--light-luminance: must be >= 0 cd/m², got -5.0"),
+    ],
+)
+def test_render_light_bad_input(tmp_path, capsys, option, value, message):
+    argv = ["impastor", "render", "--size", "8", "--out", str(tmp_path / "p.png")]
+    argv += ["--counts", str(tmp_path / "c.png"), option, value]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1
+    assert message in err[0]
+    assert not (tmp_path / "p.png").exists()
+
+
+def test_render_light_options_reach_the_counts(tmp_path, capsys, monkeypatch):
+    # --light-position and --light-luminance change the counts written, through the real CLI
+    # (the painting replaced by a uniform gray, so the test does not render).
+    import impastor.painting
+
+    gray = {"XYZ": np.full((6, 6, 3), 40.0), "sRGB": np.full((6, 6, 3), 0.5), "seconds": {}}
+    monkeypatch.setattr(impastor.painting, "render_painting", lambda *a, **k: gray)
+    counts = {}
+    for luminance in ("0", "2000"):
+        out = tmp_path / f"c{luminance}.png"
+        argv = ["impastor", "render", "--size", "6", "--out", str(tmp_path / "p.png")]
+        argv += ["--counts", str(out), "--tilt", "15", "--light-position", "0,0.5,1.0"]
+        assert main([*argv, "--light-luminance", luminance]) == 0
+        assert "specular up to" in capsys.readouterr().out
+        counts[luminance] = read_png(out)
+    assert (counts["2000"] <= counts["0"]).all()
+    assert (counts["2000"] < counts["0"]).any()

@@ -79,3 +79,16 @@ def test_smits_round_trip_is_worse_than_the_regression(root4):
     smits = recovery_figures("Smits 1999", (CC,))[CC]
     assert smits["D65 mean"] > root4[2][CC]["D65 mean"]
     assert np.isfinite(smits["A mean"])
+
+
+@pytest.mark.xslow
+@pytest.mark.parametrize(("kind", "degree"), [("root_polynomial", 4), ("polynomial", 4)])
+def test_smoothness_prior_does_not_reach_the_peak(kind, degree):
+    # Erratum E44, what was tried: a second-difference smoothness prior with (λ, μ) chosen by
+    # cross-validated ΔE94 on the training set. It keeps the mean target and misses the peak.
+    from validation.spectral_env import smoothness_study
+
+    study = smoothness_study(kind, degree)
+    assert study["held_out"][CC]["D65 mean"] <= 0.77
+    assert study["held_out"][CC]["D65 max"] > 1.5
+    assert study["clipped"][CC]["D65 max"] > 1.5

@@ -73,7 +73,7 @@ def add_parser(sub) -> None:
     f.add_argument("-o", "--out", required=True, help="output model .json")
     f.set_defaults(func=_cmd_env_fit)
     s = env.add_parser("spectralize", help="expand an HDR panorama to a spectral .exr or .tif")
-    s.add_argument("panorama", help="linear HDR panorama, .hdr or RGB .exr")
+    s.add_argument("panorama", help="linear HDR panorama: .hdr, RGB .exr or float RGB .tif")
     s.add_argument("--model", required=True, help="model .json from `env fit`, or 'default'")
     s.add_argument("--rows", type=int, default=None, help="rows per block (default: 2^17 pixels)")
     s.add_argument("-o", "--out", required=True, help="output .exr or .tif")

@@ -35,6 +35,7 @@ def _cmd_impastor_render(args) -> int:
     from validation.impastor_cli import render_for_cli
 
     observer = _vector(args.observer, "--observer")
+    lamp = _vector(args.light_position, "--light-position")
     print(
         render_for_cli(
             args.light,
@@ -45,6 +46,8 @@ def _cmd_impastor_render(args) -> int:
             observer,
             args.tilt,
             args.screen_lux,
+            lamp,
+            args.light_luminance,
         )
     )
     return 0
@@ -82,5 +85,16 @@ def add_parser(sub) -> None:
     r.add_argument("--tilt", type=float, default=0.0, help="display tilt about x, degrees")
     r.add_argument(
         "--screen-lux", type=float, default=1000.0, help="booth illuminance on the screen, lux"
+    )
+    r.add_argument(
+        "--light-position",
+        default="0,1.2,0.9",
+        help="booth light centre x,y,z in metres from the screen centre (specular screen flare)",
+    )
+    r.add_argument(
+        "--light-luminance",
+        type=float,
+        default=None,
+        help="booth light luminance, cd/m² (default: the booth ceiling's mean)",
     )
     r.set_defaults(func=_cmd_impastor_render)

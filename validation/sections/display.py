@@ -5,7 +5,9 @@ compute → :func:`display_calibration`; present → :func:`present`; checks →
 Figs. 6 and 7 of the paper reproduced on the simulated display (``reference.display_spectral``):
 the tone curves reached (gamma 1.8, 2.2 and L*), the white's chromaticity against the gray level
 when the calibration is read by a spectroradiometer and by a colorimeter, the verification table
-for the four whites, and the instrument comparison (the colorimeter's shadow failure).
+for the four whites, and the instrument comparison (the colorimeter's shadow failure). Then a scene
+with ``[display] calibration`` as the display emits it against the intended XYZ, and ImpastoR's
+painting seen on and off axis with and without the compensation of §3.4, Ferwerda.
 """
 
 from __future__ import annotations
@@ -31,6 +33,8 @@ BANDS = ((0.5, 1.01), (0.25, 0.5), (0.125, 0.25), (0.05, 0.125), (0.02, 0.05))
 HOLD_DUV = 0.004
 # Issue 16's targets with the noise-free spectroradiometer.
 TARGET_DUV, TARGET_Y = 0.001, 0.01
+#: ΔE00 below which a displayed image counts as the intended one (about one just-noticeable step).
+TARGET_SCENE_DE = 1.0
 
 
 def _verification(display, white, curve, instrument, points=15):
@@ -88,6 +92,10 @@ def display_calibration(ctx: ReportContext | None = None) -> SectionData:
                 data.results.setdefault("instruments", {})[instrument] = _bands(cal, v)
     data.results["whites"] = whites
     data.results["screen"] = screen_compensation()
+    data.results["scene"], data.arrays["scene"] = scene_on_calibrated_display(display)
+    data.results["painting"], data.arrays["painting"] = painting_on_screen(
+        16 if ctx is None or ctx.quick else 48
+    )
     return data
 
 
@@ -130,6 +138,112 @@ def screen_compensation() -> dict:
     return found
 
 
+#: The scene shown on the calibrated display (docs/examples), its size and the calibration.
+SCENE_FILE = "colorchecker-d65.toml"
+SCENE_SIZE = (90, 60)
+SCENE_CALIBRATION = ("D65", "gamma2.2")
+
+
+def _delta_E00(XYZ, reference_XYZ, white_XYZ) -> np.ndarray:
+    """CIEDE2000 between two XYZ images (cd/m²), both in Lab relative to ``white_XYZ``."""
+    import colour
+
+    xy = colour.XYZ_to_xy(white_XYZ)
+    Lab = colour.XYZ_to_Lab(XYZ / white_XYZ[1], xy)
+    Lab_reference = colour.XYZ_to_Lab(reference_XYZ / white_XYZ[1], xy)
+    return colour.delta_E(Lab, Lab_reference, method="CIE 2000")
+
+
+def scene_on_calibrated_display(display) -> tuple[dict, dict]:
+    """A scene with ``[display] calibration``: what the display emits against the intended XYZ.
+
+    Issue 16: the ColorChecker example is calibrated for (:data:`SCENE_CALIBRATION`, 15 points,
+    noise-free instrument), written as ``CAL.cal`` and named by the scene file; the render's device
+    values are sent through the ``.cal`` tables to the simulated spectral display
+    (``measure_through_calibration``, noise-free) and compared, in CIEDE2000 relative to the
+    emitted white, with the intended XYZ (the render's XYZ times the calibrated white's luminance,
+    relative colorimetric). Pixels outside the display's gamut (``in_gamut`` of
+    ``XYZ_to_calibrated_values``: the black frame, below the display's black) are counted apart;
+    the figures are given over the pixels in gamut and over those above 5 % of white (erratum E47).
+    """
+    import tempfile
+    from pathlib import Path
+
+    from reference.calibration_files import (
+        XYZ_to_calibrated_values,
+        measure_through_calibration,
+        write_calibration,
+    )
+    from reference.render import render_scene
+    from reference.scene import loads_scene
+    from validation.sections.examples import EXAMPLES_DIR
+
+    white, curve = SCENE_CALIBRATION
+    cal = calibrate_display(display, white, curve, points=15, instrument="ideal")
+    text = (EXAMPLES_DIR / SCENE_FILE).read_text(encoding="utf-8")
+    with tempfile.TemporaryDirectory() as folder:
+        cal_path = Path(folder) / "display.cal"
+        write_calibration(cal_path, display, cal)
+        shown = text.replace("[display]\n", f'[display]\ncalibration = "{cal_path}"\n', 1)
+        scene = loads_scene(shown, SCENE_FILE, EXAMPLES_DIR)
+        result = render_scene(scene, *SCENE_SIZE, supersample=1)
+    _, in_gamut = XYZ_to_calibrated_values(
+        result.XYZ * scene.display.exposure, scene.display.calibration
+    )
+    # what the display emits for the device values, through the video card's tables
+    values = result.encoded.reshape(-1, 3)
+    emitted = measure_through_calibration(display, cal, values).reshape(result.XYZ.shape)
+    white_XYZ = measure_through_calibration(display, cal, np.ones((1, 3)))[0]
+    intended = result.XYZ * scene.display.exposure * cal.Y_white
+    dE = _delta_E00(emitted, intended, white_XYZ)
+    inside = dE[in_gamut]
+    # the range issue 16's calibration targets speak for: above 5 % of white luminance
+    lit = dE[in_gamut & (intended[..., 1] > 0.05 * white_XYZ[1])]
+    found = {
+        "scene": SCENE_FILE,
+        "calibration": f"{white} {curve}",
+        "pixels": int(dE.size),
+        "out_of_gamut": int((~in_gamut).sum()),
+        "dE00_mean": float(inside.mean()),
+        "dE00_p95": float(np.percentile(inside, 95)),
+        "dE00_max": float(inside.max()),
+        "pixels_above_5pct": int(lit.size),
+        "dE00_mean_above_5pct": float(lit.mean()),
+        "dE00_max_above_5pct": float(lit.max()),
+    }
+    return found, {"intended": intended, "emitted": emitted, "dE00": dE, "white": white_XYZ}
+
+
+def painting_on_screen(size: int) -> tuple[dict, dict]:
+    """The demo painting displayed for each observer of :data:`OBSERVERS`, compensated or not.
+
+    Eq. (1), Ferwerda per pixel with ``L_factor`` and the diffuse and specular flare of §3.4.3
+    (:func:`validation.impastor_cli.painting_on_display`, the booth light of ``specref impastor
+    render`` at 1000 lx on the screen), for the painting rendered under D65 (median-cut lights):
+    CIEDE2000 of what the observer sees against the intended painting, relative to the display
+    white, over the pixels the display can show.
+    """
+    from impastor.painting import _booth_kind, booth_light_image, render_painting
+    from reference.display_model import virtual_display
+    from reference.display_pipeline import ScreenGeometry
+    from validation.impastor_cli import DEFAULT_LIGHT_POSITION, painting_on_display
+
+    XYZ = render_painting("D65", size, "median_cut")["XYZ"]
+    luminance = float(booth_light_image(_booth_kind("D65")).mean())
+    flare = {"screen_lux": 1000.0, "position": DEFAULT_LIGHT_POSITION, "luminance": luminance}
+    white = virtual_display().white_XYZ
+    found, seen = {}, {}
+    for name, eye in OBSERVERS.items():
+        geometry = ScreenGeometry(tilt=np.radians(15.0) if "tilted" in name else 0.0)
+        for compensate in (True, False):
+            out = painting_on_display(XYZ, geometry, eye, flare, compensate)
+            dE = _delta_E00(out["seen_XYZ"], XYZ, white)[out["in_gamut"]]
+            key = f"{name}, {'compensated' if compensate else 'not compensated'}"
+            found[key] = {"dE00_mean": float(dE.mean()), "dE00_max": float(dE.max())}
+            seen[key] = out["seen_XYZ"]
+    return found, {"intended": XYZ, "seen": seen, "white": white}
+
+
 def _bands(cal, v) -> dict:
     relative = v["Y_target"] / cal.Y_white
     bands = {}
@@ -160,7 +274,86 @@ def present(ctx: ReportContext, data: SectionData) -> list:
     blocks.append(_whites_table(data))
     blocks.append(_instrument_table(data))
     blocks.append(_screen_table(data))
+    blocks += _scene_blocks(ctx, data)
+    blocks += _painting_blocks(ctx, data)
     return blocks
+
+
+def _to_sRGB(XYZ, white_XYZ) -> np.ndarray:
+    """XYZ (cd/m²) as sRGB for a figure: the display white maps to sRGB white (von Kries)."""
+    import colour
+
+    D65 = colour.xy_to_XYZ(colour.CCS_ILLUMINANTS["CIE 1931 2 Degree Standard Observer"]["D65"])
+    XYZ_D65 = XYZ / white_XYZ[1] * (D65 / (white_XYZ / white_XYZ[1]))
+    return np.clip(colour.XYZ_to_sRGB(XYZ_D65), 0.0, 1.0)
+
+
+def _scene_blocks(ctx: ReportContext, data: SectionData) -> list:
+    """A scene through its calibration: emitted against intended (issue 16)."""
+    import matplotlib.pyplot as plt
+
+    r, a = data.results["scene"], data.arrays["scene"]
+    fig, axes = plt.subplots(1, 3, figsize=(11, 2.8))
+    axes[0].imshow(_to_sRGB(a["intended"], a["white"]))
+    axes[0].set_title("intended")
+    axes[1].imshow(_to_sRGB(a["emitted"], a["white"]))
+    axes[1].set_title("emitted by the simulated display")
+    shown = axes[2].imshow(a["dE00"], cmap="magma", vmin=0.0, vmax=max(2.0, r["dE00_p95"]))
+    axes[2].set_title("ΔE00")
+    fig.colorbar(shown, ax=axes[2], fraction=0.03)
+    for ax in axes:
+        ax.set_axis_off()
+    caption = (
+        f"{r['scene']} with [display] calibration ({r['calibration']}): device values through "
+        "the .cal to the simulated spectral display, against the intended XYZ"
+    )
+    table = Table(
+        [
+            *("scene", "calibration", "pixels", "out of gamut", "ΔE00 mean", "p95", "max"),
+            *("pixels > 5 % white", "ΔE00 mean", "max"),
+        ],
+        [
+            [r[k] for k in ("scene", "calibration", "pixels", "out_of_gamut")]
+            + [r["dE00_mean"], r["dE00_p95"], r["dE00_max"], r["pixels_above_5pct"]]
+            + [r["dE00_mean_above_5pct"], r["dE00_max_above_5pct"]]
+        ],
+        "A scene on its calibrated display: emitted against intended, pixels in gamut (all, and "
+        "above 5 % of white luminance; the shadows below are erratum E47)",
+    )
+    return [ctx.figure("scene", fig, caption), table]
+
+
+def _painting_blocks(ctx: ReportContext, data: SectionData) -> list:
+    """The painting seen from three positions, with and without compensation (§3.4, Ferwerda)."""
+    import matplotlib.pyplot as plt
+
+    a = data.arrays["painting"]
+    keys = list(a["seen"])
+    fig, axes = plt.subplots(2, len(OBSERVERS) + 1, figsize=(12, 5.8))
+    axes[0, 0].imshow(_to_sRGB(a["intended"], a["white"]))
+    axes[0, 0].set_title("intended", fontsize=8)
+    axes[1, 0].set_axis_off()
+    for k, key in enumerate(keys):
+        ax = axes[k % 2, 1 + k // 2]
+        ax.imshow(_to_sRGB(a["seen"][key], a["white"]))
+        ax.set_title(key, fontsize=8)
+    for ax in axes.ravel():
+        ax.set_xticks([])
+        ax.set_yticks([])
+    rows = [[k, r["dE00_mean"], r["dE00_max"]] for k, r in data.results["painting"].items()]
+    return [
+        ctx.figure(
+            "painting",
+            fig,
+            "The painting as each observer sees it (emission at their angle plus the booth "
+            "light's screen flare), with the compensation of Eq. (1), Ferwerda (top) and without",
+        ),
+        Table(
+            ["observer", "ΔE00 mean", "max"],
+            rows,
+            "The painting seen against intended (CIEDE2000, display white; pixels in gamut)",
+        ),
+    ]
 
 
 def _figures(ctx: ReportContext, data: SectionData) -> list:
@@ -303,6 +496,27 @@ def checks(data: SectionData) -> list[Check]:
             spectro < colorimeter,
         )
     )
+    scene = data.results["scene"]
+    found.append(
+        Check(
+            f"{scene['scene']} on its calibrated display: emitted against intended, in gamut "
+            "above 5 % of white",
+            f"mean ΔE00 <= {TARGET_SCENE_DE}",
+            scene["dE00_mean_above_5pct"],
+            scene["dE00_mean_above_5pct"] <= TARGET_SCENE_DE,
+        )
+    )
+    for key, r in data.results["painting"].items():
+        if "not compensated" in key:
+            continue
+        found.append(
+            Check(
+                f"painting seen, compensated, {key.split(',')[0]}",
+                f"max ΔE00 <= {TARGET_SCENE_DE}",
+                r["dE00_max"],
+                r["dE00_max"] <= TARGET_SCENE_DE,
+            )
+        )
     for key, r in data.results["screen"].items():
         if "not compensated" in key:
             continue
