@@ -1,0 +1,112 @@
+"""Scale-out: a 32-task sweep on a 2-worker LocalCluster against the same sweep serially, and the
+streamed SH projection of a Zarr panorama against the in-memory projection, in one run.
+
+Group ``scaleout-sweep`` (issue target: distributed / serial speed-up >= 1.6 on 2 cores):
+
+- ``serial``: 32 independent SH projections (seeded 512×1024×3 maps, order 128), one after another;
+- ``local-cluster``: the same tasks through ``reference.tasks.run_tasks`` on a running 2-worker
+  ``LocalCluster`` (the cluster's start-up is not timed: it is paid once per sweep session).
+
+Group ``scaleout-zarr`` (throughput of the out-of-core path >= 70 % of the in-memory path):
+
+- ``in-memory``: ``shrm.transform.project_latlong`` of a 1024×2048×41 float32 map in memory,
+  L = 100 (ducc0);
+- ``zarr-streamed``: ``shrm.streamed.project_zarr`` of the same map from a Zarr store (64-row
+  chunks), and its peak Python memory (tracemalloc).
+"""
+
+import numpy as np
+import pytest
+
+from reference.tasks import dask_client, run_tasks
+
+N_TASKS = 32
+
+
+def projection_task(seed: int) -> float:
+    from shrm.transform import project_latlong
+
+    image = np.random.default_rng(seed).random((512, 1024, 3))
+    return float(np.abs(project_latlong(image, 128, backend="numpy")).sum())
+
+
+@pytest.fixture(scope="module")
+def client():
+    with dask_client(n_workers=2) as c:
+        run_tasks(projection_task, [0, 1], client=c, progress=False)  # warm the workers
+        yield c
+
+
+@pytest.mark.benchmark(group="scaleout-sweep")
+def test_sweep_serial(benchmark):
+    benchmark.extra_info.update({"role": "serial", "tasks": N_TASKS})
+    result = benchmark.pedantic(
+        run_tasks,
+        args=(projection_task, range(N_TASKS)),
+        kwargs={"scheduler": "serial", "progress": False},
+        rounds=2,
+        iterations=1,
+    )
+    assert len(result) == N_TASKS
+
+
+@pytest.mark.benchmark(group="scaleout-sweep")
+def test_sweep_local_cluster(benchmark, client):
+    benchmark.extra_info.update({"role": "distributed", "tasks": N_TASKS, "workers": 2})
+    result = benchmark.pedantic(
+        run_tasks,
+        args=(projection_task, range(N_TASKS)),
+        kwargs={"client": client, "progress": False},
+        rounds=2,
+        iterations=1,
+    )
+    assert (
+        result
+        == run_tasks(projection_task, range(4), scheduler="serial", progress=False) + result[4:]
+    )
+
+
+HEIGHT = 1024
+
+
+@pytest.fixture(scope="module")
+def zarr_map(tmp_path_factory):
+    from reference.images import spectral_channel_names
+    from reference.zarr_images import write_zarr_blocks
+
+    rng = np.random.default_rng(18)
+    names = spectral_channel_names(np.arange(380.0, 790.0, 10.0))
+    image = rng.random((HEIGHT, 2 * HEIGHT, 41), dtype=np.float32)
+    path = tmp_path_factory.mktemp("bench") / "map.zarr"
+    blocks = (image[i : i + 64] for i in range(0, HEIGHT, 64))
+    write_zarr_blocks(path, HEIGHT, 2 * HEIGHT, names, blocks, rows_per_chunk=64)
+    return path, image
+
+
+@pytest.mark.benchmark(group="scaleout-zarr")
+def test_projection_in_memory(benchmark, zarr_map):
+    from shrm.transform import project_latlong
+
+    _, image = zarr_map
+    benchmark.extra_info.update({"role": "in-memory", "pixels": image.shape[0] * image.shape[1]})
+    benchmark.pedantic(project_latlong, args=(image, 100), kwargs={"backend": "ducc0"}, rounds=2)
+
+
+@pytest.mark.benchmark(group="scaleout-zarr")
+def test_projection_zarr_streamed(benchmark, zarr_map):
+    import tracemalloc
+
+    from shrm.streamed import project_zarr
+
+    path, image = zarr_map
+    benchmark.extra_info.update(
+        {"role": "zarr-streamed", "pixels": image.shape[0] * image.shape[1]}
+    )
+    benchmark.pedantic(project_zarr, args=(path, 100), kwargs={"backend": "ducc0"}, rounds=2)
+    tracemalloc.start()
+    project_zarr(path, 100, backend="ducc0")
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    benchmark.extra_info["peak_python_bytes"] = peak
+    # a few chunks, never the map: 64 rows × 2048 × 41 float64 is 43 MB; the map is 344 MB
+    assert peak < image.nbytes / 2
