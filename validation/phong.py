@@ -240,7 +240,14 @@ def table_error_row(
     check_interpolation(interpolation, entries)
     buffer = state.buffer
     table = build_table(
-        state.model, entries, placement, segments, state.compiled, buffer.t_range, buffer.t_density
+        state.model,
+        entries,
+        placement,
+        segments,
+        state.compiled,
+        buffer.t_range,
+        buffer.t_density,
+        interpolation,
     )
     RGB = shade_pixels(
         state.buffer, state.model, "table", table, interpolation, compiled=state.compiled
@@ -344,7 +351,7 @@ def time_row(state: ViewState, row: dict, exact_shade_s: float, shared_s: float,
     args = (state.model, row["entries"], row["placement"], row["segments"])
     compiled = state.compiled
     # properties of the cached G-buffer, like t itself
-    seen = (state.buffer.t_range, state.buffer.t_density)
+    seen = (state.buffer.t_range, state.buffer.t_density, row["interpolation"])
     build_s = _minimum_time(lambda: build_table(*args, compiled, *seen), repeats)
     table = build_table(*args, compiled, *seen)
     shade_s = build_s + time_shading(state, table, row["interpolation"], repeats)

@@ -36,7 +36,9 @@ def test_table(benchmark, scene, view, placement, interpolation):
     seen = {"t_range": buffer.t_range, "t_density": buffer.t_density}
 
     def run():
-        table = build_table(model, 200, placement, compiled=True, **seen)
+        table = build_table(
+            model, 200, placement, compiled=True, **seen, interpolation=interpolation
+        )
         return compiled_shader(model, table, interpolation)(buffer, out)
 
     run()
