@@ -484,6 +484,25 @@ def bimodal_material(n_low: float, n_high: float, split_nm: float = 580.0) -> Sp
     )
 
 
+def rising_material(n_top: float, power: float = 1.0, n_bottom: float = 10.0) -> SpectralPhong:
+    """Flat ``k_d = 0.2``, ``k_s = 0.5`` under D65; ``n`` rises steadily to ``n_top``.
+
+    ``n(λ) = n_bottom + (n_top − n_bottom) x^power`` with ``x`` from 0 at the grid's first band
+    to 1 at its last: every band has its own exponent (41 distinct powers), the class on which
+    issue 17 measured the table's speed-up (the benchmarks' ``rising`` sweep).
+
+    Examples
+    --------
+    >>> rising_material(2000.0).n[[0, 20, -1]]
+    array([  10., 1005., 2000.])
+    """
+    x = np.linspace(0.0, 1.0, DEFAULT_GRID.n_bands)
+    n = n_bottom + (n_top - n_bottom) * x**power
+    flat = np.ones(x.size)
+    name = f"rising {n_top:g}" + (f"^{power:g}" if power != 1.0 else "")
+    return spectral_phong_unit_peak(0.2 * flat, 0.5 * flat, n, "D65", name)
+
+
 def format_tolerance(result: dict) -> str:
     """A tolerance search as text.
 
