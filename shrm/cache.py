@@ -466,7 +466,7 @@ class Cache:
         if not self.enabled or self.unusable:
             return False
         path = self.path_of(key)
-        if path.is_file():
+        if path.exists():  # a folder of that name is foreign too, not an unusable cache
             try:
                 self._read(path)
             except _ForeignError as why:

@@ -159,6 +159,9 @@ def test_foreign_files_are_ignored_with_a_warning_and_never_deleted(tmp_path):
         assert cache.get(_key(2)) is None
     with pytest.warns(SpecrefWarning, match="is not cached"):
         assert cache.put(_key(1), {"x": np.ones(3)}) is False
+    with pytest.warns(SpecrefWarning, match="is not cached"):
+        assert cache.put(_key(2), {"x": np.ones(3)}) is False
+    assert cache.unusable is None  # one foreign name does not turn the cache off
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", SpecrefWarning)
         cache.put(_key(3), {"x": np.ones(3)})  # evicts down to 0 bytes
