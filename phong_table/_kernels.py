@@ -428,13 +428,14 @@ def tabulate_kernel(nodes, C, n, cells_per_entry):
 
 
 @numba.njit(cache=False)
-def table_error_kernel(t_fine, C, n, entries, floor, p, hedge):
+def table_error_kernel(t_fine, C, n, entries, floor, p, hedge, grading):
     """Nodes that equidistribute the interpolation error of the true ``f_sp``.
 
     Twin of ``phong_table.placement.table_error``; one ``exp`` per band and fine point gives both
     ``t^{n−3}`` and ``t^{n−2} = t · t^{n−3}`` (Eq. (11), Wang et al., differentiated). ``p`` is
     the pixel density at the fine grid's midpoints (size 0: none); with it, the max-norm densities
-    enter at the weight ``hedge``.
+    enter at the weight ``hedge``. ``grading`` > 0 caps the growth of the interval width
+    (``phong_table.placement._graded``).
     """
     F = t_fine.size
     n_bands = n.size
@@ -491,10 +492,27 @@ def table_error_kernel(t_fine, C, n, entries, floor, p, hedge):
         r3p = rho3p[q] / mass3p if mass3p > 0.0 else 0.0
         rho[q] = max(hedge * r2, hedge * r3, r2p, r3p) if weighted else max(r2, r3)
         mass += rho[q] * (t_fine[q + 1] - t_fine[q])
+    for q in range(F - 1):
+        rho[q] = (rho[q] / mass if mass > 0.0 else 0.0) + floor
+    if grading > 0.0:
+        # the width w = M/(m ρ), capped each way at w(s) + grading·|t − s| (placement._graded)
+        total = 0.0
+        for q in range(F - 1):
+            total += rho[q] * (t_fine[q + 1] - t_fine[q])
+        w = np.empty(F - 1)
+        for q in range(F - 1):
+            w[q] = total / (entries * rho[q])
+        for q in range(1, F - 1):
+            step = 0.5 * (t_fine[q + 1] - t_fine[q - 1])  # between midpoints q − 1 and q
+            w[q] = min(w[q], w[q - 1] + grading * step)
+        for q in range(F - 3, -1, -1):
+            step = 0.5 * (t_fine[q + 2] - t_fine[q])
+            w[q] = min(w[q], w[q + 1] + grading * step)
+        for q in range(F - 1):
+            rho[q] = total / (entries * w[q])
     cdf = np.zeros(F)
     for q in range(F - 1):
-        r = (rho[q] / mass if mass > 0.0 else 0.0) + floor
-        cdf[q + 1] = cdf[q] + r * (t_fine[q + 1] - t_fine[q])
+        cdf[q + 1] = cdf[q] + rho[q] * (t_fine[q + 1] - t_fine[q])
     # invert the cumulative density at q/m by linear interpolation (np.interp)
     nodes = np.empty(entries + 1)
     total = cdf[F - 1]

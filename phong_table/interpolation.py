@@ -329,6 +329,8 @@ def _example_inputs(rng):
 #: compiled twin is the branch ``extra["code"]`` of ``shade_table_kernel``; ``extra["min_entries"]``
 #: is the smallest table it accepts; ``extra["order"]`` its convergence order (error O(h^order) on
 #: smooth data); and
+#: ``extra["graded"]`` says that its stencil spans two intervals (the 3-point parabolas), so the
+#: error placement grades its nodes for it (``phong_table.placement.ERROR_GRADING``); and
 #: ``extra["coordinate"]`` is the coordinate it interpolates in: ``"t"`` (any node set) or ``"w"``
 #: (``w = ir(t)``, in which only importance nodes with ``p = m`` are uniform). Registration order is
 #: the order of Table 1's columns and of the report: the paper's parabola first, its reading in w,
@@ -341,7 +343,13 @@ INTERPOLATION_METHODS.register(
         None,
         "Eq. (11), Wang et al.",
         _example_inputs,
-        {"code": _kernels.PARABOLIC, "min_entries": 3, "order": 3, "coordinate": "t"},
+        {
+            "code": _kernels.PARABOLIC,
+            "min_entries": 3,
+            "order": 3,
+            "coordinate": "t",
+            "graded": True,
+        },
     )
 )
 INTERPOLATION_METHODS.register(
@@ -351,7 +359,13 @@ INTERPOLATION_METHODS.register(
         None,
         "Eq. (14), Wang et al.",
         _example_inputs,
-        {"code": _kernels.PARABOLIC_W, "min_entries": 3, "order": 3, "coordinate": "w"},
+        {
+            "code": _kernels.PARABOLIC_W,
+            "min_entries": 3,
+            "order": 3,
+            "coordinate": "w",
+            "graded": True,
+        },
     )
 )
 INTERPOLATION_METHODS.register(
@@ -361,7 +375,7 @@ INTERPOLATION_METHODS.register(
         None,
         "Eq. (11), Wang et al.",
         _example_inputs,
-        {"code": _kernels.LINEAR, "min_entries": 1, "order": 2, "coordinate": "t"},
+        {"code": _kernels.LINEAR, "min_entries": 1, "order": 2, "coordinate": "t", "graded": False},
     )
 )
 INTERPOLATION_METHODS.register(
@@ -371,6 +385,12 @@ INTERPOLATION_METHODS.register(
         None,
         "Eq. (11), Wang et al.",
         _example_inputs,
-        {"code": _kernels.MONOTONE, "min_entries": 1, "order": 3, "coordinate": "t"},
+        {
+            "code": _kernels.MONOTONE,
+            "min_entries": 1,
+            "order": 3,
+            "coordinate": "t",
+            "graded": False,
+        },
     )
 )

@@ -92,6 +92,7 @@ def shade_phong_point_table(surface, material, light, ctx) -> np.ndarray:
         compiled=True,
         t_range=buffer.t_range,
         t_density=buffer.t_density,
+        interpolation=settings["interpolation"],
     )
     check_interpolation(settings["interpolation"], table.entries)
     shade = compiled_shader(model, table, settings["interpolation"])

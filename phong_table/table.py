@@ -253,6 +253,7 @@ def build_table(
     compiled: bool = False,
     t_range=None,
     t_density=None,
+    interpolation: str | None = None,
 ) -> SpecularTable:
     """Tabulate the specular functions of a material: place nodes, evaluate, precompute lookups.
 
@@ -279,6 +280,10 @@ def build_table(
     t_density : ndarray, optional
         The frame's pixel density in ``t`` over ``t_range`` (``ShadingBuffer.t_density``), for
         the same placements (``error`` also equidistributes the pixels' RMS error).
+    interpolation : str, optional
+        The interpolation the table will be read with, for the placements that place for it
+        (``error`` grades its nodes for the parabolas: ``phong_table.placement.ERROR_GRADING``).
+        The table can still be read with any interpolation.
 
     Returns
     -------
@@ -316,6 +321,9 @@ def build_table(
     seen = {}
     if method.extra.get("t_range") and t_range is not None:
         seen = {"t_range": t_range, "t_density": t_density}
+    if method.extra.get("interpolation") and interpolation is not None:
+        check_interpolation(interpolation, m)
+        seen["interpolation"] = interpolation
     nodes = np.ascontiguousarray(place(material, m, p, **seen), dtype=np.float64)
     require(
         nodes[0] == 0.0 and nodes[-1] == 1.0 and bool((np.diff(nodes) > 0).all()),

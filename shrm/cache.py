@@ -21,8 +21,19 @@ map reuse." specref's scheme:
   but 2^-32 of other accidents, at about 7 GB/s against SHA-256's 2 GB/s, and a hit must verify
   every byte it maps. It guards against accidents, not against someone who can write to the
   user's own cache folder (the keys themselves are SHA-256 hashes of the inputs).
+  An entry cut shorter than the magic itself (a few bytes, or none) is a truncated entry too.
 - **Foreign files.** A file in the cache folder that does not start with our magic, or that cannot
   be read, is ignored with a warning and never deleted or overwritten.
+- **An unusable folder.** A cache folder that cannot be created, read or written (read-only, a
+  full disk, a regular file where the folder should be, a read-only home) is reported once per
+  :class:`Cache` as a one-line :class:`~reference.errors.SpecrefWarning`; the cache then passes
+  through (every lookup misses, nothing is written) and the caller runs without it.
+- **Temporary files.** A writer's temporary file older than :data:`STALE_TEMP_SECONDS` (an hour)
+  belongs to a writer that died (a live writer fills and renames its file within the time of
+  one write, and rewrites it meanwhile): opening a :class:`Cache`, ``clear`` and eviction remove
+  such files, empty ones included. Younger temporary files are left alone, so ``clear`` never
+  pulls a file from under a live writer; a writer whose temporary file vanishes anyway (an
+  outside ``rm``) keeps its result, uncached.
 - **Size limit.** After each write the least-recently-used entries are deleted until the folder's
   entries fit in ``max_bytes``; a hit refreshes the entry's modification time, which is the LRU
   clock.
@@ -53,7 +64,7 @@ from pathlib import Path
 import numpy as np
 
 from reference.errors import SpecrefError, SpecrefWarning, require
-from reference.images import atomic_write
+from reference.images import atomic_write, output_error
 
 __all__ = [
     "CACHE_MAGIC",
@@ -75,8 +86,8 @@ DEFAULT_MAX_BYTES = 2 * 1024**3
 _SUFFIX = ".specref"
 _PREFIX = struct.Struct("<III")  # format version, header length, CRC-32 of the rest
 _HEAD = len(CACHE_MAGIC) + _PREFIX.size
-#: A leftover temporary file older than this (s) belongs to a writer that died; ``clear`` and
-#: eviction remove it if it carries our magic.
+#: A leftover temporary file older than this (s) belongs to a writer that died; opening a cache,
+#: ``clear`` and eviction remove it (empty or carrying our magic); younger ones are left alone.
 STALE_TEMP_SECONDS = 3600.0
 
 
@@ -319,6 +330,9 @@ class Cache:
         self.hits = 0
         self.misses = 0
         self._warned: set[tuple[str, str]] = set()
+        self.unusable: str | None = None
+        if self.enabled:
+            self._remove_stale_temps()
 
     # --- paths and warnings --------------------------------------------------------------------
 
@@ -337,18 +351,34 @@ class Cache:
         self._warned.add((str(path), reason))
         warnings.warn(f"{path}: {reason}", SpecrefWarning, stacklevel=3)
 
+    def _give_up(self, reason: str) -> None:
+        """The folder cannot be used: warn once, then pass through (no reads, no writes)."""
+        if self.unusable is None:
+            self.unusable = reason
+            warnings.warn(
+                f"{self.directory}: cache folder unusable ({reason}); running without the cache",
+                SpecrefWarning,
+                stacklevel=4,
+            )
+
     # --- reading -------------------------------------------------------------------------------
 
     @staticmethod
     def _read(path: Path) -> tuple[dict, dict]:
-        """Header and arrays of an entry; raises _ForeignError, _CorruptError, FileNotFoundError."""
+        """Header and arrays of an entry.
+
+        Raises _ForeignError, _CorruptError, FileNotFoundError, NotADirectoryError (the folder).
+        """
         try:
             data = _map_file(path)
-        except FileNotFoundError:
+        except (FileNotFoundError, NotADirectoryError):
             raise
         except OSError as error:
             raise _ForeignError(f"unreadable ({error.strerror or error})") from None
-        if bytes(data[: len(CACHE_MAGIC)]) != CACHE_MAGIC:
+        head = bytes(data[: len(CACHE_MAGIC)])
+        if head != CACHE_MAGIC:
+            if CACHE_MAGIC.startswith(head):  # cut inside the magic (or empty): ours, truncated
+                raise _CorruptError(f"truncated entry ({len(head)} bytes)")
             raise _ForeignError("not a specref cache entry (no specref header)")
         if len(data) < _HEAD:
             raise _CorruptError(f"truncated entry ({len(data)} bytes)")
@@ -384,24 +414,27 @@ class Cache:
         A corrupted entry is reported once, deleted and reported as a miss; a foreign or unreadable
         file is reported once and left alone.
         """
-        if not self.enabled:
+        if not self.enabled or self.unusable:
             return None
         path = self.path_of(key)
         try:
             header, arrays = self._read(path)
         except FileNotFoundError:
             return None
+        except NotADirectoryError:
+            self._give_up("a part of the path is a file, not a folder")
+            return None
         except _ForeignError as why:
             self._warn(path, f"{why}; ignored and left in place")
             return None
         except _CorruptError as why:
             self._warn(path, f"{why}; deleted, the result is rebuilt")
-            with contextlib.suppress(FileNotFoundError):
+            with contextlib.suppress(OSError):  # a read-only folder: rebuilt, not deleted
                 path.unlink()
             return None
         if header.get("key") != key:
             self._warn(path, "entry holds another key; deleted, the result is rebuilt")
-            with contextlib.suppress(FileNotFoundError):
+            with contextlib.suppress(OSError):
                 path.unlink()
             return None
         # A hit refreshes the LRU clock.
@@ -426,19 +459,20 @@ class Cache:
         Returns
         -------
         bool
-            True if stored; False if the cache is disabled or a foreign file occupies the entry's
-            name (it is never overwritten).
+            True if stored; False if the cache is disabled or unusable (:meth:`_give_up`: one
+            warning, then nothing is written), if a foreign file occupies the entry's name (it is
+            never overwritten), or if the temporary file was removed under the writer.
         """
-        if not self.enabled:
+        if not self.enabled or self.unusable:
             return False
         path = self.path_of(key)
-        if path.exists():
+        if path.exists():  # a folder of that name is foreign too, not an unusable cache
             try:
                 self._read(path)
             except _ForeignError as why:
                 self._warn(path, f"{why}; ignored and left in place, the result is not cached")
                 return False
-            except (_CorruptError, FileNotFoundError):
+            except (_CorruptError, OSError):
                 pass
         manifest, payload = _encode_payload(arrays)
         header = json.dumps(
@@ -454,16 +488,26 @@ class Cache:
         ).encode("utf-8")
         checksum = zlib.crc32(payload, zlib.crc32(header))
         prefix = CACHE_MAGIC + _PREFIX.pack(FORMAT_VERSION, len(header), checksum)
-        with atomic_write(path, "wb") as handle:
-            handle.write(prefix + header)
-            half = len(payload) // 2
-            handle.write(payload[:half])
-            if self.write_hook is not None:
-                handle.flush()
-                self.write_hook(
-                    path, len(prefix) + len(header) + half, len(prefix) + len(header) + len(payload)
-                )
-            handle.write(payload[half:])
+        try:
+            with atomic_write(path, "wb") as handle:
+                handle.write(prefix + header)
+                half = len(payload) // 2
+                handle.write(payload[:half])
+                if self.write_hook is not None:
+                    handle.flush()
+                    start = len(prefix) + len(header)
+                    self.write_hook(path, start + half, start + len(payload))
+                handle.write(payload[half:])
+        except FileNotFoundError:
+            # the temporary file was removed before the rename (an outside rm of the folder's
+            # files): the result stays valid, it is just not cached
+            self._warn(path, "temporary file removed while writing; the result is not cached")
+            return False
+        except (SpecrefError, OSError) as error:
+            # a read-only folder or home, a full disk, a file where the folder should be
+            # (reference.images.output_error): one warning, then no cache
+            self._give_up(_reason(error))
+            return False
         self.evict()
         return True
 
@@ -499,15 +543,16 @@ class Cache:
     def _scan(self) -> tuple[list[tuple[float, int, Path]], list[str], list[Path]]:
         """Our entries (mtime, size, path), foreign file names, and our stale temporary files."""
         ours, foreign, stale = [], [], []
-        if not self.directory.is_dir():
+        try:
+            paths = sorted(self.directory.iterdir()) if self.directory.is_dir() else []
+        except OSError:
             return ours, foreign, stale
         now = time.time()
-        for path in sorted(self.directory.iterdir()):
+        for path in paths:
             if _is_our_temp(path.name):
                 # A writer's temporary file: in progress, or left by a writer that died.
-                with contextlib.suppress(OSError):
-                    if now - path.stat().st_mtime > STALE_TEMP_SECONDS and _has_magic(path):
-                        stale.append(path)
+                if _is_stale_temp(path, now):
+                    stale.append(path)
                 continue
             try:
                 if not path.is_file():
@@ -522,15 +567,26 @@ class Cache:
                 foreign.append(path.name)
                 self._warn(path, "unreadable; ignored and left in place")
                 continue
-            if magic != CACHE_MAGIC:
+            # an entry's name and a magic cut short (a truncated entry) count as ours
+            truncated = _is_entry_name(path.name) and CACHE_MAGIC.startswith(magic)
+            if magic == CACHE_MAGIC or truncated:
+                ours.append((stat.st_mtime, stat.st_size, path))
+            else:
                 foreign.append(path.name)
                 self._warn(path, "not a specref cache entry (no specref header); ignored")
-            else:
-                ours.append((stat.st_mtime, stat.st_size, path))
         return ours, foreign, stale
+
+    def _remove_stale_temps(self) -> None:
+        """Remove temporary files left by writers that died (:data:`STALE_TEMP_SECONDS`)."""
+        _, _, stale = self._scan()
+        for path in stale:
+            with contextlib.suppress(OSError):
+                path.unlink()
 
     def evict(self) -> int:
         """Delete least-recently-used entries until the entries fit in ``max_bytes``.
+
+        Also removes stale temporary files (:data:`STALE_TEMP_SECONDS`).
 
         Returns
         -------
@@ -539,14 +595,14 @@ class Cache:
         """
         ours, _, stale = self._scan()
         for path in stale:
-            with contextlib.suppress(FileNotFoundError):
+            with contextlib.suppress(OSError):
                 path.unlink()
         total = sum(size for _, size, _ in ours)
         deleted = 0
         for _, size, path in sorted(ours):
             if total <= self.max_bytes:
                 break
-            with contextlib.suppress(FileNotFoundError):
+            with contextlib.suppress(OSError):
                 path.unlink()
                 deleted += 1
             total -= size
@@ -560,29 +616,58 @@ class Cache:
         )
 
     def clear(self) -> int:
-        """Delete every entry (and our temporary files); foreign files stay. Returns the count."""
-        ours, _, _ = self._scan()
+        """Delete every entry and the stale temporary files; foreign files stay.
+
+        Temporary files younger than :data:`STALE_TEMP_SECONDS` may belong to a live writer and
+        stay. A folder that refuses the deletion is a one-line :class:`SpecrefError`.
+
+        Returns
+        -------
+        int
+            Number of entries deleted.
+        """
+        ours, _, stale = self._scan()
         count = 0
-        for _, _, path in ours:
-            with contextlib.suppress(FileNotFoundError):
+        for path in [p for _, _, p in ours] + stale:
+            try:
                 path.unlink()
-                count += 1
-        if self.directory.is_dir():
-            for path in self.directory.iterdir():
-                if _is_our_temp(path.name) and _has_magic(path):
-                    with contextlib.suppress(FileNotFoundError):
-                        path.unlink()
+            except FileNotFoundError:
+                continue
+            except OSError as error:
+                raise (output_error(path, error) or error) from None
+            count += path.suffix == _SUFFIX
         return count
+
+
+def _reason(error: Exception) -> str:
+    """The short reason of a write refusal: the parenthesis of reference.images.output_error."""
+    if isinstance(error, OSError):
+        translated = output_error("", error)
+        if translated is None:
+            return error.strerror or str(error)
+        error = translated
+    text = str(error)
+    return text[text.rfind("(") + 1 : text.rfind(")")] if text.endswith(")") else text
+
+
+def _is_entry_name(name: str) -> bool:
+    """Whether ``name`` is an entry's file name, ``<64 hex digits>.specref``."""
+    stem = name[: -len(_SUFFIX)]
+    return name.endswith(_SUFFIX) and len(stem) == 64 and all(c in "0123456789abcdef" for c in stem)
+
+
+def _is_stale_temp(path: Path, now: float) -> bool:
+    """Whether our temporary file ``path`` was left by a dead writer: old, and empty or ours."""
+    try:
+        stat = path.stat()
+        with path.open("rb") as handle:
+            head = handle.read(len(CACHE_MAGIC))
+    except OSError:
+        return False
+    # empty, cut inside the magic, or carrying it: ours (never a foreign file of that name)
+    return now - stat.st_mtime > STALE_TEMP_SECONDS and CACHE_MAGIC.startswith(head)
 
 
 def _is_our_temp(name: str) -> bool:
     """Whether ``name`` is an entry's temporary file (:func:`reference.images.atomic_write`)."""
     return name.startswith(".") and name.endswith(".tmp") and f"{_SUFFIX}." in name
-
-
-def _has_magic(path: Path) -> bool:
-    try:
-        with path.open("rb") as handle:
-            return handle.read(len(CACHE_MAGIC)) == CACHE_MAGIC
-    except OSError:
-        return False

@@ -309,6 +309,8 @@ def demo_state(
     )
     if path.is_file():
         image = read_image(path)
+        H, W = image.shape[:2]
+        require(W == 2 * H, f"{path}: a lat-long map must be 2:1 (width = 2 × height), got {W}×{H}")
         factor = max(1, image.shape[0] // env_height)
         image = downsample_box(image[: factor * env_height, : factor * 2 * env_height], factor)
     else:  # a synthetic sky: bright zenith, a warm sun, a dark ground

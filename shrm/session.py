@@ -207,6 +207,7 @@ class RenderSession:
         self.executions = {s.name: 0 for s in self.stages}
         self.hits = {s.name: 0 for s in self.stages}
         self.frame_times: list[dict] = []
+        self._prepared: dict[str, float] = {}
         self.update(**state)
 
     def update(self, **changes) -> None:
@@ -220,11 +221,47 @@ class RenderSession:
         """Run one frame; return every stage's result (``{stage: {name: array or object}}``).
 
         Also appends ``{stage: seconds}`` for the stages that ran to :attr:`frame_times` (0 for
-        stages reused from memory, the load time for persistent-cache hits).
+        stages reused from memory, the load time for persistent-cache hits); stages run ahead by
+        :meth:`prepare` count in this frame.
         """
+        keys, times = self._run(self.stages)
+        for name, seconds in self._prepared.items():
+            times[name] = times.get(name, 0.0) + seconds
+        self._prepared = {}
+        self.frame_times.append(times)
+        return {name: self._results[name][key] for name, key in keys.items()}
+
+    def prepare(self, *names: str) -> None:
+        """Run the named stages (and the stages they use) now, ahead of the next frame.
+
+        Their errors (a requested order the BRDF does not allow, say) surface before any frame
+        starts; their times are added to the next frame's :attr:`frame_times`.
+
+        Examples
+        --------
+        >>> def one(state, inputs):
+        ...     return {"x": np.asarray(1.0)}
+        >>> session = RenderSession({"config": {}}, [Stage("one", ("config",), (), one)])
+        >>> session.prepare("one"); session.executions["one"], session.frame_times
+        (1, [])
+        >>> _ = session.render(); session.executions["one"], sorted(session.frame_times[0])
+        (1, ['one'])
+        """
+        wanted = set(names)
+        for name in names:
+            require_choice(name, [s.name for s in self.stages], "render session: stage")
+        for stage in reversed(self.stages):
+            if stage.name in wanted:
+                wanted.update(stage.after)
+        _, times = self._run([s for s in self.stages if s.name in wanted])
+        for name, seconds in times.items():
+            self._prepared[name] = self._prepared.get(name, 0.0) + seconds
+
+    def _run(self, stages) -> tuple[dict, dict]:
+        """Run ``stages`` (in graph order, each after the ones it uses): their keys and times."""
         keys: dict[str, str] = {}
         times: dict[str, float] = {}
-        for stage in self.stages:
+        for stage in stages:
             missing = [k for k in stage.reads if k not in self.state]
             require(not missing, f"render session: stage {stage.name!r} needs state {missing}")
             key = cache_key(
@@ -259,8 +296,7 @@ class RenderSession:
             if self._current.get(stage.name) != key:
                 times[stage.name] = time.perf_counter() - start
             self._current[stage.name] = key
-        self.frame_times.append(times)
-        return {name: self._results[name][key] for name, key in keys.items()}
+        return keys, times
 
 
 # --- the stages of §5.2, Herbert et al. ------------------------------------------------------

@@ -240,7 +240,14 @@ def table_error_row(
     check_interpolation(interpolation, entries)
     buffer = state.buffer
     table = build_table(
-        state.model, entries, placement, segments, state.compiled, buffer.t_range, buffer.t_density
+        state.model,
+        entries,
+        placement,
+        segments,
+        state.compiled,
+        buffer.t_range,
+        buffer.t_density,
+        interpolation,
     )
     RGB = shade_pixels(
         state.buffer, state.model, "table", table, interpolation, compiled=state.compiled
@@ -344,7 +351,7 @@ def time_row(state: ViewState, row: dict, exact_shade_s: float, shared_s: float,
     args = (state.model, row["entries"], row["placement"], row["segments"])
     compiled = state.compiled
     # properties of the cached G-buffer, like t itself
-    seen = (state.buffer.t_range, state.buffer.t_density)
+    seen = (state.buffer.t_range, state.buffer.t_density, row["interpolation"])
     build_s = _minimum_time(lambda: build_table(*args, compiled, *seen), repeats)
     table = build_table(*args, compiled, *seen)
     shade_s = build_s + time_shading(state, table, row["interpolation"], repeats)
@@ -475,6 +482,25 @@ def bimodal_material(n_low: float, n_high: float, split_nm: float = 580.0) -> Sp
     return spectral_phong_unit_peak(
         0.2 * flat, 0.5 * flat, n, "D65", f"bimodal {n_low:g}/{n_high:g}"
     )
+
+
+def rising_material(n_top: float, power: float = 1.0, n_bottom: float = 10.0) -> SpectralPhong:
+    """Flat ``k_d = 0.2``, ``k_s = 0.5`` under D65; ``n`` rises steadily to ``n_top``.
+
+    ``n(λ) = n_bottom + (n_top − n_bottom) x^power`` with ``x`` from 0 at the grid's first band
+    to 1 at its last: every band has its own exponent (41 distinct powers), the class on which
+    issue 17 measured the table's speed-up (the benchmarks' ``rising`` sweep).
+
+    Examples
+    --------
+    >>> rising_material(2000.0).n[[0, 20, -1]]
+    array([  10., 1005., 2000.])
+    """
+    x = np.linspace(0.0, 1.0, DEFAULT_GRID.n_bands)
+    n = n_bottom + (n_top - n_bottom) * x**power
+    flat = np.ones(x.size)
+    name = f"rising {n_top:g}" + (f"^{power:g}" if power != 1.0 else "")
+    return spectral_phong_unit_peak(0.2 * flat, 0.5 * flat, n, "D65", name)
 
 
 def format_tolerance(result: dict) -> str:

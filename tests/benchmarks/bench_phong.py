@@ -6,13 +6,22 @@ import pytest
 from phong_table import INTERPOLATION_METHODS, PLACEMENT_METHODS, SCENES, VIEWS, build_table
 from phong_table.interpolation import interval_index
 from phong_table.render import compiled_shader, shading_buffer, sphere_gbuffer
+from validation.phong import rising_material
 
-# the rows of Table 1: every scene the registry marks table1, in every view
+#: Materials outside R1-R3 (issue 17 §6): the exponent rises steadily across the spectrum to a
+#: few thousand (every band its own power), linearly and quadratically
+RISING = {
+    "rising2000": lambda: rising_material(2000.0),
+    "rising5000": lambda: rising_material(5000.0),
+    "rising3000^2": lambda: rising_material(3000.0, 2.0),
+}
+# the rows of Table 1: every scene the registry marks table1, in every view; then the rising sweep
 CASES = [(s.name, v) for s in SCENES.values() if s.table1 for v in VIEWS]
+CASES += [(name, v) for name in RISING for v in VIEWS]
 
 
 def _setup(scene, view):
-    model = SCENES.lookup(scene).build()
+    model = RISING[scene]() if scene in RISING else SCENES.lookup(scene).build()
     buffer = shading_buffer(sphere_gbuffer(view, 512), model)
     return model, buffer, np.empty((buffer.t.size, 3))
 
@@ -36,7 +45,9 @@ def test_table(benchmark, scene, view, placement, interpolation):
     seen = {"t_range": buffer.t_range, "t_density": buffer.t_density}
 
     def run():
-        table = build_table(model, 200, placement, compiled=True, **seen)
+        table = build_table(
+            model, 200, placement, compiled=True, **seen, interpolation=interpolation
+        )
         return compiled_shader(model, table, interpolation)(buffer, out)
 
     run()

@@ -143,3 +143,42 @@ def test_bad_pixel_density():
 def test_bad_seen_range():
     with pytest.raises(SpecrefError, match="t_range: must be 0 <= t_lo <= t_hi <= 1"):
         table_error(constant_material(10.0), 10, t_range=(0.7, 0.2))
+
+
+def _one_band(n_band=1e4, n_other=10.0, band=17):
+    from phong_table.scenes import spectral_phong_unit_peak
+
+    bands = 41
+    k_s = np.zeros(bands)
+    k_s[band] = 0.8
+    n = np.full(bands, n_other)
+    n[band] = n_band
+    return spectral_phong_unit_peak(np.full(bands, 0.2), k_s, n, "D65", "one band")
+
+
+@pytest.mark.parametrize("t_range", [None, (0.78, 1.0)])
+@pytest.mark.parametrize("scene", ["R2", "bimodal", "one band"])
+def test_graded_nodes_twins_agree_and_neighbouring_widths_stay_alike(scene, t_range):
+    from phong_table.placement import ERROR_GRADING
+
+    model = _one_band() if scene == "one band" else SCENES.lookup(scene).build()
+    for entries in (25, 200):
+        graded = table_error(model, entries, t_range=t_range, interpolation="parabolic")
+        compiled = PLACEMENT_METHODS.lookup("error").extra["compiled"]
+        np.testing.assert_allclose(
+            compiled(model, entries, t_range=t_range, interpolation="parabolic"),
+            graded,
+            rtol=0,
+            atol=1e-12,
+        )
+        # linear and monotone keep the ungraded nodes
+        np.testing.assert_array_equal(
+            table_error(model, entries, t_range=t_range, interpolation="monotone"),
+            table_error(model, entries, t_range=t_range),
+        )
+        # |dw/dt| <= g: a width at most 1/(1 - g) times its neighbour's, up to the fine grid's
+        # resolution (factor 1.25 of slack) and the margins of the seen range (place_seen)
+        h = np.diff(graded)
+        inner = slice(2, -2) if t_range else slice(None)
+        ratio = np.maximum(h[1:] / h[:-1], h[:-1] / h[1:])[inner]
+        assert ratio.max() <= 1.25 / (1 - ERROR_GRADING), (entries, ratio.max())

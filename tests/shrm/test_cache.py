@@ -1,4 +1,5 @@
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -158,6 +159,9 @@ def test_foreign_files_are_ignored_with_a_warning_and_never_deleted(tmp_path):
         assert cache.get(_key(2)) is None
     with pytest.warns(SpecrefWarning, match="is not cached"):
         assert cache.put(_key(1), {"x": np.ones(3)}) is False
+    with pytest.warns(SpecrefWarning, match="is not cached"):
+        assert cache.put(_key(2), {"x": np.ones(3)}) is False
+    assert cache.unusable is None  # one foreign name does not turn the cache off
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", SpecrefWarning)
         cache.put(_key(3), {"x": np.ones(3)})  # evicts down to 0 bytes
@@ -301,3 +305,169 @@ def test_cli_cache_info_and_clear(tmp_path, capsys):
         assert Cache(tmp_path).info().entries == 0
     assert "deleted 1 entries" in capsys.readouterr().out
     assert (tmp_path / "README").read_text() == "foreign"
+
+
+# --- an unusable folder, races with clear, leftovers ----------------------------------------
+
+
+def _mount_read_only(folder) -> bool:
+    """A real read-only file system at ``folder`` (root: a tmpfs mounted ro); False otherwise."""
+    import shutil
+
+    folder.mkdir()
+    if os.geteuid() != 0 or shutil.which("mount") is None:
+        return False
+    done = subprocess.run(
+        ["mount", "-t", "tmpfs", "-o", "size=64k,ro", "tmpfs", str(folder)], capture_output=True
+    )
+    return done.returncode == 0
+
+
+@pytest.fixture
+def read_only_cache(tmp_path):
+    folder = tmp_path / "ro"
+    if _mount_read_only(folder):
+        yield folder
+        subprocess.run(["umount", str(folder)], check=False)
+        return
+    folder.chmod(0o555)  # not root: the permission bits refuse the write
+    yield folder
+    folder.chmod(0o755)
+
+
+def _full_disk(folder, monkeypatch):
+    """ENOSPC at the writer's temporary file, as tests/validation/test_cli_outputs.py does."""
+    import errno
+    import tempfile
+
+    real = tempfile.mkstemp
+
+    def mkstemp(*args, dir=None, **kwargs):
+        if dir is not None and Path(dir).resolve().is_relative_to(folder.resolve()):
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        return real(*args, dir=dir, **kwargs)
+
+    monkeypatch.setattr(tempfile, "mkstemp", mkstemp)
+
+
+def _unusable(kind, tmp_path, monkeypatch, read_only_cache):
+    if kind == "read-only":
+        return read_only_cache, "read-only file system|permission denied"
+    if kind == "full":
+        folder = tmp_path / "full"
+        folder.mkdir()
+        _full_disk(folder, monkeypatch)
+        return folder, "no space left"
+    if kind == "file":
+        (tmp_path / "file").write_text("not a folder")
+        return tmp_path / "file", "a part of the path is a file"
+    # a read-only home: the default ~/.cache/specref cannot be created
+    monkeypatch.delenv("SPECREF_CACHE_DIR", raising=False)
+    monkeypatch.delenv("XDG_CACHE_HOME", raising=False)
+    monkeypatch.setenv("HOME", str(read_only_cache))
+    return None, "read-only file system|permission denied"
+
+
+@pytest.mark.parametrize("kind", ["read-only", "full", "file", "read-only home"])
+def test_unusable_folder_warns_once_and_runs_without_the_cache(
+    kind, tmp_path, monkeypatch, read_only_cache
+):
+    folder, reason = _unusable(kind, tmp_path, monkeypatch, read_only_cache)
+    cache = Cache(folder)
+    calls = []
+
+    def compute(n):
+        calls.append(n)
+        return {"x": np.full(4, float(n))}
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        for n in (0, 1, 0):
+            got = cache.get_or_compute(_key(n), lambda n=n: compute(n))
+            np.testing.assert_array_equal(got["x"], np.full(4, float(n)))
+        cache.info()
+    messages = [str(w.message) for w in caught if issubclass(w.category, SpecrefWarning)]
+    assert len(messages) == 1, messages
+    assert "\n" not in messages[0]
+    assert "cache folder unusable" in messages[0]
+    assert re.search(reason, messages[0]), messages[0]
+    assert calls == [0, 1, 0]  # nothing was cached, every result computed
+
+
+@pytest.mark.slow
+def test_shrm_orbit_runs_without_an_unusable_cache(tmp_path, capsys):
+    (tmp_path / "file").write_text("not a folder")
+    argv = ["shrm", "orbit", "--quick", "--frames", "1", "-o", str(tmp_path / "out")]
+    with pytest.warns(SpecrefWarning, match="cache folder unusable") as caught:
+        assert main([*argv, "--cache-dir", str(tmp_path / "file")]) == 0
+    assert len([w for w in caught if "unusable" in str(w.message)]) == 1
+    assert (tmp_path / "out" / "frame_000.png").is_file()
+
+
+def test_writer_survives_a_clear_in_the_middle_of_its_write(tmp_path, capsys):
+    # Deterministic interleaving: `specref cache clear` runs while the writer's temporary file
+    # holds half an entry (before the fix, clear deleted it and the writer's rename crashed).
+    value = np.arange(1000.0)
+    Cache(tmp_path).put(_key(1), {"x": value})
+    cleared = []
+
+    def clear_now(path, written, total):
+        assert list(tmp_path.glob(".*.tmp"))
+        cleared.append(main(["cache", "clear", "--cache-dir", str(tmp_path)]))
+
+    cache = Cache(tmp_path, write_hook=clear_now)
+    assert cache.put(_key(), {"x": value}) is True
+    assert cleared == [0]
+    assert "deleted 1 entries" in capsys.readouterr().out
+    np.testing.assert_array_equal(Cache(tmp_path).get(_key())["x"], value)
+
+
+def test_writer_whose_temporary_file_vanishes_keeps_its_result(tmp_path):
+    # an outside `rm` of the folder's files mid-write: not cached, no crash
+    def remove(path, written, total):
+        for temp in tmp_path.glob(".*.tmp"):
+            temp.unlink()
+
+    cache = Cache(tmp_path, write_hook=remove)
+    with pytest.warns(SpecrefWarning, match="temporary file removed"):
+        got = cache.get_or_compute(_key(), lambda: {"x": np.ones(8)})
+    np.testing.assert_array_equal(got["x"], np.ones(8))
+    assert not cache.path_of(_key()).exists()
+
+
+@pytest.mark.filterwarnings("ignore:.*notes.tmp")
+@pytest.mark.parametrize("content", [b"", b"SPECREF", CACHE_MAGIC + b"\x03\x00"])
+def test_stale_temporary_files_are_removed_young_ones_kept(tmp_path, content):
+    from shrm.cache import STALE_TEMP_SECONDS
+
+    cache = Cache(tmp_path)
+    old, young = (tmp_path / f".{_key(n)}.specref.abc{n}.tmp" for n in (0, 1))
+    for temp in (old, young):
+        temp.write_bytes(content)
+    foreign = tmp_path / ".notes.tmp"  # not a name our writers make
+    foreign.write_bytes(b"")
+    past = time.time() - STALE_TEMP_SECONDS - 60
+    for path in (old, foreign):
+        os.utime(path, (past, past))
+    assert cache.clear() == 0
+    assert not old.exists()
+    assert young.exists()
+    assert foreign.exists()
+    # and on opening a cache
+    os.utime(young, (past, past))
+    Cache(tmp_path)
+    assert not young.exists()
+    assert foreign.exists()
+
+
+@pytest.mark.parametrize("size", [0, 3, len(CACHE_MAGIC) - 1])
+def test_entry_truncated_inside_the_magic_is_rebuilt(tmp_path, size):
+    cache = Cache(tmp_path)
+    cache.put(_key(), {"x": np.arange(10.0)})
+    path = _entry(cache, _key())
+    path.write_bytes(path.read_bytes()[:size])
+    assert cache.info().entries == 1  # ours, not foreign
+    with pytest.warns(SpecrefWarning, match="truncated"):
+        got = cache.get_or_compute(_key(), lambda: {"x": np.arange(10.0)})
+    np.testing.assert_array_equal(got["x"], np.arange(10.0))
+    np.testing.assert_array_equal(Cache(tmp_path).get(_key())["x"], np.arange(10.0))

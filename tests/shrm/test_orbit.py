@@ -161,3 +161,79 @@ def test_loads_scene_reads_spectral_parameters(tmp_path):
     assert m.params["n"].shape == (41,)
     assert (m.params["n"] == 12.0).all()
     assert m.params["rho_s"] == 0.6  # the default, a number
+
+
+def _square_map(tmp_path):
+    from reference.images import write_exr
+
+    path = tmp_path / "square.exr"
+    write_exr(path, np.ones((16, 16, 3), dtype=np.float32))
+    return path
+
+
+#: bad arguments of the built-in orbit -> what the one line says; none needs the BRDF's coefficients
+BAD_ARGUMENTS = {
+    "P below 2": (["--P", "1"], "shrm orbit: --P: must be in [2, 10]"),
+    "P above 10": (["--P", "11"], "shrm orbit: --P: must be in [2, 10]"),
+    "negative F": (["--F", "-1"], "shrm orbit: --F: must be >= 0"),
+    "negative tol": (["--tol", "-1"], "shrm orbit: --tol: must be in (0, 1)"),
+    "NaN tol": (["--tol", "nan"], "shrm orbit: --tol: must be in (0, 1)"),
+    "tol above 1": (["--tol", "5"], "shrm orbit: --tol: must be in (0, 1)"),
+    "square map": (["--env", "{square}"], "square.exr: a lat-long map must be 2:1"),
+}
+
+
+@pytest.mark.parametrize("case", BAD_ARGUMENTS, ids=list(BAD_ARGUMENTS))
+def test_orbit_arguments_are_refused_before_any_work(case, tmp_path, capsys):
+    extra, message = BAD_ARGUMENTS[case]
+    extra = [a.format(square=_square_map(tmp_path)) for a in extra]
+    argv = ["shrm", "orbit", "--quick", "--frames", "2", "--no-cache", *extra]
+    assert main([*argv, "-o", str(tmp_path / "o")]) == 2
+    captured = capsys.readouterr()
+    err = captured.err.strip().splitlines()
+    # one line, and no progress bar (or anything else) before it
+    assert len(err) == 1, err
+    assert err[0].startswith("specref: error: ")
+    assert message in err[0], err[0]
+    assert "orbit:" not in captured.err.replace("shrm orbit:", "")
+    assert captured.out == ""
+
+
+@pytest.mark.slow
+def test_orders_the_brdf_does_not_allow_are_refused_before_the_first_frame(tmp_path, capsys):
+    # F beyond what the BRDF's coefficients hold: checked on them (session.prepare), before the
+    # first frame's progress line
+    argv = ["shrm", "orbit", "--quick", "--frames", "2", "--no-cache", "--F", "500"]
+    assert main([*argv, "-o", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    assert "SHRM: F = 500 is outside what tol 0.05 allows" in err[0]
+
+
+def test_prepare_runs_a_stage_ahead_and_counts_it_in_the_next_frame():
+    calls = []
+
+    def first(state, inputs):
+        calls.append("first")
+        return {"x": np.asarray(float(state["config"]["a"]))}
+
+    def second(state, inputs):
+        calls.append("second")
+        return {"y": inputs["first"]["x"] + 1.0}
+
+    from shrm.session import Stage
+
+    stages = [
+        Stage("first", ("config",), (), first),
+        Stage("second", ("gloss",), ("first",), second),
+    ]
+    session = RenderSession({"config": {"a": 1.0}, "gloss": 2.0}, stages)
+    session.prepare("first")
+    assert calls == ["first"]
+    assert session.frame_times == []
+    result = session.render()
+    assert calls == ["first", "second"]  # first is not run again
+    assert float(result["second"]["y"]) == 2.0
+    assert sorted(session.frame_times[0]) == ["first", "second"]
+    with pytest.raises(SpecrefError, match="render session: stage"):
+        session.prepare("third")

@@ -134,3 +134,72 @@ def test_never_worse_interpolations_are_the_registered_ones_in_t(monkeypatch):
     monkeypatch.setattr(phong, "INTERPOLATION_METHODS", registry)
     # in t only, from the lowest convergence order up
     assert phong.never_worse_interpolations() == ["demo_t", "linear", "parabolic", "monotone"]
+
+
+def _held_out_material(seed):
+    # Material classes the placement was not designed on (issue 17 §6), drawn at random:
+    # one band (k_s in one band, n up to 1e4 there), an exponent rising steadily to a few
+    # thousand, and two narrow bands with far-apart exponents; random illuminants.
+    rng = np.random.default_rng(seed)
+    wl = DEFAULT_GRID.wavelengths_nm
+    bands = wl.size
+    k_d = rng.uniform(0.05, 0.5) * np.ones(bands)
+    kind = seed % 3
+    if kind == 0:
+        band = rng.integers(3, bands - 3)
+        k_s = np.zeros(bands)
+        k_s[band] = rng.uniform(0.3, 0.9)
+        n = np.exp(rng.uniform(np.log(2.0), np.log(50.0), bands))
+        n[band] = np.exp(rng.uniform(np.log(1e3), np.log(1e4)))
+    elif kind == 1:
+        k_s = rng.uniform(0.2, 0.8) * np.ones(bands)
+        top = rng.uniform(1000.0, 5000.0)
+        n = rng.uniform(1.0, 20.0) + (top - 20.0) * np.linspace(0, 1, bands) ** rng.uniform(0.5, 3)
+    else:
+        k_s = np.zeros(bands)
+        a, b = rng.choice(np.arange(3, bands - 3), 2, replace=False)
+        k_s[[a, b]] = rng.uniform(0.3, 0.9, 2)
+        n = np.full(bands, 5.0)
+        n[a], n[b] = rng.uniform(5.0, 50.0), rng.uniform(2000.0, 10000.0)
+    illuminant = ("D65", "A", "FL2", "FL11")[rng.integers(4)]
+    return spectral_phong_unit_peak(k_d, k_s, n, illuminant, f"held-out {seed}")
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_error_placement_is_never_worse_on_held_out_material_classes(seed):
+    # For every interpolation the "never worse" target serves, the error placement (placed for
+    # that interpolation, as every study builds it) against the paper's tables.
+    from validation.phong import never_worse_interpolations
+
+    model = _held_out_material(seed)
+    for view in ("far", "near"):
+        state = view_state(model, view, 48)
+        for m in (25, 50):
+            for interpolation in never_worse_interpolations():
+                error = table_error_row(state, "error", interpolation, m)["rms"]
+                for placement, segments in (("uniform", None), ("importance", m)):
+                    other = table_error_row(state, placement, interpolation, m, segments)["rms"]
+                    where = (view, m, interpolation, placement)
+                    assert error <= other + 1e-6, (where, error, other)
+
+
+def test_one_band_material_parabolic_error_table_beats_importance():
+    # Source: issue 17 §6: a one-band material (n = 1e4 in that band) where the ungraded error
+    # table with the parabola lost to the importance table (p = m) at m = 25 and 50.
+    from phong_table.render import shade_pixels
+    from phong_table.table import build_table
+
+    bands = DEFAULT_GRID.n_bands
+    k_s, n = np.zeros(bands), np.full(bands, 10.0)
+    k_s[17], n[17] = 0.8, 1e4
+    model = spectral_phong_unit_peak(np.full(bands, 0.2), k_s, n, "D65", "one band")
+    state = view_state(model, "far", 128)
+    for m in (25, 50):
+        graded = table_error_row(state, "error", "parabolic", m)["rms"]
+        importance = table_error_row(state, "importance", "parabolic", m, m)["rms"]
+        seen = (state.buffer.t_range, state.buffer.t_density)
+        ungraded = build_table(model, m, "error", None, True, *seen)  # no interpolation given
+        rgb = shade_pixels(state.buffer, model, "table", ungraded, "parabolic")
+        ungraded_rms = max(rms_8bit(rgb, state.exact, exact_encoded=state.exact_encoded))
+        assert graded < importance, (m, graded, importance)
+        assert graded < ungraded_rms, (m, graded, ungraded_rms)

@@ -4,8 +4,30 @@ from __future__ import annotations
 
 import numpy as np
 
-from reference.errors import SpecrefError
+from reference.errors import SpecrefError, require, require_positive_int
 from validation.cli.parser import Parser, registry_option
+
+
+def _check_arguments(args) -> None:
+    """The arguments that need no data, before any work (issue 17 §5)."""
+    from reference.images import check_output_folder
+    from shrm.brdf_sh import P_RANGE
+
+    require_positive_int(args.frames, "orbit --frames", 100000)
+    if args.tol is not None:
+        require(
+            bool(np.isfinite(args.tol)) and 0.0 < args.tol < 1.0,
+            f"shrm orbit: --tol: must be in (0, 1) (an L2 tail of the BRDF), got {args.tol}",
+        )
+    if args.P is not None:
+        low, high = P_RANGE
+        require(
+            low <= args.P <= high,
+            f"shrm orbit: --P: must be in [{low}, {high}] (§5.5, Herbert et al.), got {args.P}",
+        )
+    if args.F is not None:
+        require(args.F >= 0, f"shrm orbit: --F: must be >= 0, got {args.F}")
+    check_output_folder(args.out)
 
 
 def _cmd_shrm_orbit(args) -> int:
@@ -13,6 +35,7 @@ def _cmd_shrm_orbit(args) -> int:
     from shrm.orbit import demo_state, render_orbit, scene_state
     from shrm.session import RenderSession
 
+    _check_arguments(args)
     quick = {"env_height": 16, "size": 8, "resolution": 48, "F_max": 12, "P_max": 6}
     orders = {k: v for k, v in (("tol", args.tol), ("F", args.F), ("P", args.P)) if v is not None}
     if args.scene is not None:
@@ -29,6 +52,9 @@ def _cmd_shrm_orbit(args) -> int:
             args.env, brdf=args.brdf or "effect_pigment", **(quick if args.quick else {}), **orders
         )
     session = RenderSession(state, cache=Cache(args.cache_dir, enabled=not args.no_cache))
+    # the orders that --tol, --F and --P ask for are checked against the BRDF's coefficients
+    # before the first frame (and its progress line) starts
+    session.prepare("brdf_coeffs")
     rows = render_orbit(session, args.frames, args.out)
     total = [sum(r.values()) for r in rows]
     print(

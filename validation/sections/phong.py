@@ -149,7 +149,7 @@ def _speed_accuracy_view(study: PhongStudy, model, scene: str, view: str, found:
             for m in study.ladder:
                 r = table_error_row(state, variant.placement, interpolation, m, variant.segments(m))
                 found["records"].append({"scene": scene, "view": view, **r})
-                seen = (state.buffer.t_range, state.buffer.t_density)
+                seen = (state.buffer.t_range, state.buffer.t_density, interpolation)
                 table = build_table(
                     model, m, variant.placement, r["segments"], study.compiled, *seen
                 )
