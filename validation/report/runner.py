@@ -45,6 +45,7 @@ from validation.sections import (
     polymer,
     polymer_scene,
     raster,
+    scaleout,
     sh,
     shrm,
     spectral,
@@ -60,7 +61,13 @@ PARTS: tuple[ReportPart, ...] = (
         "core",
         "The shared spectral core",
         "Spectra, colorimetry, the rasterizer, the scenes all papers render with; a cross-check.",
-        (spectral.SECTION, raster.SECTION, examples.SECTION, crosscheck.SECTION),
+        (
+            spectral.SECTION,
+            raster.SECTION,
+            examples.SECTION,
+            crosscheck.SECTION,
+            scaleout.SECTION,
+        ),
     ),
     ReportPart(
         "wang",

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from validation.report.types import Check, ReportSection, SectionData, Table, Text
+from validation.report.types import Check, Headline, ReportSection, SectionData, Table, Text
 
 #: Agreement targets (erratum E83): the RMS z of a case within this factor of Student's t
 #: expectation, and its mean relative difference in Y below MEAN_REL_Y_TARGET. Both allow for the
@@ -126,6 +126,28 @@ def checks(data: SectionData) -> list:
     return out
 
 
+def headlines(data: SectionData) -> list[Headline]:
+    """The summary's figure: agreement with Mitsuba 3 within its Monte Carlo error."""
+    r = data.results
+    if not r["available"]:
+        return [Headline("Mitsuba 3 cross-check: not run (`pip install .[mitsuba]`)")]
+    worst = max(r["cases"], key=lambda c: c["rms_z"] / c["expected_rms_z"])
+    mean = max(abs(c["mean_rel_Y"]) for c in r["cases"])
+    return [
+        Headline(
+            f"Mitsuba 3 agrees on {len(r['cases'])} scenes: RMS z at most "
+            f"{worst['rms_z']:.2f} (expected {worst['expected_rms_z']:.2f}), mean |ΔY/Y| at "
+            f"most {100 * mean:.1f} %",
+            f"targets RMS z ≤ {RMS_Z_FACTOR:g}× expected, |mean ΔY/Y| ≤ {MEAN_REL_Y_TARGET}",
+        )
+    ]
+
+
 SECTION = ReportSection(
-    "crosscheck", "Cross-check against Mitsuba 3", crosscheck_figures, present, checks
+    "crosscheck",
+    "Cross-check against Mitsuba 3",
+    crosscheck_figures,
+    present,
+    checks,
+    headlines=headlines,
 )

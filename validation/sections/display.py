@@ -23,7 +23,15 @@ from reference.calibration import (
 from reference.calibration_files import colorchecker_through_display
 from reference.display_spectral import spectral_display
 from reference.instruments import INSTRUMENTS
-from validation.report import Check, ReportContext, ReportSection, SectionData, Table, Text
+from validation.report import (
+    Check,
+    Headline,
+    ReportContext,
+    ReportSection,
+    SectionData,
+    Table,
+    Text,
+)
 
 #: Fig. 6, Herbert et al.: the three curves of the paper.
 FIG6_CURVES = ("gamma1.8", "gamma2.2", "lstar")
@@ -531,6 +539,33 @@ def checks(data: SectionData) -> list[Check]:
     return found
 
 
+def headlines(data: SectionData) -> list[Headline]:
+    """The summary's figures: the calibration targets, and the instruments' shadow limits."""
+    targets = data.results["targets"].values()
+    duv = max(r["max_duv_above_5pct"] for r in targets)
+    dY = max(r["max_abs_Y_error_above_1pct"] for r in targets)
+    instruments = data.results["instruments"]
+    spectro = instruments["spectro"]["holds_down_to_cd_m2"]
+    colorimeter = instruments["colorimeter"]["holds_down_to_cd_m2"]
+    return [
+        Headline(
+            f"calibrated to {len(data.results['targets'])} white × curve pairs: gray within "
+            f"Δu'v' {duv:.1e} above 5 % of white, luminance within {100 * dY:.2f} %",
+            f"targets ≤ {TARGET_DUV} and ≤ {100 * TARGET_Y:g} %",
+        ),
+        Headline(
+            f"the spectroradiometer holds the white down to {spectro:.1f} cd/m², the "
+            f"colorimeter only to {colorimeter:.1f} cd/m²",
+            "paper §6: only spectrometers held x, y below about 15 cd/m²",
+        ),
+    ]
+
+
 SECTION = ReportSection(
-    "display-calibration", "Display calibration", display_calibration, present, checks
+    "display-calibration",
+    "Display calibration",
+    display_calibration,
+    present,
+    checks,
+    headlines=headlines,
 )

@@ -1,0 +1,153 @@
+"""Report section "Scale-out": sweeps on Dask and Zarr panoramas, from ``make bench``.
+
+The figures come from ``tests/benchmarks/bench_scaleout.py`` (groups ``scaleout-sweep`` and
+``scaleout-zarr``), measured in one run: a 32-task sweep serially and on a 2-worker local cluster,
+and the SH projection (L = 100, 41 bands) of a 1024×2048 map in memory and streamed from a Zarr
+store. From the sweep's times the section derives the per-task time and the scheduling overhead,
+and the speed-up Amdahl's law predicts for more machines (``docs/scale-out.md``).
+
+compute → :func:`scaleout_figures`; present → :func:`present`; checks → :func:`checks`.
+"""
+
+from __future__ import annotations
+
+from validation.report import (
+    Check,
+    Headline,
+    ReportContext,
+    ReportSection,
+    SectionData,
+    Table,
+    Text,
+)
+
+#: Targets of the scale-out issue: distributed / serial on 2 cores, streamed / in-memory throughput.
+SWEEP_TARGET, ZARR_TARGET = 1.6, 0.7
+
+
+def _by_role(records: list[dict]) -> dict:
+    return {r.get("extra_info", {}).get("role"): r for r in records}
+
+
+def scaleout_figures(ctx: ReportContext | None = None) -> SectionData:
+    """The scale-out benchmarks' ratios, or nothing without ``make bench``.
+
+    Returns
+    -------
+    SectionData
+        ``results``: ``measured`` (bool); with benchmarks, ``sweep`` (serial and distributed
+        seconds, tasks, workers, speed-up, per-task seconds, overhead per task, predicted
+        speed-ups on 1–16 two-core machines) and ``zarr`` (seconds, throughput ratio, peak bytes).
+
+    Examples
+    --------
+    >>> scaleout_figures().results
+    {'measured': False}
+    """
+    groups = ctx.bench_groups("scaleout") if ctx is not None else {}
+    sweep = _by_role(groups.get("scaleout-sweep", []))
+    zarr = _by_role(groups.get("scaleout-zarr", []))
+    if not (
+        {"serial", "distributed"} <= set(sweep) and {"in-memory", "zarr-streamed"} <= set(zarr)
+    ):
+        return SectionData({"measured": False})
+    serial, dist = sweep["serial"], sweep["distributed"]
+    n = serial["extra_info"]["tasks"]
+    workers = dist["extra_info"]["workers"]
+    t_serial, t_dist = serial["stats"]["min"], dist["stats"]["min"]
+    task = t_serial / n
+    # Amdahl with the measured overhead: t_dist = n·task/workers + n·o
+    overhead = max(t_dist - n * task / workers, 0.0) / n
+    predicted = {
+        machines: t_serial / (n * task / (2 * machines) + n * overhead + task)
+        for machines in (1, 2, 4, 8, 16)
+    }
+    memory, streamed = zarr["in-memory"], zarr["zarr-streamed"]
+    return SectionData(
+        {
+            "measured": True,
+            "sweep": {
+                "tasks": n,
+                "workers": workers,
+                "serial_s": t_serial,
+                "distributed_s": t_dist,
+                "speedup": t_serial / t_dist,
+                "task_s": task,
+                "overhead_s": overhead,
+                "predicted_speedup": predicted,
+            },
+            "zarr": {
+                "in_memory_s": memory["stats"]["min"],
+                "streamed_s": streamed["stats"]["min"],
+                "throughput_ratio": memory["stats"]["min"] / streamed["stats"]["min"],
+                "peak_python_bytes": streamed["extra_info"].get("peak_python_bytes"),
+            },
+        }
+    )
+
+
+def present(ctx: ReportContext, data: SectionData) -> list:
+    """The sweep and Zarr figures, and the predicted speed-up on more machines."""
+    r = data.results
+    if not r["measured"]:
+        return [Text("Not measured in this run: `make bench` runs the scale-out benchmarks.")]
+    s, z = r["sweep"], r["zarr"]
+    peak = z["peak_python_bytes"]
+    return [
+        Text(
+            f"A sweep of {s['tasks']} independent tasks ran {s['speedup']:.2f}× faster on a "
+            f"{s['workers']}-worker local Dask cluster than serially ({s['serial_s']:.1f} s → "
+            f"{s['distributed_s']:.1f} s): {s['task_s']:.2f} s per task and "
+            f"{1e3 * s['overhead_s']:.0f} ms of scheduling per task. The streamed projection of a "
+            f"Zarr panorama ran at {100 * z['throughput_ratio']:.0f} % of the in-memory "
+            "projection's speed"
+            + (f", with {peak / 1e6:.0f} MB of peak Python memory." if peak else ".")
+        ),
+        Table(
+            ["two-core machines", "predicted speed-up"],
+            [[m, v] for m, v in s["predicted_speedup"].items()],
+            "Amdahl's law with this run's task time and overhead (docs/scale-out.md)",
+            "{:.3g}",
+        ),
+    ]
+
+
+def checks(data: SectionData) -> list[Check]:
+    """The scale-out issue's targets, when the benchmarks ran."""
+    r = data.results
+    if not r["measured"]:
+        return []
+    return [
+        Check(
+            f"{r['sweep']['tasks']}-task sweep, 2-worker local cluster / serial",
+            f">= {SWEEP_TARGET}×",
+            r["sweep"]["speedup"],
+            r["sweep"]["speedup"] >= SWEEP_TARGET,
+        ),
+        Check(
+            "streamed Zarr SH projection / in-memory projection, throughput",
+            f">= {ZARR_TARGET}",
+            r["zarr"]["throughput_ratio"],
+            r["zarr"]["throughput_ratio"] >= ZARR_TARGET,
+        ),
+    ]
+
+
+def headlines(data: SectionData) -> list[Headline]:
+    """The summary's figure: the sweep's speed-up on a local cluster."""
+    r = data.results
+    if not r["measured"]:
+        return [Headline("sweeps on Dask and Zarr panoramas: measured by `make bench`")]
+    return [
+        Headline(
+            f"a {r['sweep']['tasks']}-task sweep {r['sweep']['speedup']:.2f}× faster on a "
+            f"2-worker Dask cluster; Zarr panoramas project at "
+            f"{100 * r['zarr']['throughput_ratio']:.0f} % of in-memory speed",
+            f"targets ≥ {SWEEP_TARGET}× and ≥ {100 * ZARR_TARGET:.0f} %",
+        )
+    ]
+
+
+SECTION = ReportSection(
+    "scaleout", "Scale-out", scaleout_figures, present, checks, headlines=headlines
+)
