@@ -149,14 +149,23 @@ def _lobe_over_region(P, N, V, a, light: PlaneLight, lights: PointLights):
     return 2.0 * a**2 / np.maximum(s2, 1e-300)
 
 
+#: The Cranley–Patterson rotation of FIS's second sample set (the fractional parts of the golden
+#: ratio and of √2): any shift that moves every sample off the first set's strata would do.
+SECOND_SET_SHIFT = (0.6180339887498949, 0.41421356237309515)
+#: Where the estimated errors differ by more than this factor, or cannot explain the methods'
+#: disagreement, the hybrid takes the method with the smaller error instead of blending.
+CHOOSE_RATIO = 3.0
+
+
 def _hybrid_parts(P, N, V, a, light, lights, K, vis, backend):
-    """Both estimates ``(P, C)`` and their estimated absolute errors ``(P,)`` (channel mean)."""
+    """Both estimates ``(P, C)``, their estimated absolute errors ``(P,)`` and the choice mask."""
     sigma = sigma_point_lights(light, lights)
     vis_sigma = None if vis is None else np.repeat(vis, 4, axis=1)
     I_pl = specular_point_lights(P, N, V, a, lights, vis, backend=backend)
     I_sigma = specular_point_lights(P, N, V, a, sigma, vis_sigma, backend=backend)
     I_fis = specular_fis(P, N, V, a, light, K, backend=backend)
-    I_half = specular_fis(P, N, V, a, light, K // 2, backend=backend)
+    # An independent second FIS estimate: K/2 samples of a rotated Hammersley set.
+    I_half = specular_fis(P, N, V, a, light, K // 2, backend=backend, shift=SECOND_SET_SHIFT)
     pl, sig, fis, half = (x.mean(axis=-1) for x in (I_pl, I_sigma, I_fis, I_half))
     x_pl = _lobe_over_region(P, N, V, a, light, lights)
     # The Taylor expansion behind the sigma points holds where the lobe is wider than the region.
@@ -167,13 +176,17 @@ def _hybrid_parts(P, N, V, a, light, lights, K, vis, backend):
     peak = np.minimum(1.0, 1.0 / (2.0 * x_pl))
     e_pl = np.maximum(2.0 * np.abs(sig - pl), np.where(narrow, peak * np.abs(fis), 0.0))
     # FIS: error ∝ 1/K (stratified samples and the mip filter's blur, both ∝ 1/K), so
-    # Richardson's rule gives e_K ≈ |I_K − I_{K/2}|.
+    # Richardson's rule with the independent K/2 set gives e_K ≈ |I_K − I_{K/2}|; the sets share
+    # no sample, so a peak that one set misses and the other meets shows up in the difference.
     e_fis = np.abs(fis - half)
     # |I_pl − I_fis| ≤ e_pl + e_fis; the excess goes to the method outside its model's validity.
     excess = np.maximum(np.abs(pl - fis) - e_pl - e_fis, 0.0)
     e_pl = np.where(narrow, e_pl + excess, e_pl)
     e_fis = np.where(narrow, e_fis, e_fis + excess)
-    return I_pl, I_fis, e_pl, e_fis
+    # Fail-safe: blend only where the estimates are alike and explain the disagreement.
+    ratio = np.maximum(e_pl, e_fis) / np.maximum(np.minimum(e_pl, e_fis), 1e-300)
+    choose = (excess > 0.0) | (ratio > CHOOSE_RATIO)
+    return I_pl, I_fis, e_pl, e_fis, choose
 
 
 def hybrid_error_estimates(
@@ -242,7 +255,7 @@ def hybrid_error_estimates(
     >>> bool(e_fis[0] < e_pl[0]), bool(e_fis[1] > e_pl[1])
     (True, True)
     """
-    shape, _, I_fis, e_pl, e_fis = _evaluate(
+    shape, _, I_fis, e_pl, e_fis, _ = _evaluate(
         points, normals, views, alpha, light, lights, n_samples, visibility, backend
     )
     scale = np.maximum(np.abs(I_fis.mean(axis=-1)), 1e-300)
@@ -302,12 +315,14 @@ def specular_hybrid_parts(
     >>> sorted(parts), bool(0.0 <= parts["w_point_lights"] <= 1.0)
     (['e_fis', 'e_point_lights', 'fis', 'hybrid', 'point_lights', 'w_point_lights'], True)
     """
-    shape, I_pl, I_fis, e_pl, e_fis = _evaluate(
+    shape, I_pl, I_fis, e_pl, e_fis, choose = _evaluate(
         points, normals, views, alpha, light, lights, n_samples, visibility, backend
     )
     total = e_pl**2 + e_fis**2
     # Inverse-variance weights; where both errors vanish the two estimates agree: take FIS.
     w_pl = np.where(total > 0, e_fis**2 / np.where(total > 0, total, 1.0), 0.0)
+    # The fail-safe: a choice, not a blend, where the estimates disagree.
+    w_pl = np.where(choose, (e_pl < e_fis).astype(np.float64), w_pl)
     I_hybrid = w_pl[:, None] * I_pl + (1.0 - w_pl[:, None]) * I_fis
     return {
         "hybrid": I_hybrid.reshape((*shape, -1)),
