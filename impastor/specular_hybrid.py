@@ -38,6 +38,7 @@ from impastor.specular_lighting import (
     specular_fis,
     specular_point_lights,
 )
+from reference.brdf import brdf_ward_duer_specular
 from reference.errors import require, require_positive_int
 from reference.registry import Method, Registry
 
@@ -125,17 +126,28 @@ def sigma_point_lights(light: PlaneLight, lights: PointLights) -> PointLights:
 
 
 def _lobe_over_region(P, N, V, a, light: PlaneLight, lights: PointLights):
-    """Per pixel: ``x_pl = σ²/s²``, the lobe's angular variance over the spread of the region hit.
+    """Per pixel: whether the lobe is narrower than the regions that light it.
 
-    ``σ² = 2α²`` (Ward's ``exp(−tan²θ_h/α²)`` with ``θ_i ≈ 2θ_h``, both axes); ``s²`` is the
-    energy spread (``PointLights.spread`` × cos θ_l / d², sr) of the median-cut region that the
-    mirror direction meets, or the mean region's where it misses the light.
+    ``x_n = σ²/s_n²`` compares the lobe's angular variance ``σ² = 2α²`` (Ward's
+    ``exp(−tan²θ_h/α²)`` with ``θ_i ≈ 2θ_h``, both axes) with the energy spread ``s_n²`` of
+    region n (``PointLights.spread`` × cos θ_l / d², sr). The lobe is *narrow* where the regions
+    with ``x_n < 1`` carry most of the point lights' estimate (their shares ``c_n`` of
+    Eq. (2), Ferwerda); where the point lights see nothing, where the region that the mirror
+    direction meets has ``x < 1``. Returns the boolean mask and ``x`` of that mirror region.
     """
     H, W = light.shape
     to_light = lights.position[None] - P[:, None]
     d2 = np.einsum("pni,pni->pn", to_light, to_light)
-    cos_l = np.maximum(-(to_light @ light.n_light) / np.sqrt(d2), 0.0)
+    I_n = to_light / np.sqrt(d2)[..., None]
+    cos_l = np.maximum(-(I_n @ light.n_light), 0.0)
+    cos_s = np.maximum(np.einsum("pni,pi->pn", I_n, N), 0.0)
     spread = lights.spread * cos_l / d2  # sr
+    x_n = 2.0 * a[:, None] ** 2 / np.maximum(spread, 1e-300)
+    # Eq. (2), Ferwerda: each light's share of the point lights' estimate
+    f = brdf_ward_duer_specular(I_n, V[:, None, :], N[:, None, :], a[:, None])
+    c_n = f * cos_s * cos_l / d2 * lights.L.mean(axis=-1)
+    total = c_n.sum(axis=1)
+    share = np.where(x_n < 1.0, c_n, 0.0).sum(axis=1) / np.where(total > 0, total, 1.0)
     cos_o = np.clip(np.einsum("pi,pi->p", N, V), 1e-6, 1.0)
     mirror = 2.0 * cos_o[:, None] * N - V
     a_uv, b_uv, d = light_plane_uv(light, P, mirror)
@@ -146,7 +158,9 @@ def _lobe_over_region(P, N, V, a, light: PlaneLight, lights: PointLights):
     for k, (y0, y1, x0, x1) in enumerate(lights.regions):
         owner[y0:y1, x0:x1] = k
     s2 = np.where(on, spread[np.arange(P.shape[0]), owner[row, col]], spread.mean(axis=1))
-    return 2.0 * a**2 / np.maximum(s2, 1e-300)
+    x_mirror = 2.0 * a**2 / np.maximum(s2, 1e-300)
+    seen = total > 1e-12 * max(float(total.max(initial=0.0)), 1e-300)
+    return np.where(seen, share > 0.5, x_mirror < 1.0), x_mirror
 
 
 #: The Cranley–Patterson rotation of FIS's second sample set (the fractional parts of the golden
@@ -164,12 +178,12 @@ def _hybrid_parts(P, N, V, a, light, lights, K, vis, backend):
     I_pl = specular_point_lights(P, N, V, a, lights, vis, backend=backend)
     I_sigma = specular_point_lights(P, N, V, a, sigma, vis_sigma, backend=backend)
     I_fis = specular_fis(P, N, V, a, light, K, backend=backend)
-    # An independent second FIS estimate: K/2 samples of a rotated Hammersley set.
-    I_half = specular_fis(P, N, V, a, light, K // 2, backend=backend, shift=SECOND_SET_SHIFT)
+    # An independent FIS estimate: K/2 samples of a rotated Hammersley set, its mip level not
+    # biased upwards (less blur), so that the difference also sees the blur of the K estimate.
+    I_half = specular_fis(P, N, V, a, light, K // 2, 0.0, backend, SECOND_SET_SHIFT)
     pl, sig, fis, half = (x.mean(axis=-1) for x in (I_pl, I_sigma, I_fis, I_half))
-    x_pl = _lobe_over_region(P, N, V, a, light, lights)
     # The Taylor expansion behind the sigma points holds where the lobe is wider than the region.
-    narrow = x_pl < 1.0
+    narrow, x_pl = _lobe_over_region(P, N, V, a, light, lights)
     # Point lights: twice the sigma points' correction is their second-moment error; where the
     # lobe is narrower than the region, at least the one-point rule's error at the lobe's peak,
     # min(1, s²/(2σ²)) of the integral (FIS's estimate of it).
@@ -185,7 +199,7 @@ def _hybrid_parts(P, N, V, a, light, lights, K, vis, backend):
     e_fis = np.where(narrow, e_fis, e_fis + excess)
     # Fail-safe: blend only where the estimates are alike and explain the disagreement.
     ratio = np.maximum(e_pl, e_fis) / np.maximum(np.minimum(e_pl, e_fis), 1e-300)
-    choose = (excess > 0.0) | (ratio > CHOOSE_RATIO)
+    choose = (excess > 0.25 * (e_pl + e_fis - excess)) | (ratio > CHOOSE_RATIO)
     return I_pl, I_fis, e_pl, e_fis, choose
 
 

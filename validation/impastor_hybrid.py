@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from impastor.arealights import PlaneLight, booth_light_image
+from impastor.arealights import PlaneLight
 from impastor.painting import booth_plane_light, impasto_painting, painting_samples
 from impastor.point_lights import point_lights_from_plane
 from impastor.specular_hybrid import specular_hybrid_parts
@@ -69,6 +69,7 @@ class HybridCase:
 
     @property
     def name(self) -> str:
+        """A readable label: light, painting seed, N and K."""
         return f"{self.light} seed {self.painting_seed} N={self.n_lights} K={self.n_samples}"
 
 
@@ -245,8 +246,8 @@ def hybrid_case_ratios(
         reference = specular_brute_force(P, N, V, a, plane, 2 * supersample, backend)[..., 0]
         coarse = specular_brute_force(P, N, V, a, plane, supersample, backend)[..., 0]
         parts = specular_hybrid_parts(P, N, V, a, plane, lights, case.n_samples, backend=backend)
-        errors = {k: rms(parts[m][..., 0], reference) for k, m in
-                  (("median_cut", "point_lights"), ("fis", "fis"), ("hybrid", "hybrid"))}  # fmt: skip
+        pairs = (("median_cut", "point_lights"), ("fis", "fis"), ("hybrid", "hybrid"))
+        errors = {k: rms(parts[m][..., 0], reference) for k, m in pairs}
         out["alpha"].append(float(alpha))
         for key, value in errors.items():
             out[key].append(value)
