@@ -55,7 +55,7 @@ class ImpastorSettings:
         Channel counts N of :func:`validation.impastor.channel_count_errors` (6 must be one).
     alpha, shadows, gloss, albedo : dict
         Keywords of :func:`validation.impastor_lighting.specular_error_vs_alpha`,
-        ``shadow_agreement`` (18 sectors must be among them), ``gloss_validation`` and
+        ``shadow_agreement`` (``HORIZON_SECTORS`` must be among them), ``gloss_validation`` and
         ``ward_duer_albedo``; defaults where empty.
     alpha_painting_size : int or None
         Side of the painting (seed 2) of the error-against-α study; None for the study's own.
