@@ -4,11 +4,12 @@ ImpastoR renders specular reflection per pixel with either median-cut point ligh
 importance sampling, chosen by a "custom error minimization metric" that the paper does not give
 (§3.5.2, Ferwerda). specref's metric, :func:`hybrid_error_estimates`, estimates each method's
 error at each pixel from the estimates themselves: the point lights' second-moment error from
-sigma-point lights (:func:`sigma_point_lights`), FIS's by Richardson's rule from a second FIS
-estimate with half the samples, and whatever part of the two methods' disagreement these leave
-unexplained is charged to the method whose error estimate is outside its range of validity.
-:func:`specular_hybrid` combines the two estimates (``impastor.specular_lighting``) with
-inverse-variance weights.
+sigma-point lights (:func:`sigma_point_lights`), FIS's by Richardson's rule from an independent
+second FIS estimate with half the samples (a rotated Hammersley set), and whatever part of the
+two methods' disagreement these leave unexplained is charged to the method whose error estimate
+is outside its range of validity. :func:`specular_hybrid` combines the two estimates
+(``impastor.specular_lighting``) with inverse-variance weights where the error estimates are
+alike, and chooses the one with the smaller error where they are not (erratum E17).
 
 :data:`SPECULAR_METHODS` registers all four specular methods (point lights, FIS, the hybrid and
 the brute-force reference); it lives here, beside the hybrid that uses the others.
@@ -43,6 +44,8 @@ from reference.errors import require, require_positive_int
 from reference.registry import Method, Registry
 
 __all__ = [
+    "CHOOSE_RATIO",
+    "SECOND_SET_SHIFT",
     "SPECULAR_METHODS",
     "hybrid_error_estimates",
     "sigma_point_lights",
@@ -197,7 +200,8 @@ def _hybrid_parts(P, N, V, a, light, lights, K, vis, backend):
     excess = np.maximum(np.abs(pl - fis) - e_pl - e_fis, 0.0)
     e_pl = np.where(narrow, e_pl + excess, e_pl)
     e_fis = np.where(narrow, e_fis, e_fis + excess)
-    # Fail-safe: blend only where the estimates are alike and explain the disagreement.
+    # Fail-safe: blend only where the estimates are alike and explain the disagreement (the
+    # unexplained part under a quarter of the two estimates' sum before it was added).
     ratio = np.maximum(e_pl, e_fis) / np.maximum(np.minimum(e_pl, e_fis), 1e-300)
     choose = (excess > 0.25 * (e_pl + e_fis - excess)) | (ratio > CHOOSE_RATIO)
     return I_pl, I_fis, e_pl, e_fis, choose
@@ -223,21 +227,22 @@ def hybrid_error_estimates(
       in the lobe's variation over the region. The second-moment error of the one-point rule,
       ``−½ Φ (σ_x² g_xx + σ_y² g_yy)``, is twice the difference between the point lights'
       estimate and the :func:`sigma_point_lights` one (Eq. (2), Ferwerda, with both).
-      That expansion holds where the lobe is wider than the region the mirror direction meets,
-      ``x = σ²/s² ≥ 1`` (``σ² = 2α²`` the lobe's angular variance, ``s²`` the region's angular
+      That expansion holds where the lobe is wider than the regions that carry the estimate,
+      ``x = σ²/s² ≥ 1`` (``σ² = 2α²`` the lobe's angular variance, ``s²`` a region's angular
       spread); where it is narrower, the estimate is at least the one-point rule's error at the
       lobe's peak, ``min(1, s²/(2σ²))`` of the integral.
     - **FIS**: its error falls as 1/K (the K Hammersley samples are stratified, and the mip
-      level's blur covers ``Ω_s = 1/(K p)``), so Richardson's rule with a second FIS estimate of
-      K/2 samples gives ``e_K ≈ |I_K − I_{K/2}|``.
+      level's blur covers ``Ω_s = 1/(K p)``), so Richardson's rule with a second, independent
+      FIS estimate of K/2 samples (a Cranley–Patterson-rotated set, :data:`SECOND_SET_SHIFT`,
+      its mip level unbiased) gives ``e_K ≈ |I_K − I_{K/2}|``.
     - **Consistency**: the two errors must explain the methods' disagreement,
       ``|I_pl − I_fis| ≤ e_pl + e_fis``. What they leave unexplained is added to the point
       lights' error where ``x < 1`` (the point lights' estimate is outside its validity) and to
-      FIS's elsewhere (a bias of the mip filter that does not change between K/2 and K).
+      FIS's elsewhere.
 
     No constant is fitted to a scene: 2 and ½ come from the expansions, 1/K from the sampler,
     and ``x = 1`` is where the lobe and the region have the same width. :func:`specular_hybrid`
-    combines the two estimates with inverse-variance weights.
+    combines the two estimates with inverse-variance weights, or chooses one (the fail-safe).
 
     Parameters
     ----------
@@ -364,7 +369,9 @@ def specular_hybrid(
     Eq. (4), Ferwerda, estimated at each pixel by both methods and combined with the weights that
     minimise the variance of the combination, given the errors :func:`hybrid_error_estimates`
     estimates: ``I = (e_fis² I_pl + e_pl² I_fis) / (e_pl² + e_fis²)``. Where one error is far
-    below the other this is a switch; near the crossover it averages the two. Besides the two
+    below the other this is a switch; near the crossover it averages the two. Fail-safe: where
+    the errors differ by more than :data:`CHOOSE_RATIO` or cannot explain the disagreement
+    between the two estimates, it takes the one with the smaller error. Besides the two
     methods it evaluates the sigma-point lights (4N) and FIS with K/2 samples for the estimates
     (:func:`specular_hybrid_parts` returns them too).
 
