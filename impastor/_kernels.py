@@ -197,10 +197,12 @@ def _sample_periodic(h, y, x):
 
 
 @numba.njit(cache=False)
-def _horizon_along(h, pixel_size, j, i, phi, max_steps):
+def _horizon_along(h, pixel_size, j, i, phi, max_steps, step):
     dx, dy = math.cos(phi), math.sin(phi)
     best = 0.0
-    for t in range(1, max_steps + 1):
+    n_steps = round(max_steps / step)
+    for k in range(1, n_steps + 1):
+        t = k * step
         rise = _sample_periodic(h, j + t * dy, i + t * dx) - h[j, i]
         # Sloan & Cohen 2000: the horizon is the largest elevation angle seen along the ray
         best = max(best, rise / (t * pixel_size))
@@ -208,21 +210,21 @@ def _horizon_along(h, pixel_size, j, i, phi, max_steps):
 
 
 @numba.njit(cache=False)
-def horizon_map_kernel(h, pixel_size, n_sectors, max_steps, out):
+def horizon_map_kernel(h, pixel_size, n_sectors, max_steps, step, out):
     """Twin of ``horizon_map``: each sector marched along its centre azimuth."""
     H, W = h.shape
     for s in range(n_sectors):
         phi = (s + 0.5) * 2.0 * math.pi / n_sectors
         for j in range(H):
             for i in range(W):
-                out[j, i, s] = _horizon_along(h, pixel_size, j, i, phi, max_steps)
+                out[j, i, s] = _horizon_along(h, pixel_size, j, i, phi, max_steps, step)
 
 
 @numba.njit(cache=False)
-def ray_march_shadows_kernel(h, pixel_size, phi, beta, max_steps, out):
+def ray_march_shadows_kernel(h, pixel_size, phi, beta, max_steps, step, out):
     """Twin of ``ray_march_shadows``: lit where β exceeds the horizon along the exact azimuth."""
     H, W = h.shape
     for j in range(H):
         for i in range(W):
-            horizon = _horizon_along(h, pixel_size, j, i, phi[j, i], max_steps)
+            horizon = _horizon_along(h, pixel_size, j, i, phi[j, i], max_steps, step)
             out[j, i] = beta[j, i] > horizon and beta[j, i] > 0.0

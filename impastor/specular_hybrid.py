@@ -4,11 +4,12 @@ ImpastoR renders specular reflection per pixel with either median-cut point ligh
 importance sampling, chosen by a "custom error minimization metric" that the paper does not give
 (§3.5.2, Ferwerda). specref's metric, :func:`hybrid_error_estimates`, estimates each method's
 error at each pixel from the estimates themselves: the point lights' second-moment error from
-sigma-point lights (:func:`sigma_point_lights`), FIS's by Richardson's rule from a second FIS
-estimate with half the samples, and whatever part of the two methods' disagreement these leave
-unexplained is charged to the method whose error estimate is outside its range of validity.
-:func:`specular_hybrid` combines the two estimates (``impastor.specular_lighting``) with
-inverse-variance weights.
+sigma-point lights (:func:`sigma_point_lights`), FIS's by Richardson's rule from an independent
+second FIS estimate with half the samples (a rotated Hammersley set), and whatever part of the
+two methods' disagreement these leave unexplained is charged to the method whose error estimate
+is outside its range of validity. :func:`specular_hybrid` combines the two estimates
+(``impastor.specular_lighting``) with inverse-variance weights where the error estimates are
+alike, and chooses the one with the smaller error where they are not (erratum E17).
 
 :data:`SPECULAR_METHODS` registers all four specular methods (point lights, FIS, the hybrid and
 the brute-force reference); it lives here, beside the hybrid that uses the others.
@@ -38,10 +39,13 @@ from impastor.specular_lighting import (
     specular_fis,
     specular_point_lights,
 )
+from reference.brdf import brdf_ward_duer_specular
 from reference.errors import require, require_positive_int
 from reference.registry import Method, Registry
 
 __all__ = [
+    "CHOOSE_RATIO",
+    "SECOND_SET_SHIFT",
     "SPECULAR_METHODS",
     "hybrid_error_estimates",
     "sigma_point_lights",
@@ -125,17 +129,28 @@ def sigma_point_lights(light: PlaneLight, lights: PointLights) -> PointLights:
 
 
 def _lobe_over_region(P, N, V, a, light: PlaneLight, lights: PointLights):
-    """Per pixel: ``x_pl = σ²/s²``, the lobe's angular variance over the spread of the region hit.
+    """Per pixel: whether the lobe is narrower than the regions that light it.
 
-    ``σ² = 2α²`` (Ward's ``exp(−tan²θ_h/α²)`` with ``θ_i ≈ 2θ_h``, both axes); ``s²`` is the
-    energy spread (``PointLights.spread`` × cos θ_l / d², sr) of the median-cut region that the
-    mirror direction meets, or the mean region's where it misses the light.
+    ``x_n = σ²/s_n²`` compares the lobe's angular variance ``σ² = 2α²`` (Ward's
+    ``exp(−tan²θ_h/α²)`` with ``θ_i ≈ 2θ_h``, both axes) with the energy spread ``s_n²`` of
+    region n (``PointLights.spread`` × cos θ_l / d², sr). The lobe is *narrow* where the regions
+    with ``x_n < 1`` carry most of the point lights' estimate (their shares ``c_n`` of
+    Eq. (2), Ferwerda); where the point lights see nothing, where the region that the mirror
+    direction meets has ``x < 1``. Returns the boolean mask and ``x`` of that mirror region.
     """
     H, W = light.shape
     to_light = lights.position[None] - P[:, None]
     d2 = np.einsum("pni,pni->pn", to_light, to_light)
-    cos_l = np.maximum(-(to_light @ light.n_light) / np.sqrt(d2), 0.0)
+    I_n = to_light / np.sqrt(d2)[..., None]
+    cos_l = np.maximum(-(I_n @ light.n_light), 0.0)
+    cos_s = np.maximum(np.einsum("pni,pi->pn", I_n, N), 0.0)
     spread = lights.spread * cos_l / d2  # sr
+    x_n = 2.0 * a[:, None] ** 2 / np.maximum(spread, 1e-300)
+    # Eq. (2), Ferwerda: each light's share of the point lights' estimate
+    f = brdf_ward_duer_specular(I_n, V[:, None, :], N[:, None, :], a[:, None])
+    c_n = f * cos_s * cos_l / d2 * lights.L.mean(axis=-1)
+    total = c_n.sum(axis=1)
+    share = np.where(x_n < 1.0, c_n, 0.0).sum(axis=1) / np.where(total > 0, total, 1.0)
     cos_o = np.clip(np.einsum("pi,pi->p", N, V), 1e-6, 1.0)
     mirror = 2.0 * cos_o[:, None] * N - V
     a_uv, b_uv, d = light_plane_uv(light, P, mirror)
@@ -146,34 +161,50 @@ def _lobe_over_region(P, N, V, a, light: PlaneLight, lights: PointLights):
     for k, (y0, y1, x0, x1) in enumerate(lights.regions):
         owner[y0:y1, x0:x1] = k
     s2 = np.where(on, spread[np.arange(P.shape[0]), owner[row, col]], spread.mean(axis=1))
-    return 2.0 * a**2 / np.maximum(s2, 1e-300)
+    x_mirror = 2.0 * a**2 / np.maximum(s2, 1e-300)
+    seen = total > 1e-12 * max(float(total.max(initial=0.0)), 1e-300)
+    return np.where(seen, share > 0.5, x_mirror < 1.0), x_mirror
+
+
+#: The Cranley–Patterson rotation of FIS's second sample set (the fractional parts of the golden
+#: ratio and of √2): any shift that moves every sample off the first set's strata would do.
+SECOND_SET_SHIFT = (0.6180339887498949, 0.41421356237309515)
+#: Where the estimated errors differ by more than this factor, or cannot explain the methods'
+#: disagreement, the hybrid takes the method with the smaller error instead of blending.
+CHOOSE_RATIO = 3.0
 
 
 def _hybrid_parts(P, N, V, a, light, lights, K, vis, backend):
-    """Both estimates ``(P, C)`` and their estimated absolute errors ``(P,)`` (channel mean)."""
+    """Both estimates ``(P, C)``, their estimated absolute errors ``(P,)`` and the choice mask."""
     sigma = sigma_point_lights(light, lights)
     vis_sigma = None if vis is None else np.repeat(vis, 4, axis=1)
     I_pl = specular_point_lights(P, N, V, a, lights, vis, backend=backend)
     I_sigma = specular_point_lights(P, N, V, a, sigma, vis_sigma, backend=backend)
     I_fis = specular_fis(P, N, V, a, light, K, backend=backend)
-    I_half = specular_fis(P, N, V, a, light, K // 2, backend=backend)
+    # An independent FIS estimate: K/2 samples of a rotated Hammersley set, its mip level not
+    # biased upwards (less blur), so that the difference also sees the blur of the K estimate.
+    I_half = specular_fis(P, N, V, a, light, K // 2, 0.0, backend, SECOND_SET_SHIFT)
     pl, sig, fis, half = (x.mean(axis=-1) for x in (I_pl, I_sigma, I_fis, I_half))
-    x_pl = _lobe_over_region(P, N, V, a, light, lights)
     # The Taylor expansion behind the sigma points holds where the lobe is wider than the region.
-    narrow = x_pl < 1.0
+    narrow, x_pl = _lobe_over_region(P, N, V, a, light, lights)
     # Point lights: twice the sigma points' correction is their second-moment error; where the
     # lobe is narrower than the region, at least the one-point rule's error at the lobe's peak,
     # min(1, s²/(2σ²)) of the integral (FIS's estimate of it).
     peak = np.minimum(1.0, 1.0 / (2.0 * x_pl))
     e_pl = np.maximum(2.0 * np.abs(sig - pl), np.where(narrow, peak * np.abs(fis), 0.0))
     # FIS: error ∝ 1/K (stratified samples and the mip filter's blur, both ∝ 1/K), so
-    # Richardson's rule gives e_K ≈ |I_K − I_{K/2}|.
+    # Richardson's rule with the independent K/2 set gives e_K ≈ |I_K − I_{K/2}|; the sets share
+    # no sample, so a peak that one set misses and the other meets shows up in the difference.
     e_fis = np.abs(fis - half)
     # |I_pl − I_fis| ≤ e_pl + e_fis; the excess goes to the method outside its model's validity.
     excess = np.maximum(np.abs(pl - fis) - e_pl - e_fis, 0.0)
     e_pl = np.where(narrow, e_pl + excess, e_pl)
     e_fis = np.where(narrow, e_fis, e_fis + excess)
-    return I_pl, I_fis, e_pl, e_fis
+    # Fail-safe: blend only where the estimates are alike and explain the disagreement (the
+    # unexplained part under a quarter of the two estimates' sum before it was added).
+    ratio = np.maximum(e_pl, e_fis) / np.maximum(np.minimum(e_pl, e_fis), 1e-300)
+    choose = (excess > 0.25 * (e_pl + e_fis - excess)) | (ratio > CHOOSE_RATIO)
+    return I_pl, I_fis, e_pl, e_fis, choose
 
 
 def hybrid_error_estimates(
@@ -196,21 +227,22 @@ def hybrid_error_estimates(
       in the lobe's variation over the region. The second-moment error of the one-point rule,
       ``−½ Φ (σ_x² g_xx + σ_y² g_yy)``, is twice the difference between the point lights'
       estimate and the :func:`sigma_point_lights` one (Eq. (2), Ferwerda, with both).
-      That expansion holds where the lobe is wider than the region the mirror direction meets,
-      ``x = σ²/s² ≥ 1`` (``σ² = 2α²`` the lobe's angular variance, ``s²`` the region's angular
+      That expansion holds where the lobe is wider than the regions that carry the estimate,
+      ``x = σ²/s² ≥ 1`` (``σ² = 2α²`` the lobe's angular variance, ``s²`` a region's angular
       spread); where it is narrower, the estimate is at least the one-point rule's error at the
       lobe's peak, ``min(1, s²/(2σ²))`` of the integral.
     - **FIS**: its error falls as 1/K (the K Hammersley samples are stratified, and the mip
-      level's blur covers ``Ω_s = 1/(K p)``), so Richardson's rule with a second FIS estimate of
-      K/2 samples gives ``e_K ≈ |I_K − I_{K/2}|``.
+      level's blur covers ``Ω_s = 1/(K p)``), so Richardson's rule with a second, independent
+      FIS estimate of K/2 samples (a Cranley–Patterson-rotated set, :data:`SECOND_SET_SHIFT`,
+      its mip level unbiased) gives ``e_K ≈ |I_K − I_{K/2}|``.
     - **Consistency**: the two errors must explain the methods' disagreement,
       ``|I_pl − I_fis| ≤ e_pl + e_fis``. What they leave unexplained is added to the point
       lights' error where ``x < 1`` (the point lights' estimate is outside its validity) and to
-      FIS's elsewhere (a bias of the mip filter that does not change between K/2 and K).
+      FIS's elsewhere.
 
     No constant is fitted to a scene: 2 and ½ come from the expansions, 1/K from the sampler,
     and ``x = 1`` is where the lobe and the region have the same width. :func:`specular_hybrid`
-    combines the two estimates with inverse-variance weights.
+    combines the two estimates with inverse-variance weights, or chooses one (the fail-safe).
 
     Parameters
     ----------
@@ -242,7 +274,7 @@ def hybrid_error_estimates(
     >>> bool(e_fis[0] < e_pl[0]), bool(e_fis[1] > e_pl[1])
     (True, True)
     """
-    shape, _, I_fis, e_pl, e_fis = _evaluate(
+    shape, _, I_fis, e_pl, e_fis, _ = _evaluate(
         points, normals, views, alpha, light, lights, n_samples, visibility, backend
     )
     scale = np.maximum(np.abs(I_fis.mean(axis=-1)), 1e-300)
@@ -302,12 +334,14 @@ def specular_hybrid_parts(
     >>> sorted(parts), bool(0.0 <= parts["w_point_lights"] <= 1.0)
     (['e_fis', 'e_point_lights', 'fis', 'hybrid', 'point_lights', 'w_point_lights'], True)
     """
-    shape, I_pl, I_fis, e_pl, e_fis = _evaluate(
+    shape, I_pl, I_fis, e_pl, e_fis, choose = _evaluate(
         points, normals, views, alpha, light, lights, n_samples, visibility, backend
     )
     total = e_pl**2 + e_fis**2
     # Inverse-variance weights; where both errors vanish the two estimates agree: take FIS.
     w_pl = np.where(total > 0, e_fis**2 / np.where(total > 0, total, 1.0), 0.0)
+    # The fail-safe: a choice, not a blend, where the estimates disagree.
+    w_pl = np.where(choose, (e_pl < e_fis).astype(np.float64), w_pl)
     I_hybrid = w_pl[:, None] * I_pl + (1.0 - w_pl[:, None]) * I_fis
     return {
         "hybrid": I_hybrid.reshape((*shape, -1)),
@@ -335,7 +369,9 @@ def specular_hybrid(
     Eq. (4), Ferwerda, estimated at each pixel by both methods and combined with the weights that
     minimise the variance of the combination, given the errors :func:`hybrid_error_estimates`
     estimates: ``I = (e_fis² I_pl + e_pl² I_fis) / (e_pl² + e_fis²)``. Where one error is far
-    below the other this is a switch; near the crossover it averages the two. Besides the two
+    below the other this is a switch; near the crossover it averages the two. Fail-safe: where
+    the errors differ by more than :data:`CHOOSE_RATIO` or cannot explain the disagreement
+    between the two estimates, it takes the one with the smaller error. Besides the two
     methods it evaluates the sigma-point lights (4N) and FIS with K/2 samples for the estimates
     (:func:`specular_hybrid_parts` returns them too).
 

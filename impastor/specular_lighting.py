@@ -245,6 +245,7 @@ def specular_fis(
     n_samples: int = 32,
     bias: float = 1.0,
     backend: str = "numpy",
+    shift=(0.0, 0.0),
 ) -> np.ndarray:
     """Specular integral by filtered importance sampling of the Ward–Dür lobe.
 
@@ -262,6 +263,10 @@ def specular_fis(
     bias : float
         Added to the mip level (GPU Gems 3 ch. 20 uses 1: a slightly blurrier, smoother result).
     backend : {"numpy", "numba"}
+    shift : tuple of float
+        A Cranley–Patterson rotation of the Hammersley set, ``u ← (u + shift) mod 1``: (0, 0) is
+        the plain set; the hybrid (``impastor.specular_hybrid``) draws a second, independent
+        estimate with another shift.
 
     Returns
     -------
@@ -277,7 +282,8 @@ def specular_fis(
     """
     require_choice(backend, BACKENDS, "backend")
     P, N, V, a, shape = _flat(points, normals, views, alpha)
-    u = hammersley(n_samples)
+    # Cranley & Patterson 1976: a rotated set keeps the stratification, moves every sample
+    u = np.mod(hammersley(n_samples) + np.asarray(shift, dtype=np.float64), 1.0)
     K = u.shape[0]
     out = np.zeros((P.shape[0], light.image.shape[-1]))
     A, B = np.asarray(light.A), np.asarray(light.B)

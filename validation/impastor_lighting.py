@@ -90,53 +90,109 @@ def specular_error_vs_alpha(
     return out
 
 
+#: The height fields of the shadow study: (label, relief scale, amplitude of 1-pixel bumps, m).
+SHADOW_FIELDS = (
+    ("default", 1.0, 0.0),
+    ("relief ×2", 2.0, 0.0),
+    ("relief ×4", 4.0, 0.0),
+    ("fine bumps", 1.0, 1e-4),
+)
+
+
+def shadow_field(size: int, seed: int, relief: float = 1.0, bumps: float = 0.0):
+    """A painting's height field, its relief scaled, with optional 1-pixel bumps (m, std).
+
+    Examples
+    --------
+    >>> h, pixel = shadow_field(16, 1, 2.0, 1e-4)
+    >>> h.shape, round(pixel, 5)
+    ((16, 16), 0.01875)
+    """
+    painting = impasto_painting(size, seed=seed)
+    h = relief * painting["height"]
+    if bumps > 0:
+        h = h + np.random.default_rng(1000 + seed).normal(0.0, bumps, h.shape)
+    return h, painting["pixel_size"]
+
+
 def shadow_agreement(
-    sector_counts=(3, 6, 9, 12, 18, 24, 36),
+    sector_counts=(6, 12, 18, 24, 36, 48),
     size: int = 256,
-    elevations_deg=(15.0, 30.0, 45.0),
-    n_azimuths: int = 16,
+    elevations_deg=(10.0, 15.0, 20.0, 30.0, 45.0, 60.0, 75.0),
+    n_azimuths: int = 8,
     max_steps: int = 32,
-    painting=None,
+    fields=SHADOW_FIELDS,
+    seed: int = 4,
+    step: float = 0.25,
     backend: str = "numba",
 ) -> dict:
-    """Share of pixels where horizon-map and ray-marched shadows disagree, per sector count.
+    """Share of pixels where horizon-map and ray-marched shadows disagree, per elevation.
 
     §3.5.3, Ferwerda. Lights at each elevation and ``n_azimuths`` azimuths offset from the sector
-    centres (raking light across a painting-like height field); both methods march the same steps,
-    so only the azimuth quantisation differs.
+    centres (raking light across a painting-like height field, :func:`shadow_field`). Both
+    methods march the same ``step``; the reference along the light's exact azimuth, the map along
+    sector centres, interpolated between them. Also measured, per elevation: the reference's own
+    error (``step`` against ``step / 2``) and the paper's first version (one-pixel steps, the
+    sector that holds φ, against a one-pixel reference) at 18 sectors.
 
     Returns
     -------
     dict
-        ``sectors``, ``disagreement`` (share of pixel-light pairs), ``shadowed`` (share of
-        pixel-light pairs in shadow by the reference).
+        ``elevation_deg``, ``sectors``, ``images`` (three-channel images per sector count),
+        ``fields`` (labels) and, per field, ``disagreement[field][sector][elevation]``,
+        ``reference_error[field][elevation]``, ``one_pixel_steps[field][elevation]``;
+        ``shadowed[field][elevation]`` (share in shadow by the reference).
 
     Examples
     --------
-    >>> r = shadow_agreement((4, 18), size=32, n_azimuths=4, max_steps=8)
-    >>> r["sectors"], all(0 <= v <= 1 for v in r["disagreement"])
-    ([4, 18], True)
+    >>> r = shadow_agreement((4, 18), 32, (15.0,), 4, 8, (("default", 1.0, 0.0),))
+    >>> r["sectors"], r["images"], all(0 <= v <= 1 for v in r["disagreement"]["default"][1])
+    ([4, 18], [2, 6], True)
     """
-    painting = painting or impasto_painting(size, seed=4)
-    h, pixel = painting["height"], painting["pixel_size"]
     azimuths = (np.arange(n_azimuths) + 0.37) * 2.0 * np.pi / n_azimuths
-    reference = {}
-    for beta in elevations_deg:
-        for phi in azimuths:
-            reference[(beta, phi)] = ray_march_shadows(
-                h, pixel, phi, np.radians(beta), max_steps, backend=backend
-            )
-    shadowed = float(np.mean([~lit for lit in reference.values()]))
-    out = {"sectors": [], "disagreement": [], "shadowed": shadowed}
-    for S in sector_counts:
-        hmap = horizon_map(h, pixel, int(S), max_steps, backend=backend)
-        wrong = [
-            np.mean(horizon_lookup(hmap, phi, np.radians(beta)) != lit)
-            for (beta, phi), lit in reference.items()
-        ]
-        out["sectors"].append(int(S))
-        out["disagreement"].append(float(np.mean(wrong)))
+    betas = np.radians(np.asarray(elevations_deg, dtype=np.float64))
+    out = {
+        "elevation_deg": [float(e) for e in elevations_deg],
+        "sectors": [int(S) for S in sector_counts],
+        "images": [-(-int(S) // 3) for S in sector_counts],
+        "fields": [f[0] for f in fields],
+        "step": float(step),
+        **{k: {} for k in ("disagreement", "reference_error", "one_pixel_steps", "shadowed")},
+    }
+    for label, relief, bumps in fields:
+        h, pixel = shadow_field(size, seed, relief, bumps)
+        for key, value in _shadow_field_study(
+            h, pixel, sector_counts, betas, azimuths, max_steps, step, backend
+        ).items():
+            out[key][label] = value
     return out
+
+
+def _shadow_field_study(h, pixel, sector_counts, betas, azimuths, max_steps, step, backend):
+    # shadow_agreement on one height field: per elevation, means over the azimuths
+    def march(phi, beta, d):
+        return ray_march_shadows(h, pixel, phi, beta, max_steps, backend=backend, step=d)
+
+    def per_beta(wrong):
+        return [float(np.mean([np.mean(wrong(b, p)) for p in azimuths])) for b in betas]
+
+    reference = {(b, p): march(p, b, step) for b in betas for p in azimuths}
+    half = {(b, p): march(p, b, step / 2) for b in betas for p in azimuths}
+    coarse = {(b, p): march(p, b, 1.0) for b in betas for p in azimuths}
+    # The paper's first version: one-pixel steps, the sector that holds φ, 18 sectors.
+    paper = horizon_map(h, pixel, 18, max_steps, backend=backend, step=1.0)
+    rows = []
+    for S in sector_counts:
+        hmap = horizon_map(h, pixel, int(S), max_steps, backend=backend, step=step)
+        rows.append(per_beta(lambda b, p, m=hmap: horizon_lookup(m, p, b) != reference[b, p]))
+    return {
+        "reference_error": per_beta(lambda b, p: reference[b, p] != half[b, p]),
+        "shadowed": per_beta(lambda b, p: ~reference[b, p]),
+        "one_pixel_steps": per_beta(
+            lambda b, p: horizon_lookup(paper, p, b, interpolate=False) != coarse[b, p]
+        ),
+        "disagreement": rows,
+    }
 
 
 def gloss_validation(

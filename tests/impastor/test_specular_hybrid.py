@@ -96,28 +96,56 @@ def test_hybrid_parts_are_the_two_methods_and_their_weighted_mean():
     assert ((w >= 0.0) & (w <= 1.0)).all()
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize(
-    ("seed", "kind"), [(2, "fluorescent"), (7, "fluorescent"), (5, "incandescent")]
+# Held-out cases for issue 22: painting seeds, lamp seeds and ceiling azimuths that the design
+# (validation.impastor_hybrid.TRAINING: painting seeds 2, 5, 7, ceilings at azimuth 0°, lamp 0)
+# never used. The peaked ceiling is cut from studio_small_03_1k.hdr (dynamic range ~10⁶).
+_MISSED = pytest.mark.xfail(
+    strict=True, reason="issue 22 (erratum E17): the hybrid misses the 1.5x bound on this case"
 )
-def test_hybrid_never_worse_than_the_better_method_by_ten_percent(seed, kind):
-    from impastor.painting import impasto_painting
-    from validation.impastor_lighting import specular_error_vs_alpha
+HELD_OUT_SUBSET = (
+    # measured: 2.34x at alpha = 0.03
+    pytest.param("env:studio_small_03_1k.hdr:75", 301, 32, 32, marks=_MISSED),
+    # measured: 3.21x at alpha = 0.03
+    pytest.param("env:StageEnvLatLong.exr:160", 302, 64, 16, marks=_MISSED),
+    ("lamp_panel:303", 303, 8, 64),
+    ("incandescent", 304, 32, 16),
+)
 
-    result = specular_error_vs_alpha(
-        (0.01, 0.03, 0.05, 0.07, 0.1, 0.3),
-        n_side=5,
-        light_resolution=(64, 32),
-        supersample=8,
-        painting=impasto_painting(128, seed=seed),
-        light_kind=kind,
-    )
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("light", "seed", "N", "K"), HELD_OUT_SUBSET)
+def test_hybrid_within_one_and_a_half_of_the_better_method_on_held_out_cases(light, seed, N, K):
+    from validation.impastor_hybrid import HybridCase, hybrid_case_ratios
+
+    result = hybrid_case_ratios(
+        HybridCase(seed, light, N, K), (0.01, 0.03, 0.1, 0.3), n_side=4, light_resolution=(32, 16),
+        supersample=4,
+    )  # fmt: skip
     best = np.minimum(result["median_cut"], result["fis"])
-    # The reference's own error (doubling the supersampling) is far below the methods' errors,
-    # so the comparison measures the methods, not the reference.
-    assert (np.asarray(result["reference_error"]) < 0.05 * best).all()
-    ratio = np.asarray(result["hybrid"]) / best
-    assert ratio.max() <= 1.1, dict(zip(result["alpha"], ratio.round(3), strict=True))
+    # The reference (brute force, 8² sub-pixels) is converged far below the methods' errors.
+    assert (np.asarray(result["reference_error"]) < 0.1 * best).all()
+    ratio = np.asarray(result["ratio"])
+    assert ratio.max() <= 1.5, dict(zip(result["alpha"], ratio.round(3), strict=True))
+
+
+@pytest.mark.xslow
+@pytest.mark.xfail(
+    strict=True,
+    reason="issue 22 (erratum E17): on held-out seeds 201-224 the hybrid is within 1.1x of the "
+    "better method in 88 % of (case, alpha) pairs, not 95 %, and up to 6.9x on one ceiling",
+)
+def test_hybrid_on_the_held_out_sweep():
+    # The whole held-out sweep of issue 22: 24 painting seeds (201-224), both booth lights, the
+    # lamp and panel, a ceiling cut from each shipped map, N in {8, 32, 64}, K in {16, 32, 64},
+    # the report's alpha grid, 36 points, 64 x 32 light images.
+    from validation.impastor_hybrid import held_out_cases, hybrid_case_ratios, ratio_distribution
+
+    ratios = []
+    for case in held_out_cases(24, first_seed=201):
+        ratios += hybrid_case_ratios(case, supersample=6)["ratio"]
+    summary = ratio_distribution(ratios)
+    assert summary["share_within_1.1"] >= 0.95, summary
+    assert summary["max"] <= 1.5, summary
 
 
 @pytest.mark.slow

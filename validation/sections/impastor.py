@@ -31,11 +31,11 @@ __all__ = [
 #: Targets of issue 6 for the held-out ColorChecker (mean, max ΔE00 per light, one matrix).
 TARGETS = {"box": (0.8, 2.2), "optimized": (0.25, 0.6)}
 #: Other targets of issue 6: metamers (ΔE00 under A below, under D65 above), the hybrid against
-#: the better of median cut and FIS, and horizon-map disagreement at the paper's 18 sectors.
+#: the better of median cut and FIS, and horizon-map disagreement at every elevation at the
+#: renderer's sector count (``impastor.painting.HORIZON_SECTORS``; issue 22).
 METAMER_TARGETS = {"A": 0.5, "D65": 3.0}
 HYBRID_LIMIT = 1.1
 SHADOW_LIMIT = 0.02
-SHADOW_SECTORS = 18
 #: The painting images: under these lights, lit by the paper's pipeline (the hybrid, §3.5.2).
 PAINTING_LIGHTS = ("D65", "A")
 PAINTING_METHOD = "hybrid"
@@ -55,7 +55,7 @@ class ImpastorSettings:
         Channel counts N of :func:`validation.impastor.channel_count_errors` (6 must be one).
     alpha, shadows, gloss, albedo : dict
         Keywords of :func:`validation.impastor_lighting.specular_error_vs_alpha`,
-        ``shadow_agreement`` (18 sectors must be among them), ``gloss_validation`` and
+        ``shadow_agreement`` (``HORIZON_SECTORS`` must be among them), ``gloss_validation`` and
         ``ward_duer_albedo``; defaults where empty.
     alpha_painting_size : int or None
         Side of the painting (seed 2) of the error-against-α study; None for the study's own.
@@ -87,7 +87,11 @@ QUICK = ImpastorSettings(
     (3, 6, 10),
     alpha=dict(alphas=(0.01, 0.05, 0.2), n_side=3, light_resolution=(32, 16), supersample=2),
     shadows=dict(
-        sector_counts=(6, 18), size=64, n_azimuths=4, elevations_deg=(15.0,), max_steps=16
+        sector_counts=(6, 18, 36),
+        size=64,
+        n_azimuths=4,
+        elevations_deg=(10.0, 30.0, 60.0),
+        max_steps=16,
     ),
     gloss=dict(gloss=((0.06, 0.02), (0.06, 0.15)), angles_deg=[6, 7.5, 10, 20]),
     alpha_painting_size=32,
@@ -100,7 +104,14 @@ TINY = ImpastorSettings(
     "numpy",
     (6,),
     alpha=dict(alphas=(0.05,), n_side=2, light_resolution=(16, 8), supersample=1),
-    shadows=dict(sector_counts=(18,), size=16, n_azimuths=2, elevations_deg=(15.0,), max_steps=4),
+    shadows=dict(
+        sector_counts=(36,),
+        size=16,
+        n_azimuths=2,
+        elevations_deg=(15.0,),
+        max_steps=4,
+        fields=(("default", 1.0, 0.0),),
+    ),
     gloss=dict(gloss=((0.06, 0.05),), angles_deg=[7.5]),
     albedo=dict(alphas=(0.1,), thetas_deg=(0.0, 60.0)),
     alpha_painting_size=16,
@@ -419,20 +430,45 @@ def _alpha_blocks(ctx, result) -> list:
 def _shadow_blocks(ctx, result) -> list:
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(5.5, 3.2))
-    ax.plot(result["sectors"], 100 * np.asarray(result["disagreement"]), marker="o")
-    ax.axhline(100 * SHADOW_LIMIT, color="gray", ls=":", label=f"target {100 * SHADOW_LIMIT:g} %")
-    ax.set_xlabel("azimuth sectors S")
-    ax.set_ylabel("pixels that disagree, %")
-    ax.legend()
-    ax.grid(alpha=0.3)
+    from impastor.painting import HORIZON_SECTORS
+
+    elevations, sectors = result["elevation_deg"], result["sectors"]
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.4))
+    for label in result["fields"]:
+        rows = np.asarray(result["disagreement"][label])
+        line = axes[0].plot(elevations, 100 * rows[sectors.index(HORIZON_SECTORS)], marker="o",
+                            label=f"{label}, {HORIZON_SECTORS} sectors")[0]  # fmt: skip
+        axes[0].plot(elevations, 100 * np.asarray(result["one_pixel_steps"][label]), ":",
+                     color=line.get_color(), label=f"{label}, first version")  # fmt: skip
+        axes[1].plot(result["images"], 100 * rows.max(axis=1), marker="o", label=label)
+    for ax in axes:
+        ax.axhline(100 * SHADOW_LIMIT, color="gray", ls="--", lw=0.8)
+        ax.set_ylabel("pixels that disagree, %")
+        ax.grid(alpha=0.3)
+    axes[0].set_xlabel("light elevation, degrees")
+    axes[1].set_xlabel("three-channel images stored (S / 3)")
+    axes[0].legend(fontsize=6)
+    axes[1].legend(fontsize=7)
+    rows = [
+        [label, e, 100 * result["reference_error"][label][k],
+         *(100 * np.asarray(result["disagreement"][label])[:, k])]
+        for label in result["fields"] for k, e in enumerate(elevations)
+    ]  # fmt: skip
     return [
         ctx.figure(
             "shadows",
             fig,
-            f"Horizon map vs ray-marched shadows (raking light; {100 * result['shadowed']:.1f} % "
-            "of pixel-light pairs in shadow)",
-        )
+            "Horizon map vs ray-marched shadows per light elevation (left: the renderer's sectors, "
+            "and dotted the first version: one-pixel steps, no interpolation; right: worst "
+            "elevation against storage)",
+        ),
+        Table(
+            ["field", "elevation °", "reference's own error %", *(f"S={S} %" for S in sectors)],
+            rows,
+            f"Pixels that disagree, per elevation ({result['step']:g}-pixel march; the "
+            "reference's own error is its march against one with half the step)",
+            "{:.3g}",
+        ),
     ]
 
 
@@ -536,10 +572,17 @@ def _colour_checks(channel_table: dict, metamers: dict) -> list:
 
 
 def _lighting_checks(alpha: dict, shadows: dict) -> list:
+    from impastor.painting import HORIZON_SECTORS
+
     ratio = _hybrid_over_best(alpha)
     worst = int(np.argmax(ratio))
-    sectors = list(shadows["sectors"])
-    share = shadows["disagreement"][sectors.index(SHADOW_SECTORS)]
+    row = shadows["sectors"].index(HORIZON_SECTORS)
+    worst_share, where = max(
+        (value, (label, e))
+        for label in shadows["fields"]
+        for value, e in zip(shadows["disagreement"][label][row], shadows["elevation_deg"],
+                            strict=True)
+    )  # fmt: skip
     return [
         Check(
             f"hybrid / better of median cut and FIS, worst α ({alpha['alpha'][worst]:g})",
@@ -548,10 +591,11 @@ def _lighting_checks(alpha: dict, shadows: dict) -> list:
             bool(ratio.max() <= HYBRID_LIMIT),
         ),
         Check(
-            f"horizon map ({SHADOW_SECTORS} sectors) vs ray-marched shadows, pixels that disagree",
-            f"<= {100 * SHADOW_LIMIT:g} %",
-            f"{100 * share:.3g} %",
-            share <= SHADOW_LIMIT,
+            f"horizon map ({HORIZON_SECTORS} sectors) vs ray-marched shadows, pixels that "
+            f"disagree at the worst field and elevation ({where[0]}, {where[1]:g}°)",
+            f"<= {100 * SHADOW_LIMIT:g} % at every elevation",
+            f"{100 * worst_share:.3g} %",
+            worst_share <= SHADOW_LIMIT,
         ),
     ]
 
@@ -587,8 +631,9 @@ def checks(data: SectionData) -> list[Check]:
     """One check per target of issue 6, from ``data.results`` alone.
 
     Six channels on the ColorChecker (:data:`TARGETS`, per design and booth light), metamers,
-    the hybrid against the better of median cut and FIS at every α, horizon-map shadows at 18
-    sectors, the display round trips, and the Ward–Dür white-furnace albedo (within its error).
+    the hybrid against the better of median cut and FIS at every α, horizon-map shadows at every
+    elevation at the renderer's sector count, the display round trips, and the Ward–Dür
+    white-furnace albedo (within its error).
 
     Examples
     --------
@@ -598,7 +643,8 @@ def checks(data: SectionData) -> list[Check]:
     ...     "channels": {design: six for design in TARGETS},
     ...     "metamers": {"A": {"pipeline": 0.1}, "D65": {"pipeline": 4.0}},
     ...     "error_vs_alpha": {"alpha": [0.1], "median_cut": [1], "fis": [0.1], "hybrid": [0.12]},
-    ...     "shadows": {"sectors": [18], "disagreement": [0.01]},
+    ...     "shadows": {"sectors": [36], "fields": ["default"], "elevation_deg": [10.0],
+    ...                 "disagreement": {"default": [[0.01]]}},
     ...     "display_round_trip": trip,
     ...     "ward_duer_albedo": {"albedo": [0.99], "error": [1e-4], "theta_deg": [60.0]},
     ... }
