@@ -38,10 +38,16 @@ from shrm.sh import SH_MAX_ORDER, n_coefficients
 from shrm.transform import project_latlong, synthesize_latlong
 
 __all__ = [
+    "BRIGHT_CONTRAST",
+    "BRIGHT_MAX",
+    "BRIGHT_SHARE",
     "SAFETY",
+    "BrightTexels",
     "OrderChoice",
     "accuracy_order",
+    "bright_texels",
     "degree_power",
+    "sparse_convolution",
     "truncation_error",
 ]
 
@@ -49,6 +55,126 @@ __all__ = [
 SAFETY = 0.5
 #: Highest degree the estimate resolves (and the highest order chosen).
 ESTIMATE_MAX_ORDER = 511
+#: A texel is lit exactly (not through SH) when it carries at least this share of the map's power.
+BRIGHT_SHARE = 1e-3
+#: At most this many texels are lit exactly, the brightest first.
+BRIGHT_MAX = 64
+#: ... and only texels at least this many times brighter than the map's mean luminance.
+BRIGHT_CONTRAST = 100.0
+
+
+@dataclass(frozen=True)
+class BrightTexels:
+    """The brightest texels of a map, lit exactly, and the scale that leaves the SH residual.
+
+    The residual map is ``radiance · scale`` (each selected texel clipped to the luminance of the
+    brightest texel not selected); the exact part is ``radiance · (1 − scale)`` at ``index``.
+
+    Attributes
+    ----------
+    index : ndarray of int, shape (K,)
+        Flat texel indices (row-major).
+    directions : ndarray, shape (K, 3)
+        Their pixel-centre directions.
+    weights : ndarray, shape (K,)
+        Their Fejér-1 quadrature weights (sr), as in :func:`shrm.prefilter.prefilter_bruteforce`.
+    scale : ndarray, shape (H, W)
+        1 except at the selected texels.
+    """
+
+    index: np.ndarray
+    directions: np.ndarray
+    weights: np.ndarray
+    scale: np.ndarray
+
+    def exact_part(self, radiance) -> np.ndarray:
+        """``radiance · (1 − scale)`` at the selected texels, ``(K, C)`` from ``(H, W, C)``."""
+        flat = np.asarray(radiance).reshape(-1, np.shape(radiance)[-1])
+        return flat[self.index] * (1.0 - self.scale.reshape(-1)[self.index])[:, None]
+
+
+def bright_texels(luminance) -> BrightTexels:
+    """The texels that carry :data:`BRIGHT_SHARE` of the power each and outshine the mean 100×.
+
+    At most :data:`BRIGHT_MAX`, the most powerful first.
+
+    Ours (erratum E75): a light in a few texels keeps its power to every SH degree, so no order a
+    1k map can hold reaches 2 % at the edge of its shadow; lit exactly, it costs K dot products
+    per pixel and leaves a residual that a low order represents.
+
+    Parameters
+    ----------
+    luminance : ndarray, shape (H, 2H)
+
+    Returns
+    -------
+    BrightTexels
+
+    Examples
+    --------
+    >>> Y = np.ones((8, 16)); Y[3, 5] = 1e5
+    >>> b = bright_texels(Y)
+    >>> b.index.tolist(), float(b.scale[3, 5])
+    ([53], 1e-05)
+    """
+    from reference.envmap import latlong_pixel_directions
+    from shrm.sh import fejer1_weights
+
+    Y = np.asarray(luminance, dtype=np.float64)
+    H, W = Y.shape
+    w = np.repeat(fejer1_weights(H) * (2.0 * np.pi / W), W)
+    power = np.maximum(Y.reshape(-1), 0.0) * w
+    order = np.argsort(power)[::-1]
+    top = order[:BRIGHT_MAX]
+    mean = power.sum() / (4.0 * np.pi)
+    keep = (power[top] >= BRIGHT_SHARE * power.sum()) & (
+        Y.reshape(-1)[top] >= BRIGHT_CONTRAST * mean
+    )
+    chosen = top[keep]
+    scale = np.ones(H * W)
+    if chosen.size:
+        rest = np.delete(Y.reshape(-1), chosen)
+        threshold = max(float(rest.max()), 0.0) if rest.size else 0.0
+        scale[chosen] = np.minimum(1.0, threshold / Y.reshape(-1)[chosen])
+    directions = latlong_pixel_directions(H, W).reshape(-1, 3)[chosen]
+    return BrightTexels(chosen, directions, w[chosen], scale.reshape(H, W))
+
+
+def sparse_convolution(values, directions, weights, kernel, normals) -> np.ndarray:
+    """``Σ_k K(ω_k · n) w_k L_k`` over a few texels: the angular convolution of the oracle.
+
+    Eq. (7), Ramamoorthi & Hanrahan 2001 in the angular domain, the sum of
+    :func:`shrm.prefilter.prefilter_bruteforce` restricted to the texels given.
+
+    Parameters
+    ----------
+    values : ndarray, shape (K, C)
+    directions : ndarray, shape (K, 3)
+    weights : ndarray, shape (K,)
+        Quadrature weights, sr.
+    kernel : str or RadialKernel
+    normals : ndarray, shape (N, 3)
+
+    Returns
+    -------
+    ndarray, shape (N, C)
+
+    Examples
+    --------
+    >>> sparse_convolution(np.ones((1, 1)), np.array([[0.0, 1.0, 0.0]]), np.array([0.5]),
+    ...                    "lambert", np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]))
+    array([[0.5],
+           [0. ]])
+    """
+    k = parse_kernel(kernel)
+    t = np.clip(np.asarray(normals, dtype=np.float64) @ np.asarray(directions).T, -1.0, 1.0)
+    if k.power is not None:
+        s, scale = k.power
+        K = np.where(t > 0.0, scale * np.maximum(t, 0.0) ** s, 0.0)
+    else:
+        K = k.profile(np.arccos(t))
+    # Eq. (7), Ramamoorthi & Hanrahan 2001, angular domain: Σ_k L_k K(ω_k · n) w_k
+    return (K * np.asarray(weights)) @ np.asarray(values, dtype=np.float64)
 
 
 @dataclass(frozen=True)
@@ -67,6 +193,8 @@ class OrderChoice:
         The truncation error of Y that :func:`truncation_error` measured at ``order``.
     band_limit : int
         The highest degree the estimate saw (``min(W/2 − 1, 511)``).
+    exact_texels : int
+        How many bright texels are lit exactly beside the SH residual (:func:`bright_texels`).
     met : bool
         Whether the estimate met ``SAFETY`` × both bounds (False only when the band limit was
         reached first; then the estimate, not the tolerance, is the honest bound).
@@ -80,13 +208,14 @@ class OrderChoice:
     estimate_max: float
     band_limit: int
     met: bool
+    exact_texels: int = 0
 
     def as_dict(self) -> dict:
         """Plain JSON-able dict (the render metadata's entry).
 
         Examples
         --------
-        >>> OrderChoice("lambert", 4, 5e-3, 2e-2, 1e-3, 4e-3, 63, True).as_dict()["order"]
+        >>> OrderChoice("lambert", 4, 5e-3, 2e-2, 1e-3, 4e-3, 63, True, 0).as_dict()["order"]
         4
         """
         return asdict(self)
@@ -121,7 +250,9 @@ def _truncate(coeffs: np.ndarray, L: int) -> np.ndarray:
     return coeffs[: n_coefficients(L)]
 
 
-def truncation_error(filtered, order: int, reference_map=None) -> tuple[float, float]:
+def truncation_error(
+    filtered, order: int, reference_map=None, exact_map=None
+) -> tuple[float, float]:
     """Mean and maximum relative error of the order-L truncation of a prefiltered map.
 
     Over the directions of a lat-long grid (``L_max + 1`` rows) where the full map is at least
@@ -135,6 +266,8 @@ def truncation_error(filtered, order: int, reference_map=None) -> tuple[float, f
         The candidate order L ≤ L_max.
     reference_map : ndarray, optional
         The order-``L_max`` synthesis, if already computed.
+    exact_map : ndarray, optional
+        A part computed exactly (the bright texels) on the same grid, added to both.
 
     Returns
     -------
@@ -144,7 +277,7 @@ def truncation_error(filtered, order: int, reference_map=None) -> tuple[float, f
     --------
     >>> c = np.zeros(9); c[0] = 3.0; c[6] = 0.3           # a constant plus a little Y_20
     >>> [round(v, 3) for v in truncation_error(c, 1)]
-    [0.07, 0.2]
+    [0.124, 0.126]
     """
     filtered = np.asarray(filtered, dtype=np.float64)
     L_max = round(np.sqrt(filtered.size)) - 1
@@ -152,6 +285,9 @@ def truncation_error(filtered, order: int, reference_map=None) -> tuple[float, f
         reference_map = synthesize_latlong(filtered, L_max + 1, backend="ducc0")
     H = reference_map.shape[0]
     approx = synthesize_latlong(_truncate(filtered, order), H, backend="ducc0")
+    if exact_map is not None:
+        approx = approx + exact_map
+        reference_map = reference_map + exact_map
     lit = reference_map >= LIT_FRACTION * reference_map.max()
     relative = np.abs(approx - reference_map)[lit] / reference_map[lit]
     theta = (np.arange(H) + 0.5) * np.pi / H
@@ -159,7 +295,9 @@ def truncation_error(filtered, order: int, reference_map=None) -> tuple[float, f
     return float(np.sum(relative * weight) / np.sum(weight)), float(relative.max())
 
 
-def accuracy_order(luminance, kernel, tol: float = DEFAULT_ACCURACY, where: str = "environment"):
+def accuracy_order(
+    luminance, kernel, tol: float = DEFAULT_ACCURACY, where: str = "environment", bright=None
+):
     """The smallest order whose truncation error of Y meets ``SAFETY`` × the tolerance.
 
     Eq. (7), Ramamoorthi & Hanrahan 2001 (``E_lm = Λ_l L_lm``) on the luminance map; the error is
@@ -176,6 +314,9 @@ def accuracy_order(luminance, kernel, tol: float = DEFAULT_ACCURACY, where: str 
         Mean relative error of Y over lit directions; the maximum is :data:`MAX_FACTOR` × tol.
     where : str
         Name for messages.
+    bright : BrightTexels, optional
+        Texels lit exactly: the order is chosen for the residual map, the error measured on the
+        sum (:func:`bright_texels`).
 
     Returns
     -------
@@ -192,7 +333,16 @@ def accuracy_order(luminance, kernel, tol: float = DEFAULT_ACCURACY, where: str 
     require(luminance.ndim == 2, f"{where}: luminance must be (H, W), got {luminance.shape}")
     k = parse_kernel(kernel)
     L_max = min(luminance.shape[1] // 2 - 1, ESTIMATE_MAX_ORDER, SH_MAX_ORDER)
-    coeffs = project_latlong(luminance[..., None], L_max, backend="ducc0", where=where)[0]
+    exact_map, residual = None, luminance
+    if bright is not None and bright.index.size:
+        from reference.envmap import latlong_pixel_directions
+
+        residual = luminance * bright.scale
+        grid = latlong_pixel_directions(L_max + 1, 2 * L_max + 2).reshape(-1, 3)
+        values = bright.exact_part(luminance[..., None])
+        exact_map = sparse_convolution(values, bright.directions, bright.weights, k, grid)
+        exact_map = exact_map.reshape(L_max + 1, 2 * L_max + 2)
+    coeffs = project_latlong(residual[..., None], L_max, backend="ducc0", where=where)[0]
     # Eq. (7), Ramamoorthi & Hanrahan 2001: E_lm = Λ_l L_lm
     l = np.repeat(np.arange(L_max + 1), 2 * np.arange(L_max + 1) + 1)
     filtered = k.Lambda(L_max)[l] * coeffs
@@ -200,7 +350,7 @@ def accuracy_order(luminance, kernel, tol: float = DEFAULT_ACCURACY, where: str 
     tol_max = MAX_FACTOR * tol
 
     def meets(L):
-        mean, worst = truncation_error(filtered, L, full)
+        mean, worst = truncation_error(filtered, L, full, exact_map)
         return mean <= SAFETY * tol and worst <= SAFETY * tol_max, (mean, worst)
 
     lo, hi = -1, L_max  # meets(L_max) holds trivially (zero error)
@@ -212,4 +362,5 @@ def accuracy_order(luminance, kernel, tol: float = DEFAULT_ACCURACY, where: str 
             lo = mid
     _, (mean, worst) = meets(hi)
     # At the band limit the estimate sees no tail, so it cannot promise the tolerance.
-    return OrderChoice(k.name, int(hi), tol, tol_max, mean, worst, L_max, hi < L_max)
+    K = 0 if bright is None else int(bright.index.size)
+    return OrderChoice(k.name, int(hi), tol, tol_max, mean, worst, L_max, hi < L_max, K)

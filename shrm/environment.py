@@ -47,7 +47,7 @@ from reference.render_metadata import DEFAULT_ACCURACY, check_accuracy
 from reference.shading import SHADERS, Surface
 from reference.spectra import SpectralGrid
 from reference.upsampling import DEFAULT_UPSAMPLING, RGB_to_radiance_spectra
-from shrm.accuracy import accuracy_order
+from shrm.accuracy import accuracy_order, bright_texels, sparse_convolution
 from shrm.lobes import adaptive_order, kernel_phong, parse_kernel
 from shrm.prefilter import prefilter_bruteforce, prefilter_coefficients
 from shrm.sh import sh_evaluate
@@ -124,14 +124,40 @@ def phong_environment_Lambda(n, order: int) -> np.ndarray:
     return np.stack([unique[float(v)] for v in n])
 
 
+def _bright(light, ctx):
+    """The texels lit exactly (``shrm.accuracy.bright_texels``), or None on the legacy rule."""
+    if "environment_tol" in ctx.options:
+        return None
+    state = _state(light, ctx)
+    if "bright" not in state:
+        state["bright"] = bright_texels(_luminance(light, ctx))
+    return state["bright"]
+
+
+def _exact_part(light, ctx, kernel, directions) -> np.ndarray:
+    """The bright texels' share of the prefiltered map at ``directions``, (N, n_bands), or 0."""
+    bright = _bright(light, ctx)
+    if bright is None or not bright.index.size:
+        return 0.0
+    values = bright.exact_part(_state(light, ctx)["radiance"])
+    return sparse_convolution(values, bright.directions, bright.weights, kernel, directions)
+
+
 def _frequency_map(light, ctx, name: str, kernel_order: int, Lambda) -> np.ndarray:
-    """Cached cube map (6, S, S, n_bands) of the environment prefiltered with Λ (per band)."""
+    """Cached cube map (6, S, S, n_bands) of the environment prefiltered with Λ (per band).
+
+    Without the bright texels (:func:`_exact_part` adds them) unless the legacy rule is in use.
+    """
     state = _state(light, ctx)
     # Cube faces fine enough for the order (bilinear lookup), 64 to 256 texels (erratum E76)
     size = int(ctx.options.get("environment_size", min(256, max(64, 2 * kernel_order))))
-    key = (name, kernel_order, size)
+    bright = _bright(light, ctx)
+    key = (name, kernel_order, size, bright is not None)
     if key not in state:
-        coeffs = project_latlong(state["radiance"], kernel_order, backend="ducc0", where=light.name)
+        radiance = state["radiance"]
+        if bright is not None:
+            radiance = radiance * bright.scale[..., None]
+        coeffs = project_latlong(radiance, kernel_order, backend="ducc0", where=light.name)
         filtered = prefilter_coefficients(coeffs, Lambda)
         state[key] = sh_evaluate(filtered, cubemap_texel_directions(size), backend="ducc0")
     return state[key]
@@ -162,7 +188,9 @@ def _order(light, ctx, kernel) -> int:
     state = _state(light, ctx)
     key = ("order", kernel.name, tol)
     if key not in state:
-        state[key] = accuracy_order(_luminance(light, ctx), kernel, tol, where=light.name)
+        state[key] = accuracy_order(
+            _luminance(light, ctx), kernel, tol, light.name, _bright(light, ctx)
+        )
     choice = state[key]
     ctx.record("environment", f"{light.name}:{kernel.name}", choice.as_dict())
     return choice.order
@@ -176,7 +204,8 @@ def _irradiance(surface: Surface, light, ctx) -> np.ndarray:
         return prefilter_bruteforce(radiance, "lambert", surface.normal)
     L = _order(light, ctx, "lambert")
     cube = _frequency_map(light, ctx, "lambert", L, parse_kernel("lambert").Lambda(L))
-    return cubemap_lookup_bilinear(cube, surface.normal, backend="numba")
+    E = cubemap_lookup_bilinear(cube, surface.normal, backend="numba")
+    return E + _exact_part(light, ctx, "lambert", surface.normal)
 
 
 def shade_lambert_environment(
@@ -241,6 +270,12 @@ def shade_phong_environment(
         name = "phong:" + ",".join(f"{v:g}" for v in material.n)
         cube = _frequency_map(light, ctx, name, L, Lam)
         specular = cubemap_lookup_bilinear(cube, r, backend="numba")
+        for value in np.unique(material.n):
+            bands = material.n == value
+            # the bright texels, exactly: the lobe max(t,0)^n/π is the normalized one × 2/(n+1)
+            exact = _exact_part(light, ctx, kernel_phong(value), r)
+            if not np.isscalar(exact):
+                specular[:, bands] += (2.0 / (value + 1.0)) * exact[:, bands]
     # Eq. (2), Wang et al., environment form: k_d E/π + k_s S_n(r)
     spectra = diffuse + material.k_s * specular
     return spectra @ ctx.weights(None)
