@@ -59,7 +59,7 @@ ESTIMATE_MAX_ORDER = 511
 BRIGHT_SHARE = 1e-3
 #: At most this many texels are lit exactly, the brightest first.
 BRIGHT_MAX = 64
-#: ... and only texels at least this many times brighter than the map's mean luminance.
+#: ... and only texels at least this many times brighter than the map's median luminance.
 BRIGHT_CONTRAST = 100.0
 
 
@@ -94,7 +94,7 @@ class BrightTexels:
 
 
 def bright_texels(luminance) -> BrightTexels:
-    """The texels that carry :data:`BRIGHT_SHARE` of the power each and outshine the mean 100×.
+    """The texels that carry :data:`BRIGHT_SHARE` of the power each and outshine the median 100×.
 
     At most :data:`BRIGHT_MAX`, the most powerful first.
 
@@ -126,9 +126,8 @@ def bright_texels(luminance) -> BrightTexels:
     power = np.maximum(Y.reshape(-1), 0.0) * w
     order = np.argsort(power)[::-1]
     top = order[:BRIGHT_MAX]
-    mean = power.sum() / (4.0 * np.pi)
     keep = (power[top] >= BRIGHT_SHARE * power.sum()) & (
-        Y.reshape(-1)[top] >= BRIGHT_CONTRAST * mean
+        Y.reshape(-1)[top] >= BRIGHT_CONTRAST * max(float(np.median(Y)), 0.0)
     )
     chosen = top[keep]
     scale = np.ones(H * W)

@@ -138,7 +138,7 @@ def error_by_order(luminance, kernel, orders, directions, split: bool = True) ->
     bright = bright_texels(luminance) if split else None
     chosen = accuracy_order(luminance, k, bright=bright).as_dict()
     band_limit = luminance.shape[1] // 2 - 1
-    orders = sorted({int(L) for L in orders if L <= band_limit} | {chosen["order"]})
+    orders = sorted({int(L) for L in orders if band_limit >= L} | {chosen["order"]})
     residual, exact_part = luminance, 0.0
     if bright is not None:
         residual = luminance * bright.scale
@@ -146,8 +146,8 @@ def error_by_order(luminance, kernel, orders, directions, split: bool = True) ->
         exact_part = sparse_convolution(values, bright.directions, bright.weights, k, directions)
         exact_part = exact_part[:, 0]
     coeffs = project_latlong(residual[..., None], orders[-1], backend="ducc0")[0]
-    l = np.repeat(np.arange(orders[-1] + 1), 2 * np.arange(orders[-1] + 1) + 1)
-    filtered = k.Lambda(orders[-1])[l] * coeffs
+    degree = np.repeat(np.arange(orders[-1] + 1), 2 * np.arange(orders[-1] + 1) + 1)
+    filtered = k.Lambda(orders[-1])[degree] * coeffs
     out = {"orders": orders, "mean": [], "max": []}
     for L in orders:
         # Eq. (7), Ramamoorthi & Hanrahan 2001: E = Σ_{l<=L} Λ_l L_lm Y_lm
@@ -156,7 +156,7 @@ def error_by_order(luminance, kernel, orders, directions, split: bool = True) ->
         mean, worst = relative_errors(approx, exact)
         out["mean"].append(mean)
         out["max"].append(worst)
-        if L == chosen["order"]:
+        if chosen["order"] == L:
             chosen["measured_mean"], chosen["measured_max"] = mean, worst
     out["chosen"] = chosen
     return out
