@@ -134,8 +134,15 @@ def present(ctx: ReportContext, data: SectionData) -> list:
         Table(
             ["map", "kernel", "order", "exact texels", "estimated max", "measured mean", "max"],
             [
-                [name, k, c["order"], c["exact_texels"], c["estimate_max"]]
-                + [c["measured_mean"], c["measured_max"]]
+                [
+                    name,
+                    k,
+                    c["order"],
+                    c["exact_texels"],
+                    c["estimate_max"],
+                    c["measured_mean"],
+                    c["measured_max"],
+                ]
                 for name, per in data.results["by_order"].items()
                 for k, c in ((k, v["chosen"]) for k, v in per.items())
             ],
@@ -144,11 +151,27 @@ def present(ctx: ReportContext, data: SectionData) -> list:
             "{:.3g}",
         ),
         Table(
-            ["map", "old order", "old mean", "old max", "new order", "exact texels"]
-            + ["new mean", "new max"],
             [
-                [name, r["old"]["order"], r["old"]["mean"], r["old"]["max"], r["new"]["order"]]
-                + [r["new"]["exact_texels"], r["new"]["mean"], r["new"]["max"]]
+                "map",
+                "old order",
+                "old mean",
+                "old max",
+                "new order",
+                "exact texels",
+                "new mean",
+                "new max",
+            ],
+            [
+                [
+                    name,
+                    r["old"]["order"],
+                    r["old"]["mean"],
+                    r["old"]["max"],
+                    r["new"]["order"],
+                    r["new"]["exact_texels"],
+                    r["new"]["mean"],
+                    r["new"]["max"],
+                ]
                 for name, r in renders.items()
             ],
             "Lambertian sphere (ρ = 0.5), default render against --oracle, relative error of Y "
