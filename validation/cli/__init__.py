@@ -15,6 +15,7 @@ from reference.errors import SpecrefError
 from validation.cli import (
     brdf,
     cache,
+    compare,
     display,
     env,
     equations,
@@ -44,6 +45,7 @@ COMMANDS = (
     impastor,
     phong,
     equations,
+    compare,
 )
 
 
