@@ -110,13 +110,13 @@ def test_compare_bad_input(tmp_path):
     with pytest.raises(SpecrefError, match=r"small.exr: size 2×1 differs from .*b.exr's 2×2"):
         compare_images(small, b)
     odd = write_exr(tmp_path / "odd.exr", np.ones((2, 2, 2)), ["depth", "alpha"])
-    with pytest.raises(SpecrefError, match="odd.exr: no X, Y, Z, no R, G, B and no spectral"):
+    with pytest.raises(SpecrefError, match=r"odd\.exr: no X, Y, Z, no R, G, B and no spectral"):
         compare_images(odd, b)
     (tmp_path / "junk.exr").write_bytes(b"not an exr")
-    with pytest.raises(SpecrefError, match="junk.exr: cannot read OpenEXR image"):
+    with pytest.raises(SpecrefError, match=r"junk\.exr: cannot read OpenEXR image"):
         compare_images(tmp_path / "junk.exr", b)
     with pytest.raises(SpecrefError, match="compare reads linear images"):
         compare_images(tmp_path / "a.png", b)
     write_png(tmp_path / "m.png", np.ones((3, 3, 3)))
-    with pytest.raises(SpecrefError, match="m.png: mask size 3×3 differs"):
+    with pytest.raises(SpecrefError, match=r"m\.png: mask size 3×3 differs"):
         compare_images(b, b, tmp_path / "m.png")
