@@ -91,14 +91,45 @@ def check_accuracy(tol, where: str = "--accuracy") -> float:
 
 
 def _display(result):
+    """Linear display RGB (Eq. (5), Wang et al.) of a render and its channel names.
+
+    Examples
+    --------
+    >>> from reference.render import render_scene
+    >>> from reference.scene import loads_scene
+    >>> image, names = _display(render_scene(loads_scene(""), 4, 2))
+    >>> image.shape, names
+    ((2, 4, 3), ['R', 'G', 'B'])
+    """
     return result.RGB_linear, ["R", "G", "B"]
 
 
 def _xyz(result):
+    """CIE XYZ (Eq. (4), Wang et al.; Y = 1 for a white diffuser) of a render and its channels.
+
+    Examples
+    --------
+    >>> from reference.render import render_scene
+    >>> from reference.scene import loads_scene
+    >>> _xyz(render_scene(loads_scene(""), 4, 2))[1]
+    ['X', 'Y', 'Z']
+    """
     return result.XYZ, ["X", "Y", "Z"]
 
 
 def _spectral(result):
+    """Relative spectral radiance per band (the terms of Eq. (4), Wang et al.) and its channels.
+
+    Channel names of the spectral OpenEXR layout (Fichet et al. 2021).
+
+    Examples
+    --------
+    >>> from reference.render import render_scene
+    >>> from reference.scene import loads_scene
+    >>> image, names = _spectral(render_scene(loads_scene(""), 4, 2, spectral=True))
+    >>> image.shape, names[0]
+    ((2, 4, 41), 'S0.380,000000nm')
+    """
     require(result.spectral is not None, "spectral output: the render has no spectral image")
     return result.spectral, spectral_channel_names(result.scene.grid.wavelengths_nm)
 
