@@ -61,9 +61,7 @@ def add_parser(sub) -> None:
         p,
         "--exr-output",
         RENDER_OUTPUTS,
-        "EXR content: display is linear display RGB before exposure, xyz is CIE XYZ (Y = 1 for "
-        "a white diffuser under the light), spectral is relative spectral radiance with spectral "
-        "OpenEXR channel names (docs/render-outputs.md)",
+        "what the EXR holds, see docs/render-outputs.md",
         default="display",
     )
     p.add_argument(
