@@ -27,6 +27,7 @@ ENVIRONMENTS = (
 MEASURED = 'type = "lambert"\nk_d = { csv = "%s", row = 0, extrapolation = "constant" }'
 
 
+@pytest.mark.slow  # a 1k map through the default path and the oracle: 5-20 s
 @pytest.mark.parametrize("name", ENVIRONMENTS)
 def test_default_render_meets_the_promised_bound_on_shipped_environments(shared_data, name):
     # Source: brute force (specref render --oracle, the per-pixel angular integral). The default
@@ -41,6 +42,7 @@ def test_default_render_meets_the_promised_bound_on_shipped_environments(shared_
     assert choice["met"]
 
 
+@pytest.mark.slow  # a 1k map through the default path and the oracle: 5-20 s
 def test_default_render_meets_the_bound_for_a_measured_reflectance(shared_data):
     # Source: brute force. A measured brick reflectance (held-out: the order estimate reads only
     # the light) under the environment that broke the old default.
@@ -53,6 +55,7 @@ def test_default_render_meets_the_bound_for_a_measured_reflectance(shared_data):
     assert found["max"] <= MAX_FACTOR * DEFAULT_ACCURACY
 
 
+@pytest.mark.slow  # a 1k map through the default path and the oracle: 5-20 s
 def test_phong_environment_path_meets_the_bound(shared_data):
     # Source: brute force. The Phong-prefiltered maps choose their order by the same rule.
     material = 'type = "phong"\nk_d = 0.3\nk_s = 0.5\nn = 40'
@@ -64,6 +67,7 @@ def test_phong_environment_path_meets_the_bound(shared_data):
     assert kernels == {"lambert", "phong:40"}
 
 
+@pytest.mark.slow  # a 1k map through the default path and the oracle: 5-20 s
 @pytest.mark.parametrize("name", ["single texel", "sun disc"])
 def test_worst_cases_meet_the_bound_in_a_render(tmp_path, name):
     # Source: brute force, on synthetic maps where the energy sits in a texel or a small disc.
