@@ -166,14 +166,19 @@ def sparse_convolution(values, directions, weights, kernel, normals) -> np.ndarr
            [0. ]])
     """
     k = parse_kernel(kernel)
-    t = np.clip(np.asarray(normals, dtype=np.float64) @ np.asarray(directions).T, -1.0, 1.0)
-    if k.power is not None:
-        s, scale = k.power
-        K = np.where(t > 0.0, scale * np.maximum(t, 0.0) ** s, 0.0)
-    else:
-        K = k.profile(np.arccos(t))
-    # Eq. (7), Ramamoorthi & Hanrahan 2001, angular domain: Σ_k L_k K(ω_k · n) w_k
-    return (K * np.asarray(weights)) @ np.asarray(values, dtype=np.float64)
+    normals = np.asarray(normals, dtype=np.float64)
+    values = np.asarray(values, dtype=np.float64)
+    out = np.empty((normals.shape[0], values.shape[1]))
+    for start in range(0, normals.shape[0], 1 << 15):  # bounded temporaries
+        t = np.clip(normals[start : start + (1 << 15)] @ np.asarray(directions).T, -1.0, 1.0)
+        if k.power is not None:
+            s, scale = k.power
+            K = np.where(t > 0.0, scale * np.maximum(t, 0.0) ** s, 0.0)
+        else:
+            K = k.profile(np.arccos(t))
+        # Eq. (7), Ramamoorthi & Hanrahan 2001, angular domain: Σ_k L_k K(ω_k · n) w_k
+        out[start : start + (1 << 15)] = (K * np.asarray(weights)) @ values
+    return out
 
 
 @dataclass(frozen=True)
