@@ -199,7 +199,7 @@ def _order_chart(ctx, by_order):
     axes[0].set_ylabel("relative error of Y (max —, mean ···)")
     axes[0].legend(fontsize=7)
     return ctx.figure(
-        "sh-order",
+        "error-vs-order",
         fig,
         "Error against order, SH alone; dots: the default rule's order with bright texels lit "
         "exactly (its max error); dashed: the promised max, dotted: the promised mean",
