@@ -29,7 +29,8 @@ radiance spectra carry no light to fold in.
 Options read from ``ctx.options``: ``environment`` (``"frequency"`` default, or ``"bruteforce"``),
 ``environment_accuracy`` (mean relative error of Y, default :data:`shrm.accuracy.DEFAULT_ACCURACY`),
 ``environment_tol`` (the older kernel-only tail tolerance of :func:`shrm.lobes.adaptive_order`;
-when given it replaces the accuracy rule), ``environment_size`` (cube face), ``upsampling``, ``upsampling_model``.
+when given it replaces the accuracy rule), ``environment_size`` (cube face), ``upsampling``,
+``upsampling_model``.
 """
 
 from __future__ import annotations
