@@ -67,6 +67,13 @@ MAX_FACTOR = 4.0
 LIT_FRACTION = 0.01
 
 
+def _placement_rows(name: str) -> str:
+    # the row convention the light's texel placement reads its map with (reference.envmap)
+    from reference.envmap import TEXEL_PLACEMENTS
+
+    return str(TEXEL_PLACEMENTS.lookup(name).extra.get("rows", name))
+
+
 def check_accuracy(tol, where: str = "--accuracy") -> float:
     """A mean-relative-error tolerance in (0, 0.25], or a one-line SpecrefError.
 
@@ -194,7 +201,8 @@ def _environments(scene) -> list[dict]:
                     "name": light.name,
                     "spectral": bool(light.is_spectral),
                     "upsampling": None if light.is_spectral else upsampling,
-                    "rows": getattr(light, "rows", "pixel-centred (v = (j + 1/2)/H, Fejer-1)"),
+                    "texel_placement": light.texel_placement,
+                    "rows": _placement_rows(light.texel_placement),
                     "intensity": float(light.intensity),
                 }
             )
