@@ -271,11 +271,13 @@ def demo_images(env, settings: OracleStudy, maps: dict, references: dict) -> dic
     -------
     dict
         (size, size, n_bands) spectra ``I_d``, ``I_s F_r``, ``I_trans (1 - F_r)``, ``I_effect``,
-        ``hybrid``, ``oracle``; (size, size) ``delta_E``; ``mask``.
+        ``hybrid``, ``oracle`` and the oracle's terms (``oracle specular``, ``oracle body``,
+        ``oracle transmission``); (size, size) ``delta_E``; ``mask``.
     """
     mask, N, V = _sphere(settings.size)
     terms = _hybrid(N, V, maps, characterize_model(), BASE, "fresnel")
-    oracle = references[BASE["gloss"]].result
+    reference = references[BASE["gloss"]]
+    oracle = reference.result
     pieces = {
         "I_d": terms["I_d"],
         "I_s F_r": terms["I_s"] * terms["F_r"],
@@ -283,6 +285,9 @@ def demo_images(env, settings: OracleStudy, maps: dict, references: dict) -> dic
         "I_effect": terms["I_effect"],
         "hybrid": terms["I_result"],
         "oracle": oracle,
+        "oracle specular": reference.specular,
+        "oracle body": reference.body,
+        "oracle transmission": reference.transmission,
     }
     out: dict = {"mask": mask}
     for name, values in pieces.items():
@@ -295,29 +300,37 @@ def demo_images(env, settings: OracleStudy, maps: dict, references: dict) -> dic
 
 
 def failures(sweep: dict, threshold: float = FAIL_DELTA_E) -> list[str]:
-    """Sentences: per sweep and M_s, where the mean ΔE00 exceeds ``threshold``, and the worst case.
+    """Sentences: per sweep and M_s, where the mean ΔE00 (object, rim) exceeds ``threshold``.
 
     Examples
     --------
     >>> stats = {"mean": 3.0, "p95": 7.0, "max": 9.0, "centre": 1.0, "rim": 6.0}
     >>> print(failures({"gloss": {"values": [0.5], "fresnel": [stats]}})[0])
-    gloss, M_s = fresnel: mean ΔE00 > 2 at 0.5; worst at 0.5: mean 3.00, p95 7.0, max 9.0
-    (rim 6.00, centre 1.00)
+    gloss, M_s = fresnel: object mean > 2 at 0.5, rim mean > 2 at 0.5; worst at 0.5: mean 3.00,
+    p95 7.0, max 9.0, rim 6.00, centre 1.00
     """
     sentences = []
     for axis, row in sweep.items():
         for mirror in (k for k in row if k != "values"):
             stats = row[mirror]
             worst = int(np.argmax([s["mean"] for s in stats]))
-            bad = [
-                f"{v:g}" for v, s in zip(row["values"], stats, strict=True) if s["mean"] > threshold
-            ]
+            where = {
+                part: [
+                    f"{v:g}"
+                    for v, s in zip(row["values"], stats, strict=True)
+                    if s[key] > threshold
+                ]
+                for part, key in (("object", "mean"), ("rim", "rim"))
+            }
             w = stats[worst]
+            said = ", ".join(
+                f"{part} mean > {threshold:g} at {', '.join(v) if v else 'no value'}"
+                for part, v in where.items()
+            )
             sentences.append(
-                f"{axis}, M_s = {mirror}: mean ΔE00 > {threshold:g} at "
-                f"{', '.join(bad) if bad else 'no value'}; worst at {row['values'][worst]:g}: "
-                f"mean {w['mean']:.2f}, p95 {w['p95']:.1f}, max {w['max']:.1f} "
-                f"(rim {w['rim']:.2f}, centre {w['centre']:.2f})"
+                f"{axis}, M_s = {mirror}: {said}; worst at {row['values'][worst]:g}: "
+                f"mean {w['mean']:.2f}, p95 {w['p95']:.1f}, max {w['max']:.1f}, "
+                f"rim {w['rim']:.2f}, centre {w['centre']:.2f}"
             )
     return sentences
 
@@ -341,14 +354,52 @@ def furnace_error(n: float = 1.54, height: int = 64) -> float:
     return float(np.abs(out.result / expected - 1.0).max())
 
 
+#: The hybrid's terms and the oracle's that play the same part.
+COUNTERPARTS = (
+    ("I_s F_r", "oracle specular"),
+    ("I_d", "oracle body"),
+    ("I_trans (1 - F_r)", "oracle transmission"),
+)
+
+
+def term_balance(images: dict) -> dict:
+    """Band-mean radiance of matching terms at the rim and the centre of the sphere.
+
+    Examples
+    --------
+    >>> images = {name: np.ones((2, 2, 3)) for pair in COUNTERPARTS for name in pair}
+    >>> images["mask"] = np.ones((2, 2), bool)
+    >>> term_balance(images)["I_d"]["rim"]
+    {'hybrid': 1.0, 'oracle': 1.0}
+    """
+    mask = images["mask"]
+    size = mask.shape[0]
+    x = (np.arange(size) + 0.5) / size * 2.0 - 1.0
+    X, Y = np.meshgrid(x, -x)
+    cos = np.sqrt(np.clip(1.0 - X**2 - Y**2, 0.0, 1.0))
+    parts = {"rim": mask & (cos < 0.3), "centre": mask & (cos > 0.7)}
+    return {
+        hybrid: {
+            part: {
+                "hybrid": float(images[hybrid][where].mean()),
+                "oracle": float(images[oracle][where].mean()),
+            }
+            for part, where in parts.items()
+        }
+        for hybrid, oracle in COUNTERPARTS
+    }
+
+
 def oracle_study(env, name: str) -> tuple[dict, dict]:
     """Everything the section shows of the oracle comparison: (results, arrays).
 
     Examples
     --------
     >>> results, arrays = oracle_study(np.ones((16, 32, 41)), "tiny")
-    >>> sorted(results), arrays["delta_E"].shape
-    (['failures', 'furnace_error', 'maps_seconds', 'settings', 'speed', 'sweeps'], (10, 10))
+    >>> sorted(results)
+    ['balance', 'failures', 'furnace_error', 'maps_seconds', 'settings', 'speed', 'sweeps']
+    >>> arrays["delta_E"].shape
+    (10, 10)
     """
     settings = SETTINGS[name]
     maps, seconds = hybrid_maps(env, sorted({*settings.gloss, BASE["gloss"]}))
@@ -362,4 +413,6 @@ def oracle_study(env, name: str) -> tuple[dict, dict]:
         "failures": failures(sweep),
         "furnace_error": furnace_error(),
     }
-    return results, demo_images(env, settings, maps, references)
+    images = demo_images(env, settings, maps, references)
+    results["balance"] = term_balance(images)
+    return results, images
