@@ -457,8 +457,8 @@ def effect_shrm(
     Examples
     --------
     >>> s = effect_shrm(np.ones((8, 16, 41)), F=2, P=2, size=2)
-    >>> s.frame, s.values.shape[-1]
-    ('reflection', 41)
+    >>> s.frame, s.coeffs.shape[:4]
+    ('reflection', (6, 2, 2, 41))
     """
     from reference.spectra import DEFAULT_GRID
     from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts
