@@ -367,8 +367,8 @@ def term_balance(images: dict) -> dict:
 
     Examples
     --------
-    >>> images = {name: np.ones((2, 2, 3)) for pair in COUNTERPARTS for name in pair}
-    >>> images["mask"] = np.ones((2, 2), bool)
+    >>> images = {name: np.ones((8, 8, 3)) for pair in COUNTERPARTS for name in pair}
+    >>> images["mask"] = np.ones((8, 8), bool)
     >>> term_balance(images)["I_d"]["rim"]
     {'hybrid': 1.0, 'oracle': 1.0}
     """
