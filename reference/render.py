@@ -80,6 +80,9 @@ class RenderResult:
         Seconds spent in ``"gbuffer"``, ``"shading"`` and ``"display"``, and the ``"total"``.
     scene : Scene
         The scene as rendered (with any size override).
+    metadata : dict
+        What the shaders did, one key per shader family (``ShadingContext.metadata``): e.g.
+        ``"shrm"``, the settings and promised bound of isotropic BRDFs under environments.
     """
 
     XYZ: np.ndarray
@@ -89,6 +92,7 @@ class RenderResult:
     supersample: int
     timings: dict = field(default_factory=dict)
     scene: Scene | None = None
+    metadata: dict = field(default_factory=dict)
 
 
 def check_shaders(scene: Scene) -> None:
@@ -217,7 +221,9 @@ def background_XYZ(scene: Scene, directions) -> np.ndarray:
     return (values @ to_grid.T) @ W_E
 
 
-def shade_scene(scene: Scene, gbuffer: GBuffer, options: Mapping | None = None) -> np.ndarray:
+def shade_scene(
+    scene: Scene, gbuffer: GBuffer, options: Mapping | None = None, metadata: dict | None = None
+) -> np.ndarray:
     """XYZ of every G-buffer sample: deferred shading plus the background, shape ``(H, W, 3)``.
 
     Parameters
@@ -228,6 +234,8 @@ def shade_scene(scene: Scene, gbuffer: GBuffer, options: Mapping | None = None) 
         Visible surfaces (any resolution; the background rays are the camera's at that size).
     options : mapping, optional
         Merged over the scene's ``render.options`` into ``ShadingContext.options``.
+    metadata : dict, optional
+        Becomes ``ShadingContext.metadata``: the shaders report into it.
 
     Returns
     -------
@@ -242,6 +250,8 @@ def shade_scene(scene: Scene, gbuffer: GBuffer, options: Mapping | None = None) 
     """
     check_shaders(scene)
     ctx = scene.shading_context(options)
+    if metadata is not None:
+        ctx = dataclasses.replace(ctx, metadata=metadata)
     H, W = gbuffer.shape
     XYZ = np.empty((H, W, 3))
     rows = max(1, SHADING_TILE_SAMPLES // max(W, 1))
@@ -365,7 +375,8 @@ def render_scene(
             f"{expected} (height × width × supersample)",
         )
     t_gbuffer = time.perf_counter()
-    XYZ = downsample_box(shade_scene(scene, gbuffer, options), r.supersample)
+    metadata: dict = {}
+    XYZ = downsample_box(shade_scene(scene, gbuffer, options, metadata), r.supersample)
     t_shading = time.perf_counter()
     RGB_linear, encoded = XYZ_to_display(scene, XYZ)
     t_display = time.perf_counter()
@@ -375,7 +386,7 @@ def render_scene(
         "display": t_display - t_shading,
         "total": t_display - start,
     }
-    return RenderResult(XYZ, RGB_linear, encoded, gbuffer, r.supersample, timings, scene)
+    return RenderResult(XYZ, RGB_linear, encoded, gbuffer, r.supersample, timings, scene, metadata)
 
 
 def _check_output(path, suffix: str, flag: str) -> Path:

@@ -69,6 +69,9 @@ class ShadingContext:
         Per-render switches that registered shaders read, e.g. ``{"environment": "bruteforce"}`` for
         the environment-light oracle; each shader documents the keys it reads and ignores the
         others.
+    metadata : dict
+        Filled by shaders during a render: what each one did (settings, promised bounds), under
+        its own key (e.g. ``"shrm"``); ``RenderResult.metadata`` returns it.
 
     Examples
     --------
@@ -81,6 +84,7 @@ class ShadingContext:
     observer: str = DEFAULT_OBSERVER
     weights_method: str = "astm_e308"
     options: Mapping = field(default_factory=dict)
+    metadata: dict = field(default_factory=dict, compare=False)
 
     def weights(self, spectrum: Spectrum | None) -> np.ndarray:
         """Band weights ``(n_bands, 3)`` with ``spectrum`` folded in (None: equal-energy light)."""
