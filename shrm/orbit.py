@@ -115,10 +115,16 @@ def brdf_params_on_grid(brdf: str, grid, params: dict | None = None) -> dict:
 
 
 def _parse_isotropic_brdf(reader, table: dict, key: str, name: str):
-    """Scene-file parser: ``brdf`` (required) and the BRDF's parameters (spectra or numbers)."""
+    """Scene-file parser: ``brdf`` (required) and the BRDF's parameters (spectra or numbers).
+
+    ``brdf = "table"`` takes a ``file`` key instead: a BRDF table (docs/brdf-format.md), its
+    bands interpolated linearly onto the scene's grid (constant beyond its ends).
+    """
     brdf = reader.string(table.get("brdf"), f"{key}.brdf") if "brdf" in table else None
     if brdf is None:
         reader.fail(key, "missing key 'brdf'")
+    if brdf == "table":
+        return IsotropicBRDFMaterial("table", _table_on_grid(reader, table, key), name)
     with reader.context(f"{key}.brdf"):
         method = _isotropic_method(brdf)
     defaults = {k: v for k, v in method.extra["params"].items() if k != "wavelengths_nm"}
@@ -134,6 +140,23 @@ def _parse_isotropic_brdf(reader, table: dict, key: str, name: str):
                 else reader.number(table[p], where)
             )
     return IsotropicBRDFMaterial(brdf, brdf_params_on_grid(brdf, reader.grid, params), name)
+
+
+def _table_on_grid(reader, table: dict, key: str) -> dict:
+    """``{"table": BRDFTable}`` of a material's ``file``, resampled onto the scene's grid."""
+    from reference.brdf_table import BRDFTable, read_brdf_table
+
+    reader.table(table, key, ("type", "brdf", "file"))
+    if "file" not in table:
+        reader.fail(key, "brdf = 'table' needs a key 'file' (a BRDF table, docs/brdf-format.md)")
+    path = reader.file_path(table["file"], f"{key}.file")
+    with reader.context(f"{key}.file"):
+        t = read_brdf_table(path)
+    wl, target = np.asarray(t.wavelengths_nm), reader.grid.wavelengths_nm
+    # Linear interpolation of the table's bands onto the grid
+    M = np.stack([np.interp(target, wl, np.eye(wl.size)[i]) for i in range(wl.size)])
+    values = t.values @ M
+    return {"table": BRDFTable(t.theta_i_deg, t.theta_o_deg, t.phi_d_deg, target, values, t.name)}
 
 
 MATERIAL_TYPES.register(
