@@ -170,7 +170,7 @@ def split_case():
     from shrm.orbit import brdf_params_on_grid
     from shrm.split import split_renderer
 
-    grid = SpectralGrid(410.0, 710.0, 20.0)
+    grid = SpectralGrid(400.0, 700.0, 20.0)
     image = read_image(ROOT.parent / "shared/data/environments/studio_small_03_1k.hdr")
     radiance = environment_spectral_radiance(EnvironmentLight(image), grid)
     y = ShadingContext(grid).weights(None)[:, 1]
