@@ -56,6 +56,7 @@ from shrm.sh import sh_evaluate
 from shrm.transform import project_latlong
 
 __all__ = [
+    "cached_spectral_radiance",
     "environment_spectral_radiance",
     "phong_environment_Lambda",
     "shade_lambert_environment",
@@ -111,6 +112,22 @@ def _state(light: EnvironmentLight, ctx) -> dict:
         radiance = environment_spectral_radiance(light, ctx.grid, key[1], key[2])
         per_light[key] = {"radiance": radiance}
     return per_light[key]
+
+
+def cached_spectral_radiance(light: EnvironmentLight, ctx) -> np.ndarray:
+    """:func:`environment_spectral_radiance` with the context's grid and upsampling, cached.
+
+    One array per light, grid and upsampling method (dropped with the light).
+
+    Examples
+    --------
+    >>> from reference.shading import ShadingContext
+    >>> env = EnvironmentLight(np.full((2, 4, 3), 0.5))
+    >>> cached_spectral_radiance(env, ShadingContext()) is cached_spectral_radiance(
+    ...     env, ShadingContext())
+    True
+    """
+    return _state(light, ctx)["radiance"]
 
 
 def phong_environment_Lambda(n, order: int) -> np.ndarray:
