@@ -25,6 +25,7 @@ from reference.colorimetry import (
     spectra_to_XYZ,
     white_XYZ,
 )
+from reference.compare import compare_images
 from reference.display import ENCODINGS, display_to_linear, linear_to_display, to_8bit
 from reference.envmap import (
     check_latlong_shape,
@@ -58,6 +59,7 @@ from reference.mesh import TriangleMesh, grid_mesh, mesh_from_obj, mesh_to_obj, 
 from reference.raster import RASTER_METHODS, pixel_coverage, rasterize_mesh
 from reference.registry import Method, Registry
 from reference.render import RenderResult, render_scene, render_scene_file, write_render
+from reference.render_metadata import RENDER_OUTPUTS, render_metadata
 from reference.scene import (
     LIGHT_TYPES,
     MAX_RENDER_SAMPLES,
@@ -106,6 +108,7 @@ __all__ = [
     "PRIMITIVES",
     "PROJECTIONS",
     "RASTER_METHODS",
+    "RENDER_OUTPUTS",
     "SHADERS",
     "SPECTRUM_FORMS",
     "AmbientLight",
@@ -139,6 +142,7 @@ __all__ = [
     "band_weights_point_sampled",
     "check_latlong_shape",
     "colorchecker_material",
+    "compare_images",
     "delta_E_00",
     "direction_to_latlong_uv",
     "display_RGB_to_XYZ",
@@ -169,6 +173,7 @@ __all__ = [
     "read_image",
     "read_png",
     "render_gbuffer",
+    "render_metadata",
     "render_scene",
     "render_scene_file",
     "require",

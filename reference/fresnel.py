@@ -25,6 +25,7 @@ Judd, D. B. (1942). Fresnel reflection of diffusely incident light. J. Res. NBS 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -98,6 +99,15 @@ def _fresnel_internal(cos_theta, n) -> np.ndarray:
     return np.where(sin_t2 >= 1.0, 1.0, 0.5 * (r_s**2 + r_p**2))
 
 
+@lru_cache(maxsize=8)
+def _gauss_legendre(order: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss–Legendre nodes and weights on [-1, 1], computed once per order (an eigenproblem)."""
+    nodes, weights = np.polynomial.legendre.leggauss(order)
+    nodes.setflags(write=False)
+    weights.setflags(write=False)
+    return nodes, weights
+
+
 def fresnel_diffuse(n, side: str = "outside", order: int = 400) -> np.ndarray:
     """Hemispherical Fresnel reflectance for uniformly diffuse incident light.
 
@@ -135,7 +145,7 @@ def fresnel_diffuse(n, side: str = "outside", order: int = 400) -> np.ndarray:
         side in ("outside", "inside"),
         f"fresnel_diffuse: side must be outside or inside, got {side!r}",
     )
-    nodes, weights = np.polynomial.legendre.leggauss(int(order))
+    nodes, weights = _gauss_legendre(int(order))
     n_col = n[..., None]
     if side == "outside":
         # u = cos² θ is uniform under the cosine-weighted measure: r = ∫_0^1 F(sqrt(u)) du

@@ -373,7 +373,9 @@ def channel_wavelengths_nm(names) -> np.ndarray | None:
     return np.array([float(m.group(1).replace(",", ".")) for m in found])
 
 
-def write_exr(path, image, channels: list[str] | None = None, half: bool = False) -> Path:
+def write_exr(
+    path, image, channels: list[str] | None = None, half: bool = False, attributes=None
+) -> Path:
     """Write a linear float image as OpenEXR atomically.
 
     Parameters
@@ -387,6 +389,8 @@ def write_exr(path, image, channels: list[str] | None = None, half: bool = False
         :func:`spectral_channel_names` for spectral images).
     half : bool
         Store 16-bit half floats instead of 32-bit floats.
+    attributes : dict of str to str, optional
+        Extra string attributes of the header (``reference.render_metadata.exr_attributes``).
 
     Returns
     -------
@@ -414,6 +418,7 @@ def write_exr(path, image, channels: list[str] | None = None, half: bool = False
     require(len(channels) == n, f"{path}: {len(channels)} channel names for {n} channels")
     dtype = np.float16 if half else np.float32
     header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+    header.update({str(k): str(v) for k, v in (attributes or {}).items()})
     data = {
         name: np.ascontiguousarray(image[..., i].astype(dtype)) for i, name in enumerate(channels)
     }

@@ -25,6 +25,7 @@ import dataclasses
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from json import dumps
 from pathlib import Path
 
 import numpy as np
@@ -35,11 +36,12 @@ from reference.display import linear_to_display
 from reference.envmap import latlong_lookup_bilinear
 from reference.errors import SpecrefError, format_allowed, require
 from reference.gbuffer import GBuffer, render_gbuffer
-from reference.images import write_exr, write_png
+from reference.images import write_exr, write_png, write_text_atomic
 from reference.lights import EnvironmentLight
 from reference.scene import Scene, load_scene
 from reference.shading import SHADERS, shade_gbuffer, shader_key
 from reference.spectra import make_spectrum, resample_spectrum
+from reference.upsampling import DEFAULT_UPSAMPLING, RGB_to_radiance_spectra
 
 __all__ = [
     "SHADING_TILE_SAMPLES",
@@ -80,6 +82,15 @@ class RenderResult:
         Seconds spent in ``"gbuffer"``, ``"shading"`` and ``"display"``, and the ``"total"``.
     scene : Scene
         The scene as rendered (with any size override).
+    spectral : ndarray or None, shape (H, W, n_bands)
+        Relative spectral radiance per band when rendered with ``spectral=True``
+        (``reference.shading.spectral_output_weights``); XYZ is then ``spectral @ W_E``.
+    records : dict
+        What the shaders chose (``ShadingContext.record``): SH orders and the bounds they promise;
+        ``reference.render_metadata`` puts it in the metadata.
+    metadata : dict
+        What :func:`render_scene_file` wrote into the EXR header and ``--json`` (empty from
+        :func:`render_scene`).
     """
 
     XYZ: np.ndarray
@@ -89,6 +100,9 @@ class RenderResult:
     supersample: int
     timings: dict = field(default_factory=dict)
     scene: Scene | None = None
+    spectral: np.ndarray | None = None
+    records: dict = field(default_factory=dict)
+    metadata: dict = field(default_factory=dict)
 
 
 def check_shaders(scene: Scene) -> None:
@@ -163,6 +177,40 @@ def _XYZ_to_RGB(scene: Scene) -> np.ndarray:
     )
 
 
+def background_values(scene: Scene, directions, output: str = "XYZ") -> np.ndarray:
+    """The environment background in XYZ, or as relative spectral radiance per band.
+
+    Spectral output upsamples an RGB map as the environment shaders do
+    (``reference.upsampling.RGB_to_radiance_spectra``, the scene's ``upsampling`` option).
+
+    Examples
+    --------
+    >>> from reference.scene import loads_scene
+    >>> background_values(loads_scene(""), np.zeros((1, 3))).round(4)
+    array([[0., 0., 0.]])
+    """
+    if output != "spectral":
+        return background_XYZ(scene, directions)
+    env = next(light for light in scene.lights if isinstance(light, EnvironmentLight))
+    directions = np.asarray(directions, dtype=np.float64)
+    values = latlong_lookup_bilinear(env.image, directions) * env.intensity
+    if env.is_spectral:
+        return values @ _spectral_to_grid(scene, env).T
+    upsampling = scene.render.options.get("upsampling", DEFAULT_UPSAMPLING)
+    return RGB_to_radiance_spectra(values, scene.grid, upsampling, env.colourspace)
+
+
+def _spectral_to_grid(scene: Scene, env) -> np.ndarray:
+    """The (n_bands, n_channels) linear interpolation of a spectral map's channels onto the grid."""
+    columns = []
+    for k in range(env.wavelengths_nm.size):
+        unit = np.zeros(env.wavelengths_nm.size)
+        unit[k] = 1.0
+        channel = make_spectrum(env.wavelengths_nm, unit, env.name)
+        columns.append(resample_spectrum(channel, scene.grid))
+    return np.stack(columns, axis=-1)
+
+
 def background_XYZ(scene: Scene, directions) -> np.ndarray:
     """XYZ seen along camera rays that hit nothing.
 
@@ -206,18 +254,18 @@ def background_XYZ(scene: Scene, directions) -> np.ndarray:
         f"{wl[0]:g}-{wl[-1]:g} nm but the grid needs {grid.start_nm:g}-{grid.end_nm:g} nm; use a "
         "constant background",
     )
-    columns = []
-    for k in range(env.wavelengths_nm.size):
-        unit = np.zeros(env.wavelengths_nm.size)
-        unit[k] = 1.0
-        channel = make_spectrum(env.wavelengths_nm, unit, env.name)
-        columns.append(resample_spectrum(channel, scene.grid))
-    to_grid = np.stack(columns, axis=-1)
+    to_grid = _spectral_to_grid(scene, env)
     W_E = band_weights(scene.grid, None, scene.weights_method, scene.observer)
     return (values @ to_grid.T) @ W_E
 
 
-def shade_scene(scene: Scene, gbuffer: GBuffer, options: Mapping | None = None) -> np.ndarray:
+def shade_scene(
+    scene: Scene,
+    gbuffer: GBuffer,
+    options: Mapping | None = None,
+    output: str = "XYZ",
+    records: dict | None = None,
+) -> np.ndarray:
     """XYZ of every G-buffer sample: deferred shading plus the background, shape ``(H, W, 3)``.
 
     Parameters
@@ -228,10 +276,15 @@ def shade_scene(scene: Scene, gbuffer: GBuffer, options: Mapping | None = None) 
         Visible surfaces (any resolution; the background rays are the camera's at that size).
     options : mapping, optional
         Merged over the scene's ``render.options`` into ``ShadingContext.options``.
+    output : {"XYZ", "spectral"}
+        XYZ, or relative spectral radiance per band (``ShadingContext.output``); in spectral
+        output a constant background is 0 (it is display RGB, with no spectrum).
+    records : dict, optional
+        Filled with what the shaders chose (``ShadingContext.records``).
 
     Returns
     -------
-    ndarray, shape gbuffer.shape + (3,)
+    ndarray, shape gbuffer.shape + (3,) or + (n_bands,)
 
     Examples
     --------
@@ -241,18 +294,22 @@ def shade_scene(scene: Scene, gbuffer: GBuffer, options: Mapping | None = None) 
     array([0.4752, 0.5   , 0.5444])
     """
     check_shaders(scene)
-    ctx = scene.shading_context(options)
+    ctx = dataclasses.replace(scene.shading_context(options), output=output)
     H, W = gbuffer.shape
-    XYZ = np.empty((H, W, 3))
+    XYZ = np.empty((H, W, ctx.n_outputs))
     rows = max(1, SHADING_TILE_SAMPLES // max(W, 1))
     for start in range(0, H, rows):
         tile = _gbuffer_rows(gbuffer, start, min(start + rows, H))
         XYZ[start : start + rows] = shade_gbuffer(tile, scene.materials, scene.lights, ctx)
+    if records is not None:
+        records.update(ctx.records)
     missed = ~gbuffer.mask
     if missed.any():
         if scene.render.background == "environment":
             _, directions = scene.camera.rays(W, H)
-            XYZ[missed] = background_XYZ(scene, directions[missed])
+            XYZ[missed] = background_values(scene, directions[missed], output)
+        elif output == "spectral":
+            XYZ[missed] = 0.0
         else:
             XYZ[missed] = background_XYZ(scene, np.zeros((1, 3)))[0]
     return XYZ
@@ -303,6 +360,7 @@ def render_scene(
     supersample: int | None = None,
     options: Mapping | None = None,
     gbuffer: GBuffer | None = None,
+    spectral: bool = False,
 ) -> RenderResult:
     """Render a scene: G-buffer, shading, box resolve, display conversion and encoding.
 
@@ -319,6 +377,9 @@ def render_scene(
     gbuffer : GBuffer, optional
         A G-buffer from an earlier render of the same camera and geometry, to re-shade without
         re-rasterizing; its shape must be ``(supersample·height, supersample·width)``.
+    spectral : bool
+        Also keep the relative spectral radiance per band (``RenderResult.spectral``); XYZ is then
+        its integral with the equal-energy band weights (docs/render-outputs.md).
 
     Returns
     -------
@@ -365,7 +426,18 @@ def render_scene(
             f"{expected} (height × width × supersample)",
         )
     t_gbuffer = time.perf_counter()
-    XYZ = downsample_box(shade_scene(scene, gbuffer, options), r.supersample)
+    records: dict = {}
+    spectral_image = None
+    if spectral:
+        samples = shade_scene(scene, gbuffer, options, "spectral", records)
+        W_E = band_weights(scene.grid, None, scene.weights_method, scene.observer)
+        XYZ = samples @ W_E
+        if scene.render.background != "environment":
+            XYZ[~gbuffer.mask] = background_XYZ(scene, np.zeros((1, 3)))[0]
+        spectral_image = downsample_box(samples, r.supersample)
+        XYZ = downsample_box(XYZ, r.supersample)
+    else:
+        XYZ = downsample_box(shade_scene(scene, gbuffer, options, records=records), r.supersample)
     t_shading = time.perf_counter()
     RGB_linear, encoded = XYZ_to_display(scene, XYZ)
     t_display = time.perf_counter()
@@ -375,7 +447,9 @@ def render_scene(
         "display": t_display - t_shading,
         "total": t_display - start,
     }
-    return RenderResult(XYZ, RGB_linear, encoded, gbuffer, r.supersample, timings, scene)
+    return RenderResult(
+        XYZ, RGB_linear, encoded, gbuffer, r.supersample, timings, scene, spectral_image, records
+    )
 
 
 def _check_output(path, suffix: str, flag: str) -> Path:
@@ -388,8 +462,10 @@ def _check_output(path, suffix: str, flag: str) -> Path:
     return path
 
 
-def write_render(result: RenderResult, png=None, exr=None) -> list[Path]:
-    """Write a render's PNG (display-encoded, 8 bit) and EXR (linear display RGB), atomically.
+def write_render(
+    result: RenderResult, png=None, exr=None, exr_output: str = "display", metadata=None
+) -> list[Path]:
+    """Write a render's PNG (display-encoded, 8 bit) and EXR, atomically.
 
     Parameters
     ----------
@@ -397,6 +473,12 @@ def write_render(result: RenderResult, png=None, exr=None) -> list[Path]:
         From :func:`render_scene`.
     png, exr : str or Path, optional
         Destinations (``.png`` and ``.exr``).
+    exr_output : str
+        What the EXR holds, a key of ``reference.render_metadata.RENDER_OUTPUTS``: ``display``
+        (linear display RGB, before exposure), ``xyz`` or ``spectral`` (needs a render with
+        ``spectral=True``; spectral OpenEXR channel names of Fichet et al. 2021).
+    metadata : dict, optional
+        ``reference.render_metadata.render_metadata``, stored in the EXR header.
 
     Returns
     -------
@@ -421,9 +503,19 @@ def write_render(result: RenderResult, png=None, exr=None) -> list[Path]:
     ...
     reference.errors.SpecrefError: -o: the output must end in .png, got '.../a.jpg'
     """
+    from reference.render_metadata import exr_attributes, output_image
+
     jobs = []
     if exr is not None:
-        jobs.append((_check_output(exr, ".exr", "--exr"), write_exr, result.RGB_linear))
+        image, names = output_image(result, exr_output)
+        attributes = exr_attributes(metadata) if metadata else None
+        jobs.append(
+            (
+                _check_output(exr, ".exr", "--exr"),
+                lambda p, im: write_exr(p, im, names, attributes=attributes),
+                image,
+            )
+        )
     if png is not None:
         jobs.append((_check_output(png, ".png", "-o"), write_png, result.encoded))
     written = []
@@ -446,6 +538,9 @@ def render_scene_file(
     supersample: int | None = None,
     oracle: bool = False,
     texel_placement: str | None = None,
+    exr_output: str = "display",
+    accuracy: float | None = None,
+    json=None,
 ) -> RenderResult:
     """Load a scene file, render it and write the outputs: what ``specref render`` does.
 
@@ -463,6 +558,14 @@ def render_scene_file(
     texel_placement : str, optional
         Override every environment light's ``texel_placement`` (``reference.envmap.
         TEXEL_PLACEMENTS``: ``"mitsuba"`` reads the maps as Mitsuba 3 does).
+    exr_output : {"display", "xyz", "spectral"}
+        What the EXR holds (:func:`write_render`).
+    accuracy : float, optional
+        Mean relative error of Y over lit pixels that fast methods promise (the maximum is 4×);
+        default ``reference.render_metadata.DEFAULT_ACCURACY`` (0.5 %).
+    json : str or Path, optional
+        Write the render's metadata (``reference.render_metadata.render_metadata``) there; ``-``
+        writes nothing (the CLI prints ``RenderResult.metadata``).
 
     Returns
     -------
@@ -486,16 +589,26 @@ def render_scene_file(
     >>> render_scene_file(folder / "s.toml", folder / "s.png").encoded.shape
     (4, 6, 3)
     """
+    from reference.render_metadata import RENDER_OUTPUTS, check_accuracy, render_metadata
+
     if png is not None:
         _check_output(png, ".png", "-o")
     if exr is not None:
         _check_output(exr, ".exr", "--exr")
+    if json is not None and str(json) != "-":
+        _check_output(json, ".json", "--json")
+    RENDER_OUTPUTS.lookup(exr_output)
+    options = {"environment": "bruteforce"} if oracle else {}
+    if accuracy is not None:
+        options["environment_accuracy"] = check_accuracy(accuracy)
     scene = load_scene(scene_path)
     if width is not None or height is not None or supersample is not None:
         scene = scene.with_render(width, height, supersample, where="command line: render")
     if texel_placement is not None:
         scene = scene.with_texel_placement(texel_placement)
-    options = {"environment": "bruteforce"} if oracle else None
-    result = render_scene(scene, options=options)
-    write_render(result, png, exr)
-    return result
+    result = render_scene(scene, options=options, spectral=exr_output == "spectral")
+    metadata = render_metadata(result, exr_output, result.records, oracle)
+    write_render(result, png, exr, exr_output, metadata)
+    if json is not None and str(json) != "-":
+        write_text_atomic(json, dumps(metadata, indent=2) + "\n")
+    return dataclasses.replace(result, metadata=metadata)

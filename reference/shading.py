@@ -49,6 +49,7 @@ __all__ = [
     "phong_spectral_exact",
     "shade_gbuffer",
     "shader_key",
+    "spectral_output_weights",
     "surface_of",
 ]
 
@@ -81,10 +82,56 @@ class ShadingContext:
     observer: str = DEFAULT_OBSERVER
     weights_method: str = "astm_e308"
     options: Mapping = field(default_factory=dict)
+    output: str = "XYZ"
+    records: dict = field(default_factory=dict, compare=False)
 
     def weights(self, spectrum: Spectrum | None) -> np.ndarray:
-        """Band weights ``(n_bands, 3)`` with ``spectrum`` folded in (None: equal-energy light)."""
+        """Band weights with ``spectrum`` folded in (None: equal-energy light).
+
+        ``(n_bands, 3)`` to XYZ; with ``output="spectral"`` the ``(n_bands, n_bands)`` diagonal
+        that turns a reflected fraction into relative spectral radiance, the light scaled so that
+        the equal-energy weights give Y = 1 for a white diffuser (docs/render-outputs.md).
+        """
+        if self.output == "spectral":
+            return spectral_output_weights(self.grid, spectrum, self.weights_method, self.observer)
         return band_weights(self.grid, spectrum, self.weights_method, self.observer)
+
+    @property
+    def n_outputs(self) -> int:
+        """Values per pixel that shaders return: 3 (XYZ) or the number of bands (spectral)."""
+        return self.grid.n_bands if self.output == "spectral" else 3
+
+    def record(self, group: str, key: str, value) -> None:
+        """Note a setting a shader chose (an SH order and its bound) for the render metadata.
+
+        ``records[group][key] = value``; :mod:`reference.render_metadata` puts ``records`` under
+        ``"methods"`` in the EXR header and ``specref render --json``.
+        """
+        self.records.setdefault(group, {})[key] = value
+
+
+def spectral_output_weights(grid, spectrum, method="astm_e308", observer=DEFAULT_OBSERVER):
+    """The diagonal ``(n_bands, n_bands)`` weights of spectral output.
+
+    A shader's reflected fraction ``R`` times these is the relative spectral radiance ``S R``
+    with ``S`` the light on the grid scaled by ``1 / (S · W_E,Y)``, so that ``(S R) @ W_E`` (the
+    equal-energy band weights) gives Y = 1 for a white diffuser, as the XYZ output does. None (an
+    equal-energy light, or radiance with no light folded in) is the identity.
+
+    Examples
+    --------
+    >>> from reference.spectra import GRID_41
+    >>> W = spectral_output_weights(GRID_41, None)
+    >>> W.shape, bool((W == np.eye(41)).all())
+    ((41, 41), True)
+    """
+    if spectrum is None:
+        return np.eye(grid.n_bands)
+    from reference.spectra import resample_spectrum
+
+    S = resample_spectrum(spectrum, grid, "constant")
+    W_E = band_weights(grid, None, method, observer)
+    return np.diag(S / float(S @ W_E[:, 1]))
 
 
 @dataclass(frozen=True)
@@ -342,7 +389,7 @@ def shade_gbuffer(
     """
     ctx = ctx or ShadingContext()
     H, W = gbuffer.shape
-    XYZ = np.zeros((H, W, 3))
+    XYZ = np.zeros((H, W, ctx.n_outputs))
     for index, material in enumerate(materials):
         bands = getattr(material, "k_d", None)
         require(
@@ -355,6 +402,12 @@ def shade_gbuffer(
             continue
         surface = surface_of(gbuffer, selection)
         for light in lights:
-            shader = SHADERS.lookup(shader_key(material, light)).reference
-            XYZ[selection] += shader(surface, material, light, ctx)
+            key = shader_key(material, light)
+            values = SHADERS.lookup(key).reference(surface, material, light, ctx)
+            require(
+                np.shape(values)[-1] == ctx.n_outputs,
+                f"{material.name}: the shader {key} gives {np.shape(values)[-1]} values per "
+                f"pixel, not {ctx.output} output ({ctx.n_outputs}); render it as display or xyz",
+            )
+            XYZ[selection] += values
     return XYZ

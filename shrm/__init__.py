@@ -5,6 +5,7 @@ Importing ``shrm`` registers the environment-light shaders in ``reference.shadin
 """
 
 from shrm import environment  # noqa: F401  (registers the environment-light shaders)
+from shrm.accuracy import accuracy_order, bright_texels
 from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts, shrm_orders
 from shrm.cache import Cache, cache_key, default_cache_dir
 from shrm.characterization import characterize_model, read_characterization, write_characterization
@@ -41,9 +42,11 @@ __all__ = [
     "PolymerConstituents",
     "PolymerMaterial",
     "RenderSession",
+    "accuracy_order",
     "adaptive_order",
     "apply_window",
     "brdf_sh_coefficients",
+    "bright_texels",
     "cache_key",
     "characterize_model",
     "default_cache_dir",

@@ -11,10 +11,13 @@ Importing ``shrm`` registers two shaders in ``reference.shading.SHADERS``:
   point-light model (Eq. (2), Wang et al.), as the diffuse term does; in frequency space this is the
   normalized Phong kernel times ``2 / (n + 1)``.
 
-The maps are computed in frequency space (project, scale by Λ_l, synthesize a 64×64×6 cube map per
-band), at the order :func:`shrm.lobes.adaptive_order` picks for the tolerance, and cached per
-environment. With ``ctx.options["environment"] == "bruteforce"`` (``specref render --oracle``) each
-pixel integrates the whole map instead (:func:`shrm.prefilter.prefilter_bruteforce`).
+The maps are computed in frequency space (project, scale by Λ_l, synthesize a cube map per band,
+faces of ``min(256, max(64, 2L))`` texels), at the order :func:`shrm.accuracy.accuracy_order` picks
+for a per-pixel tolerance on Y from the map's own spectrum (default 0.5 % mean, 2 % max over lit
+pixels), and cached per environment. Each choice and the bound it promises is recorded in
+``ctx.records["environment"]`` for the render metadata. With
+``ctx.options["environment"] == "bruteforce"`` (``specref render --oracle``) each pixel integrates
+the whole map instead (:func:`shrm.prefilter.prefilter_bruteforce`).
 
 A spectral environment (one channel per band) is resampled linearly onto the scene's grid; an RGB
 one is upsampled with ``reference.upsampling.RGB_to_radiance_spectra`` (Mallett & Yuksel 2019 by
@@ -24,8 +27,10 @@ and renders white; options ``ctx.options["upsampling"]`` and, for ``"regression"
 radiance spectra carry no light to fold in.
 
 Options read from ``ctx.options``: ``environment`` (``"frequency"`` default, or ``"bruteforce"``),
-``environment_tol`` (default :data:`shrm.lobes.DEFAULT_TOL`), ``environment_size`` (cube
-face, default 64), ``upsampling``, ``upsampling_model``.
+``environment_accuracy`` (mean relative error of Y, default :data:`shrm.accuracy.DEFAULT_ACCURACY`),
+``environment_tol`` (the older kernel-only tail tolerance of :func:`shrm.lobes.adaptive_order`;
+when given it replaces the accuracy rule), ``environment_size`` (cube face), ``upsampling``,
+``upsampling_model``.
 """
 
 from __future__ import annotations
@@ -34,20 +39,24 @@ import weakref
 
 import numpy as np
 
+from reference.colorimetry import band_weights
 from reference.cubemap import cubemap_lookup_bilinear, cubemap_texel_directions
 from reference.errors import require
 from reference.lights import EnvironmentLight
 from reference.materials import LambertMaterial, PhongMaterial
 from reference.registry import Method
+from reference.render_metadata import DEFAULT_ACCURACY, check_accuracy
 from reference.shading import SHADERS, Surface
 from reference.spectra import SpectralGrid
 from reference.upsampling import DEFAULT_UPSAMPLING, RGB_to_radiance_spectra
-from shrm.lobes import DEFAULT_TOL, adaptive_order, kernel_phong, parse_kernel
+from shrm.accuracy import accuracy_order, bright_texels, sparse_convolution
+from shrm.lobes import adaptive_order, kernel_phong, parse_kernel
 from shrm.prefilter import prefilter_bruteforce, prefilter_coefficients
 from shrm.sh import sh_evaluate
 from shrm.transform import project_latlong
 
 __all__ = [
+    "cached_spectral_radiance",
     "environment_spectral_radiance",
     "phong_environment_Lambda",
     "shade_lambert_environment",
@@ -105,6 +114,22 @@ def _state(light: EnvironmentLight, ctx) -> dict:
     return per_light[key]
 
 
+def cached_spectral_radiance(light: EnvironmentLight, ctx) -> np.ndarray:
+    """:func:`environment_spectral_radiance` with the context's grid and upsampling, cached.
+
+    One array per light, grid and upsampling method (dropped with the light).
+
+    Examples
+    --------
+    >>> from reference.shading import ShadingContext
+    >>> env = EnvironmentLight(np.full((2, 4, 3), 0.5))
+    >>> cached_spectral_radiance(env, ShadingContext()) is cached_spectral_radiance(
+    ...     env, ShadingContext())
+    True
+    """
+    return _state(light, ctx)["radiance"]
+
+
 def phong_environment_Lambda(n, order: int) -> np.ndarray:
     """Λ_l of the lobe ``max(t, 0)^n / π`` per band: the normalized Phong Λ_l times ``2/(n+1)``.
 
@@ -130,31 +155,88 @@ def phong_environment_Lambda(n, order: int) -> np.ndarray:
     return np.stack([unique[float(v)] for v in n])
 
 
-def _frequency_map(light, ctx, name: str, kernel_order: int, Lambda) -> np.ndarray:
-    """Cached cube map (6, S, S, n_bands) of the environment prefiltered with Λ (per band)."""
+def _bright(light, ctx):
+    """The texels lit exactly (``shrm.accuracy.bright_texels``), or None on the legacy rule."""
+    if "environment_tol" in ctx.options:
+        return None
     state = _state(light, ctx)
-    size = int(ctx.options.get("environment_size", 64))
-    key = (name, kernel_order, size)
+    if "bright" not in state:
+        state["bright"] = bright_texels(_luminance(light, ctx))
+    return state["bright"]
+
+
+def _exact_part(light, ctx, kernel, directions) -> np.ndarray:
+    """The bright texels' share of the prefiltered map at ``directions``, (N, n_bands), or 0."""
+    bright = _bright(light, ctx)
+    if bright is None or not bright.index.size:
+        return 0.0
+    values = bright.exact_part(_state(light, ctx)["radiance"])
+    return sparse_convolution(values, bright.directions, bright.weights, kernel, directions)
+
+
+def _frequency_map(light, ctx, name: str, kernel_order: int, Lambda) -> np.ndarray:
+    """Cached cube map (6, S, S, n_bands) of the environment prefiltered with Λ (per band).
+
+    Without the bright texels (:func:`_exact_part` adds them) unless the legacy rule is in use.
+    """
+    state = _state(light, ctx)
+    # Cube faces fine enough for the order (bilinear lookup), 64 to 256 texels (erratum E76)
+    size = int(ctx.options.get("environment_size", min(256, max(64, 2 * kernel_order))))
+    bright = _bright(light, ctx)
+    key = (name, kernel_order, size, bright is not None)
     if key not in state:
-        coeffs = project_latlong(state["radiance"], kernel_order, backend="ducc0", where=light.name)
+        radiance = state["radiance"]
+        if bright is not None:
+            radiance = radiance * bright.scale[..., None]
+        coeffs = project_latlong(radiance, kernel_order, backend="ducc0", where=light.name)
         filtered = prefilter_coefficients(coeffs, Lambda)
         state[key] = sh_evaluate(filtered, cubemap_texel_directions(size), backend="ducc0")
     return state[key]
 
 
+def _luminance(light, ctx) -> np.ndarray:
+    """Y of the environment's spectral radiance, (H, W): what the order estimate reads."""
+    state = _state(light, ctx)
+    if "luminance" not in state:
+        W_E = band_weights(ctx.grid, None, ctx.weights_method, ctx.observer)
+        state["luminance"] = state["radiance"] @ W_E[:, 1]
+    return state["luminance"]
+
+
 def _order(light, ctx, kernel) -> int:
-    tol = float(ctx.options.get("environment_tol", DEFAULT_TOL))
-    return min(adaptive_order(kernel, tol), light.image.shape[1] // 2 - 1)
+    """The SH order for a kernel, recorded with its bound in ``ctx.records``.
+
+    From ``environment_accuracy`` (default), or the older kernel-only ``environment_tol``.
+    """
+    band_limit = light.image.shape[1] // 2 - 1
+    kernel = parse_kernel(kernel)
+    if "environment_tol" in ctx.options:
+        tol = float(ctx.options["environment_tol"])
+        L = min(adaptive_order(kernel, tol), band_limit)
+        ctx.record("environment", f"{light.name}:{kernel.name}", {"order": L, "kernel_tol": tol})
+        return L
+    tol = check_accuracy(ctx.options.get("environment_accuracy", DEFAULT_ACCURACY), "accuracy")
+    state = _state(light, ctx)
+    key = ("order", kernel.name, tol)
+    if key not in state:
+        state[key] = accuracy_order(
+            _luminance(light, ctx), kernel, tol, light.name, _bright(light, ctx)
+        )
+    choice = state[key]
+    ctx.record("environment", f"{light.name}:{kernel.name}", choice.as_dict())
+    return choice.order
 
 
 def _irradiance(surface: Surface, light, ctx) -> np.ndarray:
     """E(n, λ) at the surface normals, (N, n_bands)."""
     if ctx.options.get("environment") == "bruteforce":
+        ctx.record("environment", f"{light.name}:lambert", {"method": "bruteforce"})
         radiance = _state(light, ctx)["radiance"]
         return prefilter_bruteforce(radiance, "lambert", surface.normal)
     L = _order(light, ctx, "lambert")
     cube = _frequency_map(light, ctx, "lambert", L, parse_kernel("lambert").Lambda(L))
-    return cubemap_lookup_bilinear(cube, surface.normal, backend="numba")
+    E = cubemap_lookup_bilinear(cube, surface.normal, backend="numba")
+    return E + _exact_part(light, ctx, "lambert", surface.normal)
 
 
 def shade_lambert_environment(
@@ -219,6 +301,12 @@ def shade_phong_environment(
         name = "phong:" + ",".join(f"{v:g}" for v in material.n)
         cube = _frequency_map(light, ctx, name, L, Lam)
         specular = cubemap_lookup_bilinear(cube, r, backend="numba")
+        for value in np.unique(material.n):
+            bands = material.n == value
+            # the bright texels, exactly: the lobe max(t,0)^n/π is the normalized one × 2/(n+1)
+            exact = _exact_part(light, ctx, kernel_phong(value), r)
+            if not np.isscalar(exact):
+                specular[:, bands] += (2.0 / (value + 1.0)) * exact[:, bands]
     # Eq. (2), Wang et al., environment form: k_d E/π + k_s S_n(r)
     spectra = diffuse + material.k_s * specular
     return spectra @ ctx.weights(None)

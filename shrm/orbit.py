@@ -16,6 +16,7 @@ direction, the mean over the shaded points.
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -114,10 +115,16 @@ def brdf_params_on_grid(brdf: str, grid, params: dict | None = None) -> dict:
 
 
 def _parse_isotropic_brdf(reader, table: dict, key: str, name: str):
-    """Scene-file parser: ``brdf`` (required) and the BRDF's parameters (spectra or numbers)."""
+    """Scene-file parser: ``brdf`` (required) and the BRDF's parameters (spectra or numbers).
+
+    ``brdf = "table"`` takes a ``file`` key instead: a BRDF table (docs/brdf-format.md), its
+    bands interpolated linearly onto the scene's grid (constant beyond its ends).
+    """
     brdf = reader.string(table.get("brdf"), f"{key}.brdf") if "brdf" in table else None
     if brdf is None:
         reader.fail(key, "missing key 'brdf'")
+    if brdf == "table":
+        return IsotropicBRDFMaterial("table", _table_on_grid(reader, table, key), name)
     with reader.context(f"{key}.brdf"):
         method = _isotropic_method(brdf)
     defaults = {k: v for k, v in method.extra["params"].items() if k != "wavelengths_nm"}
@@ -135,6 +142,23 @@ def _parse_isotropic_brdf(reader, table: dict, key: str, name: str):
     return IsotropicBRDFMaterial(brdf, brdf_params_on_grid(brdf, reader.grid, params), name)
 
 
+def _table_on_grid(reader, table: dict, key: str) -> dict:
+    """``{"table": BRDFTable}`` of a material's ``file``, resampled onto the scene's grid."""
+    from reference.brdf_table import BRDFTable, read_brdf_table
+
+    reader.table(table, key, ("type", "brdf", "file"))
+    if "file" not in table:
+        reader.fail(key, "brdf = 'table' needs a key 'file' (a BRDF table, docs/brdf-format.md)")
+    path = reader.file_path(table["file"], f"{key}.file")
+    with reader.context(f"{key}.file"):
+        t = read_brdf_table(path)
+    wl, target = np.asarray(t.wavelengths_nm), reader.grid.wavelengths_nm
+    # Linear interpolation of the table's bands onto the grid
+    M = np.stack([np.interp(target, wl, np.eye(wl.size)[i]) for i in range(wl.size)])
+    values = t.values @ M
+    return {"table": BRDFTable(t.theta_i_deg, t.theta_o_deg, t.phi_d_deg, target, values, t.name)}
+
+
 MATERIAL_TYPES.register(
     MaterialType(
         "isotropic_brdf",
@@ -146,8 +170,10 @@ MATERIAL_TYPES.register(
     )
 )
 
-#: SHRM settings of the scene shader (small: a preview of what the orbit renders).
-SHADER_SETTINGS = {"env_height": 32, "F": 12, "P": 8, "size": 16, "frame": "normal"}
+#: Per-pixel tolerance of the scene shader, relative to the image's peak (``shrm_tol``).
+DEFAULT_SHRM_TOL = 0.002
+
+_RENDERERS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def _working_environment(light: EnvironmentLight, rows: int) -> EnvironmentLight:
@@ -162,15 +188,37 @@ def _working_environment(light: EnvironmentLight, rows: int) -> EnvironmentLight
     return replace(light, image=downsample_box(image[:h, : 2 * h], factor))
 
 
+def _renderer(surface: Surface, material: IsotropicBRDFMaterial, light, ctx, tol: float):
+    """The split renderer of this light and material, made once per grid, upsampling and tol."""
+    from shrm.environment import cached_spectral_radiance
+    from shrm.split import split_renderer
+
+    key = (id(material), ctx.grid, ctx.options.get("upsampling"), tol)
+    per_light = _RENDERERS.setdefault(light, {})
+    if key not in per_light or per_light[key][0] is not material:
+        radiance = cached_spectral_radiance(light, ctx)
+        y_weights = ctx.weights(None)[:, 1]
+        renderer = split_renderer(
+            radiance, material.brdf, material.params, y_weights, surface.normal, surface.view, tol
+        )
+        per_light[key] = (material, renderer)
+    return per_light[key][1]
+
+
 def shade_isotropic_brdf_environment(
     surface: Surface, material: IsotropicBRDFMaterial, light: EnvironmentLight, ctx
 ) -> np.ndarray:
-    """XYZ of an isotropic 3-D BRDF under an environment, through a global SHRM.
+    """XYZ of an isotropic 3-D BRDF under an environment: SHRM + angular split, or brute force.
 
-    §5.5-5.6, Herbert et al.: project the environment, create the SHRM of the BRDF, extract the
-    reflection map for the (distant) view and look it up per point (:func:`shrm.shrm.shade_shrm`).
-    The view is the mean of the points' view directions (module docstring). Every call creates
-    its SHRM (:data:`SHADER_SETTINGS`, small): a preview; the orbit's session reuses its SHRM.
+    §9, Herbert et al. (:mod:`shrm.split`): the environment at full resolution is split into a
+    band-limited part, rendered through a global SHRM (§5.5-5.6, Herbert et al.; one distant view,
+    the mean of the points' views), and the residual texels, integrated per pixel in angular
+    space. The settings (F, P, cube size, split threshold) are chosen for the per-pixel tolerance
+    ``ctx.options["shrm_tol"]`` (default :data:`DEFAULT_SHRM_TOL`, relative to the peak), made
+    once per light, material, grid and upsampling, and stated in ``ctx.records["shrm"]``.
+    With ``ctx.options["environment"] == "bruteforce"`` (``specref render --oracle``) every pixel
+    sums the BRDF over every texel with its own view (:func:`shrm.split.angular_sum`). The
+    environment's spectra follow ``ctx.options["upsampling"]`` (:mod:`shrm.environment`).
 
     Examples
     --------
@@ -184,26 +232,32 @@ def shade_isotropic_brdf_environment(
     ...                                  ctx).shape
     (1, 3)
     """
-    from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts
-    from shrm.environment import environment_spectral_radiance
-    from shrm.shrm import shade_shrm, shrm_create, shrm_extract
-    from shrm.transform import project_latlong
+    from shrm.environment import cached_spectral_radiance
+    from shrm.shrm_oracles import env_quadrature
+    from shrm.split import angular_sum, split_shade
 
     if surface.normal.shape[0] == 0:
         return np.zeros((0, 3))
-    c = SHADER_SETTINGS
-    work = _working_environment(light, c["env_height"])
-    radiance = environment_spectral_radiance(work, ctx.grid)
-    F = min(c["F"], radiance.shape[1] // 2 - 1)
-    L = project_latlong(radiance, F, backend="ducc0", where=light.name)
-    brdf, expand, lam, k = shrm_brdf_parts(material.brdf, material.params)
-    rho = brdf_sh_coefficients(brdf, expand, F, c["P"], c["frame"], view_power=k)
-    s = shrm_create(L, rho, c["frame"], c["size"], "ducc0", k, lam)
-    v = surface.view.mean(axis=0)
-    v = v / np.linalg.norm(v)
-    # §5.6, Herbert et al.: extract for the viewpoint, then shade per point
-    spectra = shade_shrm(s, shrm_extract(s, v), surface.normal, v)
+    if ctx.options.get("environment") == "bruteforce":
+        env = env_quadrature(cached_spectral_radiance(light, ctx))
+        spectra = angular_sum(env, *_full_brdf(material), surface.normal, surface.view)
+        ctx.records.setdefault("shrm", {})["method"] = "bruteforce"
+        return spectra @ ctx.weights(None)
+    tol = float(ctx.options.get("shrm_tol", DEFAULT_SHRM_TOL))
+    require(0.0 < tol < 1.0, f"render.options.shrm_tol: must be in (0, 1), got {tol!r}")
+    renderer = _renderer(surface, material, light, ctx, tol)
+    spectra, clamped = split_shade(renderer, surface.normal, surface.view)
+    meta = ctx.records.setdefault("shrm", {})
+    meta.update(method="shrm+angular", **renderer.settings.metadata())
+    meta["clamped_values"] = meta.get("clamped_values", 0) + clamped
     return spectra @ ctx.weights(None)
+
+
+def _full_brdf(material: IsotropicBRDFMaterial):
+    """The material's whole BRDF (Lambertian part included) and its parameters."""
+    from reference.brdf import BRDF_METHODS
+
+    return BRDF_METHODS.lookup(material.brdf).reference, material.params
 
 
 SHADERS.register(

@@ -63,6 +63,8 @@ __all__ = [
     "MIRROR_FACTORS",
     "PolymerLook",
     "PolymerMaps",
+    "effect_radiance",
+    "effect_shrm",
     "mirror_factor_cosine",
     "mirror_factor_fresnel",
     "mirror_factor_none",
@@ -411,3 +413,105 @@ def polymer_terms(
         "M_s": M_s,
         "I_result": I_result,
     }
+
+
+def effect_shrm(
+    radiance,
+    brdf: str = "effect_pigment",
+    params: dict | None = None,
+    grid=None,
+    F: int = 8,
+    P: int = 8,
+    size: int = 16,
+    frame: str = "reflection",
+):
+    """The effect pigment's SHRM under an environment, for E_effect of Eq. (3), Herbert et al.
+
+    §5.1, Herbert et al.: "the effect pigment ... rendered through its SHRM". The pigment is an
+    isotropic BRDF of ``reference.brdf.BRDF_METHODS`` (default the thin-film ``effect_pigment``; a
+    tabulated BRDF works the same), expanded in double SH (``shrm.brdf_sh``) and combined with the
+    environment's SH coefficients in frequency space (``shrm.shrm.shrm_create``), like the SHRM
+    materials of ``shrm.orbit``. It depends on the environment and the pigment only: a change of
+    ``Mod_effect`` re-shades without rebuilding it.
+
+    Parameters
+    ----------
+    radiance : ndarray, shape (H, W, n_bands)
+        Spectral lat-long environment (the polymer's).
+    brdf : str
+        Key of ``BRDF_METHODS`` (isotropic).
+    params : dict, optional
+        Overrides of its default parameters (``shrm.orbit.brdf_params_on_grid``).
+    grid : SpectralGrid, optional
+        The environment's bands; default ``reference.spectra.DEFAULT_GRID``.
+    F, P : int
+        Lighting and view orders of the expansion (F is capped at H/2 − 1).
+    size : int
+        Cube face size.
+    frame : {"reflection", "normal"}
+
+    Returns
+    -------
+    shrm.shrm.SHRM
+
+    Examples
+    --------
+    >>> s = effect_shrm(np.ones((8, 16, 41)), F=2, P=2, size=2)
+    >>> s.frame, s.coeffs.shape[:4]
+    ('reflection', (6, 2, 2, 41))
+    """
+    from reference.spectra import DEFAULT_GRID
+    from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts
+    from shrm.orbit import brdf_params_on_grid
+    from shrm.shrm import shrm_create
+    from shrm.transform import project_latlong
+
+    radiance = np.asarray(require_finite(radiance, "polymer: effect environment"), dtype=float)
+    grid = DEFAULT_GRID if grid is None else grid
+    require(
+        radiance.shape[-1] == grid.n_bands,
+        f"polymer: effect environment has {radiance.shape[-1]} bands, the grid {grid.n_bands}",
+    )
+    F = min(int(F), radiance.shape[0] // 2 - 1)
+    L = project_latlong(radiance, F, backend="ducc0", where="polymer effect environment")
+    function, expand, lam, k = shrm_brdf_parts(brdf, brdf_params_on_grid(brdf, grid, params))
+    rho = brdf_sh_coefficients(function, expand, F, int(P), frame, view_power=k)
+    return shrm_create(L, rho, frame, int(size), "ducc0", k, lam)
+
+
+def effect_radiance(effect, normal, view) -> np.ndarray:
+    """E_effect of Eq. (3), Herbert et al.: the effect pigment's radiance from its SHRM.
+
+    §5.6, Herbert et al.: extract the SHRM's reflection map for the viewpoint (a distant viewer:
+    the mean of the view vectors), then look it up per pixel (``shrm.shrm.shade_shrm``). Pass the
+    result to :func:`polymer_terms` as ``E_effect``, with ``Mod_effect`` mixing it in.
+
+    Parameters
+    ----------
+    effect : shrm.shrm.SHRM
+        From :func:`effect_shrm`.
+    normal, view : ndarray, shape (N, 3)
+        Unit normals and unit vectors towards the eye.
+
+    Returns
+    -------
+    ndarray, shape (N, n_bands)
+
+    Examples
+    --------
+    >>> s = effect_shrm(np.ones((8, 16, 41)), F=2, P=2, size=2)
+    >>> up = np.array([[0.0, 1.0, 0.0]])
+    >>> effect_radiance(s, up, up).shape
+    (1, 41)
+    """
+    from shrm.shrm import shade_shrm, shrm_extract
+
+    N = np.asarray(normal, dtype=np.float64)
+    V = np.asarray(view, dtype=np.float64)
+    require(
+        N.ndim == 2 and N.shape == V.shape and N.shape[1] == 3,
+        f"polymer: effect_radiance: normal and view must be (N, 3), got {N.shape} and {V.shape}",
+    )
+    v = V.mean(axis=0)
+    v = v / np.linalg.norm(v)
+    return shade_shrm(effect, shrm_extract(effect, v), N, v)

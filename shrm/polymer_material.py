@@ -448,16 +448,21 @@ def polymer_shade_parts(parts: dict, look: PolymerLook, Mod_effect=0.0) -> np.nd
     return out
 
 
+#: SHRM settings of the effect pigment's term (a small preview: the pigment is a mixed-in term,
+#: erratum E60): working environment rows, F, P, cube face and frame.
+EFFECT_SHRM_SETTINGS = {"env_height": 32, "F": 12, "P": 8, "size": 16, "frame": "normal"}
+
+
 def _effect_radiance(surface: Surface, effect: IsotropicBRDFMaterial, light, ctx) -> np.ndarray:
     """E_effect of Eq. (3), Herbert et al.: the effect pigment through its (cached) SHRM."""
     from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts
     from shrm.cache import hash_inputs
     from shrm.environment import _state
-    from shrm.orbit import SHADER_SETTINGS, _working_environment
+    from shrm.orbit import _working_environment
     from shrm.shrm import shade_shrm, shrm_create, shrm_extract
     from shrm.transform import project_latlong
 
-    c = SHADER_SETTINGS
+    c = EFFECT_SHRM_SETTINGS
     state = _state(light, ctx)
     key = ("polymer-effect", effect.brdf, hash_inputs({"p": effect.params}))
     if key not in state:

@@ -17,6 +17,10 @@ Groups:
 - ``shrm-cache``: a persistent-cache hit on the 64²×6 SHRM against rebuilding it from the inputs:
   projecting the environment and the BRDF and creating the SHRM, which is what a session without
   the cache pays (baseline; target ≥ 20×).
+- ``shrm-split-frame``: a frame after the first of the scene path (SH + angular split,
+  :mod:`shrm.split`; maps built, viewpoint changed: extraction, lookup, residual sum) against the
+  brute force of ``--oracle`` (baseline), GGX α 0.1 (ρ_d 0, F_0 1) under
+  ``studio_small_03_1k.hdr`` at full resolution, a 16² orthographic sphere (target ≥ 20×).
 
 Slow calls run a fixed, small number of rounds (``benchmark.pedantic``): their spread is a few
 per cent, far below the margins of the targets.
@@ -155,3 +159,46 @@ def test_cache_hit(benchmark, shrm_64, tmp_path):
     cache.put(key, {"coeffs": s.coeffs})
     got = benchmark(cache.get, key)
     assert got["coeffs"].shape == (6, 64, 64, 3, (P + 1) ** 2)
+
+
+@pytest.fixture(scope="module")
+def split_case():
+    from reference.lights import EnvironmentLight
+    from reference.shading import ShadingContext
+    from reference.spectra import SpectralGrid
+    from shrm.environment import environment_spectral_radiance
+    from shrm.orbit import brdf_params_on_grid
+    from shrm.split import split_renderer
+
+    grid = SpectralGrid(400.0, 700.0, 20.0)
+    image = read_image(ROOT.parent / "shared/data/environments/studio_small_03_1k.hdr")
+    radiance = environment_spectral_radiance(EnvironmentLight(image), grid)
+    y = ShadingContext(grid).weights(None)[:, 1]
+    x, z = np.meshgrid((np.arange(16) + 0.5) / 8 - 1, (np.arange(16) + 0.5) / 8 - 1)
+    inside = x**2 + z**2 < 1
+    normals = np.stack([x[inside], -z[inside], np.sqrt(1 - x[inside] ** 2 - z[inside] ** 2)], -1)
+    views = np.broadcast_to([0.0, 0.0, 1.0], normals.shape)
+    params = brdf_params_on_grid("ggx", grid, {"alpha": 0.1, "rho_d": 0.0, "F_0": 1.0})
+    renderer = split_renderer(radiance, "ggx", params, y, normals, views)
+    # The viewpoint changes after creation: the next frame turns the sphere (normals rotate)
+    c, s_ = np.cos(0.3), np.sin(0.3)
+    turn = np.array([[c, 0.0, s_], [0.0, 1.0, 0.0], [-s_, 0.0, c]])
+    return radiance, renderer, normals @ turn.T, views @ turn.T
+
+
+@pytest.mark.benchmark(group="shrm-split-frame")
+def test_split_frame_bruteforce_baseline(benchmark, split_case):
+    from shrm.split import angular_sum
+
+    radiance, r, n, v = split_case
+    benchmark.extra_info["role"] = "baseline"
+    benchmark.pedantic(angular_sum, (env_quadrature(radiance), r.brdf, r.params, n, v), rounds=1)
+
+
+@pytest.mark.benchmark(group="shrm-split-frame")
+def test_split_frame_after_the_first(benchmark, split_case):
+    from shrm.split import split_shade
+
+    _, r, n, v = split_case
+    benchmark.extra_info["residual_fraction"] = r.settings.residual_fraction
+    benchmark.pedantic(split_shade, (r, n, v), rounds=3)

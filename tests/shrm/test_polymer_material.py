@@ -124,8 +124,10 @@ def test_effect_term_is_the_effect_pigment_through_its_shrm():
     difference = shade_polymer_environment(surface, with_effect, light, ctx) - (
         shade_polymer_environment(surface, without, light, ctx)
     )
+    # The isotropic_brdf shader chooses its SHRM settings from a tolerance (issue 21, SH + angular
+    # split); the effect term uses the fixed preview SHRM (E60): they agree to the preview's error.
     expected = shade_isotropic_brdf_environment(surface, effect, light, ctx)
-    np.testing.assert_allclose(difference, expected, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(difference, expected, rtol=1e-2, atol=1e-12)
 
 
 def test_equal_gloss_exponents_share_one_prefiltered_map(sky, tmp_path, monkeypatch):
@@ -193,7 +195,7 @@ def test_modulation_image_is_looked_up_by_uv(sky, tmp_path):
         ("tint = 1.5", r"materials.p.tint: must be in \[0, 1\], got a maximum of 1.5$"),
         ("gloss = 2.0", r"materials.p.gloss: must be <= 1, got 2.0$"),
         ("modulation = 0.5", r"materials.p.modulation: mixes in an effect pigment; set 'effect'"),
-        ('effect = "table"', r"materials.p.effect.brdf: must be an analytic isotropic 3-D BRDF"),
+        ('effect = "table"', r"materials.p.effect: brdf = 'table' needs a key 'file'"),
         ('mirror = "sharp"', r"materials.p.mirror: unknown value 'sharp'; allowed: cosine, "),
         ("thicknes = 1.0", r"materials.p: unknown key 'thicknes'; allowed: "),
     ],

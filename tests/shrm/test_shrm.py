@@ -144,8 +144,8 @@ def test_render_through_the_gbuffer_converges_to_the_closed_form(rng):
 
 def test_cli_orbit_refuses_orders_the_tolerance_does_not_allow(tmp_path, capsys):
     argv = ["shrm", "orbit", "--quick", "--brdf", "lafortune", "--no-cache", "-o", str(tmp_path)]
-    assert main([*argv, "--frames", "1", "--P", "1"]) == 2
-    assert "SHRM: P = 1 is outside what tol 0.05 allows" in capsys.readouterr().err
+    assert main([*argv, "--frames", "1", "--P", "3"]) == 2
+    assert "SHRM: P = 3 is outside what tol 0.05 allows" in capsys.readouterr().err
 
 
 def test_shrm_extract_is_linear_in_the_view_basis():

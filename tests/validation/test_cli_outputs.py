@@ -154,6 +154,11 @@ def _commands(out: Path, tmp_path: Path) -> dict[str, list[str]]:
     material = tmp_path / "m.toml"
     material.write_text("[material]\nk_d = 0.2\nk_s = 0.5\nn = 3\n")
     scene = EXAMPLES / "phong-sphere.toml"
+    sweep = tmp_path / "sweep.toml"
+    sweep.write_text(
+        'kind = "phong"\n[grid]\nmaterials = ["R1"]\nviews = ["near"]\n'
+        'placements = ["error"]\ninterpolations = ["monotone"]\nentries = [25]\nresolution = 8\n'
+    )
     return {
         "render -o": ["render", str(scene), "-o", f"{out}.png", "--width", "8"],
         "render --exr": [
@@ -206,6 +211,19 @@ def _commands(out: Path, tmp_path: Path) -> dict[str, list[str]]:
         "polymer characterize -o": ["polymer", "characterize", "-o", f"{out}.csv"],
         "display calibrate -o": ["display", "calibrate", "--points", "4", "-o", f"{out}.cal"],
         "env fit -o": ["env", "fit", "-o", f"{out}.json"],
+        "render --json": [
+            "render",
+            str(scene),
+            "-o",
+            str(tmp_path / "ok.png"),
+            "--width",
+            "8",
+            "--json",
+            f"{out}.json",
+        ],
+        "compare --json": ["compare", str(env), str(env), "--json", f"{out}.json"],
+        "compare --diff": ["compare", str(env), str(env), "--diff", f"{out}.exr"],
+        "sweep -o": ["sweep", str(sweep), "--scheduler", "serial", "-o", f"{out}.csv"],
         "shrm orbit -o": [
             "shrm",
             "orbit",
@@ -230,6 +248,10 @@ COMMANDS = (
     "polymer characterize -o",
     "display calibrate -o",
     "env fit -o",
+    "render --json",
+    "compare --json",
+    "compare --diff",
+    "sweep -o",
     "shrm orbit -o",
 )
 

@@ -86,6 +86,17 @@ BAD_INPUT = {
     ),
     "wrong output type": (GOOD.replace("{k_d}", "1"), ["-o", "out.jpg"], "-o: the output must end"),
     "width not a number": (GOOD.replace("{k_d}", "1"), ["--width", "abc"], "argument --width"),
+    "accuracy zero": (
+        GOOD.replace("{k_d}", "1"),
+        ["--accuracy", "0"],
+        "--accuracy: must be a relative error in (0, 0.25], got 0",
+    ),
+    "unknown EXR output": (
+        GOOD.replace("{k_d}", "1"),
+        ["--exr", "out.exr", "--exr-output", "rgb"],
+        "unknown render output 'rgb'; allowed: display, spectral, xyz",
+    ),
+    "JSON suffix": (GOOD.replace("{k_d}", "1"), ["--json", "out.txt"], "--json: the output must"),
 }
 
 

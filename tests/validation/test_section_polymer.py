@@ -1,5 +1,6 @@
 import pytest
 
+from shrm.polymer import MIRROR_FACTORS
 from validation.report.runner import REPORT_SECTIONS, SECTIONS, run_report
 
 
@@ -17,9 +18,15 @@ def test_report_polymer_section_quick(tmp_path):
     assert sorted(section["fig2"]) == ["0.762", "1.524", "3.048"]
     assert all(len(c["L_transmission"]) == 11 for c in section["fig2"].values())
     checks = [c for c in results["checks"] if c["section"] == "polymer"]
-    assert len(checks) == 13
+    assert len(checks) == 15
     assert all(c["passed"] for c in checks), [c for c in checks if not c["passed"]]
-    for name in ("fig2", "chips", "terms-fresnel", "terms-cosine", "terms-none"):
+    names = ("fig2", "chips", "terms-fresnel", "terms-cosine", "terms-none", "oracle-images")
+    for name in (*names, "oracle-sweeps", "oracle-speed"):
         assert (tmp_path / "images" / f"polymer-{name}.png").is_file()
     # Erratum E34: the printed model returns more than a passive surface can at grazing views
     assert all(v["grazing"] > 1.0 for v in section["uniform_sky"].values())
+    # The hybrid against the layered oracle: every sweep, every M_s, and the speed chart's points
+    oracle = section["oracle"]
+    assert sorted(oracle["sweeps"]) == ["gloss", "thickness_mm", "tio2_pct"]
+    assert sorted(oracle["speed"]["hybrid"]) == sorted(MIRROR_FACTORS.names())
+    assert len(oracle["failures"]) == 3 * len(MIRROR_FACTORS.names())

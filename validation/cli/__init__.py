@@ -15,6 +15,7 @@ from reference.errors import SpecrefError
 from validation.cli import (
     brdf,
     cache,
+    compare,
     crosscheck,
     display,
     env,
@@ -48,6 +49,7 @@ COMMANDS = (
     sweep,
     equations,
     crosscheck,
+    compare,
 )
 
 

@@ -7,6 +7,8 @@ from validation.cli.parser import registry_option
 
 
 def _cmd_render(args) -> int:
+    import json
+
     import phong_table  # noqa: F401  (registers its shaders, if any)
     import shrm  # noqa: F401  (registers the environment-light shaders, if any)
     from reference.render import render_scene_file
@@ -20,30 +22,62 @@ def _cmd_render(args) -> int:
         supersample=args.supersample,
         oracle=args.oracle,
         texel_placement=args.texel_placement,
+        exr_output=args.exr_output,
+        accuracy=args.accuracy,
+        json=args.json,
     )
+    if args.json == "-":
+        print(json.dumps(result.metadata, indent=2))
+        return 0
     r = result.scene.render
-    outputs = " and ".join(str(p) for p in (args.output, args.exr) if p is not None)
+    outputs = " and ".join(str(p) for p in (args.output, args.exr, args.json) if p is not None)
+    orders = [
+        f"{key} order {choice['order']}"
+        for key, choice in result.metadata["methods"].get("environment", {}).items()
+        if "order" in choice
+    ]
     print(
         f"wrote {outputs} ({r.width}×{r.height}, supersample {r.supersample}, "
-        f"{result.timings['total']:.2f} s)"
+        f"{result.timings['total']:.2f} s{''.join('; ' + o for o in orders)})"
     )
     return 0
 
 
 def add_parser(sub) -> None:
     """Add ``specref render`` and its options to the subcommand parsers ``sub``."""
+    from reference.render_metadata import DEFAULT_ACCURACY, RENDER_OUTPUTS
+
     p = sub.add_parser(
         "render",
         help="render a scene file to a display-encoded PNG (and optionally a linear EXR)",
         description="Render a TOML scene (docs/scene-format.md). Relative paths in the scene are "
-        "relative to its folder.",
+        "relative to its folder. Outputs and metadata: docs/render-outputs.md.",
     )
     p.add_argument("scene", metavar="SCENE.toml", help="the scene file")
     p.add_argument(
         "-o", "--output", required=True, metavar="OUT.png", help="display-encoded 8-bit PNG"
     )
     p.add_argument(
-        "--exr", metavar="OUT.exr", help="also write linear display RGB (before exposure) as EXR"
+        "--exr", metavar="OUT.exr", help="also write a linear EXR (what it holds: --exr-output)"
+    )
+    registry_option(
+        p,
+        "--exr-output",
+        RENDER_OUTPUTS,
+        "what the EXR holds, see docs/render-outputs.md",
+        default="display",
+    )
+    p.add_argument(
+        "--accuracy",
+        metavar="TOL",
+        help=f"mean relative error of Y over lit pixels that fast environment lighting promises "
+        f"(max 4×TOL), default {DEFAULT_ACCURACY:g}; the SH order follows from it",
+    )
+    p.add_argument(
+        "--json",
+        metavar="OUT.json",
+        help="write the render's metadata (orders chosen, bounds promised, units) as JSON; "
+        "'-' prints it",
     )
     p.add_argument("--width", type=int, help="override render.width (alone: keep the aspect)")
     p.add_argument("--height", type=int, help="override render.height (alone: keep the aspect)")

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from reference.errors import SpecrefError, require, require_positive_int
@@ -27,6 +29,8 @@ def _check_arguments(args) -> None:
         )
     if args.F is not None:
         require(args.F >= 0, f"shrm orbit: --F: must be >= 0, got {args.F}")
+    if args.env is not None:  # before the output folder is made: a refusal leaves nothing behind
+        require(Path(args.env).is_file(), f"{args.env}: environment file not found (--env)")
     check_output_folder(args.out)
 
 

@@ -47,6 +47,7 @@ from validation.sections import (
     raster,
     scaleout,
     sh,
+    sh_order,
     shrm,
     spectral,
     spectral_env,
@@ -81,6 +82,7 @@ PARTS: tuple[ReportPart, ...] = (
         "SH to order 100, prefiltering, SHRMs, spectral panoramas, display calibration.",
         (
             sh.SECTION,
+            sh_order.SECTION,
             spectral_env.SECTION,
             shrm.SECTION,
             polymer.SECTION,

@@ -261,7 +261,14 @@ class ReportContext:
         return Image(rel, caption, int(width), int(height))
 
     def comparison(
-        self, name: str, reference, method, labels=("reference", "method"), caption: str = ""
+        self,
+        name: str,
+        reference,
+        method,
+        labels=("reference", "method"),
+        caption: str = "",
+        difference=None,
+        difference_label: str = "difference (reference units)",
     ) -> Image:
         """Reference | method | difference, the report's one layout for every comparison.
 
@@ -270,13 +277,15 @@ class ReportContext:
         are shown with one exposure (the reference's 99th percentile maps to white), the
         difference ``method − reference`` on a diverging colour scale symmetric about zero,
         in the reference's units, with its colour bar. Pixels are shown without smoothing.
+        ``difference`` replaces that difference (for example ΔY relative to the peak), labelled
+        ``difference_label``.
         """
         import matplotlib.pyplot as plt
 
         ref = np.asarray(reference, dtype=float)
         got = np.asarray(method, dtype=float)
         scale = float(np.percentile(ref, 99)) or 1.0
-        diff = got - ref
+        diff = got - ref if difference is None else np.asarray(difference, dtype=float)
         if diff.ndim == 3:
             diff = diff.mean(axis=-1)
         limit = float(np.max(np.abs(diff))) or 1.0
@@ -288,7 +297,7 @@ class ReportContext:
             diff, cmap="RdBu_r", vmin=-limit, vmax=limit, interpolation="nearest"
         )
         axes[2].set_title(f"{labels[1]} − {labels[0]}")
-        fig.colorbar(shown, ax=axes[2], shrink=0.85, label="difference (reference units)")
+        fig.colorbar(shown, ax=axes[2], shrink=0.85, label=difference_label)
         for ax in axes:
             ax.set_xticks([])
             ax.set_yticks([])
