@@ -405,9 +405,11 @@ def _oracle_image_figure(ctx: ReportContext, images: dict):
     names = ["I_d", "I_s F_r", "I_trans (1 - F_r)", "I_effect", "hybrid", "oracle"]
     fig, axes = plt.subplots(1, len(names) + 1, figsize=(2.1 * (len(names) + 1), 2.5))
     for ax, name in zip(axes, names, strict=False):
-        ax.imshow(_to_srgb(images[name], W_E, scale))
+        ax.imshow(_to_srgb(images[name], W_E, scale), interpolation="nearest")
         ax.set_title(name if name != "hybrid" else "hybrid (sum)", fontsize=9)
-    shown = axes[-1].imshow(np.where(images["mask"], images["delta_E"], np.nan), cmap="magma")
+    shown = axes[-1].imshow(
+        np.where(images["mask"], images["delta_E"], np.nan), cmap="magma", interpolation="nearest"
+    )
     axes[-1].set_title("ΔE00 hybrid − oracle", fontsize=9)
     fig.colorbar(shown, ax=axes[-1], fraction=0.046)
     for ax in axes:
