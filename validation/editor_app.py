@@ -341,7 +341,7 @@ class EditorPage:
             self.rms_div.text = "RMS: exact render pending (after the drag)"
             return
         rms = max(rms_8bit(table.linear, self.exact[2].linear))
-        self.rms_div.text = f"RMS {rms:.4f} (8-bit, max of display and linear)"
+        self.rms_div.text = f"RMS {rms:.4g} (8-bit units, max of display and linear)"
         self.image_sources["diff"].data = {
             "image": [difference_rgba(table, self.exact[2]).view(np.uint32)[..., 0]]
         }

@@ -22,7 +22,17 @@ from reference.errors import SpecrefError, require
 from reference.images import atomic_path
 from validation.report.browser import CHROMIUM_FLAGS, INSTALL_HINT, find_chromium
 
-__all__ = ["editor_driver", "editor_screenshot", "editor_server", "free_port", "page_value"]
+__all__ = [
+    "click_button",
+    "editor_driver",
+    "editor_screenshot",
+    "editor_server",
+    "free_port",
+    "image_checksum",
+    "page_value",
+    "set_control_point",
+    "set_widget",
+]
 
 
 def free_port() -> int:
@@ -42,14 +52,16 @@ def free_port() -> int:
 def editor_server(path=None, port: int | None = None, timeout: float = 60.0):
     """Run ``specref phong edit`` in a child process; yield ``(url, process)``; stop it by pid."""
     port = free_port() if port is None else port
-    command = [sys.executable, "-m", "validation.cli", "phong", "edit", "--port", str(port)]
+    command = [sys.executable, "-m", "validation.cli", "phong", "edit"]
     command += [] if path is None else [str(path)]
+    command += ["--port", str(port)]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         line = process.stdout.readline()  # the URL, once the server listens
         if "http://" not in line:
             process.wait(timeout)
-            raise SpecrefError(f"specref phong edit: did not start: {process.stderr.read()[-300:]}")
+            tail = process.stderr.read().strip().splitlines()[-1:] or [""]
+            raise SpecrefError(f"specref phong edit: did not start: {tail[0]}")
         yield line.split()[3] if len(line.split()) > 3 else f"http://127.0.0.1:{port}/", process
     finally:
         if process.poll() is None:
@@ -139,6 +151,41 @@ def set_control_point(driver, curve: str, index: int, value: float) -> None:
 def set_widget(driver, name: str, attribute: str, value) -> None:
     """Set a widget's attribute through the page's JS model (synced to the server)."""
     driver.execute_script(_SET_JS, name, attribute, value)
+
+
+_CLICK_JS = """
+function find(root, label) {
+    for (const el of root.querySelectorAll('*')) {
+        if (el.tagName === 'BUTTON' && el.textContent.trim() === label) { return el; }
+        if (el.shadowRoot) {
+            const inner = find(el.shadowRoot, label);
+            if (inner) { return inner; }
+        }
+    }
+    return null;
+}
+const button = find(document, arguments[0]);
+if (button) { button.click(); }
+return button !== null;
+"""
+
+_CHECKSUM_JS = """
+const source = Bokeh.documents[0].get_model_by_name(arguments[0] + '_image');
+const data = source.data.image[0];
+let sum = 0;
+for (let i = 0; i < data.length; i += 3) { sum = (sum * 31 + data[i]) % 1000000007; }
+return sum;
+"""
+
+
+def click_button(driver, label: str) -> None:
+    """Click the page's button with this label, as a user does (through Bokeh's shadow DOM)."""
+    require(driver.execute_script(_CLICK_JS, label), f"editor page: no button {label!r}")
+
+
+def image_checksum(driver, kind: str = "table") -> int:
+    """A checksum of an image the page shows (``table``, ``exact``, ``diff``)."""
+    return driver.execute_script(_CHECKSUM_JS, kind)
 
 
 def editor_screenshot(path, out, port: int | None = None) -> None:
