@@ -358,6 +358,18 @@ def serve_editor(path=None, port: int = 5006, announce=None, view="far", resolut
     ------
     SpecrefError
         The port is in use or not allowed (one line).
+
+    Examples
+    --------
+    >>> import socket
+    >>> with socket.socket() as busy:
+    ...     busy.bind(("127.0.0.1", 0))
+    ...     busy.listen()
+    ...     try:
+    ...         serve_editor(port=busy.getsockname()[1])
+    ...     except SpecrefError as error:
+    ...         print(str(error).split("; ")[-1])
+    choose another --port
     """
     from bokeh.application import Application
     from bokeh.application.handlers.function import FunctionHandler

@@ -17,22 +17,13 @@ import subprocess
 import sys
 import tempfile
 import time
+from pathlib import Path
 
 from reference.errors import SpecrefError, require
 from reference.images import atomic_path
 from validation.report.browser import CHROMIUM_FLAGS, INSTALL_HINT, find_chromium
 
-__all__ = [
-    "click_button",
-    "editor_driver",
-    "editor_screenshot",
-    "editor_server",
-    "free_port",
-    "image_checksum",
-    "page_value",
-    "set_control_point",
-    "set_widget",
-]
+__all__ = ["editor_screenshot", "free_port", "wait_for"]
 
 
 def free_port() -> int:
@@ -114,7 +105,17 @@ def page_value(driver, name: str, attribute: str = "text"):
 
 
 def wait_for(driver, predicate, timeout: float = 60.0, what: str = "the page"):
-    """Poll ``predicate(driver)`` until truthy; return its value; SpecrefError on timeout."""
+    """Poll ``predicate(driver)`` until truthy; return its value; SpecrefError on timeout.
+
+    Examples
+    --------
+    >>> calls = []
+    >>> wait_for(None, lambda d: calls.append(1) or len(calls) > 2 and len(calls))
+    3
+    >>> wait_for(None, lambda d: None, 0.05, "nothing")
+    Traceback (most recent call last):
+    reference.errors.SpecrefError: editor page: nothing did not happen within 0.05 s
+    """
     end = time.monotonic() + timeout
     while time.monotonic() < end:
         value = predicate(driver)
@@ -189,7 +190,16 @@ def image_checksum(driver, kind: str = "table") -> int:
 
 
 def editor_screenshot(path, out, port: int | None = None) -> None:
-    """Write a PNG of the editor: 50 uniform entries, one k_s point raised (atomic write)."""
+    """Write a PNG of the editor: 50 uniform entries, one k_s point raised (atomic write).
+
+    Examples
+    --------
+    >>> editor_screenshot(None, "/nonexistent/editor.png")
+    Traceback (most recent call last):
+    reference.errors.SpecrefError: /nonexistent/editor.png: the folder /nonexistent does not exist
+    """
+    folder = Path(out).resolve().parent
+    require(folder.is_dir(), f"{out}: the folder {folder} does not exist")
     with (
         editor_server(path, None if port == 5006 else port) as (url, _process),
         editor_driver() as driver,
