@@ -116,9 +116,9 @@ class EditorPage:
 
         label, low, high, log = CURVES[key]
         plot = figure(
-            title=label, width=380, height=220, y_axis_type="log" if log else "linear",
-            x_range=(370, 790), y_range=(low * 0.9 if log else low, high), tools="",
-            x_axis_label="λ (nm)",
+            name=f"{key}_plot", title=label, width=380, height=220,
+            y_axis_type="log" if log else "linear", x_range=(370, 790),
+            y_range=(low * 0.9 if log else low, high), tools="", x_axis_label="λ (nm)",
         )  # fmt: skip
         grid = self.state.grid.wavelengths_nm
         line = ColumnDataSource({"x": grid, "y": self.state.curve(key)}, name=f"{key}_curve")

@@ -149,6 +149,38 @@ def set_control_point(driver, curve: str, index: int, value: float) -> None:
     driver.execute_script(_POINT_JS, curve, index, value)
 
 
+_PIXELS_JS = """
+const doc = Bokeh.documents[0];
+const plot = doc.get_model_by_name(arguments[0] + '_plot');
+const source = doc.get_model_by_name(arguments[0] + '_points');
+const view = Bokeh.index.get_one(plot);
+const x = source.data.x[arguments[1]], y = source.data.y[arguments[1]];
+const rect = view.canvas_view.el.getBoundingClientRect();
+return [rect.left + view.frame.x_scale.compute(x), rect.top + view.frame.y_scale.compute(y),
+        rect.top + view.frame.y_scale.compute(arguments[2])];
+"""
+
+
+def drag_control_point(driver, curve: str, index: int, value: float, steps: int = 6) -> None:
+    """Drag a control point with the mouse (press, move in ``steps``, release), as a user does.
+
+    The point's pixel position comes from the plot's own scales (``Bokeh.index``); the page is
+    scrolled so the point is in view first. ``PointDrawTool`` is the plot's active drag tool.
+    """
+    from selenium.webdriver.common.actions.action_builder import ActionBuilder
+
+    x, y, _ = driver.execute_script(_PIXELS_JS, curve, index, value)
+    driver.execute_script(f"window.scrollBy(0, {max(0.0, y - 300.0)})")
+    x, y, target = driver.execute_script(_PIXELS_JS, curve, index, value)
+    action = ActionBuilder(driver, duration=40)
+    action.pointer_action.move_to_location(round(x), round(y)).pointer_down()
+    for k in range(1, steps + 1):
+        action.pointer_action.move_to_location(round(x), round(y + (target - y) * k / steps))
+    action.pointer_action.release()
+    action.perform()
+    driver.execute_script("window.scrollTo(0, 0)")
+
+
 def set_widget(driver, name: str, attribute: str, value) -> None:
     """Set a widget's attribute through the page's JS model (synced to the server)."""
     driver.execute_script(_SET_JS, name, attribute, value)
@@ -209,7 +241,7 @@ def editor_screenshot(path, out, port: int | None = None) -> None:
         first = wait_for(driver, rms_shown, what="the first RMS")
         set_widget(driver, "placement", "value", "uniform")
         set_widget(driver, "entries", "value", 50)
-        set_control_point(driver, "k_s", 3, 0.8)
+        drag_control_point(driver, "k_s", 3, 0.8)
         wait_for(driver, lambda d: (rms_shown(d) or first) != first, what="the edited RMS")
         time.sleep(1.0)  # the last renders of the edit, then the canvases paint
         wait_for(driver, rms_shown, what="the edited RMS")

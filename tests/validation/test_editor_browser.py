@@ -2,9 +2,9 @@
 
 Needs Debian's ``chromium`` and ``chromium-driver`` (``apt install chromium chromium-driver``;
 ``.ci/run`` installs them) and ``selenium`` (a test extra); skipped with that hint where missing.
-The control point is moved through the page's JS model (the ``data`` of the curve's
-``ColumnDataSource``, which is what Bokeh's ``PointDrawTool`` writes when a point is dragged), not
-by a synthesized mouse drag; the buttons are clicked as a user clicks them.
+The control point is dragged with the mouse (Selenium pointer actions at the pixel the plot's own
+scales give); a second edit goes through the page's JS model (the ``data`` of the curve's
+``ColumnDataSource``, which ``PointDrawTool`` writes). The buttons are clicked as a user clicks.
 """
 
 import shutil
@@ -28,6 +28,7 @@ pytestmark = pytest.mark.skipif(
 def test_an_edit_in_the_browser_renders_and_saves(tmp_path):
     from validation.editor_browser import (
         click_button,
+        drag_control_point,
         editor_driver,
         editor_server,
         image_checksum,
@@ -45,14 +46,29 @@ def test_an_edit_in_the_browser_renders_and_saves(tmp_path):
         driver.get(url)
         rms0 = wait_for(driver, rms_shown, 120, "the first RMS")
         frame0, image0 = page_value(driver, "frame"), image_checksum(driver)
-        # A drag of the k_s point at 500 nm, then the table image arrives, then the exact one.
-        edited = time.perf_counter()
-        set_control_point(driver, "k_s", 3, 0.95)
+        # A mouse drag of the k_s point at 500 nm: the table image and then the exact one change.
+        drag_control_point(driver, "k_s", 3, 0.95)
         wait_for(driver, lambda d: page_value(d, "frame") != frame0, 30, "the edited frame")
-        latency = time.perf_counter() - edited
-        assert image_checksum(driver) != image0
+        dragged = page_value(driver, "k_s_points", "data")["y"][3]
+        assert dragged == pytest.approx(0.95, abs=0.02)  # one pixel of the plot is ~0.005
+        wait_for(driver, lambda d: image_checksum(d) != image0, 30, "the new image")
         rms1 = wait_for(driver, lambda d: rms_shown(d) != rms0 and rms_shown(d), 30, "new RMS")
-        print(f"\nedit-to-image latency: {latency * 1e3:.0f} ms; RMS {rms0!r} -> {rms1!r}")  # noqa: T201
+        # One edit through the page's JS model, timed from the edit to the new image on the page.
+        frame1, image1 = page_value(driver, "frame"), image_checksum(driver)
+        edited = time.perf_counter()
+        set_control_point(driver, "n", 0, 3000.0)
+        wait_for(driver, lambda d: image_checksum(d) != image1, 30, "the image of the n edit")
+        latency = time.perf_counter() - edited
+        assert page_value(driver, "frame") != frame1
+        rms2 = wait_for(
+            driver,
+            lambda d: rms_shown(d) not in (None, rms1) and rms_shown(d),
+            30,
+            "the n edit's RMS",
+        )
+        print(
+            f"\nedit-to-image latency: {latency * 1e3:.0f} ms; RMS {rms0.split()[1]} -> {rms1.split()[1]} -> {rms2.split()[1]}"
+        )  # noqa: T201
         # Save to a new file through the page's path field and its "save" button.
         saved = tmp_path / "saved.toml"
         set_widget(driver, "path", "value", str(saved))
@@ -75,7 +91,8 @@ def test_an_edit_in_the_browser_renders_and_saves(tmp_path):
     # The saved file holds the edit and `specref phong --material` accepts it.
     model = load_material_file(saved)
     wl = model.grid.wavelengths_nm.tolist()
-    assert model.material.k_s[wl.index(500.0)] == pytest.approx(0.95)
+    assert model.material.k_s[wl.index(500.0)] == pytest.approx(dragged)
+    assert model.material.n[0] == pytest.approx(3000.0)
     np.testing.assert_allclose(model.material.k_d, start.curve("k_d"))
     command = [sys.executable, "-m", "validation.cli", "phong", "--material", str(saved)]
     command += ["--resolution", "24", "--repeats", "1", "--entries", "32"]
