@@ -66,9 +66,8 @@ def test_an_edit_in_the_browser_renders_and_saves(tmp_path):
             30,
             "the n edit's RMS",
         )
-        print(
-            f"\nedit-to-image latency: {latency * 1e3:.0f} ms; RMS {rms0.split()[1]} -> {rms1.split()[1]} -> {rms2.split()[1]}"
-        )  # noqa: T201
+        figures = " -> ".join(text.split()[1] for text in (rms0, rms1, rms2))
+        print(f"\nedit-to-image latency: {latency * 1e3:.0f} ms; RMS {figures}")  # noqa: T201
         # Save to a new file through the page's path field and its "save" button.
         saved = tmp_path / "saved.toml"
         set_widget(driver, "path", "value", str(saved))
