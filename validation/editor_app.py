@@ -209,7 +209,9 @@ class EditorPage:
         open_button.on_click(self._on_open)
         save_button.on_click(self._on_save)
         self.error_div = Div(text=self._error_html(), name="error", width=900)
-        self.rms_div = Div(text="RMS: …", name="rms", width=380)
+        self.rms_div = Div(
+            text="RMS: rendering (a new server compiles its kernels first)", name="rms", width=380
+        )
         self.times_div = Div(text="", name="times", width=380)
         self.frame_div = Div(text="frame 0", name="frame", width=380)
         return [self.placement, self.interp, self.entries, self.path_input, open_button,

@@ -14,11 +14,12 @@ def _cmd_phong(args) -> int:
     if args.action == "edit":
         from validation import editor_app, editor_browser
 
+        path = args.file if args.file is not None else args.material
         if args.screenshot:
-            editor_browser.editor_screenshot(args.file, args.screenshot, args.port)
+            editor_browser.editor_screenshot(path, args.screenshot, args.port)
             print(f"wrote {args.screenshot}")
             return 0
-        editor_app.serve_editor(args.file, args.port, partial(print, flush=True))
+        editor_app.serve_editor(path, args.port, partial(print, flush=True))
         return 0
     if args.file is not None:
         raise SpecrefError(f"specref phong: {args.file}: a file is taken by 'edit' only")
