@@ -1,6 +1,8 @@
-"""``specref phong``: Table 1 of Wang et al., or one material file's tables."""
+"""``specref phong``: Table 1 of Wang et al., one material file's tables, or the editor."""
 
 from __future__ import annotations
+
+from functools import partial
 
 from validation.cli.parser import registry_option, write_json
 
@@ -9,6 +11,18 @@ def _cmd_phong(args) -> int:
     from reference.errors import SpecrefError
     from validation import phong, phong_table1
 
+    if args.action == "edit":
+        from validation import editor_app, editor_browser
+
+        path = args.file if args.file is not None else args.material
+        if args.screenshot:
+            editor_browser.editor_screenshot(path, args.screenshot, args.port)
+            print(f"wrote {args.screenshot}")
+            return 0
+        editor_app.serve_editor(path, args.port, partial(print, flush=True))
+        return 0
+    if args.file is not None:
+        raise SpecrefError(f"specref phong: {args.file}: a file is taken by 'edit' only")
     if args.action == "table1":
         result = phong_table1.run_table1(args.resolution, args.entries, args.repeats, progress=True)
         print(f"Table 1 (Wang et al.), {args.resolution}x{args.resolution}, {args.entries} entries")
@@ -46,11 +60,22 @@ def add_parser(sub) -> None:
     p = sub.add_parser(
         "phong",
         help="spectral Phong tables: Table 1 of Wang et al., or one material file",
-        description="specref phong table1 [--json FILE] | specref phong --material FILE.toml "
+        description="specref phong table1 [--json FILE] | specref phong edit [MATERIAL.toml] "
+        "[--port N] | specref phong --material FILE.toml "
         "--view V --entries M --placement P --interp I [--segments S] [--tolerance T] "
         "[--json FILE]",
     )
-    p.add_argument("action", nargs="?", choices=["table1"], help="reproduce Table 1")
+    p.add_argument(
+        "action",
+        nargs="?",
+        choices=["table1", "edit"],
+        help="table1: reproduce Table 1; edit: the material editor in the browser",
+    )
+    p.add_argument("file", nargs="?", metavar="MATERIAL.toml", help="edit: the file to open")
+    p.add_argument("--port", type=int, default=5006, help="edit: the local port (default 5006)")
+    p.add_argument(
+        "--screenshot", metavar="PNG", help="edit: write a screenshot of the page and exit"
+    )
     p.add_argument(
         "--material",
         metavar="FILE.toml",
