@@ -31,10 +31,31 @@ __all__ = [
 #: Table 1 of Wang et al. as printed: per scene, (RMS, seconds) of (a)-(f); (a), (d) are the exact
 #: "standard images" (RMS None); (b), (e) their algorithm; (c), (f) uniform tables, 200 entries.
 PAPER_TABLE1 = {
-    "R1": [(None, 3.658), (0.067, 0.382), (0.252, 0.291), (None, 11.777), (0.570, 0.606), (2.053, 0.43)],
-    "R2": [(None, 5.438), (0.177, 0.495), (1.198, 0.331), (None, 11.847), (1.570, 0.712), (11.524, 0.461)],
-    "R3": [(None, 3.685), (0.040, 0.490), (0.943, 0.311), (None, 11.707), (0.189, 0.610), (7.732, 0.401)],
-}  # fmt: skip
+    "R1": [
+        (None, 3.658),
+        (0.067, 0.382),
+        (0.252, 0.291),
+        (None, 11.777),
+        (0.570, 0.606),
+        (2.053, 0.43),
+    ],
+    "R2": [
+        (None, 5.438),
+        (0.177, 0.495),
+        (1.198, 0.331),
+        (None, 11.847),
+        (1.570, 0.712),
+        (11.524, 0.461),
+    ],
+    "R3": [
+        (None, 3.685),
+        (0.040, 0.490),
+        (0.943, 0.311),
+        (None, 11.707),
+        (0.189, 0.610),
+        (7.732, 0.401),
+    ],
+}
 #: The rows of one view in the paper's order, (label, placement, interpolation, segments of m),
 #: then specref's error placement: the paper's (b) is importance p = m with its parabola (in t,
 #: Erratum E19), its (c) a uniform table (interpolation not stated; the t-parabola here).
@@ -246,14 +267,16 @@ def table1_blocks(states: dict, entries: int = TABLE1_ENTRIES, repeats: int = 3,
     rows, paper = [], []
     for (scene, view), state in states.items():
         exact_s = time_shading(state, None, repeats=repeats)
-        for k, method in enumerate(TABLE1_METHODS):
+        for method in TABLE1_METHODS:
             rows.append(_table1_row(state, scene, *method, entries, exact_s, repeats))
         printed = PAPER_TABLE1.get(scene)
         if printed is None:
             continue
         base = 0 if view == "far" else 3
         exact_printed = printed[base][1]
-        for letter, (rms, seconds) in zip("abc" if base == 0 else "def", printed[base : base + 3]):
+        for letter, (rms, seconds) in zip(
+            "abc" if base == 0 else "def", printed[base : base + 3], strict=True
+        ):
             paper.append(
                 [
                     scene,
@@ -274,7 +297,8 @@ def table1_blocks(states: dict, entries: int = TABLE1_ENTRIES, repeats: int = 3,
         Table(
             ["scene", "view", "image", "RMS (printed)", "time / exact (printed)"],
             paper,
-            "Table 1 as printed in Wang et al. ((a)-(c) far, (d)-(f) near; 200 entries, Athlon 700 MHz)",
+            "Table 1 as printed in Wang et al. ((a)-(c) far, (d)-(f) near; 200 entries, "
+            "Athlon 700 MHz)",
             "{:.3g}",
         ),
         Text(
@@ -301,16 +325,20 @@ def paper_figures(
 
     Examples
     --------
-    >>> import tempfile
-    >>> from pathlib import Path
-    >>> from validation.report import ReportContext
-    >>> with tempfile.TemporaryDirectory() as d:
-    ...     ctx = ReportContext(Path(d), quick=True, section="phong")
-    ...     blocks = paper_figures(ctx, 12, False, 16, scenes=("R1",), repeats=1)
-    ...     names = sorted(p.name for p in (Path(d) / "images").iterdir())
-    >>> len(names), names[0]
-    (9, 'phong-fig2-R1-far.png')
-    """  # noqa: E501
+    A writer that keeps the names (``ReportContext`` writes the PNGs):
+
+    >>> import matplotlib.pyplot as plt
+    >>> class Names(list):
+    ...     def figure(self, name, fig, caption=""):
+    ...         plt.close(fig)
+    ...         self.append(name)
+    ...     def comparison(self, name, reference, method, labels, caption=""):
+    ...         self.append(name)
+    >>> names = Names()
+    >>> blocks = paper_figures(names, 12, False, 16, scenes=("R1",), repeats=1)
+    >>> len(names), names[:3]
+    (9, ['fig2-R1-far', 'fig2-R1-near', 'fig3-cosine-powers'])
+    """
     scenes = tuple(PAPER_TABLE1) if scenes is None else tuple(scenes)
     states = {}
     for scene in scenes:

@@ -62,7 +62,8 @@ def add_parser(sub) -> None:
     p = sub.add_parser(
         "phong",
         help="spectral Phong tables: Table 1 of Wang et al., or one material file",
-        description="specref phong table1 [--json FILE] [--images DIR] | specref phong --material FILE.toml "
+        description="specref phong table1 [--json FILE] [--images DIR] | "
+        "specref phong --material FILE.toml "
         "--view V --entries M --placement P --interp I [--segments S] [--tolerance T] "
         "[--json FILE]",
     )
