@@ -20,12 +20,14 @@ from validation.report import Image, Table, Text
 __all__ = [
     "PAPER_TABLE1",
     "TABLE1_METHODS",
+    "NameWriter",
     "fig2_uniform",
     "fig3_cosine_powers",
     "fig4_nodes",
     "fig567_scene",
     "paper_figures",
     "table1_blocks",
+    "table_image",
 ]
 
 #: Table 1 of Wang et al. as printed: per scene, (RMS, seconds) of (a)-(f); (a), (d) are the exact
@@ -67,6 +69,42 @@ TABLE1_METHODS = (
 )
 
 
+class NameWriter(list):
+    """A writer that keeps the names and captions and writes nothing (doctests, dry runs).
+
+    Examples
+    --------
+    >>> w = NameWriter()
+    >>> w.comparison("a", None, None, ("x", "y"), "c")
+    'a'
+    >>> w, w.captions
+    (['a'], ['c'])
+    """
+
+    def __init__(self):
+        super().__init__()
+        self.captions = []
+
+    def figure(self, name: str, fig, caption: str = "") -> str:
+        """Close ``fig``; keep the name and caption."""
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
+        return self.comparison(name, None, None, (), caption)
+
+    def comparison(self, name: str, reference, method, labels=(), caption: str = "") -> str:
+        """Keep the name and caption."""
+        self.append(name)
+        self.captions.append(caption)
+        return name
+
+
+def _r1_states(resolution: int = 8) -> dict:
+    # R1 far and near with the NumPy references (doctests)
+    model = SCENES.lookup("R1").build()
+    return {v: view_state(model, v, resolution, False) for v in VIEWS}
+
+
 def table_image(state: ViewState, placement, interpolation, entries: int, segments=None):
     """Linear display RGB image ``(H, W, 3)`` of one table (or the exact render, placement None).
 
@@ -102,7 +140,16 @@ def _rms(state: ViewState, image) -> float:
 
 
 def fig2_uniform(writer, state_far, state_near, entries: int) -> list[Image]:
-    """Fig. 2, Wang et al.: exact against a uniform table (t-parabola), far and near views."""
+    """Fig. 2, Wang et al.: exact against a uniform table (t-parabola), far and near views.
+
+    Examples
+    --------
+    >>> w = NameWriter()
+    >>> s = _r1_states()
+    >>> _ = fig2_uniform(w, s["far"], s["near"], 16)
+    >>> w, "RMS" in w.captions[0]
+    (['fig2-R1-far', 'fig2-R1-near'], True)
+    """
     blocks = []
     for state in (state_far, state_near):
         got = table_image(state, "uniform", "parabolic", entries)
@@ -121,7 +168,15 @@ def fig2_uniform(writer, state_far, state_near, entries: int) -> list[Image]:
 
 
 def fig3_cosine_powers(writer, exponents=(1, 5, 20, 100, 500, 2000)) -> Image:
-    """Fig. 3, Wang et al.: ``cos^n α`` against α for several n; the lobe narrows as n grows."""
+    """Fig. 3, Wang et al.: ``cos^n α`` against α for several n; the lobe narrows as n grows.
+
+    Examples
+    --------
+    >>> w = NameWriter()
+    >>> _ = fig3_cosine_powers(w, (1, 2))
+    >>> w.captions[0].split(":")[1]
+    ' cos^n α. The half-maximum angle falls from 60° at n = 1 to 45° at n = 2'
+    """
     import matplotlib.pyplot as plt
 
     alpha = np.linspace(0.0, 90.0, 901)
@@ -134,15 +189,23 @@ def fig3_cosine_powers(writer, exponents=(1, 5, 20, 100, 500, 2000)) -> Image:
     ax.set_ylabel("cos^n α")
     ax.legend(fontsize=7)
     caption = (
-        f"Fig. 3: cos^n α. The half-maximum angle falls from {half[0]:.0f}° at n = {exponents[0]} "
-        f"to {half[-1]:.2f}° at n = {exponents[-1]}: a uniform table in t = cos α wastes its "
+        f"Fig. 3: cos^n α. The half-maximum angle falls from {half[0]:.3g}° at n = {exponents[0]} "
+        f"to {half[-1]:.3g}° at n = {exponents[-1]}: a uniform table in t = cos α wastes its "
         "entries where the high-exponent lobe is 0."
     )
     return writer.figure("fig3-cosine-powers", fig, caption)
 
 
 def fig4_nodes(writer, state: ViewState, entries: int = 20, divisor: int = 4) -> Image:
-    """Fig. 4, Wang et al.: node positions of each placement over ``f_sp(t)``, segment bounds."""
+    """Fig. 4, Wang et al.: node positions of each placement over ``f_sp(t)``, segment bounds.
+
+    Examples
+    --------
+    >>> w = NameWriter()
+    >>> _ = fig4_nodes(w, _r1_states()["far"], 12, 3)
+    >>> w, "uniform 0.50" in w.captions[0]
+    (['fig4-nodes-R1'], True)
+    """
     import matplotlib.pyplot as plt
 
     buffer = state.buffer
@@ -206,6 +269,13 @@ def fig567_scene(writer, scene: str, states: dict, entries: int = TABLE1_ENTRIES
     ``states`` maps each view to its :class:`validation.phong.ViewState`. Per view: the exact
     render against importance p = m + t-parabola (the paper's algorithm) and against error +
     monotone (specref's default), each with its difference map (the "enlarged error map").
+
+    Examples
+    --------
+    >>> w = NameWriter()
+    >>> _ = fig567_scene(w, "R1", _r1_states(), 16)
+    >>> w[:3]
+    ['fig567-R1-curves', 'fig567-R1-far-importance', 'fig567-R1-far-error']
     """
     model = next(iter(states.values())).model
     blocks = [
@@ -279,6 +349,13 @@ def table1_blocks(states: dict, entries: int = TABLE1_ENTRIES, repeats: int = 3,
 
     ``states`` maps ``(scene, view)`` to a :class:`validation.phong.ViewState`. Response time is
     shading time (table build excluded, as the paper's per-frame time) over the exact shading time.
+
+    Examples
+    --------
+    >>> states = {("R1", v): s for v, s in _r1_states().items()}
+    >>> ours, printed, note = table1_blocks(states, 16, 1)
+    >>> len(ours.rows), [r[2] for r in printed.rows]
+    (8, ['a', 'b', 'c', 'd', 'e', 'f'])
     """
     rows, paper = [], []
     for (scene, view), state in states.items():
@@ -344,16 +421,9 @@ def paper_figures(
 
     Examples
     --------
-    A writer that keeps the names (``ReportContext`` writes the PNGs):
+    ``ReportContext`` writes the PNGs; :class:`NameWriter` keeps the names:
 
-    >>> import matplotlib.pyplot as plt
-    >>> class Names(list):
-    ...     def figure(self, name, fig, caption=""):
-    ...         plt.close(fig)
-    ...         self.append(name)
-    ...     def comparison(self, name, reference, method, labels, caption=""):
-    ...         self.append(name)
-    >>> names = Names()
+    >>> names = NameWriter()
     >>> blocks = paper_figures(names, 12, False, 16, scenes=("R1",), repeats=1)
     >>> len(names), names[:3]
     (9, ['fig2-R1-far', 'fig2-R1-near', 'fig3-cosine-powers'])
