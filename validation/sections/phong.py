@@ -2,7 +2,8 @@
 
 Full mode renders at 256×256 with the numba kernels; ``--quick`` renders at 24×24 with the NumPy
 references (timings are then not representative, and the charts say so). ``specref phong table1``
-gives Table 1 itself at 512×512.
+gives Table 1 itself at 512×512. The paper's Figs. 2-7 and Table 1 in its layout, beside the printed
+figures, come from ``validation.phong_figures`` (``PhongStudy.figures``: 32×32 quick, 256×256 full).
 
 compute → :func:`phong_speed_accuracy`; present → :func:`present`; checks → :func:`checks`. The
 table variants and interpolations come from the registries (``validation.phong.table_variants``,
