@@ -408,7 +408,8 @@ def table1_blocks(states: dict, entries: int = TABLE1_ENTRIES, repeats: int = 3,
         Table(
             ["scene", "view", "image", "RMS (printed)", "time / exact (printed)"],
             paper,
-            "Table 1 as printed in Wang et al. ((a)-(c) far, (d)-(f) near; 200 entries, "
+            "Table 1 as printed in Wang et al. (transcribed from its text, every figure legible; "
+            "(a)-(c) far, (d)-(f) near; 200 entries, "
             "Athlon 700 MHz)",
             "{:.3g}",
         ),

@@ -105,3 +105,9 @@ def test_table1_images_into_a_file_is_refused(tmp_path, capsys):
     blocker.write_text("x")
     assert main(["phong", "table1", "--images", str(blocker)]) == 2
     assert "Traceback" not in capsys.readouterr().err
+
+
+def test_images_without_table1_is_refused(tmp_path, capsys):
+    args = ["phong", "--material", str(tmp_path / "m.toml"), "--images", str(tmp_path)]
+    assert main(args) == 2
+    assert "--images goes with table1" in capsys.readouterr().err

@@ -20,6 +20,8 @@ def _cmd_phong(args) -> int:
     else:
         if args.material is None:
             raise SpecrefError("specref phong: give table1 or --material FILE.toml")
+        if args.images is not None:
+            raise SpecrefError("specref phong: --images goes with table1, not --material")
         result = phong_table1.run_material(
             args.material,
             args.view,
