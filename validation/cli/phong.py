@@ -24,6 +24,8 @@ def _cmd_phong(args) -> int:
     if args.file is not None:
         raise SpecrefError(f"specref phong: {args.file}: a file is taken by 'edit' only")
     if args.action == "table1":
+        if args.images is not None:
+            _write_images(args)
         result = phong_table1.run_table1(args.resolution, args.entries, args.repeats, progress=True)
         print(f"Table 1 (Wang et al.), {args.resolution}x{args.resolution}, {args.entries} entries")
         print(phong_table1.format_rows(result["rows"]))
@@ -32,6 +34,8 @@ def _cmd_phong(args) -> int:
     else:
         if args.material is None:
             raise SpecrefError("specref phong: give table1 or --material FILE.toml")
+        if args.images is not None:
+            raise SpecrefError("specref phong: --images goes with table1, not --material")
         result = phong_table1.run_material(
             args.material,
             args.view,
@@ -51,6 +55,20 @@ def _cmd_phong(args) -> int:
     return 0
 
 
+def _write_images(args) -> None:
+    """``table1 --images DIR``: Figs. 2-7 of Wang et al. as ``DIR/images/phong-*.png``."""
+    from pathlib import Path
+
+    from reference.images import check_output_folder
+    from validation.phong_figures import paper_figures
+    from validation.report import ReportContext
+
+    folder = check_output_folder(args.images)
+    ctx = ReportContext(Path(folder), section="phong")
+    blocks = paper_figures(ctx, args.resolution, True, args.entries, repeats=args.repeats)
+    print(f"wrote {sum(hasattr(b, 'path') for b in blocks)} figures under {folder}/images")
+
+
 def add_parser(sub) -> None:
     """Add ``specref phong`` and its options to the subcommand parsers ``sub``."""
     from phong_table.interpolation import INTERPOLATION_METHODS
@@ -60,8 +78,8 @@ def add_parser(sub) -> None:
     p = sub.add_parser(
         "phong",
         help="spectral Phong tables: Table 1 of Wang et al., or one material file",
-        description="specref phong table1 [--json FILE] | specref phong edit [MATERIAL.toml] "
-        "[--port N] | specref phong --material FILE.toml "
+        description="specref phong table1 [--json FILE] [--images DIR] | specref phong edit "
+        "[MATERIAL.toml] [--port N] | specref phong --material FILE.toml "
         "--view V --entries M --placement P --interp I [--segments S] [--tolerance T] "
         "[--json FILE]",
     )
@@ -92,4 +110,9 @@ def add_parser(sub) -> None:
     p.add_argument("--resolution", type=int, default=512, help="image size (default 512)")
     p.add_argument("--repeats", type=int, default=9, help="timing repetitions (minimum kept)")
     p.add_argument("--json", metavar="FILE", help="write the records as JSON")
+    p.add_argument(
+        "--images",
+        metavar="DIR",
+        help="table1: also write Figs. 2-7 of Wang et al. as DIR/images/phong-*.png",
+    )
     p.set_defaults(func=_cmd_phong)
