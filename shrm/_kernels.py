@@ -294,7 +294,7 @@ def rough_specular_samples_kernel(N, V, radiance, alpha, n, u, total, total_sq):
             hz = max(0.0, q1 * t1z + q2 * t2z + q3 * vz)
             norm = math.sqrt(hx * hx + hy * hy + hz * hz)
             hx, hy, hz = hx / norm, hy / norm, hz / norm
-            # i = 2 (o·h) h − o; weight F(o·h) G_1(i) (Walter et al. 2007, Eq. (34))
+            # i = 2 (o·h) h − o; weight F(o·h) G_1(i) (Eq. (34), Walter et al. 2007)
             oh = ox * hx + oy * hy + oz * hz
             ix, iy, iz = 2.0 * oh * hx - ox, 2.0 * oh * hy - oy, 2.0 * oh * hz - oz
             if iz > 0.0:

@@ -9,8 +9,9 @@ shades that layer per pixel by integrating over the environment directly, with n
 
 - **specular**: reflection at the interface. Smooth (gloss = 1): ``F(cos θ_o) L(r)``, the exact
   Fresnel factor times the environment in the mirror direction (bilinear look-up). Rough: the GGX
-  microfacet reflection ``f_s = F(o·h) D(h) G_1(i) G_1(o) / (4 cos θ_i cos θ_o)`` (Walter et al.
-  2007, Eqs. (20), (33), (34); separable Smith masking), integrated by Monte Carlo with GGX
+  microfacet reflection ``f_s = F(o·h) D(h) G_1(i) G_1(o) / (4 cos θ_i cos θ_o)`` (Eq. (20),
+  Walter et al. 2007; Eq. (33), Walter et al. 2007; Eq. (34), Walter et al. 2007; separable Smith
+  masking), integrated by Monte Carlo with GGX
   visible-normal sampling (Heitz 2018), seeded, in rounds until a stated tolerance (erratum E65).
 - **body**: the light that is not reflected enters the slab, ``1 − E_ρ(θ)`` of it, where ``E_ρ`` is
   the interface's directional reflectance (``F`` when smooth; the rough lobe's albedo otherwise,
@@ -380,7 +381,8 @@ def rough_specular_samples(normal, view, radiance, alpha, n, u) -> tuple[np.ndar
     The interface term of the oracle (physical counterpart of ``I_s F_r`` in Eq. (1), Herbert
     et al.): each sample draws a GGX visible normal ``h`` (Heitz 2018) from two uniforms, reflects
     the view about it, ``i = 2 (o·h) h − o``, and weighs the environment there (bilinear) by
-    ``F(o·h) G_1(i)`` (Walter et al. 2007, Eqs. (20), (34); 0 below the horizon).
+    ``F(o·h) G_1(i)`` (Eq. (20), Walter et al. 2007, and Eq. (34), Walter et al. 2007; 0 below
+    the horizon).
 
     Parameters
     ----------

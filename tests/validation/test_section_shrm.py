@@ -79,7 +79,7 @@ def test_shrm_section_quick(tmp_path):
     assert all(c["name"].startswith("quick") for c in checks_found)
     html = (tmp_path / "index.html").read_text()
     assert "SHRMs" in html
-    for name in ("error-vs-P", "ggx-bruteforce", "ggx-shrm", "ggx-difference", "orbit-stages"):
+    for name in ("error-vs-P", "ggx-comparison", "orbit-stages"):
         assert (tmp_path / "images" / f"shrm-{name}.png").is_file()
 
 

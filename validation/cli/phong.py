@@ -1,6 +1,8 @@
-"""``specref phong``: Table 1 of Wang et al., or one material file's tables."""
+"""``specref phong``: Table 1 of Wang et al., one material file's tables, or the editor."""
 
 from __future__ import annotations
+
+from functools import partial
 
 from validation.cli.parser import registry_option, write_json
 
@@ -9,7 +11,21 @@ def _cmd_phong(args) -> int:
     from reference.errors import SpecrefError
     from validation import phong, phong_table1
 
+    if args.action == "edit":
+        from validation import editor_app, editor_browser
+
+        path = args.file if args.file is not None else args.material
+        if args.screenshot:
+            editor_browser.editor_screenshot(path, args.screenshot, args.port)
+            print(f"wrote {args.screenshot}")
+            return 0
+        editor_app.serve_editor(path, args.port, partial(print, flush=True))
+        return 0
+    if args.file is not None:
+        raise SpecrefError(f"specref phong: {args.file}: a file is taken by 'edit' only")
     if args.action == "table1":
+        if args.images is not None:
+            _write_images(args)
         result = phong_table1.run_table1(args.resolution, args.entries, args.repeats, progress=True)
         print(f"Table 1 (Wang et al.), {args.resolution}x{args.resolution}, {args.entries} entries")
         print(phong_table1.format_rows(result["rows"]))
@@ -18,6 +34,8 @@ def _cmd_phong(args) -> int:
     else:
         if args.material is None:
             raise SpecrefError("specref phong: give table1 or --material FILE.toml")
+        if args.images is not None:
+            raise SpecrefError("specref phong: --images goes with table1, not --material")
         result = phong_table1.run_material(
             args.material,
             args.view,
@@ -37,6 +55,20 @@ def _cmd_phong(args) -> int:
     return 0
 
 
+def _write_images(args) -> None:
+    """``table1 --images DIR``: Figs. 2-7 of Wang et al. as ``DIR/images/phong-*.png``."""
+    from pathlib import Path
+
+    from reference.images import check_output_folder
+    from validation.phong_figures import paper_figures
+    from validation.report import ReportContext
+
+    folder = check_output_folder(args.images)
+    ctx = ReportContext(Path(folder), section="phong")
+    blocks = paper_figures(ctx, args.resolution, True, args.entries, repeats=args.repeats)
+    print(f"wrote {sum(hasattr(b, 'path') for b in blocks)} figures under {folder}/images")
+
+
 def add_parser(sub) -> None:
     """Add ``specref phong`` and its options to the subcommand parsers ``sub``."""
     from phong_table.interpolation import INTERPOLATION_METHODS
@@ -46,11 +78,22 @@ def add_parser(sub) -> None:
     p = sub.add_parser(
         "phong",
         help="spectral Phong tables: Table 1 of Wang et al., or one material file",
-        description="specref phong table1 [--json FILE] | specref phong --material FILE.toml "
+        description="specref phong table1 [--json FILE] [--images DIR] | specref phong edit "
+        "[MATERIAL.toml] [--port N] | specref phong --material FILE.toml "
         "--view V --entries M --placement P --interp I [--segments S] [--tolerance T] "
         "[--json FILE]",
     )
-    p.add_argument("action", nargs="?", choices=["table1"], help="reproduce Table 1")
+    p.add_argument(
+        "action",
+        nargs="?",
+        choices=["table1", "edit"],
+        help="table1: reproduce Table 1; edit: the material editor in the browser",
+    )
+    p.add_argument("file", nargs="?", metavar="MATERIAL.toml", help="edit: the file to open")
+    p.add_argument("--port", type=int, default=5006, help="edit: the local port (default 5006)")
+    p.add_argument(
+        "--screenshot", metavar="PNG", help="edit: write a screenshot of the page and exit"
+    )
     p.add_argument(
         "--material",
         metavar="FILE.toml",
@@ -67,4 +110,9 @@ def add_parser(sub) -> None:
     p.add_argument("--resolution", type=int, default=512, help="image size (default 512)")
     p.add_argument("--repeats", type=int, default=9, help="timing repetitions (minimum kept)")
     p.add_argument("--json", metavar="FILE", help="write the records as JSON")
+    p.add_argument(
+        "--images",
+        metavar="DIR",
+        help="table1: also write Figs. 2-7 of Wang et al. as DIR/images/phong-*.png",
+    )
     p.set_defaults(func=_cmd_phong)

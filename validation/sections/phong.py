@@ -2,7 +2,8 @@
 
 Full mode renders at 256×256 with the numba kernels; ``--quick`` renders at 24×24 with the NumPy
 references (timings are then not representative, and the charts say so). ``specref phong table1``
-gives Table 1 itself at 512×512.
+gives Table 1 itself at 512×512. The paper's Figs. 2-7 and Table 1 in its layout, beside the printed
+figures, come from ``validation.phong_figures`` (``PhongStudy.figures``: 32×32 quick, 256×256 full).
 
 compute → :func:`phong_speed_accuracy`; present → :func:`present`; checks → :func:`checks`. The
 table variants and interpolations come from the registries (``validation.phong.table_variants``,
@@ -69,6 +70,8 @@ class PhongStudy:
         Largest table the tolerance search tries.
     quick : bool
         Quick mode: no in-run speed-up, and the labels say so.
+    figures : int
+        Image size of the paper's figures and Table 1 (``validation.phong_figures``); 0: none.
     """
 
     resolution: int
@@ -82,6 +85,7 @@ class PhongStudy:
     divisors: tuple
     max_entries: int
     quick: bool
+    figures: int = 0
 
 
 #: The ``--quick`` sizes: 24×24 with the NumPy references.
@@ -97,6 +101,7 @@ QUICK = PhongStudy(
     divisors=(1, 10, 200),
     max_entries=256,
     quick=True,
+    figures=32,
 )
 #: The full sizes: 256×256 with the numba kernels.
 FULL = PhongStudy(
@@ -111,6 +116,7 @@ FULL = PhongStudy(
     divisors=(1, 2, 4, 5, 8, 10, 20, 25, 40, 50, 100, 200),
     max_entries=4096,
     quick=False,
+    figures=256,
 )
 
 
@@ -450,6 +456,18 @@ def present(ctx: ReportContext, data: SectionData) -> list:
         _tolerance_table(data),
         Text(f"Non-finite RMS values in all sweeps: {results['nonfinite']} (must be 0)."),
     ]
+    if study.figures:
+        from validation.phong_figures import paper_figures
+
+        blocks.append(
+            Text(
+                f"The paper's figures and Table 1 at {study.figures}×{study.figures} "
+                "(`specref phong table1 --images DIR` writes them at 512×512)."
+            )
+        )
+        blocks += paper_figures(
+            ctx, study.figures, study.compiled, repeats=study.repeats, quick=study.quick
+        )
     if "bench" in results:
         blocks.append(
             Table(

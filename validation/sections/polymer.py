@@ -382,7 +382,8 @@ def _oracle_blocks(ctx: ReportContext, data: SectionData) -> list:
             "pixel over the environment with no prefiltering (body and transmission as sums over "
             "the map's pixels, the rough lobe by seeded Monte Carlo until the 99th percentile of "
             f"the relative standard error is at most {oracle['settings']['tol']:g}). The hybrid "
-            "uses the Phong exponent 2/α² − 2 (capped at 1000) and the gloss factor of Eq. (5). "
+            "uses the Phong exponent 2/α² − 2 (capped at 1000) and the gloss factor of Eq. (5), "
+            "Herbert et al. "
             f"Base chip: {BASE['thickness_mm']} mm, {BASE['tio2_pct']} % TiO2, gloss "
             f"{BASE['gloss']}; each sweep varies one of these. ΔE00 relative to a white "
             "Lambertian surface facing the camera under the same environment."
@@ -405,9 +406,11 @@ def _oracle_image_figure(ctx: ReportContext, images: dict):
     names = ["I_d", "I_s F_r", "I_trans (1 - F_r)", "I_effect", "hybrid", "oracle"]
     fig, axes = plt.subplots(1, len(names) + 1, figsize=(2.1 * (len(names) + 1), 2.5))
     for ax, name in zip(axes, names, strict=False):
-        ax.imshow(_to_srgb(images[name], W_E, scale))
+        ax.imshow(_to_srgb(images[name], W_E, scale), interpolation="nearest")
         ax.set_title(name if name != "hybrid" else "hybrid (sum)", fontsize=9)
-    shown = axes[-1].imshow(np.where(images["mask"], images["delta_E"], np.nan), cmap="magma")
+    shown = axes[-1].imshow(
+        np.where(images["mask"], images["delta_E"], np.nan), cmap="magma", interpolation="nearest"
+    )
     axes[-1].set_title("ΔE00 hybrid − oracle", fontsize=9)
     fig.colorbar(shown, ax=axes[-1], fraction=0.046)
     for ax in axes:
@@ -484,8 +487,8 @@ def _failure_text(oracle: dict) -> str:
         f"differ by at most {spread:.2f} in any mean, so the error is not the mirror term's. With "
         f"{best}, the rim (cos θ_v < 0.3) averages {rim:.2f} against {centre:.2f} at the centre "
         f"(cos θ_v > 0.7). On the base chip (band means): {balance} (I_d is not weighted by "
-        f"1 − F_r in Eq. (1), E34). The hybrid's frame is {ratio:.0f}× faster than the converged "
-        "oracle's."
+        f"1 − F_r in Eq. (1), Herbert et al.; erratum E34). The hybrid's frame is {ratio:.0f}× "
+        "faster than the converged oracle's."
     )
 
 

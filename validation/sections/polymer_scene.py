@@ -184,15 +184,14 @@ file = "{(SHARED / "environments" / "venice_sunset_1k.hdr").as_posix()}"
 
 
 def _cache_entries(scene) -> dict:
-    """Maps the environment's cache holds for the scene's light, by kind."""
+    """Maps the environment's cache holds for the scene's light, by kind (not the chosen orders)."""
     from shrm.environment import _CACHE
 
     kinds = {"lambert": 0, "normalized-phong": 0, "polymer-effect": 0}
     for state in _CACHE.get(scene.lights[0], {}).values():
         for key in state:
-            if isinstance(key, tuple):
-                kind = str(key[0]).split(":")[0]
-                kinds[kind] = kinds.get(kind, 0) + 1
+            if isinstance(key, tuple) and str(key[0]).split(":")[0] in kinds:
+                kinds[str(key[0]).split(":")[0]] += 1
     return kinds
 
 
