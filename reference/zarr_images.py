@@ -39,6 +39,7 @@ from reference.images import channel_wavelengths_nm, output_error
 __all__ = [
     "ZARR_COMPRESSIONS",
     "ZarrImage",
+    "check_chunk_fits",
     "convert_to_zarr",
     "map_zarr_blocks",
     "open_zarr_image",
@@ -55,6 +56,37 @@ ZARR_COMPRESSIONS = {
 
 #: Default rows per chunk: 64 rows of a 12k-wide, 41-band map are 126 MB as float32.
 DEFAULT_ROWS_PER_CHUNK = 64
+
+
+def check_chunk_fits(rows: int, width: int, channels: int, where: str, available=None) -> int:
+    """Refuse a chunk whose float64 working copy would not fit in half the available memory.
+
+    A streamed operation holds about one chunk as float64 (plus its input as float32); a chunk
+    larger than half the memory that is free now would swap or fail. The message says how many
+    rows would fit.
+
+    Examples
+    --------
+    >>> check_chunk_fits(64, 2048, 41, "m.zarr", available=8 << 30)
+    64
+    >>> check_chunk_fits(6000, 12000, 41, "m.zarr", available=8 << 30)
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: m.zarr: rows per chunk: 6000 rows of 12000 × 41 float64 need ...
+    GB; half the free memory (4.3 GB) holds 1091 rows
+    """
+    if available is None:
+        import psutil
+
+        available = psutil.virtual_memory().available
+    need = rows * width * channels * 8
+    fits = max(1, int(available / 2 // (width * channels * 8)))
+    require(
+        need <= available / 2,
+        f"{where}: rows per chunk: {rows} rows of {width} × {channels} float64 need "
+        f"{need / 1e9:.1f} GB; half the free memory ({available / 2e9:.1f} GB) holds {fits} rows",
+    )
+    return rows
 
 
 def _codecs():
@@ -85,6 +117,7 @@ class ZarrImage:
     def row_blocks(self, rows: int | None = None) -> Iterator[tuple[int, np.ndarray]]:
         """``(first_row, block)`` in row order; ``block`` is float64 ``(rows, W, C)``."""
         rows = rows or self.rows_per_chunk
+        check_chunk_fits(rows, self.shape[1], self.shape[2], str(self.path))
         for start in range(0, self.shape[0], rows):
             yield start, np.asarray(self.array[start : start + rows], dtype=np.float64)
 
@@ -186,6 +219,7 @@ def write_zarr_blocks(
     )
     channels = list(channels)
     n = len(channels)
+    check_chunk_fits(rows_per_chunk, width, n, str(path))
     wavelengths = channel_wavelengths_nm(channels)
     attributes = {
         "specref": "spectral-panorama",

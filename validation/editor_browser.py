@@ -11,17 +11,14 @@ from __future__ import annotations
 
 import contextlib
 import os
-import shutil
 import socket
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 from reference.errors import SpecrefError, require
 from reference.images import atomic_path
-from validation.report.browser import CHROMIUM_FLAGS, INSTALL_HINT, find_chromium
 
 __all__ = ["editor_screenshot", "free_port", "wait_for"]
 
@@ -64,31 +61,11 @@ def editor_server(path=None, port: int | None = None, timeout: float = 60.0):
                 process.wait()
 
 
-@contextlib.contextmanager
 def editor_driver(width: int = 1300, height: int = 1250):
-    """A headless Chromium driven by Selenium (fresh profile, HOME set to it)."""
-    chromium = find_chromium()
-    driver_path = shutil.which("chromedriver")
-    require(chromium is not None and driver_path is not None, f"headless Chromium: {INSTALL_HINT}")
-    try:
-        from selenium import webdriver
-        from selenium.webdriver.chrome.service import Service
-    except ImportError as exc:
-        raise SpecrefError(f"headless Chromium: pip install selenium ({exc})") from exc
-    options = webdriver.ChromeOptions()
-    options.binary_location = chromium
-    for flag in CHROMIUM_FLAGS:
-        options.add_argument(flag)
-    with tempfile.TemporaryDirectory() as profile:
-        options.add_argument(f"--user-data-dir={profile}")
-        options.add_argument(f"--window-size={width},{height}")
-        service = Service(executable_path=driver_path, env={**os.environ, "HOME": profile})
-        driver = webdriver.Chrome(options=options, service=service)
-        try:
-            driver.set_page_load_timeout(60)
-            yield driver
-        finally:
-            driver.quit()
+    """A headless Chromium driven by Selenium (``validation.report.browser.chromium_driver``)."""
+    from validation.report.browser import chromium_driver
+
+    return chromium_driver(width, height, page_load_timeout=60)
 
 
 _VALUE_JS = """

@@ -13,6 +13,7 @@ as the browser laid it out:
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
 import subprocess
@@ -122,15 +123,9 @@ return {images: images, links: links.length, broken_links: broken,
 """
 
 
-def check_report_page(page, width: int = 1280, height: int = 900) -> dict:
-    """Open an HTML report in headless Chromium and return what the checks need.
-
-    Returns
-    -------
-    dict
-        ``images`` (``src``, ``complete``, ``natural`` and ``shown`` widths), ``links`` (the
-        number of in-page links), ``broken_links``, ``scroll_width`` and ``client_width`` (CSS
-        pixels), ``first_content`` (the id of the first block after the title and provenance).
+@contextlib.contextmanager
+def chromium_driver(width: int = 1280, height: int = 900, page_load_timeout: float = 120):
+    """A headless Chromium driven by Selenium and ``chromedriver`` (fresh profile, HOME set to it).
 
     Raises
     ------
@@ -155,13 +150,32 @@ def check_report_page(page, width: int = 1280, height: int = 900) -> dict:
         service = Service(executable_path=driver_path, env={**os.environ, "HOME": profile})
         driver = webdriver.Chrome(options=options, service=service)
         try:
-            driver.set_page_load_timeout(120)
-            driver.get(Path(page).resolve().as_uri())
-            driver.execute_async_script(
-                "const done = arguments[arguments.length - 1];"
-                "Promise.all(Array.from(document.images).map(i => i.decode().catch(() => null)))"
-                ".then(() => done(true));"
-            )
-            return driver.execute_script(_PAGE_CHECKS_JS)
+            driver.set_page_load_timeout(page_load_timeout)
+            yield driver
         finally:
             driver.quit()
+
+
+def check_report_page(page, width: int = 1280, height: int = 900) -> dict:
+    """Open an HTML report in headless Chromium and return what the checks need.
+
+    Returns
+    -------
+    dict
+        ``images`` (``src``, ``complete``, ``natural`` and ``shown`` widths), ``links`` (the
+        number of in-page links), ``broken_links``, ``scroll_width`` and ``client_width`` (CSS
+        pixels), ``first_content`` (the id of the first block after the title and provenance).
+
+    Raises
+    ------
+    SpecrefError
+        Chromium, chromedriver or Selenium missing (with how to install them).
+    """
+    with chromium_driver(width, height) as driver:
+        driver.get(Path(page).resolve().as_uri())
+        driver.execute_async_script(
+            "const done = arguments[arguments.length - 1];"
+            "Promise.all(Array.from(document.images).map(i => i.decode().catch(() => null)))"
+            ".then(() => done(true));"
+        )
+        return driver.execute_script(_PAGE_CHECKS_JS)
