@@ -19,7 +19,7 @@ import numpy as np
 
 from reference.errors import require
 from shrm.sh import check_order, fejer1_weights, latlong_ring_angles
-from shrm.transform import _ring_fourier, legendre_analysis
+from shrm.transform import _ring_fourier, ducc0_ring_analysis, legendre_analysis
 
 __all__ = ["project_latlong_blocks", "project_zarr"]
 
@@ -32,26 +32,7 @@ def _partial_numpy(block, L, theta, w, method):
 
 def _partial_ducc0(block, L, theta, w, method):
     # The same sum with ducc0: map2leg on the block's rings, leg2alm at the block's θ_j.
-    import ducc0
-
-    from shrm.transform import _ducc0_to_real
-
-    H, W, C = block.shape
-    maps = np.ascontiguousarray(block, dtype=np.float64).reshape(H * W, C).T
-    leg = ducc0.sht.experimental.map2leg(
-        map=maps,
-        nphi=np.full(H, W, dtype=np.uint64),
-        phi0=np.full(H, np.pi / W),
-        ringstart=(np.arange(H) * W).astype(np.uint64),
-        ringfactor=w * (2.0 * np.pi / W),
-        mmax=L,
-    )
-    alm = np.empty((C, (L + 1) * (L + 2) // 2), dtype=np.complex128)
-    for channel in range(C):
-        alm[channel] = ducc0.sht.experimental.leg2alm(
-            leg=leg[channel : channel + 1], lmax=L, theta=theta
-        )[0]
-    return _ducc0_to_real(alm, L)
+    return ducc0_ring_analysis(block, L, theta, w)
 
 
 #: The per-block projection by backend (numba shares the NumPy path: the Legendre sum is BLAS).

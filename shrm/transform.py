@@ -47,6 +47,7 @@ __all__ = [
     "QUADRATURE_WEIGHTS",
     "SH_BACKENDS",
     "SH_KERNELS",
+    "ducc0_ring_analysis",
     "legendre_analysis",
     "legendre_synthesis",
     "project_function",
@@ -227,6 +228,21 @@ def _project_ducc0(image, L, w, method):
     >>> _project_ducc0(np.ones((4, 8, 1)), 1, fejer1_weights(4), "auto")[0, 0].round(6)
     np.float64(3.544908)
     """
+    return ducc0_ring_analysis(image, L, latlong_ring_angles(image.shape[0]), w)
+
+
+def ducc0_ring_analysis(image, L: int, theta, w) -> np.ndarray:
+    """The projection sum over the given rings with ducc0 (all rows of a map, or a row block).
+
+    Eq. (4), Ramamoorthi & Hanrahan 2001: ``map2leg`` with the rings' own geometry (``ringfactor``
+    ``w_j 2π/W``, ``phi0 = π/W``), then ``leg2alm`` at their θ_j, one channel per call.
+
+    Examples
+    --------
+    >>> theta, w = latlong_ring_angles(4), fejer1_weights(4)
+    >>> ducc0_ring_analysis(np.ones((4, 8, 1)), 1, theta, w)[0, 0].round(6)
+    np.float64(3.544908)
+    """
     import ducc0
 
     H, W, C = image.shape
@@ -239,7 +255,6 @@ def _project_ducc0(image, L, w, method):
         ringfactor=w * (2.0 * np.pi / W),
         mmax=L,
     )
-    theta = latlong_ring_angles(H)
     alm = np.empty((C, (L + 1) * (L + 2) // 2), dtype=np.complex128)
     for channel in range(C):  # ducc0's Legendre transform takes one spin-0 component per call
         alm[channel] = ducc0.sht.experimental.leg2alm(

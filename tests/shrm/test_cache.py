@@ -446,7 +446,8 @@ def test_stale_temporary_files_are_removed_young_ones_kept(tmp_path, content):
         temp.write_bytes(content)
     foreign = tmp_path / ".notes.tmp"  # not a name our writers make
     foreign.write_bytes(b"")
-    past = time.time() - STALE_TEMP_SECONDS - 60
+    # an mtime older than the stale age, relative to the file's own (not a timing measurement)
+    past = young.stat().st_mtime - STALE_TEMP_SECONDS - 60
     for path in (old, foreign):
         os.utime(path, (past, past))
     assert cache.clear() == 0

@@ -38,8 +38,7 @@ def _spectral_env(name, rows):
     from shrm.environment import environment_spectral_radiance
 
     path = ENVIRONMENTS / name
-    if not path.is_file():
-        pytest.skip(f"{path} missing: set up ../shared/data (SPECREF_SHARED_DATA)")
+    assert path.is_file(), f"{path} missing: set up ../shared/data (SPECREF_SHARED_DATA)"
     image = read_image(path)
     f = image.shape[0] // rows
     image = downsample_box(image[: f * rows, : 2 * f * rows], f)
