@@ -463,6 +463,46 @@ def _check_exr_written(tmp, path) -> None:
         raise SpecrefError(f"{path}: cannot write ({reason})") from None
 
 
+def read_exr_parts(path, read, **options):
+    """Open an OpenEXR file, return ``read(handle)``; a missing or unreadable file is one line.
+
+    The one place that opens EXR files for reading: :func:`read_exr` reads the pixels,
+    ``reference.render_metadata.read_exr_metadata`` the header (``header_only=True``).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+    read : callable
+        Takes the open ``OpenEXR.File`` and returns what the caller needs.
+    **options
+        Passed to ``OpenEXR.File`` (``separate_channels``, ``header_only``).
+
+    Raises
+    ------
+    SpecrefError
+        Missing or unreadable file.
+
+    Examples
+    --------
+    >>> read_exr_parts("/nonexistent.exr", lambda handle: handle.header())
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: /nonexistent.exr: file not found
+    """
+    import OpenEXR
+
+    path = Path(path)
+    require(path.is_file(), f"{path}: file not found")
+    try:
+        with OpenEXR.File(str(path), **options) as handle:
+            return read(handle)
+    except Exception as error:  # the bindings raise RuntimeError and others for bad files
+        raise SpecrefError(
+            f"{path}: cannot read OpenEXR image ({error.__class__.__name__})"
+        ) from None
+
+
 def read_exr(path) -> tuple[np.ndarray, list[str]]:
     """Read an OpenEXR file (scanline or tiled; the top mip level) as float64.
 
@@ -492,17 +532,12 @@ def read_exr(path) -> tuple[np.ndarray, list[str]]:
     ...
     reference.errors.SpecrefError: /nonexistent.exr: file not found
     """
-    import OpenEXR
-
     path = Path(path)
-    require(path.is_file(), f"{path}: file not found")
-    try:
-        with OpenEXR.File(str(path), separate_channels=True) as handle:
-            channels = {name: np.asarray(ch.pixels) for name, ch in handle.channels().items()}
-    except Exception as error:  # the bindings raise RuntimeError and others for bad files
-        raise SpecrefError(
-            f"{path}: cannot read OpenEXR image ({error.__class__.__name__})"
-        ) from None
+    channels = read_exr_parts(
+        path,
+        lambda handle: {name: np.asarray(ch.pixels) for name, ch in handle.channels().items()},
+        separate_channels=True,
+    )
     require(channels, f"{path}: OpenEXR file has no channels")
     names = list(channels)
     spectral = {n: _WAVELENGTH_CHANNEL.search(n) for n in names}

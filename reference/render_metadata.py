@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from reference.errors import SpecrefError, require
-from reference.images import spectral_channel_names
+from reference.images import read_exr_parts, spectral_channel_names
 from reference.registry import Method, Registry
 
 __all__ = [
@@ -324,17 +324,8 @@ def read_exr_metadata(path) -> dict:
     ...
     reference.errors.SpecrefError: /nonexistent.exr: file not found
     """
-    import OpenEXR
-
     path = Path(path)
-    require(path.is_file(), f"{path}: file not found")
-    try:
-        with OpenEXR.File(str(path), header_only=True) as handle:
-            text = handle.header().get("specref")
-    except Exception as error:  # the bindings raise RuntimeError and others for bad files
-        raise SpecrefError(
-            f"{path}: cannot read OpenEXR image ({error.__class__.__name__})"
-        ) from None
+    text = read_exr_parts(path, lambda handle: handle.header().get("specref"), header_only=True)
     if text is None:
         return {}
     try:
