@@ -224,6 +224,32 @@ def view_state(
     )
 
 
+def table_pixels(state: ViewState, placement: str, interpolation: str, entries: int, segments=None):
+    """Build one table for a view and shade its pixels: ``(table, RGB (n_pixels, 3))``.
+
+    Examples
+    --------
+    >>> from phong_table.scenes import constant_material
+    >>> state = view_state(constant_material(20.0), "far", 12, compiled=False)
+    >>> table, RGB = table_pixels(state, "error", "monotone", 16)
+    >>> RGB.shape == state.exact.shape
+    True
+    """
+    buffer = state.buffer
+    table = build_table(
+        state.model,
+        entries,
+        placement,
+        segments,
+        state.compiled,
+        buffer.t_range,
+        buffer.t_density,
+        interpolation,
+    )
+    RGB = shade_pixels(buffer, state.model, "table", table, interpolation, compiled=state.compiled)
+    return table, RGB
+
+
 def table_error_row(
     state: ViewState, placement: str, interpolation: str, entries: int, segments=None
 ) -> dict:
@@ -238,20 +264,7 @@ def table_error_row(
     (True, 0.0)
     """
     check_interpolation(interpolation, entries)
-    buffer = state.buffer
-    table = build_table(
-        state.model,
-        entries,
-        placement,
-        segments,
-        state.compiled,
-        buffer.t_range,
-        buffer.t_density,
-        interpolation,
-    )
-    RGB = shade_pixels(
-        state.buffer, state.model, "table", table, interpolation, compiled=state.compiled
-    )
+    table, RGB = table_pixels(state, placement, interpolation, entries, segments)
     rms_display, rms_linear = rms_8bit(RGB, state.exact, exact_encoded=state.exact_encoded)
     return {
         "placement": placement,

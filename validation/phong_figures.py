@@ -18,6 +18,7 @@ from validation.phong import (
     TABLE1_ENTRIES,
     ViewState,
     rms_8bit,
+    table_pixels,
     time_shading,
     tolerance_search,
     view_state,
@@ -124,20 +125,7 @@ def table_image(state: ViewState, placement, interpolation, entries: int, segmen
     """
     if placement is None:
         return state.geometry.to_image(state.exact)
-    buffer = state.buffer
-    table = build_table(
-        state.model,
-        entries,
-        placement,
-        segments,
-        state.compiled,
-        buffer.t_range,
-        buffer.t_density,
-        interpolation,
-    )
-    pixels = shade_pixels(
-        buffer, state.model, "table", table, interpolation, compiled=state.compiled
-    )
+    _, pixels = table_pixels(state, placement, interpolation, entries, segments)
     return state.geometry.to_image(pixels)
 
 
