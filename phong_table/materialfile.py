@@ -12,15 +12,13 @@ names the file and the key.
 
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
 
 from phong_table.model import SpectralPhong
 from phong_table.scenes import LIGHT_ATTENUATION, LIGHT_POSITION
-from reference.errors import SpecrefError
 from reference.lights import PointLight
 from reference.materials import PhongMaterial
-from reference.scene import parse_spectral
+from reference.scene import parse_spectral, read_toml_file
 from reference.scene_values import SceneReader
 
 __all__ = ["load_material_file"]
@@ -63,14 +61,7 @@ def load_material_file(path) -> SpectralPhong:
     (array([40., 40.]), 'gold')
     """
     path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise SpecrefError(f"{path}: file not found") from None
-    except (OSError, UnicodeDecodeError) as error:
-        raise SpecrefError(f"{path}: cannot read ({error.__class__.__name__})") from None
-    except tomllib.TOMLDecodeError as error:
-        raise SpecrefError(f"{path}: not valid TOML ({error})") from None
+    data = read_toml_file(path)
     reader = SceneReader(str(path), path.parent)
     for key in data:
         if key not in _TOP_KEYS:

@@ -612,7 +612,7 @@ def _parse_toml(text: str, file: str) -> dict:
     if not isinstance(text, str):
         raise SpecrefError(f"{file}: a scene must be TOML text, got {type(text).__name__}")
     too_deep = (
-        f"{file}: arrays and tables nested deeper than {MAX_NESTING} levels; no scene needs that"
+        f"{file}: arrays and tables nested deeper than {MAX_NESTING} levels; no input needs that"
     )
     try:
         doc = tomllib.loads(text)
@@ -657,12 +657,36 @@ def load_scene(path) -> Scene:
     """
     file = str(path)
     path = Path(path)
+    return scene_from_dict(read_toml_file(path), file, path.parent, path)
+
+
+def read_toml_file(path) -> dict:
+    """Read and parse a TOML file (scene, material, sweep or constituents file).
+
+    The one reader of specref's TOML inputs: a missing or unreadable file, text that is not
+    UTF-8, malformed TOML and nesting deeper than :data:`MAX_NESTING` are each one line naming
+    the file.
+
+    Raises
+    ------
+    SpecrefError
+        As above.
+
+    Examples
+    --------
+    >>> read_toml_file("no-such-file.toml")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: no-such-file.toml: file not found
+    """
+    file = str(path)
+    path = Path(path)
     if not path.is_file():
         raise SpecrefError(f"{file}: file not found")
     try:
         text = path.read_bytes().decode("utf-8")
     except UnicodeDecodeError:
-        raise SpecrefError(f"{file}: not UTF-8 text, so not a TOML scene") from None
+        raise SpecrefError(f"{file}: not UTF-8 text, so not a TOML file") from None
     except OSError as error:
         raise SpecrefError(f"{file}: cannot read ({error.__class__.__name__})") from None
-    return scene_from_dict(_parse_toml(text, file), file, path.parent, path)
+    return _parse_toml(text, file)

@@ -33,7 +33,6 @@ Saunderson, J. L. (1942). Calculation of the color of pigmented plastics. J. Opt
 
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -41,6 +40,7 @@ import numpy as np
 
 from reference.errors import SpecrefError, require, require_finite
 from reference.fresnel import fresnel_dielectric, fresnel_diffuse
+from reference.scene import read_toml_file
 from reference.spectra import DEFAULT_GRID, SpectralGrid
 
 __all__ = [
@@ -138,11 +138,7 @@ def polymer_constituents(
     True
     """
     path = Path(DEFAULT_CONSTITUENTS if path is None else path)
-    require(path.is_file(), f"{path}: no such constituents file")
-    try:
-        data = tomllib.loads(path.read_text())
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
-        raise SpecrefError(f"{path}: not a TOML file: {str(error).splitlines()[0]}") from error
+    data = read_toml_file(path)
     for table in ("base", "tio2"):
         require(isinstance(data.get(table), dict), f"{path}: missing table [{table}]")
     base = data["base"]

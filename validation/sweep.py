@@ -27,13 +27,13 @@ import csv
 import functools
 import io
 import itertools
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from reference.errors import SpecrefError, format_allowed, require, require_positive_int
+from reference.errors import format_allowed, require, require_positive_int
 from reference.images import write_text_atomic
 from reference.registry import Registry
+from reference.scene import read_toml_file
 from reference.tasks import run_tasks
 
 __all__ = ["SWEEP_KINDS", "SweepKind", "load_sweep", "run_sweep", "sweep_csv"]
@@ -149,14 +149,7 @@ def load_sweep(path) -> tuple[SweepKind, list[dict]]:
     reference.errors.SpecrefError: /nonexistent/sweep.toml: file not found
     """
     path = Path(path)
-    try:
-        doc = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise SpecrefError(f"{path}: file not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SpecrefError(f"{path}: cannot read the sweep file ({exc})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise SpecrefError(f"{path}: malformed TOML: {exc}") from None
+    doc = read_toml_file(path)
     file = str(path)
     unknown = sorted(set(doc) - {"kind", "grid"})
     require(not unknown, f"{file}: unknown keys {unknown}; allowed: grid, kind")

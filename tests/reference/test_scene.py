@@ -395,3 +395,26 @@ def test_deeply_nested_scenes_are_refused_in_one_line(text, tmp_path, capsys):
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1
     assert "Traceback" not in err
+
+
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["phong", "--material", "{path}", "--json", "{out}"],
+        ["sweep", "{path}", "-o", "{out}"],
+    ],
+    ids=["phong-material", "sweep"],
+)
+def test_every_toml_input_refuses_deep_nesting_in_one_line(command, tmp_path, capsys):
+    # Material and sweep files go through the scene's reader (reference.scene.read_toml_file):
+    # before it, they raised a RecursionError with a traceback.
+    from validation.cli import main
+
+    path = tmp_path / "deep.toml"
+    path.write_text("a = " + "[" * 100_000 + "]" * 100_000)
+    args = [a.format(path=path, out=tmp_path / "out") for a in command]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1, err
+    assert "deep.toml" in err
+    assert "nested deeper than" in err
