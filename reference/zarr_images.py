@@ -58,12 +58,14 @@ ZARR_COMPRESSIONS = {
 DEFAULT_ROWS_PER_CHUNK = 64
 
 
-def check_chunk_fits(rows: int, width: int, channels: int, where: str, available=None) -> int:
-    """Refuse a chunk whose float64 working copy would not fit in half the available memory.
+def check_chunk_fits(
+    rows: int, width: int, channels: int, where: str, available=None, copies: int = 1
+) -> int:
+    """Refuse a chunk whose float64 working copies would not fit in half the available memory.
 
-    A streamed operation holds about one chunk as float64 (plus its input as float32); a chunk
-    larger than half the memory that is free now would swap or fail. The message says how many
-    rows would fit.
+    A streamed operation holds about one chunk as float64 (plus its input as float32), two when
+    the next chunk is read ahead (``copies=2``); chunks larger than half the memory that is free
+    now would swap or fail. The message says how many rows would fit.
 
     Examples
     --------
@@ -79,11 +81,13 @@ def check_chunk_fits(rows: int, width: int, channels: int, where: str, available
         import psutil
 
         available = psutil.virtual_memory().available
-    need = rows * width * channels * 8
-    fits = max(1, int(available / 2 // (width * channels * 8)))
+    row_bytes = width * channels * 8 * copies
+    need = rows * row_bytes
+    fits = max(1, int(available / 2 // row_bytes))
+    held = f"{copies} copies of " if copies > 1 else ""
     require(
         need <= available / 2,
-        f"{where}: rows per chunk: {rows} rows of {width} × {channels} float64 need "
+        f"{where}: rows per chunk: {held}{rows} rows of {width} × {channels} float64 need "
         f"{need / 1e9:.1f} GB; half the free memory ({available / 2e9:.1f} GB) holds {fits} rows",
     )
     return rows
@@ -114,12 +118,45 @@ class ZarrImage:
         """Band centres in nm, or None for an RGB store."""
         return channel_wavelengths_nm(self.channels)
 
-    def row_blocks(self, rows: int | None = None) -> Iterator[tuple[int, np.ndarray]]:
-        """``(first_row, block)`` in row order; ``block`` is float64 ``(rows, W, C)``."""
+    def row_blocks(
+        self, rows: int | None = None, prefetch: bool = True
+    ) -> Iterator[tuple[int, np.ndarray]]:
+        """``(first_row, block)`` in row order; ``block`` is float64 ``(rows, W, C)``.
+
+        With ``prefetch`` a reader thread reads, decompresses and converts the next block while
+        the caller works on this one (Zarr's codecs and NumPy's cast release the GIL), so at most
+        two blocks are held at once; the blocks are the same either way.
+
+        Examples
+        --------
+        >>> import tempfile, os
+        >>> with tempfile.TemporaryDirectory() as d:
+        ...     image = np.arange(5 * 10, dtype=np.float32).reshape(5, 10, 1)
+        ...     z = open_zarr_image(write_zarr_image(os.path.join(d, "m.zarr"), image, ["Y"],
+        ...                                          rows_per_chunk=2))
+        ...     [(start, block.shape[0], block.dtype.name) for start, block in z.row_blocks()]
+        [(0, 2, 'float64'), (2, 2, 'float64'), (4, 1, 'float64')]
+        """
         rows = rows or self.rows_per_chunk
-        check_chunk_fits(rows, self.shape[1], self.shape[2], str(self.path))
-        for start in range(0, self.shape[0], rows):
-            yield start, np.asarray(self.array[start : start + rows], dtype=np.float64)
+        height, width, n = self.shape
+        check_chunk_fits(rows, width, n, str(self.path), copies=2 if prefetch else 1)
+        starts = range(0, height, rows)
+
+        def read(start: int) -> tuple[int, np.ndarray]:
+            return start, np.asarray(self.array[start : start + rows], dtype=np.float64)
+
+        if not prefetch:
+            yield from map(read, starts)
+            return
+        from concurrent.futures import ThreadPoolExecutor
+
+        with ThreadPoolExecutor(1, thread_name_prefix="zarr-read") as reader:
+            pending = reader.submit(read, starts[0])
+            for start in starts[1:]:
+                block = pending.result()
+                pending = reader.submit(read, start)  # read the next block during this one
+                yield block
+            yield pending.result()
 
     def to_dask(self):
         """The store as a ``dask.array`` with the store's chunks (nothing read yet)."""
