@@ -73,6 +73,28 @@ def test_streamed_sh_projection_equals_in_memory(panorama, backend):
     assert np.max(np.abs(streamed - whole) / scale) <= 1e-12
 
 
+@pytest.mark.parametrize("backend", ["numba", "numpy"])
+def test_streamed_cubemap_is_bit_identical_to_in_memory(panorama, backend):
+    from reference.cubemap import latlong_to_cubemap, zarr_to_cubemap
+
+    path, image = panorama
+    streamed = zarr_to_cubemap(path, 128, backend=backend)
+    np.testing.assert_array_equal(
+        streamed, latlong_to_cubemap(image.astype(np.float64), 128, backend=backend)
+    )
+
+
+def test_prefetched_blocks_equal_plain_reads(panorama):
+    path, image = panorama
+    store = open_zarr_image(path)
+    ahead = list(store.row_blocks(100))
+    plain = list(store.row_blocks(100, prefetch=False))
+    assert [s for s, _ in ahead] == [s for s, _ in plain] == list(range(0, 512, 100))
+    for (_, a), (_, b) in zip(ahead, plain, strict=True):
+        np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(np.concatenate([b for _, b in ahead]), image)
+
+
 def test_refusals_are_one_line(tmp_path, panorama):
     path, _ = panorama
     with pytest.raises(SpecrefError, match=r"pano.zarr: 41 channels; expected 3"):
