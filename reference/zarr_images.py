@@ -290,6 +290,8 @@ def write_zarr_blocks(
                 array[row : row + full] = pending[:full]
                 row += full
                 pending = pending[full:]
+            if len(pending) and np.may_share_memory(pending, block):
+                pending = pending.copy()  # the rest waits; the caller may reuse its block's buffer
         if len(pending):
             require(row + len(pending) <= height, f"{path}: more than {height} rows given")
             array[row : row + len(pending)] = pending
