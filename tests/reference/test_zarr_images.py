@@ -160,3 +160,19 @@ def test_cli_convert_and_project(tmp_path, capsys):
     assert np.max(np.abs(z["coeffs"] - e["coeffs"])) <= 1e-12 * np.abs(e["coeffs"]).max()
     assert main(["env", "convert", str(tmp_path / "m.exr"), str(out), "--rows", "0"]) == 2
     assert "rows per chunk" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf])
+def test_cli_convert_refuses_non_finite_input_in_one_line(tmp_path, capsys, bad):
+    from reference.images import write_exr
+    from validation.cli import main
+
+    image = np.ones((8, 16, 3), dtype=np.float32)
+    image[5, 3, 1] = bad
+    write_exr(tmp_path / "bad.exr", image)
+    assert main(["env", "convert", str(tmp_path / "bad.exr"), str(tmp_path / "b.zarr")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.endswith("bad.exr: radiance must be finite, found NaN or inf")
+    assert "\n" not in err
+    assert "Traceback" not in err
+    assert not (tmp_path / "b.zarr").exists()
