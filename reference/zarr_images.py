@@ -8,9 +8,12 @@ Layout of a store ``NAME.zarr`` (a folder), documented in ``docs/scale-out.md``:
 
 - one array, shape ``(H, W, C)`` float32, lat-long rows top (θ = 0) to bottom, ``W = 2H``;
 - chunks ``(rows_per_chunk, W, C)``: every band of a band of rows in one chunk, so a streamed
-  operation reads each chunk once, in row order;
-- compression (:data:`ZARR_COMPRESSIONS`): ``zstd`` (level 3, byte shuffle; the default: measured
-  in ``make bench``), ``blosc-lz4`` (faster, larger) or ``none``;
+  operation reads each chunk once, in row order; by default about 21.5 MB of float32 per chunk
+  (:func:`rows_per_chunk_for`);
+- compression (:data:`ZARR_COMPRESSIONS`): ``blosc-lz4`` (level 5, byte shuffle; the default),
+  ``zstd`` (level 3, no shuffle) or ``none``. On spectral panoramas blosc-lz4 reads back two to
+  three times faster than zstd at about the same size (``make bench``, group
+  ``scaleout-zarr-read``; erratum E48);
 - attributes: ``{"specref": "spectral-panorama", "channels": [...], "wavelengths_nm": [...] or
   null, "rows_per_chunk": n}``; the channel names are the spectral OpenEXR names
   (``S0.550,000000nm``) or ``R, G, B``.
@@ -43,6 +46,7 @@ __all__ = [
     "convert_to_zarr",
     "map_zarr_blocks",
     "open_zarr_image",
+    "rows_per_chunk_for",
     "write_zarr_blocks",
     "write_zarr_image",
 ]
@@ -54,8 +58,22 @@ ZARR_COMPRESSIONS = {
     "none": lambda: None,
 }
 
-#: Default rows per chunk: 64 rows of a 12k-wide, 41-band map are 126 MB as float32.
-DEFAULT_ROWS_PER_CHUNK = 64
+#: Target bytes of a float32 chunk: 64 rows of a 2048 × 41 map (21.5 MB), the fastest to read of
+#: 16, 64 and 128-row chunks of a 1024 × 2048 × 41 store (``make bench``, group
+#: ``scaleout-zarr-read``); a 12k-wide map gets 11 rows per chunk.
+CHUNK_BYTES = 64 * 2048 * 41 * 4
+
+
+def rows_per_chunk_for(width: int, channels: int, height: int | None = None) -> int:
+    """Rows per chunk of a ``W × C`` float32 map: :data:`CHUNK_BYTES` worth, one to ``height``.
+
+    Examples
+    --------
+    >>> rows_per_chunk_for(2048, 41), rows_per_chunk_for(12000, 41), rows_per_chunk_for(64, 3, 32)
+    (64, 11, 32)
+    """
+    rows = max(1, round(CHUNK_BYTES / (width * channels * 4)))
+    return rows if height is None else min(rows, height)
 
 
 def check_chunk_fits(
@@ -211,8 +229,8 @@ def write_zarr_blocks(
     width: int,
     channels,
     blocks: Iterable[np.ndarray],
-    rows_per_chunk: int = DEFAULT_ROWS_PER_CHUNK,
-    compression: str = "zstd",
+    rows_per_chunk: int | None = None,
+    compression: str = "blosc-lz4",
 ) -> Path:
     """Write a panorama given as row blocks (in order) to a Zarr store, atomically.
 
@@ -226,8 +244,8 @@ def write_zarr_blocks(
         Channel names (spectral OpenEXR names or ``R, G, B``).
     blocks : iterable of ndarray, shape (rows, W, C)
         Consecutive row blocks covering ``H`` rows; any block height.
-    rows_per_chunk : int
-        Chunk height (at most the image's height).
+    rows_per_chunk : int, optional
+        Chunk height (at most the image's height); default :func:`rows_per_chunk_for`.
     compression : str
         A key of :data:`ZARR_COMPRESSIONS`.
 
@@ -247,6 +265,8 @@ def write_zarr_blocks(
     path = Path(path)
     height = require_positive_int(height, f"{path}: height", 1 << 20)
     width = require_positive_int(width, f"{path}: width", 1 << 21)
+    if rows_per_chunk is None:
+        rows_per_chunk = rows_per_chunk_for(width, len(channels), height)
     rows_per_chunk = require_positive_int(rows_per_chunk, f"{path}: rows per chunk", 1 << 20)
     rows_per_chunk = min(rows_per_chunk, height)
     require(
@@ -314,9 +334,10 @@ def write_zarr_image(path, image, channels, **kwargs) -> Path:
     image = np.asarray(image)
     require(image.ndim == 3, f"{path}: expected an (H, W, C) image, got shape {image.shape}")
     channels = _check_channels(channels, image.shape[2], str(path))
-    rows = require_positive_int(
-        kwargs.get("rows_per_chunk", DEFAULT_ROWS_PER_CHUNK), f"{path}: rows per chunk", 1 << 20
-    )
+    rows = kwargs.get("rows_per_chunk")
+    if rows is None:
+        rows = rows_per_chunk_for(image.shape[1], image.shape[2], image.shape[0])
+    rows = require_positive_int(rows, f"{path}: rows per chunk", 1 << 20)
     blocks = (image[i : i + rows] for i in range(0, image.shape[0], rows))
     return write_zarr_blocks(path, image.shape[0], image.shape[1], channels, blocks, **kwargs)
 
@@ -385,7 +406,7 @@ def open_zarr_image(path, n_channels: int | None = None, wavelengths_nm=None) ->
 
 
 def convert_to_zarr(
-    source, out, rows_per_chunk: int = DEFAULT_ROWS_PER_CHUNK, compression: str = "zstd"
+    source, out, rows_per_chunk: int | None = None, compression: str = "blosc-lz4"
 ) -> dict:
     """Convert a panorama file (``.exr``, ``.hdr``, spectral ``.tif``) to a Zarr store.
 
@@ -400,7 +421,7 @@ def convert_to_zarr(
     ...     _ = write_exr(os.path.join(d, "m.exr"), np.ones((4, 8, 3), dtype=np.float32))
     ...     info = convert_to_zarr(os.path.join(d, "m.exr"), os.path.join(d, "m.zarr"), 2)
     >>> info["chunks"], info["channels"], info["compression"]
-    (2, 3, 'zstd')
+    (2, 3, 'blosc-lz4')
     """
     from reference.envmap import check_latlong_shape
     from reference.spectral_images import read_environment_file
@@ -408,6 +429,8 @@ def convert_to_zarr(
     image, names = read_environment_file(source)
     check_latlong_shape(image.shape, str(source))
     require(np.isfinite(image).all(), f"{source}: radiance must be finite, found NaN or inf")
+    if rows_per_chunk is None:
+        rows_per_chunk = rows_per_chunk_for(image.shape[1], image.shape[2], image.shape[0])
     write_zarr_image(out, image, names, rows_per_chunk=rows_per_chunk, compression=compression)
     stored = sum(f.stat().st_size for f in Path(out).rglob("*") if f.is_file())
     height, width, n = image.shape

@@ -99,10 +99,14 @@ def project_latlong_blocks(
     return out
 
 
-def project_zarr(path, order: int, backend: str = "ducc0", rows: int | None = None) -> np.ndarray:
+def project_zarr(
+    path, order: int, backend: str = "ducc0", rows: int | None = None, progress: bool | None = False
+) -> np.ndarray:
     """SH coefficients of a Zarr panorama, streamed by the store's row chunks.
 
-    Returns ``(C, (L+1)²)``; equals :func:`shrm.transform.project_latlong` of the whole map.
+    Returns ``(C, (L+1)²)``; equals :func:`shrm.transform.project_latlong` of the whole map. The
+    next chunk is read while this one is projected (``ZarrImage.row_blocks``). ``progress``: a
+    progress bar of rows on stderr (tqdm; None shows it only on a terminal).
 
     Examples
     --------
@@ -117,4 +121,21 @@ def project_zarr(path, order: int, backend: str = "ducc0", rows: int | None = No
     from reference.zarr_images import open_zarr_image
 
     image = open_zarr_image(path)
-    return project_latlong_blocks(image.row_blocks(rows), image.shape[0], order, backend)
+    blocks = image.row_blocks(rows)
+    if progress is False:
+        return project_latlong_blocks(blocks, image.shape[0], order, backend)
+    from tqdm import tqdm
+
+    with tqdm(
+        total=image.shape[0],
+        unit="row",
+        desc=f"SH L={order}",
+        disable=None if progress is None else False,
+    ) as bar:
+
+        def counted():
+            for start, block in blocks:
+                yield start, block
+                bar.update(block.shape[0])
+
+        return project_latlong_blocks(counted(), image.shape[0], order, backend)

@@ -139,7 +139,7 @@ def test_cli_convert_and_project(tmp_path, capsys):
     write_exr(tmp_path / "m.exr", image)
     out = tmp_path / "m.zarr"
     assert main(["env", "convert", str(tmp_path / "m.exr"), str(out), "--rows", "8"]) == 0
-    assert "4 chunks of 8 rows, zstd" in capsys.readouterr().out
+    assert "4 chunks of 8 rows, blosc-lz4" in capsys.readouterr().out
     np.testing.assert_array_equal(open_zarr_image(out).read(), image)
     assert main(["sh", "project", str(out), "--order", "8", "-o", str(tmp_path / "z.npz")]) == 0
     assert (
