@@ -11,9 +11,9 @@ Layout of a store ``NAME.zarr`` (a folder), documented in ``docs/scale-out.md``:
   operation reads each chunk once, in row order; by default about 21.5 MB of float32 per chunk
   (:func:`rows_per_chunk_for`);
 - compression (:data:`ZARR_COMPRESSIONS`): ``blosc-lz4`` (level 5, byte shuffle; the default),
-  ``zstd`` (level 3, no shuffle) or ``none``. On spectral panoramas blosc-lz4 reads back two to
-  three times faster than zstd at about the same size (``make bench``, group
-  ``scaleout-zarr-read``; erratum E48);
+  ``zstd`` (level 3, no shuffle) or ``none``. On a spectral panorama blosc-lz4 reads back faster
+  than zstd at about the same size (``make bench``, group ``scaleout-zarr-read``, shown in the
+  report; erratum E48);
 - attributes: ``{"specref": "spectral-panorama", "channels": [...], "wavelengths_nm": [...] or
   null, "rows_per_chunk": n}``; the channel names are the spectral OpenEXR names
   (``S0.550,000000nm``) or ``R, G, B``.
@@ -59,8 +59,8 @@ ZARR_COMPRESSIONS = {
 }
 
 #: Target bytes of a float32 chunk: 64 rows of a 2048 × 41 map (21.5 MB), the fastest to read of
-#: 16, 64 and 128-row chunks of a 1024 × 2048 × 41 store (``make bench``, group
-#: ``scaleout-zarr-read``); a 12k-wide map gets 11 rows per chunk.
+#: 5.4, 21.5 and 43 MB chunks with every compression (``make bench``, group
+#: ``scaleout-zarr-read``, shown in the report); a 12k-wide map gets 11 rows per chunk.
 CHUNK_BYTES = 64 * 2048 * 41 * 4
 
 
