@@ -28,8 +28,6 @@ import numpy as np
 import pytest
 
 HEIGHT, BANDS, ORDER = 6000, 41, 100
-#: The issue's bound on the projection's peak resident memory.
-PEAK_RSS_LIMIT = 2 << 30
 
 
 def panorama_rows(row0: int, row1: int, height: int, wavelengths_nm) -> np.ndarray:
