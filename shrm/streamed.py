@@ -26,8 +26,9 @@ __all__ = ["project_latlong_blocks", "project_zarr"]
 
 def _partial_numpy(block, L, theta, w, method):
     # Eq. (4), Ramamoorthi & Hanrahan 2001: Σ over this block's rings of w_j λ_lm(θ_j) F_m(θ_j)
-    F_cos, F_sin = _ring_fourier(block, L)
-    return legendre_analysis(L, theta, w, F_cos, F_sin, method)
+    with np.errstate(invalid="ignore", over="ignore"):  # NaN/inf: refused after the sum
+        F_cos, F_sin = _ring_fourier(block, L)
+        return legendre_analysis(L, theta, w, F_cos, F_sin, method)
 
 
 def _partial_ducc0(block, L, theta, w, method):
