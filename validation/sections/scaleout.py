@@ -35,6 +35,51 @@ def _by_role(records: list[dict]) -> dict:
     return {r.get("extra_info", {}).get("role"): r for r in records}
 
 
+_FULL_SIZE_KEYS = (
+    "height",
+    "width",
+    "bands",
+    "order",
+    "wall_s",
+    "peak_rss_bytes",
+    "imports_rss_bytes",
+    "store_bytes",
+    "float32_bytes",
+    "rows_per_chunk",
+    "compression",
+    "generate_s",
+)
+
+
+def _zarr_full_size(groups: dict, memory: dict) -> dict | None:
+    # the 12k×6k projection's figures, and its per-pixel throughput against the 2k in-memory path
+    full = _by_role(groups.get("scaleout-zarr-12k", [])).get("zarr-12k")
+    if full is None:
+        return None
+    e = full["extra_info"]
+    pixels_per_s = e["height"] * e["width"] / e["wall_s"]
+    in_memory_pixels_per_s = memory["extra_info"]["pixels"] / memory["stats"]["min"]
+    return {key: e[key] for key in _FULL_SIZE_KEYS} | {
+        "throughput_vs_2k_in_memory": pixels_per_s / in_memory_pixels_per_s
+    }
+
+
+def _zarr_layout(groups: dict) -> list[dict]:
+    # read time and size by map, compression and chunk size (the spectral map first)
+    layout = [
+        {
+            "data": r["extra_info"]["data"],
+            "compression": r["extra_info"]["compression"],
+            "chunk_mb": r["extra_info"]["chunk_bytes"] / 1e6,
+            "ratio": r["extra_info"]["ratio"],
+            "read_s": r["stats"]["min"],
+            "read_gb_s": r["extra_info"]["float32_bytes"] / r["stats"]["min"] / 1e9,
+        }
+        for r in groups.get("scaleout-zarr-read", [])
+    ]
+    return sorted(layout, key=lambda r: (r["data"] != "spectral", r["compression"], r["chunk_mb"]))
+
+
 def scaleout_figures(ctx: ReportContext | None = None) -> SectionData:
     """The scale-out benchmarks' ratios, or nothing without ``make bench``.
 
@@ -69,40 +114,7 @@ def scaleout_figures(ctx: ReportContext | None = None) -> SectionData:
         for machines in (1, 2, 4, 8, 16)
     }
     memory, streamed = zarr["in-memory"], zarr["zarr-streamed"]
-    full = _by_role(groups.get("scaleout-zarr-12k", [])).get("zarr-12k")
-    if full is not None:
-        e = full["extra_info"]
-        pixels_per_s = e["height"] * e["width"] / e["wall_s"]
-        in_memory_pixels_per_s = memory["extra_info"]["pixels"] / memory["stats"]["min"]
-        full = {
-            key: e[key]
-            for key in (
-                "height",
-                "width",
-                "bands",
-                "order",
-                "wall_s",
-                "peak_rss_bytes",
-                "imports_rss_bytes",
-                "store_bytes",
-                "float32_bytes",
-                "rows_per_chunk",
-                "compression",
-                "generate_s",
-            )
-        } | {"throughput_vs_2k_in_memory": pixels_per_s / in_memory_pixels_per_s}
-    layout = [
-        {
-            "data": r["extra_info"]["data"],
-            "compression": r["extra_info"]["compression"],
-            "chunk_mb": r["extra_info"]["chunk_bytes"] / 1e6,
-            "ratio": r["extra_info"]["ratio"],
-            "read_s": r["stats"]["min"],
-            "read_gb_s": r["extra_info"]["float32_bytes"] / r["stats"]["min"] / 1e9,
-        }
-        for r in groups.get("scaleout-zarr-read", [])
-    ]
-    layout.sort(key=lambda r: (r["data"] != "spectral", r["compression"], r["chunk_mb"]))
+    full, layout = _zarr_full_size(groups, memory), _zarr_layout(groups)
     return SectionData(
         {
             "measured": True,
