@@ -9,8 +9,8 @@ machine's disk and the benchmark's time. The projection's work does not depend o
 does not compress, is measured on the 2k map of ``bench_scaleout.py``.
 
 Each step runs in a child process of its own (``python bench_zarr_panorama.py generate|project
-STORE``) so that its peak resident set size (``resource.getrusage``, ``ru_maxrss``) is its own,
-not pytest's; the projection shows its progress bar on the terminal (pytest's capture is
+STORE``) so that its peak resident set size (``VmHWM``, :func:`_peak_rss`) is its own, not
+pytest's; the projection shows its progress bar on the terminal (pytest's capture is
 suspended for it; tqdm draws nothing when stderr is not a terminal, as under CI). The figures go
 to ``bench.json`` (``extra_info``) and the report's Scale-out section.
 """
@@ -53,9 +53,17 @@ def panorama_rows(row0: int, row1: int, height: int, wavelengths_nm) -> np.ndarr
 
 
 def _peak_rss() -> int:
-    import resource
+    """This process's peak resident set size in bytes: ``VmHWM`` of ``/proc/self/status``.
 
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # kB on Linux
+    Not ``getrusage``'s ``ru_maxrss``: Linux carries the parent's high-water mark across the
+    fork and exec that start a child, so a child of a large pytest process would report the
+    parent's peak instead of its own.
+    """
+    with open("/proc/self/status") as status:
+        for line in status:
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) * 1024  # kB
+    raise RuntimeError("no VmHWM in /proc/self/status (Linux only)")
 
 
 def _generate(store: str) -> dict:
