@@ -81,9 +81,10 @@ def check_chunk_fits(
 ) -> int:
     """Refuse a chunk whose float64 working copies would not fit in half the available memory.
 
-    A streamed operation holds about one chunk as float64 (plus its input as float32), two when
-    the next chunk is read ahead (``copies=2``); chunks larger than half the memory that is free
-    now would swap or fail. The message says how many rows would fit.
+    A streamed operation holds about one chunk as float64 (plus its input as float32), up to three
+    when the next chunk is read ahead (``copies=3``: the caller's last block, this one and the
+    next); chunks larger than half the memory that is free now would swap or fail. The message
+    says how many rows would fit.
 
     Examples
     --------
@@ -142,8 +143,9 @@ class ZarrImage:
         """``(first_row, block)`` in row order; ``block`` is float64 ``(rows, W, C)``.
 
         With ``prefetch`` a reader thread reads, decompresses and converts the next block while
-        the caller works on this one (Zarr's codecs and NumPy's cast release the GIL), so at most
-        two blocks are held at once; the blocks are the same either way.
+        the caller works on this one (Zarr's codecs and NumPy's cast release the GIL): two blocks
+        are held at once, three while the caller lets go of its last one; the blocks are the same
+        either way.
 
         Examples
         --------
@@ -157,7 +159,7 @@ class ZarrImage:
         """
         rows = rows or self.rows_per_chunk
         height, width, n = self.shape
-        check_chunk_fits(rows, width, n, str(self.path), copies=2 if prefetch else 1)
+        check_chunk_fits(rows, width, n, str(self.path), copies=3 if prefetch else 1)
         starts = range(0, height, rows)
 
         def read(start: int) -> tuple[int, np.ndarray]:
