@@ -80,12 +80,13 @@ def gather_bilinear_kernel(image, taps, weights, texel, out):
     """Twin of ``reference.cubemap.gather_bilinear``: out[texel[j]] = Σ_k w[j, k] image[taps[j, k]].
 
     ``image``: (P, C) flattened pixels; ``taps``, ``weights``: (N, 4); ``texel``: (N,) output rows;
-    ``out``: (N, C). The four rows of a texel are read as contiguous channel vectors. Taps sorted
-    by input pixel (``reference.cubemap._latlong_taps``) read the input in memory order and write
-    the output through ``texel``, faster on a 41-band map than walking the output in order,
-    whose taps jump between distant input rows.
+    ``out``: (M, C), M ≥ N (a subset of the texels may be gathered). The four rows of a texel are
+    read as contiguous channel vectors. Taps sorted by input pixel
+    (``reference.cubemap._latlong_taps``) read the input in memory order and write the output
+    through ``texel``, faster on a 41-band map than walking the output in order, whose taps jump
+    between distant input rows.
     """
-    N = out.shape[0]
+    N = taps.shape[0]
     C = out.shape[1]
     for j in range(N):
         r0 = image[taps[j, 0]]

@@ -23,6 +23,7 @@ References
 from __future__ import annotations
 
 import functools
+from collections.abc import Iterable
 
 import numpy as np
 
@@ -39,7 +40,9 @@ __all__ = [
     "cubemap_texel_solid_angles",
     "cubemap_to_latlong",
     "gather_bilinear",
+    "latlong_blocks_to_cubemap",
     "latlong_to_cubemap",
+    "zarr_to_cubemap",
 ]
 
 #: Face order of specref's cube maps.
@@ -244,7 +247,7 @@ def _latlong_taps(
     return taps, weights, texel
 
 
-def gather_bilinear(image, taps, weights, texel=None) -> np.ndarray:
+def gather_bilinear(image, taps, weights, texel=None, out=None) -> np.ndarray:
     """Weighted sum of four taps per output: ``out[texel[j]] = Σ_k w[j, k] image[taps[j, k]]``.
 
     The data movement of §7.1, Herbert et al. (bilinear filtering at memory bandwidth), as used by
@@ -261,10 +264,12 @@ def gather_bilinear(image, taps, weights, texel=None) -> np.ndarray:
     texel : ndarray of int, shape (N,), optional
         The output row of each tap row, a permutation of ``range(N)`` (default: the identity), so
         that the rows can be sorted for the order in which they read ``image``.
+    out : ndarray, shape (M, C), optional
+        Write ``out[texel[j]]`` here instead (a subset of the texels: a row block's).
 
     Returns
     -------
-    ndarray, shape (N, C), the dtype of ``image``
+    ndarray, shape (N, C), the dtype of ``image`` (``out`` when given)
 
     Examples
     --------
@@ -278,6 +283,9 @@ def gather_bilinear(image, taps, weights, texel=None) -> np.ndarray:
     gathered = np.zeros((taps.shape[0], image.shape[1]), dtype=np.result_type(image, weights))
     for k in range(4):
         gathered += weights[:, k, None] * image[taps[:, k]]
+    if out is not None:
+        out[np.arange(taps.shape[0]) if texel is None else texel] = gathered
+        return out
     if texel is None:
         return gathered.astype(image.dtype)
     out = np.empty_like(gathered, dtype=image.dtype)
@@ -333,6 +341,104 @@ def latlong_to_cubemap(image, size: int = 64, backend: str = "numba", out=None) 
     )
     _k.gather_bilinear_kernel(flat, taps, weights, texel, out.reshape(-1, C))
     return out
+
+
+def latlong_blocks_to_cubemap(
+    blocks: Iterable[tuple[int, np.ndarray]], height: int, size: int = 64, backend: str = "numba"
+) -> np.ndarray:
+    """:func:`latlong_to_cubemap` of a lat-long map given as row blocks, block by block.
+
+    §7.1, Herbert et al. Each texel's four bilinear taps lie on two adjacent rows ``y0`` and
+    ``y0 + 1`` (:func:`_latlong_taps`, sorted by ``y0``), so the texels whose rows both lie in a
+    block are gathered from that block, and those on the seam between two blocks from the last
+    row of one and the first row of the next. Every texel gets the same four products in the same
+    order as in memory: the result is bit-identical to :func:`latlong_to_cubemap` of the whole map,
+    with one block (and one saved row) in memory.
+
+    Parameters
+    ----------
+    blocks : iterable of (first_row, ndarray (rows, W, C))
+        Consecutive row blocks, in row order, covering the ``height`` rows once; the first
+        block's dtype (float32 or float64) is kept.
+    height : int
+        The whole map's height H (``W = 2H``).
+    size : int
+        Face size S.
+    backend : {"numba", "numpy"}
+
+    Returns
+    -------
+    ndarray, shape (6, S, S, C)
+
+    Examples
+    --------
+    >>> image = np.random.default_rng(2).random((8, 16, 3))
+    >>> blocks = [(0, image[:3]), (3, image[3:4]), (4, image[4:])]
+    >>> streamed = latlong_blocks_to_cubemap(blocks, 8, 4)
+    >>> bool((streamed == latlong_to_cubemap(image, 4)).all())
+    True
+    """
+    size = require_positive_int(size, "cube map size", 16384)
+    require_choice(backend, ("numba", "numpy"), "cube-map backend")
+    out, seam, row = None, None, 0
+
+    def gather(pixels, first_row, y0_from, y0_to):
+        # texels with y0 in [y0_from, y0_to), read from ``pixels`` (rows from first_row on)
+        lo, hi = np.searchsorted(taps[:, 0], [y0_from * W, y0_to * W])
+        local = taps[lo:hi] - first_row * W
+        flat = np.ascontiguousarray(pixels).reshape(-1, C)
+        if backend == "numpy":
+            gather_bilinear(flat, local, weights[lo:hi], texel[lo:hi], out=out)
+        else:
+            _k.gather_bilinear_kernel(flat, local, weights[lo:hi], texel[lo:hi], out)
+
+    for start, block in blocks:
+        block = np.asarray(block)
+        if out is None:
+            require(block.ndim == 3, f"latlong_blocks_to_cubemap: a block of shape {block.shape}")
+            W, C = block.shape[1:]
+            check_latlong_shape((height, W, C), "latlong_blocks_to_cubemap")
+            dtype = block.dtype if block.dtype in (np.float32, np.float64) else np.float64
+            taps, weights, texel = _latlong_taps(height, W, size, np.dtype(dtype).str)
+            out = np.empty((6 * size * size, C), dtype=dtype)
+        block = np.asarray(block, dtype=dtype)
+        stop = start + block.shape[0]
+        require(
+            start == row and block.shape[1:] == (W, C) and stop <= height,
+            f"latlong_blocks_to_cubemap: block at row {start} of shape {block.shape}; expected "
+            f"the rows from {row} on of a ({height}, {W}, {C}) map, in order",
+        )
+        if seam is not None:  # texels on rows start − 1 and start
+            gather(np.concatenate([seam, block[:1]]), start - 1, start - 1, start)
+        last = stop == height  # on the last row, y0 + 1 clamps to y0
+        gather(block, start, start, stop if last else stop - 1)
+        seam, row = block[-1:].copy(), stop
+    require(row == height and out is not None, f"latlong_blocks_to_cubemap: {row} of {height} rows")
+    return out.reshape(6, size, size, C)
+
+
+def zarr_to_cubemap(path, size: int = 64, backend: str = "numba") -> np.ndarray:
+    """:func:`latlong_to_cubemap` of a Zarr panorama (``reference.zarr_images``), streamed.
+
+    The store's chunks are read in row order (float64, the next read ahead) and gathered by
+    :func:`latlong_blocks_to_cubemap`; equal, bit for bit, to ``latlong_to_cubemap`` of the store
+    read whole.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> from reference.zarr_images import write_zarr_image
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     path = write_zarr_image(os.path.join(d, "m.zarr"), np.ones((8, 16, 2)), ["R", "G"],
+    ...                             rows_per_chunk=3)
+    ...     cube = zarr_to_cubemap(path, 4)
+    >>> cube.shape, float(cube.min()), float(cube.max())
+    ((6, 4, 4, 2), 1.0, 1.0)
+    """
+    from reference.zarr_images import open_zarr_image
+
+    store = open_zarr_image(path)
+    return latlong_blocks_to_cubemap(store.row_blocks(), store.shape[0], size, backend)
 
 
 def cubemap_to_latlong(cube, height: int, backend: str = "numpy") -> np.ndarray:

@@ -10,6 +10,8 @@ specref writes that (through tifffile) and, beside it, the spectral OpenEXR layo
 - **TIFF**: one page, ``(H, W, n_bands)`` float32, contiguous (chunky) samples, uncompressed;
   the ImageDescription tag holds JSON ``{"specref": "spectral", "wavelengths_nm": [...]}``.
   Rows are written through a memory map (``tifffile.memmap``), so the output is never held whole.
+- **Zarr** (``.zarr``, ``reference.zarr_images``): row-band chunks of every band, written chunk
+  by chunk; read by row windows too (:func:`open_panorama_rows`).
 
 Both are written to a temporary file beside the destination, synced and renamed into place (the
 writers need a path, so :func:`reference.images.atomic_write`'s open handle does not serve).
@@ -50,7 +52,7 @@ __all__ = [
 ]
 
 #: Output formats of spectral panoramas by file suffix.
-SPECTRAL_FORMATS = (".exr", ".tif", ".tiff")
+SPECTRAL_FORMATS = (".exr", ".tif", ".tiff", ".zarr")
 # Suffixes of 8-bit images that are refused as panoramas (they are not HDR).
 _LDR_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".gif", ".webp")
 
@@ -90,6 +92,15 @@ def _write_tiff_blocks(path: Path, height, width, wavelengths, blocks) -> None:
     del image
 
 
+def _in_order(blocks, path):
+    # the blocks of write_spectral_blocks, checked to be consecutive from row 0
+    row = 0
+    for row0, block in blocks:
+        require(row0 == row, f"{path}: a block at row {row0}; expected row {row}")
+        row += block.shape[0]
+        yield block
+
+
 def write_spectral_blocks(
     path, height: int, width: int, wavelengths_nm, blocks: Iterable[tuple[int, np.ndarray]]
 ) -> Path:
@@ -124,9 +135,15 @@ def write_spectral_blocks(
     suffix = path.suffix.lower()
     require(
         suffix in SPECTRAL_FORMATS,
-        f"{path}: unsupported spectral image type {suffix!r}; allowed: .exr, .tif, .tiff",
+        f"{path}: unsupported spectral image type {suffix!r}; allowed: .exr, .tif, .tiff, .zarr",
     )
     wavelengths = [float(w) for w in np.asarray(wavelengths_nm, dtype=np.float64)]
+    if suffix == ".zarr":  # a Zarr store is written atomically by its own writer
+        from reference.zarr_images import write_zarr_blocks
+
+        return write_zarr_blocks(
+            path, height, width, spectral_channel_names(wavelengths), _in_order(blocks, path)
+        )
     with atomic_path(path, suffix) as tmp:
         if suffix == ".exr":
             try:
@@ -433,13 +450,27 @@ def _open_tiff_rows(path: Path) -> PanoramaRows:
     )
 
 
+def _open_zarr_rows(path: Path) -> PanoramaRows:
+    """A Zarr store (``reference.zarr_images``) by row windows: only the chunks they touch."""
+    from reference.zarr_images import open_zarr_image
+
+    store = open_zarr_image(path)
+    height, width, _ = store.shape
+
+    def read(row0, row1):
+        return np.asarray(store.array[row0:row1], dtype=np.float64)
+
+    return PanoramaRows(path, height, width, store.channels, read)
+
+
 def open_panorama_rows(path) -> PanoramaRows:
     """Open a panorama for reading by row windows, never holding it whole (where the file allows).
 
     ``.exr``: OpenEXR scanline windows; ``.hdr``: Radiance scanlines found one by one (flat or
     new-style RLE) and decoded a block at a time by imagecodecs, bit for bit as
     :func:`reference.images.read_hdr` (rows in order); ``.tif``: a memory map of an uncompressed
-    float TIFF (RGB without a description, or spectral as :func:`write_spectral_blocks` writes).
+    float TIFF (RGB without a description, or spectral as :func:`write_spectral_blocks` writes);
+    ``.zarr``: the chunks of a store (``reference.zarr_images``) that a window touches.
     Rotated Radiance files and compressed TIFFs are read whole (``streamed`` is False).
 
     Raises
@@ -465,6 +496,8 @@ def open_panorama_rows(path) -> PanoramaRows:
         return _open_hdr_rows(path)
     if suffix in (".tif", ".tiff"):
         return _open_tiff_rows(path)
+    if suffix == ".zarr":
+        return _open_zarr_rows(path)
     read_environment_file(path)  # the one-line refusals of 8-bit and unknown types
     raise AssertionError("unreachable")  # pragma: no cover
 
@@ -480,10 +513,11 @@ def spectralize_file(panorama, model, out, rows_per_block: int | None = None) ->
     Parameters
     ----------
     panorama : str or Path
-        ``.hdr`` or RGB ``.exr``, linear camera RGB in the model's camera space.
+        ``.hdr``, RGB ``.exr`` or an RGB ``.zarr`` store, linear camera RGB in the model's
+        camera space.
     model : SpectralRegression
     out : str or Path
-        ``.exr`` or ``.tif``/``.tiff``.
+        ``.exr``, ``.tif``/``.tiff`` or ``.zarr`` (written chunk by chunk).
     rows_per_block : int, optional
         Default: :data:`reference.spectral_regression.PIXELS_PER_BLOCK` pixels' worth of rows.
 
@@ -517,7 +551,7 @@ def spectralize_file(panorama, model, out, rows_per_block: int | None = None) ->
         )
         require(
             suffix in SPECTRAL_FORMATS,
-            f"{out}: unsupported spectral image type {suffix!r}; allowed: .exr, .tif, .tiff",
+            f"{out}: unsupported spectral image type {suffix!r}; allowed: .exr, .tif, .tiff, .zarr",
         )
         count = [0]
 

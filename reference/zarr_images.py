@@ -8,9 +8,12 @@ Layout of a store ``NAME.zarr`` (a folder), documented in ``docs/scale-out.md``:
 
 - one array, shape ``(H, W, C)`` float32, lat-long rows top (θ = 0) to bottom, ``W = 2H``;
 - chunks ``(rows_per_chunk, W, C)``: every band of a band of rows in one chunk, so a streamed
-  operation reads each chunk once, in row order;
-- compression (:data:`ZARR_COMPRESSIONS`): ``zstd`` (level 3, byte shuffle; the default: measured
-  in ``make bench``), ``blosc-lz4`` (faster, larger) or ``none``;
+  operation reads each chunk once, in row order; by default about 21.5 MB of float32 per chunk
+  (:func:`rows_per_chunk_for`);
+- compression (:data:`ZARR_COMPRESSIONS`): ``blosc-lz4`` (level 5, byte shuffle; the default),
+  ``zstd`` (level 3, no shuffle) or ``none``. On a spectral panorama blosc-lz4 reads back faster
+  than zstd at about the same size (``make bench``, group ``scaleout-zarr-read``, shown in the
+  report; erratum E48);
 - attributes: ``{"specref": "spectral-panorama", "channels": [...], "wavelengths_nm": [...] or
   null, "rows_per_chunk": n}``; the channel names are the spectral OpenEXR names
   (``S0.550,000000nm``) or ``R, G, B``.
@@ -43,6 +46,7 @@ __all__ = [
     "convert_to_zarr",
     "map_zarr_blocks",
     "open_zarr_image",
+    "rows_per_chunk_for",
     "write_zarr_blocks",
     "write_zarr_image",
 ]
@@ -54,16 +58,34 @@ ZARR_COMPRESSIONS = {
     "none": lambda: None,
 }
 
-#: Default rows per chunk: 64 rows of a 12k-wide, 41-band map are 126 MB as float32.
-DEFAULT_ROWS_PER_CHUNK = 64
+#: Target bytes of a float32 chunk: 64 rows of a 2048 × 41 map (21.5 MB). Of 5.4, 21.5 and 43 MB
+#: chunks, the first two read about equally fast with every compression and the last slower
+#: (``make bench``, group ``scaleout-zarr-read``, shown in the report); the larger of the two means
+#: fewer chunks. A 12k-wide map gets 11 rows per chunk.
+CHUNK_BYTES = 64 * 2048 * 41 * 4
 
 
-def check_chunk_fits(rows: int, width: int, channels: int, where: str, available=None) -> int:
-    """Refuse a chunk whose float64 working copy would not fit in half the available memory.
+def rows_per_chunk_for(width: int, channels: int, height: int | None = None) -> int:
+    """Rows per chunk of a ``W × C`` float32 map: :data:`CHUNK_BYTES` worth, one to ``height``.
 
-    A streamed operation holds about one chunk as float64 (plus its input as float32); a chunk
-    larger than half the memory that is free now would swap or fail. The message says how many
-    rows would fit.
+    Examples
+    --------
+    >>> rows_per_chunk_for(2048, 41), rows_per_chunk_for(12000, 41), rows_per_chunk_for(64, 3, 32)
+    (64, 11, 32)
+    """
+    rows = max(1, round(CHUNK_BYTES / (width * channels * 4)))
+    return rows if height is None else min(rows, height)
+
+
+def check_chunk_fits(
+    rows: int, width: int, channels: int, where: str, available=None, copies: int = 1
+) -> int:
+    """Refuse a chunk whose float64 working copies would not fit in half the available memory.
+
+    A streamed operation holds about one chunk as float64 (plus its input as float32), up to three
+    when the next chunk is read ahead (``copies=3``: the caller's last block, this one and the
+    next); chunks larger than half the memory that is free now would swap or fail. The message
+    says how many rows would fit.
 
     Examples
     --------
@@ -79,11 +101,13 @@ def check_chunk_fits(rows: int, width: int, channels: int, where: str, available
         import psutil
 
         available = psutil.virtual_memory().available
-    need = rows * width * channels * 8
-    fits = max(1, int(available / 2 // (width * channels * 8)))
+    row_bytes = width * channels * 8 * copies
+    need = rows * row_bytes
+    fits = max(1, int(available / 2 // row_bytes))
+    held = f"{copies} copies of " if copies > 1 else ""
     require(
         need <= available / 2,
-        f"{where}: rows per chunk: {rows} rows of {width} × {channels} float64 need "
+        f"{where}: rows per chunk: {held}{rows} rows of {width} × {channels} float64 need "
         f"{need / 1e9:.1f} GB; half the free memory ({available / 2e9:.1f} GB) holds {fits} rows",
     )
     return rows
@@ -114,12 +138,46 @@ class ZarrImage:
         """Band centres in nm, or None for an RGB store."""
         return channel_wavelengths_nm(self.channels)
 
-    def row_blocks(self, rows: int | None = None) -> Iterator[tuple[int, np.ndarray]]:
-        """``(first_row, block)`` in row order; ``block`` is float64 ``(rows, W, C)``."""
+    def row_blocks(
+        self, rows: int | None = None, prefetch: bool = True
+    ) -> Iterator[tuple[int, np.ndarray]]:
+        """``(first_row, block)`` in row order; ``block`` is float64 ``(rows, W, C)``.
+
+        With ``prefetch`` a reader thread reads, decompresses and converts the next block while
+        the caller works on this one (Zarr's codecs and NumPy's cast release the GIL): two blocks
+        are held at once, three while the caller lets go of its last one; the blocks are the same
+        either way.
+
+        Examples
+        --------
+        >>> import tempfile, os
+        >>> with tempfile.TemporaryDirectory() as d:
+        ...     image = np.arange(5 * 10, dtype=np.float32).reshape(5, 10, 1)
+        ...     z = open_zarr_image(write_zarr_image(os.path.join(d, "m.zarr"), image, ["Y"],
+        ...                                          rows_per_chunk=2))
+        ...     [(start, block.shape[0], block.dtype.name) for start, block in z.row_blocks()]
+        [(0, 2, 'float64'), (2, 2, 'float64'), (4, 1, 'float64')]
+        """
         rows = rows or self.rows_per_chunk
-        check_chunk_fits(rows, self.shape[1], self.shape[2], str(self.path))
-        for start in range(0, self.shape[0], rows):
-            yield start, np.asarray(self.array[start : start + rows], dtype=np.float64)
+        height, width, n = self.shape
+        check_chunk_fits(rows, width, n, str(self.path), copies=3 if prefetch else 1)
+        starts = range(0, height, rows)
+
+        def read(start: int) -> tuple[int, np.ndarray]:
+            return start, np.asarray(self.array[start : start + rows], dtype=np.float64)
+
+        if not prefetch:
+            yield from map(read, starts)
+            return
+        from concurrent.futures import ThreadPoolExecutor
+
+        with ThreadPoolExecutor(1, thread_name_prefix="zarr-read") as reader:
+            pending = reader.submit(read, starts[0])
+            for start in starts[1:]:
+                block = pending.result()
+                pending = reader.submit(read, start)  # read the next block during this one
+                yield block
+            yield pending.result()
 
     def to_dask(self):
         """The store as a ``dask.array`` with the store's chunks (nothing read yet)."""
@@ -174,8 +232,8 @@ def write_zarr_blocks(
     width: int,
     channels,
     blocks: Iterable[np.ndarray],
-    rows_per_chunk: int = DEFAULT_ROWS_PER_CHUNK,
-    compression: str = "zstd",
+    rows_per_chunk: int | None = None,
+    compression: str = "blosc-lz4",
 ) -> Path:
     """Write a panorama given as row blocks (in order) to a Zarr store, atomically.
 
@@ -189,8 +247,8 @@ def write_zarr_blocks(
         Channel names (spectral OpenEXR names or ``R, G, B``).
     blocks : iterable of ndarray, shape (rows, W, C)
         Consecutive row blocks covering ``H`` rows; any block height.
-    rows_per_chunk : int
-        Chunk height (at most the image's height).
+    rows_per_chunk : int, optional
+        Chunk height (at most the image's height); default :func:`rows_per_chunk_for`.
     compression : str
         A key of :data:`ZARR_COMPRESSIONS`.
 
@@ -210,6 +268,8 @@ def write_zarr_blocks(
     path = Path(path)
     height = require_positive_int(height, f"{path}: height", 1 << 20)
     width = require_positive_int(width, f"{path}: width", 1 << 21)
+    if rows_per_chunk is None:
+        rows_per_chunk = rows_per_chunk_for(width, len(channels), height)
     rows_per_chunk = require_positive_int(rows_per_chunk, f"{path}: rows per chunk", 1 << 20)
     rows_per_chunk = min(rows_per_chunk, height)
     require(
@@ -253,6 +313,8 @@ def write_zarr_blocks(
                 array[row : row + full] = pending[:full]
                 row += full
                 pending = pending[full:]
+            if len(pending) and np.may_share_memory(pending, block):
+                pending = pending.copy()  # the rest waits; the caller may reuse its block's buffer
         if len(pending):
             require(row + len(pending) <= height, f"{path}: more than {height} rows given")
             array[row : row + len(pending)] = pending
@@ -275,9 +337,10 @@ def write_zarr_image(path, image, channels, **kwargs) -> Path:
     image = np.asarray(image)
     require(image.ndim == 3, f"{path}: expected an (H, W, C) image, got shape {image.shape}")
     channels = _check_channels(channels, image.shape[2], str(path))
-    rows = require_positive_int(
-        kwargs.get("rows_per_chunk", DEFAULT_ROWS_PER_CHUNK), f"{path}: rows per chunk", 1 << 20
-    )
+    rows = kwargs.get("rows_per_chunk")
+    if rows is None:
+        rows = rows_per_chunk_for(image.shape[1], image.shape[2], image.shape[0])
+    rows = require_positive_int(rows, f"{path}: rows per chunk", 1 << 20)
     blocks = (image[i : i + rows] for i in range(0, image.shape[0], rows))
     return write_zarr_blocks(path, image.shape[0], image.shape[1], channels, blocks, **kwargs)
 
@@ -346,7 +409,7 @@ def open_zarr_image(path, n_channels: int | None = None, wavelengths_nm=None) ->
 
 
 def convert_to_zarr(
-    source, out, rows_per_chunk: int = DEFAULT_ROWS_PER_CHUNK, compression: str = "zstd"
+    source, out, rows_per_chunk: int | None = None, compression: str = "blosc-lz4"
 ) -> dict:
     """Convert a panorama file (``.exr``, ``.hdr``, spectral ``.tif``) to a Zarr store.
 
@@ -361,7 +424,7 @@ def convert_to_zarr(
     ...     _ = write_exr(os.path.join(d, "m.exr"), np.ones((4, 8, 3), dtype=np.float32))
     ...     info = convert_to_zarr(os.path.join(d, "m.exr"), os.path.join(d, "m.zarr"), 2)
     >>> info["chunks"], info["channels"], info["compression"]
-    (2, 3, 'zstd')
+    (2, 3, 'blosc-lz4')
     """
     from reference.envmap import check_latlong_shape
     from reference.spectral_images import read_environment_file
@@ -369,6 +432,8 @@ def convert_to_zarr(
     image, names = read_environment_file(source)
     check_latlong_shape(image.shape, str(source))
     require(np.isfinite(image).all(), f"{source}: radiance must be finite, found NaN or inf")
+    if rows_per_chunk is None:
+        rows_per_chunk = rows_per_chunk_for(image.shape[1], image.shape[2], image.shape[0])
     write_zarr_image(out, image, names, rows_per_chunk=rows_per_chunk, compression=compression)
     stored = sum(f.stat().st_size for f in Path(out).rglob("*") if f.is_file())
     height, width, n = image.shape

@@ -81,12 +81,12 @@ def project_file(path, order: int, out, window=None, bands=None, backend: str = 
     if Path(path).suffix.lower() == ".zarr" and bands is None:
         # a chunked store is projected block by block, never read whole (shrm.streamed)
         from reference.zarr_images import open_zarr_image
-        from shrm.streamed import project_latlong_blocks
+        from shrm.streamed import project_zarr
         from shrm.windows import apply_window
 
-        store = open_zarr_image(path)
-        names = store.channels
-        coeffs = project_latlong_blocks(store.row_blocks(), store.shape[0], order, backend)
+        names = open_zarr_image(path).channels
+        # a progress bar of rows on a terminal (none under CI or in a pipe)
+        coeffs = project_zarr(path, order, backend, progress=None)
         if window is not None and window != "none":
             coeffs = apply_window(coeffs, window)
     else:

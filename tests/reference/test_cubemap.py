@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 from operator import attrgetter
 
 import numpy as np
@@ -147,3 +148,28 @@ def test_latlong_to_cubemap_float32_twin_and_out(rng):
 def test_cubemap_bad_input(call, match):
     with pytest.raises(SpecrefError, match=match):
         call()
+
+
+@pytest.mark.parametrize("backend", ["numba", "numpy"])
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_streamed_cubemap_is_bit_identical_to_in_memory(backend, dtype, rng):
+    # Blocks of uneven heights, one of a single row (its texels all lie on seams).
+    from reference.cubemap import latlong_blocks_to_cubemap
+
+    image = rng.gamma(0.5, 1.0, (64, 128, 5)).astype(dtype)
+    cuts = [0, 7, 8, 30, 31, 64]
+    blocks = [(a, image[a:b]) for a, b in itertools.pairwise(cuts)]
+    streamed = latlong_blocks_to_cubemap(blocks, 64, 24, backend=backend)
+    whole = latlong_to_cubemap(image, 24, backend=backend)
+    assert streamed.dtype == whole.dtype == dtype
+    np.testing.assert_array_equal(streamed, whole)
+
+
+def test_streamed_cubemap_refuses_gaps_and_disorder(rng):
+    from reference.cubemap import latlong_blocks_to_cubemap
+
+    image = rng.random((8, 16, 1))
+    with pytest.raises(SpecrefError, match=r"block at row 4 .* expected the rows from 3 on"):
+        latlong_blocks_to_cubemap([(0, image[:3]), (4, image[4:])], 8, 4)
+    with pytest.raises(SpecrefError, match=r"latlong_blocks_to_cubemap: 3 of 8 rows"):
+        latlong_blocks_to_cubemap([(0, image[:3])], 8, 4)

@@ -184,3 +184,27 @@ def test_nan_in_a_late_block_leaves_no_output(tmp_path, rng):
     with pytest.raises(SpecrefError, match=r"pano.exr: RGB must be finite and >= 0 \(rows 8-11\)"):
         spectralize_file(pano, default_regression(), tmp_path / "o.tif", rows_per_block=4)
     assert not (tmp_path / "o.tif").exists()
+
+
+def test_spectralize_zarr_to_zarr_equals_in_memory(tmp_path, rng):
+    # Issue 18: a 512×1024 RGB store in, a 41-band store out, streamed by row blocks (7 rows, so
+    # blocks straddle the output's 64-row chunks); equal, bit for bit, to the blocks spectralized
+    # in memory (the same float32 arithmetic, erratum E45).
+    from reference.spectral_images import spectralize_file
+    from reference.spectral_regression import spectralize_blocks
+    from reference.upsampling import default_regression
+    from reference.zarr_images import open_zarr_image, write_zarr_image
+
+    RGB = rng.gamma(0.7, 0.5, (512, 1024, 3)).astype(np.float32)
+    source = write_zarr_image(tmp_path / "rgb.zarr", RGB, ["R", "G", "B"], rows_per_chunk=48)
+    model = default_regression()
+    info = spectralize_file(source, model, tmp_path / "spectral.zarr", rows_per_block=7)
+    assert info["streamed"]
+    assert info["blocks"] == -(-512 // 7)
+    store = open_zarr_image(tmp_path / "spectral.zarr", wavelengths_nm=model.wavelengths_nm)
+    in_memory = np.concatenate(
+        [b.copy() for _, b in spectralize_blocks(model, RGB.astype(np.float64), 7)]
+    )
+    np.testing.assert_array_equal(store.read(), in_memory)
+    with pytest.raises(SpecrefError, match=r"spectralize needs an RGB panorama"):
+        spectralize_file(tmp_path / "spectral.zarr", model, tmp_path / "again.zarr")

@@ -73,6 +73,28 @@ def test_streamed_sh_projection_equals_in_memory(panorama, backend):
     assert np.max(np.abs(streamed - whole) / scale) <= 1e-12
 
 
+@pytest.mark.parametrize("backend", ["numba", "numpy"])
+def test_streamed_cubemap_is_bit_identical_to_in_memory(panorama, backend):
+    from reference.cubemap import latlong_to_cubemap, zarr_to_cubemap
+
+    path, image = panorama
+    streamed = zarr_to_cubemap(path, 128, backend=backend)
+    np.testing.assert_array_equal(
+        streamed, latlong_to_cubemap(image.astype(np.float64), 128, backend=backend)
+    )
+
+
+def test_prefetched_blocks_equal_plain_reads(panorama):
+    path, image = panorama
+    store = open_zarr_image(path)
+    ahead = list(store.row_blocks(100))
+    plain = list(store.row_blocks(100, prefetch=False))
+    assert [s for s, _ in ahead] == [s for s, _ in plain] == list(range(0, 512, 100))
+    for (_, a), (_, b) in zip(ahead, plain, strict=True):
+        np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(np.concatenate([b for _, b in ahead]), image)
+
+
 def test_refusals_are_one_line(tmp_path, panorama):
     path, _ = panorama
     with pytest.raises(SpecrefError, match=r"pano.zarr: 41 channels; expected 3"):
@@ -117,7 +139,7 @@ def test_cli_convert_and_project(tmp_path, capsys):
     write_exr(tmp_path / "m.exr", image)
     out = tmp_path / "m.zarr"
     assert main(["env", "convert", str(tmp_path / "m.exr"), str(out), "--rows", "8"]) == 0
-    assert "4 chunks of 8 rows, zstd" in capsys.readouterr().out
+    assert "4 chunks of 8 rows, blosc-lz4" in capsys.readouterr().out
     np.testing.assert_array_equal(open_zarr_image(out).read(), image)
     assert main(["sh", "project", str(out), "--order", "8", "-o", str(tmp_path / "z.npz")]) == 0
     assert (
@@ -138,3 +160,19 @@ def test_cli_convert_and_project(tmp_path, capsys):
     assert np.max(np.abs(z["coeffs"] - e["coeffs"])) <= 1e-12 * np.abs(e["coeffs"]).max()
     assert main(["env", "convert", str(tmp_path / "m.exr"), str(out), "--rows", "0"]) == 2
     assert "rows per chunk" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf])
+def test_cli_convert_refuses_non_finite_input_in_one_line(tmp_path, capsys, bad):
+    from reference.images import write_exr
+    from validation.cli import main
+
+    image = np.ones((8, 16, 3), dtype=np.float32)
+    image[5, 3, 1] = bad
+    write_exr(tmp_path / "bad.exr", image)
+    assert main(["env", "convert", str(tmp_path / "bad.exr"), str(tmp_path / "b.zarr")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.endswith("bad.exr: radiance must be finite, found NaN or inf")
+    assert "\n" not in err
+    assert "Traceback" not in err
+    assert not (tmp_path / "b.zarr").exists()

@@ -72,13 +72,17 @@ def add_parser(sub) -> None:
     f.add_argument("--noise", action="store_true", help="add 0.5 %% + 0.1 %% camera noise")
     f.add_argument("-o", "--out", required=True, help="output model .json")
     f.set_defaults(func=_cmd_env_fit)
-    s = env.add_parser("spectralize", help="expand an HDR panorama to a spectral .exr or .tif")
-    s.add_argument("panorama", help="linear HDR panorama: .hdr, RGB .exr or float RGB .tif")
+    s = env.add_parser(
+        "spectralize", help="expand an HDR panorama to a spectral .exr, .tif or .zarr"
+    )
+    s.add_argument(
+        "panorama", help="linear HDR panorama: .hdr, RGB .exr, float RGB .tif or RGB .zarr"
+    )
     s.add_argument("--model", required=True, help="model .json from `env fit`, or 'default'")
     s.add_argument("--rows", type=int, default=None, help="rows per block (default: 2^17 pixels)")
-    s.add_argument("-o", "--out", required=True, help="output .exr or .tif")
+    s.add_argument("-o", "--out", required=True, help="output .exr, .tif or .zarr")
     s.set_defaults(func=_cmd_env_spectralize)
-    from reference.zarr_images import DEFAULT_ROWS_PER_CHUNK, ZARR_COMPRESSIONS
+    from reference.zarr_images import ZARR_COMPRESSIONS
 
     c = env.add_parser(
         "convert", help="convert a panorama (.exr, .hdr, .tif) to a chunked Zarr store"
@@ -88,8 +92,8 @@ def add_parser(sub) -> None:
     c.add_argument(
         "--rows",
         type=int,
-        default=DEFAULT_ROWS_PER_CHUNK,
-        help="rows per chunk (default %(default)s)",
+        default=None,
+        help="rows per chunk (default: about 21.5 MB of float32 per chunk)",
     )
-    registry_option(c, "--compression", ZARR_COMPRESSIONS, "chunk compression", default="zstd")
+    registry_option(c, "--compression", ZARR_COMPRESSIONS, "chunk compression", default="blosc-lz4")
     c.set_defaults(func=_cmd_env_convert)
