@@ -24,7 +24,15 @@ from collections.abc import Callable, Sequence
 
 from reference.errors import SpecrefError, require
 
-__all__ = ["SCHEDULER_ENV", "SERIAL", "dask_client", "run_tasks", "scheduler_address"]
+__all__ = [
+    "LOCAL",
+    "SCHEDULER_ENV",
+    "SERIAL",
+    "add_scheduler_option",
+    "dask_client",
+    "run_tasks",
+    "scheduler_address",
+]
 
 #: The environment variable that names a remote scheduler.
 SCHEDULER_ENV = "SPECREF_SCHEDULER"
@@ -32,9 +40,17 @@ SCHEDULER_ENV = "SPECREF_SCHEDULER"
 #: The scheduler name that runs tasks in this process, one after another.
 SERIAL = "serial"
 
+#: The scheduler name that starts a local cluster (one single-threaded worker process per core).
+LOCAL = "local"
 
-def scheduler_address(scheduler: str | None = None) -> str | None:
-    """The scheduler to use: ``scheduler``, else ``$SPECREF_SCHEDULER``, else None (local).
+
+def scheduler_address(scheduler: str | None = None, default: str | None = None) -> str | None:
+    """The scheduler to use: ``scheduler``, else ``$SPECREF_SCHEDULER``, else ``default``.
+
+    None (and ``"local"``) mean a new local cluster; ``"serial"`` this process. Commands whose
+    tasks are short or timed (``specref phong table1``, ``specref impastor table1``) pass
+    ``default="serial"``: a local cluster starts in seconds and its workers would share the
+    cores that the timings measure.
 
     Examples
     --------
@@ -42,10 +58,29 @@ def scheduler_address(scheduler: str | None = None) -> str | None:
     'tcp://127.0.0.1:8786'
     >>> scheduler_address("serial")
     'serial'
+    >>> scheduler_address("local", default="serial") is None
+    True
     """
-    if scheduler:
-        return str(scheduler)
-    return os.environ.get(SCHEDULER_ENV) or None
+    address = scheduler or os.environ.get(SCHEDULER_ENV) or default
+    if not address or str(address) == LOCAL:
+        return None
+    return str(address)
+
+
+def add_scheduler_option(parser, default: str | None = None) -> None:
+    """The ``--scheduler`` option of every command that runs tasks (one help text for all)."""
+    fallback = (
+        "this process, one task after another"
+        if default == SERIAL
+        else ("a local cluster of one worker process per core")
+    )
+    parser.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="where the tasks run: a running Dask scheduler (tcp://host:8786), 'local' (a local "
+        f"cluster of one worker process per core) or 'serial'; default $SPECREF_SCHEDULER, "
+        f"else {fallback}",
+    )
 
 
 @contextlib.contextmanager
@@ -116,6 +151,7 @@ def run_tasks(
     progress: bool = True,
     desc: str = "tasks",
     retries: int = 3,
+    default: str | None = None,
 ) -> list:
     """``[function(task) for task in tasks]``, on a Dask cluster or serially, in task order.
 
@@ -133,6 +169,9 @@ def run_tasks(
         A progress bar on stderr (never under CI or without a terminal).
     retries : int
         Times a task is run again after its worker died.
+    default : str, optional
+        Where the tasks run when neither ``scheduler`` nor ``$SPECREF_SCHEDULER`` says
+        (:func:`scheduler_address`).
 
     Returns
     -------
@@ -148,11 +187,12 @@ def run_tasks(
 
     tasks = list(tasks)
     show = progress and not os.environ.get("CI") and sys.stderr.isatty()
-    if client is None and scheduler_address(scheduler) == SERIAL:
+    address = scheduler_address(scheduler, default)
+    if client is None and address == SERIAL:
         return [function(task) for task in tqdm(tasks, desc=desc, disable=not show, leave=False)]
     with contextlib.ExitStack() as stack:
         if client is None:
-            client = stack.enter_context(dask_client(scheduler))
+            client = stack.enter_context(dask_client(address or LOCAL))
         return _gather(client, function, tasks, show, desc, retries)
 
 

@@ -37,6 +37,7 @@ from reference.display_model import (
 )
 from reference.errors import require
 from reference.spectra import resample_spectrum, spectrum_from_dataset
+from reference.tasks import SERIAL, run_tasks
 from validation.metrics import colorchecker_truth, delta_E_stats
 
 __all__ = [
@@ -172,12 +173,57 @@ def channel_count_errors(designs=None, counts=range(3, 11), lights=LIGHTS + EXTR
     return out
 
 
+def _table1_light(cell: tuple) -> tuple[list[dict], dict]:
+    """One light of :func:`table1` (a task): its rows and its per-light record."""
+    light, d, white_luminance, display = cell
+    rows = []
+    patches, truth, white = colorchecker_truth_cached(light)
+    names = list(patches)
+    S6 = light_to_channels(spectrum_from_dataset("illuminant", light), d)
+    XYZ_sim = channels_to_XYZ(spectra_to_channels(_cc_on_grid(patches), d) * S6, d)
+    dE_sim = _lab_delta_E(XYZ_sim, truth, white)
+    # Screen output: absolute luminance, booth-light flare off the screen, Eq. (1), Ferwerda.
+    white_abs = white * white_luminance
+    flare = screen_flare_XYZ(display, white * white_luminance * np.pi)
+    counts, in_gamut, _ = XYZ_to_display_counts(XYZ_sim * white_luminance, display, 0, 0, flare)
+    shown = display_counts_to_XYZ(counts, display) + flare
+    dE_screen = _lab_delta_E(shown, truth * white_luminance, white_abs)
+    out_names = [n for n, ok in zip(names, in_gamut, strict=True) if not ok]
+    entry = {
+        "out_of_gamut": out_names,
+        "simulation_delta_E00": dE_sim.tolist(),
+        "screen_delta_E00": dE_screen.tolist(),
+    }
+    rows.append(
+        {
+            "label": f"{light} (24)",
+            "light": light,
+            "n": 24,
+            "simulation": delta_E_stats(dE_sim),
+            "screen": delta_E_stats(dE_screen),
+        }
+    )
+    if out_names:
+        keep = np.asarray(in_gamut)
+        rows.append(
+            {
+                "label": f"{light} ({int(keep.sum())})",
+                "light": light,
+                "n": int(keep.sum()),
+                "simulation": delta_E_stats(dE_sim[keep]),
+                "screen": delta_E_stats(dE_screen[keep]) if keep.any() else None,
+            }
+        )
+    return rows, entry
+
+
 def table1(
     design: str = "optimized",
     n_channels: int = 6,
     white_luminance: float = 200.0,
     display=None,
     lights=LIGHTS,
+    scheduler: str | None = None,
 ) -> dict:
     """Table 1, Ferwerda: six-channel simulation and screen output against the spectral truth.
 
@@ -199,6 +245,10 @@ def table1(
     display : DisplayModel, optional
         Default: :func:`reference.display_model.virtual_display`.
     lights : sequence of str
+    scheduler : str, optional
+        Each light is one task of :func:`reference.tasks.run_tasks` (an address, ``"local"`` or
+        ``"serial"``; default ``$SPECREF_SCHEDULER``, else serial: a light takes well under a
+        second, less than a local cluster takes to start).
 
     Returns
     -------
@@ -218,45 +268,10 @@ def table1(
     )
     display = display or virtual_display()
     d = MULTISPECTRAL_DESIGNS.lookup(design).reference(n_channels)
-    rows, per_light = [], {}
-    for light in lights:
-        patches, truth, white = colorchecker_truth_cached(light)
-        names = list(patches)
-        S6 = light_to_channels(spectrum_from_dataset("illuminant", light), d)
-        XYZ_sim = channels_to_XYZ(spectra_to_channels(_cc_on_grid(patches), d) * S6, d)
-        dE_sim = _lab_delta_E(XYZ_sim, truth, white)
-        # Screen output: absolute luminance, booth-light flare off the screen, Eq. (1), Ferwerda.
-        white_abs = white * white_luminance
-        flare = screen_flare_XYZ(display, white * white_luminance * np.pi)
-        counts, in_gamut, _ = XYZ_to_display_counts(XYZ_sim * white_luminance, display, 0, 0, flare)
-        shown = display_counts_to_XYZ(counts, display) + flare
-        dE_screen = _lab_delta_E(shown, truth * white_luminance, white_abs)
-        out_names = [n for n, ok in zip(names, in_gamut, strict=True) if not ok]
-        per_light[light] = {
-            "out_of_gamut": out_names,
-            "simulation_delta_E00": dE_sim.tolist(),
-            "screen_delta_E00": dE_screen.tolist(),
-        }
-        rows.append(
-            {
-                "label": f"{light} (24)",
-                "light": light,
-                "n": 24,
-                "simulation": delta_E_stats(dE_sim),
-                "screen": delta_E_stats(dE_screen),
-            }
-        )
-        if out_names:
-            keep = np.asarray(in_gamut)
-            rows.append(
-                {
-                    "label": f"{light} ({int(keep.sum())})",
-                    "light": light,
-                    "n": int(keep.sum()),
-                    "simulation": delta_E_stats(dE_sim[keep]),
-                    "screen": delta_E_stats(dE_screen[keep]) if keep.any() else None,
-                }
-            )
+    cells = [(light, d, white_luminance, display) for light in lights]
+    found = run_tasks(_table1_light, cells, scheduler, progress=False, default=SERIAL)
+    rows = [row for light_rows, _ in found for row in light_rows]
+    per_light = {light: entry for light, (_, entry) in zip(lights, found, strict=True)}
     return {
         "design": design,
         "n_channels": n_channels,

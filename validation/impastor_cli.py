@@ -10,7 +10,9 @@ from reference.errors import require
 __all__ = ["format_table1", "render_for_cli", "table1_for_cli"]
 
 
-def table1_for_cli(design: str, n_channels: int, white_luminance: float, display_file=None):
+def table1_for_cli(
+    design: str, n_channels: int, white_luminance: float, display_file=None, scheduler=None
+):
     """Validate the CLI's arguments and compute :func:`validation.impastor.table1`.
 
     Examples
@@ -29,7 +31,7 @@ def table1_for_cli(design: str, n_channels: int, white_luminance: float, display
         f"--channels: channel count must be >= {MIN_CHANNELS}, got {n_channels}",
     )
     display = load_display_measurements(display_file) if display_file else virtual_display()
-    return table1(design, n_channels, white_luminance, display)
+    return table1(design, n_channels, white_luminance, display, scheduler=scheduler)
 
 
 def format_table1(result: dict) -> str:

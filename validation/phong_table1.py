@@ -18,6 +18,7 @@ from phong_table.model import SpectralPhong
 from phong_table.scenes import SCENES, VIEWS
 from phong_table.table import check_interpolation
 from reference.errors import require_positive_int
+from reference.tasks import SERIAL, run_tasks
 from validation.phong import (
     ENTRY_LADDER,
     TABLE1_ENTRIES,
@@ -424,6 +425,20 @@ def _speed_check(speed, speed_source: str) -> Check:
     )
 
 
+def table1_cell(cell: tuple) -> tuple[list[dict], ViewState]:
+    """A task of :func:`run_table1`: ``(scene, view, resolution, entries, repeats)`` → rows, state.
+
+    Examples
+    --------
+    >>> rows, state = table1_cell(("R1", "far", 8, 8, 1))
+    >>> rows[0]["placement"], rows[0]["scene"], len(rows)
+    ('exact', 'R1', 17)
+    """
+    scene, view, resolution, entries, repeats = cell
+    model = SCENES.lookup(scene).build()
+    return material_rows(model, view, list(_table1_variants(entries)), resolution, repeats, scene)
+
+
 def run_table1(
     resolution: int = 512,
     entries: int = TABLE1_ENTRIES,
@@ -432,6 +447,7 @@ def run_table1(
     views=None,
     targets: bool = True,
     progress: bool = False,
+    scheduler: str | None = None,
 ) -> dict:
     """Table 1 of Wang et al., reproduced and extended, with the issue's target checks.
 
@@ -439,6 +455,12 @@ def run_table1(
     ``phong_table.scenes.VIEWS``), the exact render (the baseline), then each table variant
     (``validation.phong.table_variants``: importance p = m and p = m/10, uniform, error) at
     ``entries`` entries with each registered interpolation.
+
+    Each scene and view is one task of :func:`reference.tasks.run_tasks` (``scheduler``: an
+    address, ``"local"`` or ``"serial"``; default ``$SPECREF_SCHEDULER``, else serial, so that
+    the timings have the cores to themselves). A task times its exact render and its tables in
+    the same worker, so each speed-up is a ratio measured under one load; the errors are the
+    same wherever the task runs.
 
     Returns
     -------
@@ -456,18 +478,21 @@ def run_table1(
 
     scenes = table1_scenes() if scenes is None else scenes
     views = tuple(VIEWS) if views is None else views
+    cells = [(scene, view, resolution, entries, repeats) for scene in scenes for view in views]
+    found = run_tasks(
+        table1_cell,
+        cells,
+        scheduler,
+        progress=progress,
+        desc="specref phong table1",
+        default=SERIAL,
+    )
     rows, states = [], {}
-    steps = len(scenes) * len(views) * (2 if targets else 1) + (1 if targets else 0)
-    bar = tqdm(total=steps, desc="specref phong table1", disable=not progress, leave=False)
-    for scene in scenes:
-        model = SCENES.lookup(scene).build()
-        for view in views:
-            scene_rows, state = material_rows(
-                model, view, list(_table1_variants(entries)), resolution, repeats, scene
-            )
-            rows += scene_rows
-            states[(scene, view)] = state
-            bar.update()
+    for (scene, view, *_), (scene_rows, state) in zip(cells, found, strict=True):
+        rows += scene_rows
+        states[(scene, view)] = state
+    steps = len(scenes) * len(views) + 1
+    bar = tqdm(total=steps, desc="Table 1 targets", disable=not (progress and targets), leave=False)
     checks = table1_targets(resolution, states, rows, bar.update) if targets else []
     bar.close()
     return {"resolution": resolution, "entries": entries, "rows": rows, "targets": checks}

@@ -46,6 +46,59 @@ def test_local_cluster_equals_serial(client):
     assert distributed == serial  # bit-identical, in task order
 
 
+#: The figures of ``specref phong table1`` that do not depend on the machine (timings do).
+TABLE1_FIGURES = ("scene", "view", "placement", "interpolation", "entries", "segments", "rms")
+
+
+def test_phong_table1_on_a_cluster_equals_serial(client):
+    # issue 18: Table 1's scenes × views are tasks; the errors do not depend on where they ran
+    from validation.phong_table1 import run_table1
+
+    def figures(result):
+        return [tuple(row[k] for k in TABLE1_FIGURES) for row in result["rows"]]
+
+    args = (16, 16, 1, ("R1", "R3"), ("far", "near"), False)
+    serial = run_table1(*args, scheduler="serial")
+    distributed = run_table1(*args, scheduler=client.scheduler.address)
+    assert len(serial["rows"]) == 4 * 17  # exact + 16 table rows per scene and view
+    assert figures(distributed) == figures(serial)
+
+
+def test_impastor_table1_on_a_cluster_equals_serial(client):
+    # issue 18: Ferwerda's Table 1 runs one task per light; the same table as serially
+    import numpy as np
+
+    from validation.impastor import table1
+
+    serial = table1(lights=("D65", "A"), scheduler="serial")
+    distributed = table1(lights=("D65", "A"), scheduler=client.scheduler.address)
+    assert [r["label"] for r in distributed["rows"]] == [r["label"] for r in serial["rows"]]
+    for light in ("D65", "A"):
+        got, want = distributed["lights"][light], serial["lights"][light]
+        assert got["out_of_gamut"] == want["out_of_gamut"]
+        for key in ("simulation_delta_E00", "screen_delta_E00"):
+            # the last bits of NumPy's matrix products differ between processes (measured:
+            # <= 3e-13 relative), so not byte for byte
+            np.testing.assert_allclose(got[key], want[key], rtol=1e-12, atol=0)
+
+
+def test_scheduler_names():
+    from reference.tasks import SCHEDULER_ENV, scheduler_address
+
+    env = os.environ.pop(SCHEDULER_ENV, None)
+    try:
+        assert scheduler_address(None, default="serial") == "serial"
+        assert scheduler_address("local", default="serial") is None  # a new local cluster
+        assert scheduler_address(None) is None
+        os.environ[SCHEDULER_ENV] = "tcp://127.0.0.1:8786"
+        assert scheduler_address(None, default="serial") == "tcp://127.0.0.1:8786"
+        assert scheduler_address("serial") == "serial"
+    finally:
+        os.environ.pop(SCHEDULER_ENV, None)
+        if env is not None:
+            os.environ[SCHEDULER_ENV] = env
+
+
 def test_sweep_survives_a_killed_worker(client):
     futures_done = []
     tasks = list(range(16))

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from reference.tasks import SERIAL, add_scheduler_option
 from validation.cli.parser import Parser, registry_option
 
 
@@ -10,7 +11,9 @@ def _cmd_impastor_table1(args) -> int:
 
     from validation.impastor_cli import format_table1, table1_for_cli
 
-    result = table1_for_cli(args.design, args.channels, args.white_luminance, args.display)
+    result = table1_for_cli(
+        args.design, args.channels, args.white_luminance, args.display, args.scheduler
+    )
     print(format_table1(result))
     if args.json:
         from reference.images import write_text_atomic
@@ -68,6 +71,7 @@ def add_parser(sub) -> None:
         "--white-luminance", type=float, default=200.0, help="white diffuser luminance, cd/m²"
     )
     t.add_argument("--display", metavar="JSON", help="display measurement file (default: virtual)")
+    add_scheduler_option(t, default=SERIAL)
     t.set_defaults(func=_cmd_impastor_table1)
     r = isub.add_parser("render", help="render the demo painting under a booth light to a PNG")
     r.add_argument("--light", default="D65", help="illuminant key (D65, D50, A, FL2, ...)")

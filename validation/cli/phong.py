@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from functools import partial
 
+from reference.tasks import SERIAL, add_scheduler_option
 from validation.cli.parser import registry_option, write_json
 
 
@@ -26,7 +27,9 @@ def _cmd_phong(args) -> int:
     if args.action == "table1":
         if args.images is not None:
             _write_images(args)
-        result = phong_table1.run_table1(args.resolution, args.entries, args.repeats, progress=True)
+        result = phong_table1.run_table1(
+            args.resolution, args.entries, args.repeats, progress=True, scheduler=args.scheduler
+        )
         print(f"Table 1 (Wang et al.), {args.resolution}x{args.resolution}, {args.entries} entries")
         print(phong_table1.format_rows(result["rows"]))
         print("\nTargets")
@@ -110,6 +113,7 @@ def add_parser(sub) -> None:
     p.add_argument("--resolution", type=int, default=512, help="image size (default 512)")
     p.add_argument("--repeats", type=int, default=9, help="timing repetitions (minimum kept)")
     p.add_argument("--json", metavar="FILE", help="write the records as JSON")
+    add_scheduler_option(p, default=SERIAL)
     p.add_argument(
         "--images",
         metavar="DIR",

@@ -17,6 +17,7 @@ def _cmd_sweep(args) -> int:
 
 def add_parser(sub) -> None:
     """Add ``specref sweep`` and its options to the subcommand parsers ``sub``."""
+    from reference.tasks import add_scheduler_option
     from validation.sweep import SWEEP_KINDS
 
     p = sub.add_parser(
@@ -28,10 +29,5 @@ def add_parser(sub) -> None:
         "file", metavar="SWEEP.toml", help=f"the sweep file; kind: {kinds} (docs/scale-out.md)"
     )
     p.add_argument("-o", "--out", metavar="CSV", help="write the table here (default: stdout)")
-    p.add_argument(
-        "--scheduler",
-        metavar="ADDRESS",
-        help="a running Dask scheduler (tcp://host:8786), or 'serial'; default $SPECREF_SCHEDULER, "
-        "else a local cluster of one worker process per core",
-    )
+    add_scheduler_option(p)
     p.set_defaults(func=_cmd_sweep)
