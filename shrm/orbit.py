@@ -139,7 +139,13 @@ def _parse_isotropic_brdf(reader, table: dict, key: str, name: str):
                 if spectral
                 else reader.number(table[p], where)
             )
-    return IsotropicBRDFMaterial(brdf, brdf_params_on_grid(brdf, reader.grid, params), name)
+    on_grid = brdf_params_on_grid(brdf, reader.grid, params)
+    # The BRDF checks its own parameters: evaluated once here, so that a bad value is refused
+    # when the scene loads, naming the file and the key, not when the first pixel is shaded.
+    up = np.array([0.0, 0.0, 1.0])
+    with reader.context(key, alias=brdf):
+        method.reference(up, up, up, **on_grid)
+    return IsotropicBRDFMaterial(brdf, on_grid, name)
 
 
 def _table_on_grid(reader, table: dict, key: str) -> dict:

@@ -109,9 +109,160 @@ def _phong_kind() -> SweepKind:
     )
 
 
+def impastor_cell(cell: dict) -> dict:
+    """One cell of an ``impastor`` sweep: median cut, FIS and the hybrid against brute force.
+
+    Relative RMS errors of the three specular lighting methods of the painting (§3.5, Ferwerda)
+    at one α, and the hybrid's ratio to the better of the other two
+    (``validation.impastor_hybrid.hybrid_case_ratios``).
+
+    Examples
+    --------
+    >>> row = impastor_cell({"seeds": 3, "lights": "fluorescent", "n_lights": 8, "n_samples": 8,
+    ...                      "alphas": 0.1, "points": 2, "painting_size": 16})
+    >>> sorted(row), row["ratio"] > 0
+    (['fis', 'hybrid', 'median_cut', 'ratio', 'reference_error'], True)
+    """
+    from validation.impastor_hybrid import HybridCase, hybrid_case_ratios
+
+    case = HybridCase(cell["seeds"], cell["lights"], cell["n_lights"], cell["n_samples"])
+    found = hybrid_case_ratios(case, (cell["alphas"],), cell["points"], cell["painting_size"])
+    return {k: found[k][0] for k in ("median_cut", "fis", "hybrid", "reference_error", "ratio")}
+
+
+def _check_painting_light(value, where: str) -> str:
+    # the light names of validation.impastor_hybrid.HybridCase
+    from validation.impastor_hybrid import ENVIRONMENTS
+
+    allowed = "fluorescent, incandescent, lamp_panel:SEED, env:MAP:AZIMUTH_DEG"
+    require(isinstance(value, str), f"{where}: must be strings ({allowed}), got {value!r}")
+    kind, _, rest = value.partition(":")
+    if kind in ("fluorescent", "incandescent") and not rest:
+        return value
+    if kind == "lamp_panel" and rest.isdigit():
+        return value
+    name, _, azimuth = rest.rpartition(":")
+    try:
+        float(azimuth)
+    except ValueError:
+        azimuth = ""
+    require(
+        kind == "env" and name in ENVIRONMENTS and azimuth,
+        f"{where}: unknown light {value!r}; allowed: {allowed} (MAP one of "
+        f"{', '.join(ENVIRONMENTS)})",
+    )
+    return value
+
+
+def _impastor_kind() -> SweepKind:
+    return SweepKind(
+        "impastor",
+        lists={
+            "seeds": int,
+            "lights": _check_painting_light,
+            "n_lights": int,
+            "n_samples": int,
+            "alphas": float,
+        },
+        scalars={"points": int, "painting_size": int},
+        run_cell=impastor_cell,
+        about="median cut, FIS and the hybrid against brute force: paintings × lights × N × K × α",
+    )
+
+
+def shrm_cell(cell: dict) -> dict:
+    """One cell of an ``shrm`` sweep: a sphere's default render against ``--oracle``, in Y.
+
+    The sphere (``validation.env_accuracy.sphere_scene_toml``) of one ``isotropic_brdf``
+    material under one environment map, rendered with ``shrm_tol`` = the cell's tolerance and
+    by brute force; mean and largest relative error of Y over the lit pixels, and what the
+    shader chose and promised (``RenderResult.records["shrm"]``: the settings, and the bound
+    relative to a lower bound of the peak).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from reference.images import write_exr
+    >>> sky = write_exr(pathlib.Path(tempfile.mkdtemp()) / "sky.exr", np.ones((16, 32, 3)))
+    >>> row = shrm_cell({"environments": str(sky), "tolerances": 0.01, "size": 4,
+    ...                  "materials": {"brdf": "ggx", "alpha": 0.3, "F_0": 1.0, "rho_d": 0.0}})
+    >>> row["max"] < 0.05, row["meets_tolerance"]
+    (True, True)
+    """
+    from reference.scene import loads_scene
+    from validation.env_accuracy import render_against_oracle, sphere_scene_toml
+
+    material = _material_lines(cell["materials"])
+    scene = loads_scene(sphere_scene_toml(cell["environments"], material, cell["size"]))
+    found = render_against_oracle(scene, {"shrm_tol": cell["tolerances"]})
+    chose = found["records"].get("shrm", {})
+    promised = (
+        chose["bound_Y"] / chose["peak_lower_bound"] if chose.get("peak_lower_bound") else None
+    )
+    return {
+        "mean": found["mean"],
+        "max": found["max"],
+        **{k: chose.get(k) for k in ("F", "P", "size", "env_rows", "residual_texels")},
+        "promised_of_peak": promised,
+        "meets_tolerance": chose.get("meets_tolerance"),
+    }
+
+
+def _material_lines(material: dict) -> str:
+    # an inline table of the sweep file as the TOML lines of an isotropic_brdf material
+    import json
+
+    lines = ['type = "isotropic_brdf"']
+    lines += [f"{key} = {json.dumps(value)}" for key, value in material.items()]
+    return "\n".join(lines)
+
+
+def _check_material(value, where: str) -> dict:
+    # loaded once here, so that a bad material is one line naming the sweep file
+    from reference.scene import loads_scene
+    from validation.env_accuracy import sphere_scene_toml
+
+    require(
+        isinstance(value, dict) and "brdf" in value,
+        f"{where}: each material is an inline table with brdf = NAME and its parameters, "
+        f"got {value!r}",
+    )
+    import shrm  # noqa: F401  (registers isotropic_brdf)
+
+    scene_text = sphere_scene_toml("unused.hdr", _material_lines(value), 2).rsplit("[[lights]]")[0]
+    loads_scene(scene_text, where)
+    return value
+
+
+def _check_environment(base: Path):
+    def check(value, where: str) -> str:
+        require(isinstance(value, str), f"{where}: must be file names, got {value!r}")
+        path = Path(value) if Path(value).is_absolute() else base / value
+        require(path.is_file(), f"{where}: {value}: file not found")
+        return str(path)
+
+    return check
+
+
+def _shrm_kind() -> SweepKind:
+    return SweepKind(
+        "shrm",
+        lists={
+            "environments": _check_environment,  # bound to the sweep file's folder when loaded
+            "materials": _check_material,
+            "tolerances": float,
+        },
+        scalars={"size": int},
+        run_cell=shrm_cell,
+        about="isotropic BRDF spheres under environment maps, default render against --oracle",
+    )
+
+
 #: The kinds of sweep ``specref sweep`` runs, by the sweep file's ``kind``.
 SWEEP_KINDS = Registry("sweep kind")
 SWEEP_KINDS.register(_phong_kind(), "phong")
+SWEEP_KINDS.register(_impastor_kind(), "impastor")
+SWEEP_KINDS.register(_shrm_kind(), "shrm")
 
 
 def _check_values(file: str, key: str, values, allowed) -> list:
@@ -119,9 +270,21 @@ def _check_values(file: str, key: str, values, allowed) -> list:
         isinstance(values, list) and values,
         f"{file}: grid.{key}: must be a non-empty list, got {values!r}",
     )
+    checked = []
     for value in values:
+        if callable(allowed) and allowed not in (int, float):
+            checked.append(allowed(value, f"{file}: grid.{key}"))
+            continue
+        checked.append(value)
         if allowed is int:
             require_positive_int(value, f"{file}: grid.{key}", 1 << 20)
+        elif allowed is float:
+            require(
+                isinstance(value, int | float)
+                and not isinstance(value, bool)
+                and 0.0 < value <= 1.0,
+                f"{file}: grid.{key}: must be numbers in (0, 1], got {value!r}",
+            )
         elif isinstance(allowed, list):
             require(
                 value in allowed,
@@ -129,7 +292,7 @@ def _check_values(file: str, key: str, values, allowed) -> list:
             )
         else:
             require(isinstance(value, str), f"{file}: grid.{key}: must be strings, got {value!r}")
-    return values
+    return checked
 
 
 def load_sweep(path) -> tuple[SweepKind, list[dict]]:
@@ -166,9 +329,10 @@ def load_sweep(path) -> tuple[SweepKind, list[dict]]:
     require(not unknown, f"{file}: grid: unknown keys {unknown}; allowed: {format_allowed(keys)}")
     missing = sorted(set(keys) - set(grid))
     require(not missing, f"{file}: grid: missing keys {missing}")
-    axes = {
-        key: _check_values(file, key, grid[key], allowed) for key, allowed in kind.lists.items()
-    }
+    lists = dict(kind.lists)
+    if lists.get("environments") is _check_environment:
+        lists["environments"] = _check_environment(path.parent)
+    axes = {key: _check_values(file, key, grid[key], allowed) for key, allowed in lists.items()}
     scalars = {}
     for key in kind.scalars:
         scalars[key] = require_positive_int(grid[key], f"{file}: grid.{key}", 4096)

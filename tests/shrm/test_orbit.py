@@ -237,3 +237,22 @@ def test_prepare_runs_a_stage_ahead_and_counts_it_in_the_next_frame():
     assert sorted(session.frame_times[0]) == ["first", "second"]
     with pytest.raises(SpecrefError, match="render session: stage"):
         session.prepare("third")
+
+
+def test_bad_brdf_parameters_are_refused_when_the_scene_loads():
+    # before: the BRDF refused alpha < 0 only when shading, in a message without file or key
+    from reference.errors import SpecrefError
+    from reference.scene import loads_scene
+
+    text = """[camera]
+eye = [0.0, 0.0, 6.0]
+[materials.glossy]
+type = "isotropic_brdf"
+brdf = "ggx"
+alpha = -1
+[[objects]]
+type = "sphere"
+material = "glossy"
+"""
+    with pytest.raises(SpecrefError, match=r"^scene.toml: materials.glossy: alpha: must be >= 0"):
+        loads_scene(text, "scene.toml")

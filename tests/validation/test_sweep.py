@@ -59,7 +59,10 @@ def test_serial_sweep_matches_the_direct_computation(tmp_path):
 @pytest.mark.parametrize(
     ("edit", "message"),
     [
-        (('kind = "phong"', 'kind = "fong"'), r"kind: unknown 'fong'; allowed: phong"),
+        (
+            ('kind = "phong"', 'kind = "fong"'),
+            r"unknown 'fong'; allowed: impastor, phong, shrm",
+        ),
         (("entries = [25, 50]", "entries = []"), r"grid.entries: must be a non-empty list"),
         (("entries = [25, 50]", "entries = [25, 0]"), r"grid.entries: must be an integer"),
         (('views = ["near"]', 'views = ["nearby"]'), r"grid.views: unknown 'nearby'"),
@@ -94,6 +97,107 @@ def test_local_cluster_sweep_is_identical_to_serial(tmp_path):
     serial = sweep_csv(run_sweep(path, scheduler="serial", progress=False))
     from reference.tasks import dask_client
 
+    painting = tmp_path / "p.toml"
+    painting.write_text(PAINTING_GRID)
+    serial_painting = sweep_csv(run_sweep(painting, scheduler="serial", progress=False))
     with dask_client(n_workers=2) as client:
         distributed = sweep_csv(run_sweep(path, client=client, progress=False))
+        distributed_painting = sweep_csv(run_sweep(painting, client=client, progress=False))
     assert distributed == serial
+    assert distributed_painting == serial_painting
+
+
+PAINTING_GRID = """kind = "impastor"
+[grid]
+seeds = [301]
+lights = ["fluorescent", "lamp_panel:4"]
+n_lights = [8]
+n_samples = [8]
+alphas = [0.05, 0.2]
+points = 2
+painting_size = 16
+"""
+
+
+def test_impastor_sweep_matches_the_direct_computation(tmp_path):
+    from validation.impastor_hybrid import HybridCase, hybrid_case_ratios
+
+    path = tmp_path / "p.toml"
+    path.write_text(PAINTING_GRID)
+    rows = run_sweep(path, scheduler="serial", progress=False)
+    assert len(rows) == 1 * 2 * 1 * 1 * 2
+    direct = hybrid_case_ratios(HybridCase(301, "lamp_panel:4", 8, 8), (0.05, 0.2), 2, 16)
+    got = [r for r in rows if r["lights"] == "lamp_panel:4"]
+    assert [r["ratio"] for r in got] == direct["ratio"]
+    assert [r["fis"] for r in got] == direct["fis"]
+
+
+@pytest.mark.parametrize(
+    ("edit", "message"),
+    [
+        (('"lamp_panel:4"', '"lamp"'), r"grid.lights: unknown light 'lamp'; allowed: fluoresc"),
+        (('"lamp_panel:4"', '"env:nosuch.hdr:0"'), r"grid.lights: unknown light 'env:nosuch"),
+        (("alphas = [0.05, 0.2]", "alphas = [0.05, 2]"), r"grid.alphas: must be numbers in"),
+        (("alphas = [0.05, 0.2]", "alphas = []"), r"grid.alphas: must be a non-empty list"),
+    ],
+)
+def test_bad_impastor_sweeps_are_one_line(tmp_path, edit, message):
+    path = tmp_path / "p.toml"
+    path.write_text(PAINTING_GRID.replace(*edit))
+    with pytest.raises(SpecrefError, match=message):
+        load_sweep(path)
+
+
+SHRM_GRID = """kind = "shrm"
+[grid]
+environments = ["sky.exr"]
+materials = [{brdf = "ggx", alpha = 0.3, F_0 = 1.0, rho_d = 0.0}]
+tolerances = [0.01]
+size = 6
+"""
+
+
+def _sky(tmp_path):
+    import numpy as np
+
+    from reference.images import write_exr
+
+    rows = np.linspace(0.0, np.pi, 16, endpoint=False)[:, None, None]
+    sky = np.broadcast_to(1.0 + 4.0 * np.cos(rows) ** 2, (16, 32, 3))
+    return write_exr(tmp_path / "sky.exr", np.ascontiguousarray(sky))
+
+
+def test_shrm_sweep_matches_the_direct_computation(tmp_path):
+    from reference.scene import loads_scene
+    from validation.env_accuracy import render_against_oracle, sphere_scene_toml
+
+    sky = _sky(tmp_path)
+    path = tmp_path / "s.toml"
+    path.write_text(SHRM_GRID)  # the map relative to the sweep file's folder
+    (row,) = run_sweep(path, scheduler="serial", progress=False)
+    material = 'type = "isotropic_brdf"\nbrdf = "ggx"\nalpha = 0.3\nF_0 = 1.0\nrho_d = 0.0'
+    direct = render_against_oracle(
+        loads_scene(sphere_scene_toml(sky, material, 6)), {"shrm_tol": 0.01}
+    )
+    assert (row["mean"], row["max"]) == (direct["mean"], direct["max"])
+    # a 16-row map cannot carry 1 % at this size: the row says so, from the promised bound
+    assert row["meets_tolerance"] == (row["promised_of_peak"] <= 0.01)
+    assert row["environments"] == str(sky)
+
+
+@pytest.mark.parametrize(
+    ("edit", "message"),
+    [
+        (('brdf = "ggx"', 'brdf = "gx"'), r"s.toml: grid.materials.*'gx'"),
+        (("alpha = 0.3", "alpha = -1"), r"s.toml: grid.materials: .*alpha: must be >= 0"),
+        (('["sky.exr"]', '["none.exr"]'), r"grid.environments: none.exr: file not found"),
+        (("tolerances = [0.01]", "tolerances = [0]"), r"grid.tolerances: must be numbers in"),
+        (("materials = [{", "materials = [3, {"), r"grid.materials: each material is an inline"),
+    ],
+)
+def test_bad_shrm_sweeps_are_one_line(tmp_path, edit, message):
+    _sky(tmp_path)
+    path = tmp_path / "s.toml"
+    path.write_text(SHRM_GRID.replace(*edit))
+    with pytest.raises(SpecrefError, match=message):
+        load_sweep(path)
