@@ -206,3 +206,24 @@ def test_real_scheduler_and_workers_on_loopback(tmp_path):
                 os.kill(proc.pid, signal.SIGKILL)
                 proc.wait()
         logs.close()
+
+
+def test_report_sections_on_a_cluster_equal_serial(client, tmp_path):
+    # specref report --scheduler: a section's tasks (here the hybrid's held-out cases) run on
+    # the cluster and give the serial figures
+    import numpy as np
+
+    from validation.report.runner import run_report
+
+    def held_out(scheduler, folder):
+        results = run_report(
+            tmp_path / folder, quick=True, only=["impastor"], progress=False, scheduler=scheduler
+        )
+        return results["sections"]["impastor"]["held_out_hybrid"], results["meta"]["scheduler"]
+
+    serial, where = held_out("serial", "a")
+    distributed, where_distributed = held_out(client.scheduler.address, "b")
+    assert (where, where_distributed) == ("serial", client.scheduler.address)
+    assert distributed["cases"] == serial["cases"]
+    for got, want in zip(distributed["per_case"], serial["per_case"], strict=True):
+        np.testing.assert_allclose(got["ratio"], want["ratio"], rtol=1e-12, atol=0)

@@ -16,6 +16,7 @@ def _cmd_report(args) -> int:
         markdown=args.markdown,
         markdown_image_prefix=args.markdown_image_prefix,
         screenshot=not args.no_screenshot,
+        scheduler=args.scheduler,
     )
     print(f"wrote {args.out}/index.html and {args.out}/results.json")
     shot = results["meta"].get("screenshot")
@@ -28,6 +29,7 @@ def _cmd_report(args) -> int:
 
 def add_parser(sub) -> None:
     """Add ``specref report`` and its options to the subcommand parsers ``sub``."""
+    from reference.tasks import SERIAL, add_scheduler_option
     from validation.report.runner import REPORT_SECTIONS
 
     p = sub.add_parser(
@@ -52,4 +54,5 @@ def add_parser(sub) -> None:
         action="store_true",
         help="do not write first-screen.png (written with headless Chromium where installed)",
     )
+    add_scheduler_option(p, default=SERIAL)
     p.set_defaults(func=_cmd_report)

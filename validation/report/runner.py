@@ -16,6 +16,7 @@ A new section is a module in ``validation/sections/`` that defines ``SECTION`` (
 
 from __future__ import annotations
 
+import contextlib
 import datetime as _dt
 import json
 import os
@@ -28,6 +29,7 @@ from pathlib import Path
 from reference.errors import require
 from reference.images import read_json, write_text_atomic
 from reference.registry import Registry
+from reference.tasks import LOCAL, SERIAL, dask_client, scheduler_address
 from validation.report.render import render_html, render_markdown
 from validation.report.types import (
     ReportContext,
@@ -159,6 +161,7 @@ def run_report(
     progress: bool = True,
     sections=None,
     screenshot: bool = False,
+    scheduler: str | None = None,
 ) -> dict:
     """Run the report sections and write ``index.html`` and ``results.json`` into ``out_dir``.
 
@@ -183,6 +186,10 @@ def run_report(
     screenshot : bool
         Also write ``first-screen.png`` with headless Chromium (skipped, with the reason in
         ``results.json``, where Chromium is not installed).
+    scheduler : str, optional
+        Where the sections' independent tasks run (:meth:`ReportContext.run_tasks`): a scheduler
+        address, ``"local"`` or ``"serial"``; default ``$SPECREF_SCHEDULER``, else serial (the
+        sections time methods, and a cluster's workers would share the cores they measure).
 
     Returns
     -------
@@ -226,9 +233,13 @@ def run_report(
         "machine": platform.machine(),
         "benchmarks": str(bench_json) if bench_json else "none (run make bench)",
     }
+    address = scheduler_address(scheduler, default=SERIAL)
+    meta["scheduler"] = "serial" if address == SERIAL else (address or "local cluster")
     started = time.perf_counter()
-    with matplotlib.rc_context(CHART_STYLE):
-        done = _run_sections(sections, out_dir, quick, bench, progress and not _quiet())
+    with matplotlib.rc_context(CHART_STYLE), contextlib.ExitStack() as stack:
+        client = None if address == SERIAL else stack.enter_context(dask_client(address or LOCAL))
+        show = progress and not _quiet()
+        done = _run_sections(sections, out_dir, quick, bench, show, client)
     meta["total_seconds"] = round(time.perf_counter() - started, 1)
     meta["section_seconds"] = {s.name: round(r.seconds, 1) for s, r in done}
     results: dict = {"meta": meta, "checks": [], "sections": {}}
@@ -253,7 +264,7 @@ def run_report(
     return results
 
 
-def _run_sections(sections, out_dir, quick, bench, progress) -> list:
+def _run_sections(sections, out_dir, quick, bench, progress, client=None) -> list:
     """Run each section under its own progress bar; returns ``[(section, result), ...]``."""
     from tqdm import tqdm
 
@@ -262,7 +273,7 @@ def _run_sections(sections, out_dir, quick, bench, progress) -> list:
     for i, section in enumerate(sections, 1):
         desc = f"[{i}/{len(sections)}] {section.title:<{width}}"
         with tqdm(total=1, desc=desc, file=sys.stderr, disable=not progress, leave=True) as bar:
-            ctx = ReportContext(out_dir=out_dir, quick=quick, bench=bench, section=section.name)
+            ctx = ReportContext(out_dir, quick, bench, section.name, client)
             start = time.perf_counter()
             result = section.run(ctx)
             result.seconds = time.perf_counter() - start

@@ -246,12 +246,31 @@ class ReportContext:
         Parsed pytest-benchmark JSON (``make bench``), or None.
     section : str
         The running section's key (prefix for file names).
+    client : distributed.Client or None
+        Where :meth:`run_tasks` sends a section's independent tasks; None: in this process.
     """
 
     out_dir: Path
     quick: bool = False
     bench: dict | None = None
     section: str = ""
+    client: object = None
+
+    def run_tasks(self, function, tasks, desc: str = "tasks") -> list:
+        """``[function(task) for task in tasks]`` through :func:`reference.tasks.run_tasks`.
+
+        On the report's Dask client (``specref report --scheduler``), else serially; results in
+        task order, the same either way.
+
+        Examples
+        --------
+        >>> ReportContext(Path(".")).run_tasks(abs, [-2, 3])
+        [2, 3]
+        """
+        from reference.tasks import SERIAL, run_tasks
+
+        scheduler = None if self.client is not None else SERIAL
+        return run_tasks(function, tasks, scheduler, self.client, progress=False, desc=desc)
 
     def image(self, name: str, encoded, caption: str = "") -> Image:
         """Write an encoded image (floats in [0, 1] or uint8) as ``images/<section>-<name>.png``."""

@@ -44,6 +44,10 @@ TARGETS = {"box": (0.8, 2.2), "optimized": (0.25, 0.6)}
 #: renderer's sector count (``impastor.painting.HORIZON_SECTORS``; issue 22).
 METAMER_TARGETS = {"A": 0.5, "D65": 3.0}
 HYBRID_LIMIT = 1.1
+#: Issue 22 on held-out cases: within HYBRID_LIMIT in this share of (case, α) pairs, and never
+#: worse than HELD_OUT_MAX times the better method.
+HELD_OUT_SHARE = 0.95
+HELD_OUT_MAX = 1.5
 SHADOW_LIMIT = 0.02
 #: The painting images: under these lights, lit by the paper's pipeline (the hybrid, §3.5.2).
 PAINTING_LIGHTS = ("D65", "A")
@@ -74,6 +78,10 @@ class ImpastorSettings:
         Booth light image of the frames (width, height).
     every_frame_method : bool
         Time a frame per lighting method, or one per specular estimator (:func:`frame_methods`).
+    held_out : dict
+        The hybrid's held-out sweep (issue 22): ``n_paintings`` and ``first_seed`` of
+        :func:`validation.impastor_hybrid.held_out_cases`, and keywords of
+        ``hybrid_case_ratios``.
     """
 
     backend: str
@@ -86,6 +94,12 @@ class ImpastorSettings:
     frame_size: int = 512
     light_resolution: tuple = (128, 64)
     every_frame_method: bool = True
+    held_out: dict = field(default_factory=lambda: dict(HELD_OUT_FULL))
+
+
+#: The held-out sweep of issue 22 in the full report: painting seeds 201-224 (never used by the
+#: design, ``validation.impastor_hybrid.TRAINING``), the report's α grid, 36 points, 64 × 32 lights.
+HELD_OUT_FULL = {"n_paintings": 24, "first_seed": 201, "supersample": 6}
 
 
 #: The full report: the paper's sizes, numba kernels.
@@ -107,6 +121,16 @@ QUICK = ImpastorSettings(
     frame_size=48,
     light_resolution=(32, 16),
     every_frame_method=False,
+    held_out=dict(
+        n_paintings=2,
+        first_seed=201,
+        alphas=(0.03, 0.2),
+        n_side=3,
+        painting_size=32,
+        light_resolution=(32, 16),
+        supersample=2,
+        backend="numpy",
+    ),
 )
 #: Seconds in all (once colour-science is loaded): for doctests and tests, not for the targets.
 TINY = ImpastorSettings(
@@ -127,6 +151,16 @@ TINY = ImpastorSettings(
     frame_size=16,
     light_resolution=(16, 8),
     every_frame_method=False,
+    held_out=dict(
+        n_paintings=1,
+        first_seed=201,
+        alphas=(0.1,),
+        n_side=2,
+        painting_size=16,
+        light_resolution=(16, 8),
+        supersample=1,
+        backend="numpy",
+    ),
 )
 
 
@@ -217,6 +251,35 @@ def _lighting_figures(settings: ImpastorSettings) -> dict:
     }
 
 
+def _held_out_task(task) -> dict:
+    # one held-out case (a task of ReportContext.run_tasks)
+    from validation.impastor_hybrid import hybrid_case_ratios
+
+    case, options = task
+    return hybrid_case_ratios(case, **options)
+
+
+def _held_out_figures(settings: ImpastorSettings, run) -> dict:
+    """The hybrid over the better method on cases the design never saw (issue 22), per case."""
+    from validation.impastor_hybrid import held_out_cases, ratio_distribution
+
+    options = dict(settings.held_out)
+    cases = held_out_cases(options.pop("n_paintings"), options.pop("first_seed"))
+    found = run(_held_out_task, [(case, options) for case in cases], "held-out hybrid cases")
+    ratios = [r for f in found for r in f["ratio"]]
+    worst_case, worst_alpha, worst_ratio = max(
+        ((case.name, a, r) for case, f in zip(cases, found, strict=True)
+         for a, r in zip(f["alpha"], f["ratio"], strict=True)),
+        key=lambda x: x[2],
+    )  # fmt: skip
+    return {
+        "cases": [case.name for case in cases],
+        "per_case": found,
+        "distribution": ratio_distribution(ratios),
+        "worst": {"case": worst_case, "alpha": worst_alpha, "ratio": worst_ratio},
+    }
+
+
 def _frame_figures(settings: ImpastorSettings, spectra: dict) -> SectionData:
     # The painting under each booth light, then one timed frame per lighting method (the horizon
     # map, computed once per height field, is cached by the painting images).
@@ -264,7 +327,8 @@ def impastor_validation(
     -------
     SectionData
         ``results``: ``table1``, ``channels`` (``[design][N][light]`` ΔE00 statistics),
-        ``targets_met``, ``naive_rgb``, ``metamers``, ``error_vs_alpha``, ``shadows``, ``gloss``,
+        ``targets_met``, ``naive_rgb``, ``metamers``, ``error_vs_alpha``, ``held_out_hybrid``
+        (the hybrid on held-out cases, run through ``ctx.run_tasks``), ``shadows``, ``gloss``,
         ``display_round_trip``, ``ward_duer_albedo``, ``painting_<light>_seconds``,
         ``frame_seconds_<method>``; ``arrays``: ``naive_rgb`` (per-patch ΔE00), ``painting``
         (encoded sRGB images), ``frame_stages`` (seconds per stage), ``settings``.
@@ -278,7 +342,7 @@ def impastor_validation(
     --------
     >>> data = impastor_validation(settings=TINY)
     >>> len(checks(data)), data.arrays["painting"]["A"].shape
-    (19, (16, 16, 3))
+    (21, (16, 16, 3))
     >>> sorted(k for k in data.results if k.startswith("frame_seconds"))
     ['frame_seconds_fis', 'frame_seconds_median_cut']
     """
@@ -289,6 +353,8 @@ def impastor_validation(
     spectra = load_paint_spectra()  # fails first, with a clear message, without shared data
     colour = _colour_figures(settings)
     lighting = _lighting_figures(settings)
+    run = ctx.run_tasks if ctx is not None else (lambda f, tasks, desc: [f(t) for t in tasks])
+    lighting["held_out_hybrid"] = _held_out_figures(settings, run)
     frames = _frame_figures(settings, spectra)
     return SectionData(
         {**colour.results, **lighting, **frames.results},
@@ -472,6 +538,41 @@ def _alpha_blocks(ctx, result) -> list:
     ]
 
 
+def _held_out_blocks(ctx, result) -> list:
+    import matplotlib.pyplot as plt
+
+    d, worst = result["distribution"], result["worst"]
+    ratios = np.sort([r for f in result["per_case"] for r in f["ratio"]])
+    fig, ax = plt.subplots(figsize=(6.5, 3.2))
+    ax.step(ratios, np.arange(1, ratios.size + 1) / ratios.size, where="post", label="hybrid")
+    for limit, style in ((HYBRID_LIMIT, "--"), (HELD_OUT_MAX, ":")):
+        ax.axvline(limit, color="gray", linestyle=style, label=f"{limit:g}×")
+    ax.set_xscale("log")
+    ax.set_xlabel("hybrid error / better of median cut and FIS")
+    ax.set_ylabel("share of (case, α) pairs")
+    ax.legend(fontsize=8)
+    caption = (
+        f"{len(result['cases'])} held-out cases, {d['n']} (case, α) pairs: "
+        f"{100 * d['share_within_1.1']:.1f} % within {HYBRID_LIMIT:g}× of the better method "
+        f"(target ≥ {100 * HELD_OUT_SHARE:g} %), {100 * d['share_within_1.5']:.1f} % within "
+        f"{HELD_OUT_MAX:g}×; worst {worst['ratio']:.2f}× ({worst['case']}, α = {worst['alpha']:g})"
+    )
+    rows = [
+        [name, f["alpha"][int(np.argmax(f["ratio"]))], max(f["ratio"]), min(f["ratio"])]
+        for name, f in zip(result["cases"], result["per_case"], strict=True)
+    ]
+    return [
+        ctx.figure("held-out-hybrid", fig, caption),
+        Table(
+            ["held-out case", "worst α", "worst ratio", "best ratio"],
+            rows,
+            "The hybrid on cases the design never saw (issue 22; painting seeds from "
+            "validation.impastor_hybrid.held_out_cases)",
+            "{:.3g}",
+        ),
+    ]
+
+
 def _shadow_blocks(ctx, result) -> list:
     import matplotlib.pyplot as plt
 
@@ -629,6 +730,7 @@ def present(ctx: ReportContext, data: SectionData) -> list:
         *_channel_blocks(ctx, results, data.arrays["naive_rgb"]),
         *_metamer_blocks(ctx, results["metamers"]),
         *_alpha_blocks(ctx, results["error_vs_alpha"]),
+        *_held_out_blocks(ctx, results["held_out_hybrid"]),
         *_shadow_blocks(ctx, results["shadows"]),
         *_gloss_blocks(ctx, results["gloss"]),
         *_frame_blocks(ctx, data),
@@ -743,7 +845,29 @@ def checks(data: SectionData) -> list[Check]:
     return [
         *_colour_checks(r["channels"], r["metamers"]),
         *_lighting_checks(r["error_vs_alpha"], r["shadows"]),
+        *_held_out_checks(r.get("held_out_hybrid")),
         *_bound_checks(r["display_round_trip"], r["ward_duer_albedo"]),
+    ]
+
+
+def _held_out_checks(result) -> list:
+    if result is None:
+        return []
+    d, worst = result["distribution"], result["worst"]
+    pairs = f"{d['n']} held-out (case, α) pairs"
+    return [
+        Check(
+            f"hybrid within {HYBRID_LIMIT:g}× of the better method, share of {pairs}",
+            f">= {100 * HELD_OUT_SHARE:g} %",
+            f"{100 * d['share_within_1.1']:.1f} %",
+            d["share_within_1.1"] >= HELD_OUT_SHARE,
+        ),
+        Check(
+            f"hybrid / better method, worst of {pairs} ({worst['case']}, α = {worst['alpha']:g})",
+            f"<= {HELD_OUT_MAX:g}",
+            float(worst["ratio"]),
+            worst["ratio"] <= HELD_OUT_MAX,
+        ),
     ]
 
 
@@ -756,7 +880,8 @@ def headlines(data: SectionData) -> list[Headline]:
     found = checks(data)
     shadows = next(c for c in found if c.name.startswith("horizon map"))
     hybrid = next(c for c in found if c.name.startswith("hybrid"))
-    return [
+    held_out = r.get("held_out_hybrid")
+    lines = [
         Headline(
             f"six optimized channels render the ColorChecker within mean ΔE00 {worst:.2f} under "
             "every booth light",
@@ -773,6 +898,17 @@ def headlines(data: SectionData) -> list[Headline]:
             f"targets {shadows.target}; {hybrid.target}",
         ),
     ]
+    if held_out is not None:
+        d = held_out["distribution"]
+        lines.append(
+            Headline(
+                f"on {d['n']} held-out (case, α) pairs the hybrid is within {HYBRID_LIMIT:g}× of "
+                f"the better method in {100 * d['share_within_1.1']:.1f} % (worst "
+                f"{d['max']:.2f}×)",
+                f"issue 22: ≥ {100 * HELD_OUT_SHARE:g} %, never above {HELD_OUT_MAX:g}×",
+            )
+        )
+    return lines
 
 
 SECTION = ReportSection(

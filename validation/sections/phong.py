@@ -146,6 +146,14 @@ def _bench_speedups(bench) -> list[float]:
     return speed
 
 
+def _speed_accuracy_task(task) -> tuple[dict, dict]:
+    """A task of the section: ``(study, scene, view, benched)`` → the view's points, its finds."""
+    study, scene, view, benched = task
+    found = {"records": [], "speed": [], "nonfinite": 0, "bench_speed": [1.0] if benched else []}
+    view_result = _speed_accuracy_view(study, SCENES.lookup(scene).build(), scene, view, found)
+    return view_result, found
+
+
 def _speed_accuracy_view(study: PhongStudy, model, scene: str, view: str, found: dict) -> dict:
     """Every table variant, interpolation and m of the ladder on one view: time and RMS."""
     state = view_state(model, view, study.resolution, study.compiled)
@@ -296,10 +304,18 @@ def phong_speed_accuracy(
     bench = ctx.bench_groups("phong") if ctx is not None else {}
     found = {"records": [], "speed": [], "nonfinite": 0, "bench_speed": _bench_speedups(bench)}
     results = {}
-    for scene in study.scenes:
-        model = SCENES.lookup(scene).build()
-        for view in study.views:
-            results[f"{scene} {view}"] = _speed_accuracy_view(study, model, scene, view, found)
+    # one task per scene and view (ReportContext.run_tasks: serial, or the report's cluster);
+    # each times its exact render and its tables in one process
+    benched = bool(found["bench_speed"])
+    tasks = [(study, scene, view, benched) for scene in study.scenes for view in study.views]
+    run = ctx.run_tasks if ctx is not None else (lambda f, ts, desc: [f(t) for t in ts])
+    for (_, scene, view, _), (view_result, part) in zip(
+        tasks, run(_speed_accuracy_task, tasks, "phong views"), strict=True
+    ):
+        results[f"{scene} {view}"] = view_result
+        for key in ("records", "speed"):
+            found[key] += part[key]
+        found["nonfinite"] += part["nonfinite"]
     scales, highs = study.scales, study.highs
     results["exponent-scale"] = _failure_sweep(
         study, [constant_material(float(n)) for n in scales], scales, found
