@@ -92,6 +92,11 @@ SETTINGS = {
 }
 
 
+def _study_task(task) -> dict:
+    # one BRDF's setting search (a task of ReportContext.run_tasks)
+    return study_brdf(*task)
+
+
 def shrm_study_and_speed(ctx: ReportContext, settings: dict | None = None) -> SectionData:
     """The accuracy study per BRDF of :data:`SUITE`, then creation, extraction, cache and orbit.
 
@@ -126,7 +131,10 @@ def shrm_study_and_speed(ctx: ReportContext, settings: dict | None = None) -> Se
     F_env = max(F for key in FITS for F, _ in plan[key])
     L_env = project_latlong(env, F_env, backend="ducc0")
     data = SectionData()
-    studies = {name: study_brdf(name, env, L_env, g, view, plan) for name in SUITE}
+    # the setting search, one task per BRDF (serial, or on the report's cluster)
+    tasks = [(name, env, L_env, g, view, plan) for name in SUITE]
+    found = ctx.run_tasks(_study_task, tasks, "SHRM setting search")
+    studies = dict(zip(SUITE, found, strict=True))
     for name, st in studies.items():
         data.results[name] = _study_results(st)
     data.arrays.update(plan=plan, studies=studies, env_shape=env.shape, label=s["label"])
