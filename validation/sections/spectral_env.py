@@ -162,6 +162,7 @@ def _method_tables(ctx: ReportContext, data: SectionData) -> list:
                 row["held_out"]["CIE 2024 TCS"]["D65 mean"],
                 row["held_out"]["NIST CQS 9.0"]["D65 mean"],
                 row["xyz_floor"][CC]["D65 mean"],
+                row["xyz_floor"][CC]["D65 max"],
             ]
         )
     blocks.append(
@@ -179,6 +180,7 @@ def _method_tables(ctx: ReportContext, data: SectionData) -> list:
                 "TCS mean D65",
                 "CQS mean D65",
                 "RGB→XYZ floor CC mean",
+                "RGB→XYZ floor CC max",
             ],
             rows,
             "Regression on the held-out ColorChecker (CC) and other held-out sets, ΔE94",
