@@ -51,6 +51,7 @@ from validation.sections import (
     sh,
     sh_order,
     shrm,
+    shrm_fullres,
     spectral,
     spectral_env,
 )
@@ -87,6 +88,7 @@ PARTS: tuple[ReportPart, ...] = (
             sh_order.SECTION,
             spectral_env.SECTION,
             shrm.SECTION,
+            shrm_fullres.SECTION,
             polymer.SECTION,
             polymer_scene.SECTION,
             display.SECTION,

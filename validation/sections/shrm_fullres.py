@@ -1,0 +1,191 @@
+"""Report section "SHRMs on full-resolution maps": the default path against brute force (issue 21).
+
+The figures (``validation.shrm_fullres``): for every shipped environment map at its full
+resolution and every BRDF of :data:`validation.shrm_fullres.FULLRES_BRDFS`, an orthographic sphere
+rendered by the SH + angular split (the default of ``specref render``, Herbert §9 done), by the
+SHRM alone (the same settings, and half the lighting order) and by brute force over every texel:
+the largest error relative to the peak, the mean |ΔY/Y| over pixels brighter than 1 % of the
+peak, what the split promised, and the seconds of a frame after the first. The SHRM section's
+study on maps box-filtered to 64 rows stays there, labelled as such.
+
+compute → :func:`fullres_study`; present → :func:`present`; checks → :func:`checks`.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from validation.report import Check, ReportContext, ReportSection, SectionData, Table, Text
+from validation.shrm_fullres import FULLRES_BRDFS, fullres_case
+
+__all__ = ["SETTINGS", "fullres_study"]
+
+ROOT = Path(__file__).resolve().parents[2]
+#: Shared data beside the repository (``../shared/data``), or where SPECREF_SHARED_DATA points.
+SHARED = Path(os.environ.get("SPECREF_SHARED_DATA", ROOT.parent / "shared" / "data"))
+#: Issue 21's targets: within 1 % of the peak, mean |ΔY/Y| <= 1 % over pixels above 1 % of it.
+PEAK_LIMIT_PCT = 1.0
+MEAN_LIMIT_PCT = 1.0
+#: The split's per-pixel tolerance (``render.options.shrm_tol``'s default).
+TOL = 0.005
+
+#: Sizes per mode: the maps' rows (None: full resolution), the sphere's side, the BRDFs; the
+#: targets are checked at full resolution only (quick mode measures the same code on small maps).
+SETTINGS = {
+    "full": {
+        "rows": None,
+        "pixels": 12,
+        "brdfs": FULLRES_BRDFS,
+        "label": "full resolution",
+        "targets": True,
+    },
+    "quick": {
+        "rows": 32,
+        "pixels": 6,
+        "brdfs": (("ggx", 0.3),),
+        "label": "quick mode: maps box-filtered to 32 rows",
+        "targets": False,
+    },
+}
+
+
+def fullres_study(ctx: ReportContext, settings: dict | None = None, maps=None) -> SectionData:
+    """Every shipped map × BRDF, one task each (``ctx.run_tasks``).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from reference.images import write_exr
+    >>> sky = np.ones((16, 32, 3)); sky[3, 5] = 400.0
+    >>> path = write_exr(Path(tempfile.mkdtemp()) / "sky.exr", sky)
+    >>> s = {"rows": None, "pixels": 5, "brdfs": (("ggx", 0.3),), "label": "test", "targets": True}
+    >>> data = fullres_study(ReportContext(Path(".")), s, [path])
+    >>> [c.passed for c in checks(data)]
+    [True]
+    """
+    s = settings or SETTINGS["quick" if ctx.quick else "full"]
+    maps = maps if maps is not None else sorted((SHARED / "environments").glob("*.*"))
+    tasks = [
+        (str(path), brdf, alpha, s["pixels"], s["rows"], TOL)
+        for path in maps
+        for brdf, alpha in s["brdfs"]
+    ]
+    rows = ctx.run_tasks(fullres_case, tasks, "SHRM full-resolution cases")
+    return SectionData({"cases": rows, "label": s["label"], "tol": TOL, "targets": s["targets"]})
+
+
+def _holds(row: dict) -> bool:
+    split = row["split"]
+    return split["pct_of_peak"] <= PEAK_LIMIT_PCT and split["mean_rel_pct"] <= MEAN_LIMIT_PCT
+
+
+def _chart(ctx: ReportContext, rows: list):
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7.0, 4.0))
+    styles = {
+        "split": ("SH + angular split (default)", "o"),
+        "shrm": ("SHRM alone, same settings", "s"),
+        "shrm_half_F": ("SHRM alone, half F", "^"),
+    }
+    for key, (label, marker) in styles.items():
+        x = [1e3 * r[key]["shade_seconds"] / r["pixels"] for r in rows]
+        y = [max(r[key]["pct_of_peak"], 1e-4) for r in rows]
+        ax.scatter(x, y, marker=marker, label=label, alpha=0.8)
+    brute = [1e3 * r["bruteforce_seconds"] / r["pixels"] for r in rows]
+    ax.scatter(brute, [1e-4] * len(rows), marker="x", color="k", label="brute force (exact)")
+    ax.axhline(PEAK_LIMIT_PCT, color="gray", linestyle="--", label="target 1 % of peak")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("ms per pixel, a frame after the first")
+    ax.set_ylabel("largest error, % of the peak")
+    ax.legend(fontsize=8)
+    held = sum(_holds(r) for r in rows)
+    worst = max(rows, key=lambda r: r["split"]["pct_of_peak"])
+    speed = np.median([r["bruteforce_seconds"] / r["split"]["shade_seconds"] for r in rows])
+    caption = (
+        f"Time against error per case: the split meets both targets in {held} of {len(rows)} "
+        f"cases; its worst is {worst['split']['pct_of_peak']:.2f} % of the peak "
+        f"({worst['map']}, {worst['brdf']} α {worst['alpha']:g}); a frame after the first is "
+        f"{speed:.0f}× faster than brute force (median)."
+    )
+    return ctx.figure("time-error", fig, caption)
+
+
+def present(ctx: ReportContext, data: SectionData) -> list:
+    """The table of cases and the time–error chart."""
+    rows = data.results["cases"]
+    table = [
+        [
+            r["map"],
+            f"{r['brdf']} α {r['alpha']:g}",
+            r["split"]["pct_of_peak"],
+            r["split"]["mean_rel_pct"],
+            r["promised_pct_of_peak"],
+            "yes" if r["meets_tolerance"] else "no",
+            r["shrm"]["pct_of_peak"],
+            r["shrm_half_F"]["pct_of_peak"],
+            f"{r['F']}/{r['P']}/{r['size']}",
+            r["residual_texels"],
+            r["bruteforce_seconds"] / r["split"]["shade_seconds"],
+        ]
+        for r in rows
+    ]
+    return [
+        Text(
+            f"Issue 21 measured on the shipped maps ({data.results['label']}): a sphere of each "
+            "BRDF (GGX with ρ_d 0 and F_0 1, Ward, the thin-film effect pigment) rendered by the "
+            "default SH + angular split, by the SHRM alone and by brute force over every texel "
+            f"(the oracle of --oracle). Split tolerance {data.results['tol']:g} of the peak. "
+            "The Monte Carlo estimator of equal time that the issue asks for in the chart is "
+            "not built yet (issue 21)."
+            + ("" if data.results["targets"] else " Targets are checked in the full report only.")
+        ),
+        _chart(ctx, rows),
+        Table(
+            [
+                "map",
+                "BRDF",
+                "split: % of peak",
+                "split: mean |ΔY/Y| %",
+                "promised % of peak",
+                "meets tolerance",
+                "SHRM alone: % of peak",
+                "SHRM half F: % of peak",
+                "F/P/cube",
+                "residual texels",
+                "frame speed-up vs brute force",
+            ],
+            table,
+            "The default path against brute force; targets: ≤ 1 % of the peak, mean ≤ 1 %",
+            "{:.3g}",
+        ),
+    ]
+
+
+def checks(data: SectionData) -> list[Check]:
+    """One check per map and BRDF: both of issue 21's targets, on the split (the default).
+
+    None in quick mode: the targets are for the full-resolution maps.
+    """
+    found = []
+    for r in data.results["cases"] if data.results["targets"] else ():
+        split = r["split"]
+        found.append(
+            Check(
+                f"SHRM split, {r['map']}, {r['brdf']} α {r['alpha']:g} ({data.results['label']}):"
+                " % of peak / mean |ΔY/Y| %",
+                f"<= {PEAK_LIMIT_PCT:g} / <= {MEAN_LIMIT_PCT:g}",
+                f"{split['pct_of_peak']:.3g} / {split['mean_rel_pct']:.3g}",
+                _holds(r),
+            )
+        )
+    return found
+
+
+SECTION = ReportSection(
+    "shrm-fullres", "SHRMs on full-resolution maps", fullres_study, present, checks
+)
