@@ -68,7 +68,16 @@ def scheduler_address(scheduler: str | None = None, default: str | None = None) 
 
 
 def add_scheduler_option(parser, default: str | None = None) -> None:
-    """The ``--scheduler`` option of every command that runs tasks (one help text for all)."""
+    """The ``--scheduler`` option of every command that runs tasks (one help text for all).
+
+    Examples
+    --------
+    >>> import argparse
+    >>> parser = argparse.ArgumentParser()
+    >>> add_scheduler_option(parser, default=SERIAL)
+    >>> parser.parse_args(["--scheduler", "local"]).scheduler
+    'local'
+    """
     fallback = (
         "this process, one task after another"
         if default == SERIAL

@@ -57,6 +57,14 @@ def environment_radiance(path, rows: int | None = None) -> np.ndarray:
     """The spectral radiance ``(H, 2H, C)`` of a lat-long map on :data:`GRID`.
 
     ``rows`` box-filters the map to that height first (None: the full resolution).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from reference.images import write_exr
+    >>> path = write_exr(Path(tempfile.mkdtemp()) / "sky.exr", np.ones((8, 16, 3)))
+    >>> environment_radiance(path).shape, environment_radiance(path, 4).shape
+    ((8, 16, 7), (4, 8, 7))
     """
     from reference.camera import downsample_box
     from reference.images import read_image

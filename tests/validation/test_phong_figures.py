@@ -80,7 +80,7 @@ def test_table1_blocks_in_the_paper_layout(r1):
 @pytest.mark.slow
 def test_table1_images_via_cli(tmp_path, monkeypatch, capsys):
     # small and uncompiled (the NumPy references): the test checks the files, not the kernels
-    def tiny(resolution, entries, repeats, progress=False):
+    def tiny(resolution, entries, repeats, progress=False, scheduler=None):
         model = SCENES.lookup("R1").build()
         variants = [("error", "monotone", entries, None)]
         rows, _ = phong_table1.material_rows(model, "far", variants, resolution, 1, compiled=False)

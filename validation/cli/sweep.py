@@ -25,9 +25,11 @@ def add_parser(sub) -> None:
         help="run a sweep file's grid as Dask tasks; a tidy CSV, one row per cell",
     )
     kinds = ", ".join(SWEEP_KINDS.names())
-    p.add_argument(
-        "file", metavar="SWEEP.toml", help=f"the sweep file; kind: {kinds} (docs/scale-out.md)"
+    file = p.add_argument(
+        "file", metavar="SWEEP.toml", help=f"the sweep file (docs/scale-out.md); kind: {kinds}"
     )
+    # its help lists the kinds from the registry (as validation.cli.parser.registry_option does)
+    file.registry, file.registry_keys = SWEEP_KINDS, SWEEP_KINDS.names()
     p.add_argument("-o", "--out", metavar="CSV", help="write the table here (default: stdout)")
     add_scheduler_option(p)
     p.set_defaults(func=_cmd_sweep)
