@@ -101,7 +101,8 @@ def fullres_case(task) -> dict:
     Returns
     -------
     dict
-        ``map``, ``brdf``, ``alpha``, ``pixels`` (shaded points), ``env_rows``; per method
+        ``map``, ``brdf``, ``alpha``, ``side`` (the image's), ``pixels`` (shaded points),
+        ``env_rows``; per method
         (``split``, ``shrm``, ``shrm_half_F``) its ``pct_of_peak``, ``mean_rel_pct``,
         ``create_seconds`` (the first frame's maps) and ``shade_seconds`` (a frame after the
         first); ``bruteforce_seconds``; the split's ``F``, ``P``,
@@ -143,6 +144,7 @@ def fullres_case(task) -> dict:
         "map": Path(path).name,
         "brdf": brdf,
         "alpha": float(alpha),
+        "side": int(pixels),
         "pixels": len(n),
         "env_rows": int(env.shape[0]),
         "F": int(s.F),

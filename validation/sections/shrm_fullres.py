@@ -126,9 +126,7 @@ def _chart(ctx: ReportContext, rows: list):
 def present(ctx: ReportContext, data: SectionData) -> list:
     """The table of cases and the time–error chart."""
     rows = data.results["cases"]
-    sizes = " or ".join(
-        f"{n} × {n}" for n in sorted({int(round(np.sqrt(4 * r["pixels"] / np.pi))) for r in rows})
-    )
+    sizes = " or ".join(f"{n} × {n}" for n in sorted({r["side"] for r in rows}))
     table = [
         [
             r["map"],
