@@ -139,8 +139,11 @@ def XYZ_floor(kind: str, degree: int, camera: str = CAMERA, sets=HELD_OUT_SETS) 
     return found
 
 
-def regression_table(camera: str = CAMERA, sets=HELD_OUT_SETS) -> list[dict]:
+def regression_table(camera: str = CAMERA, sets=HELD_OUT_SETS, run=None) -> list[dict]:
     """Every feature family and degree, noise-free and noisy: in-sample and held-out figures.
+
+    Each feature family and degree is one task of ``run(function, tasks, desc)`` (default: in
+    this process; the report passes ``ReportContext.run_tasks``).
 
     Returns
     -------
@@ -148,23 +151,33 @@ def regression_table(camera: str = CAMERA, sets=HELD_OUT_SETS) -> list[dict]:
         ``{"features", "degree", "noise", "ridge", "in_sample": {...}, "held_out": {set: {...}},
         "xyz_floor": {set: {...}}}``.
     """
+    tasks = [
+        (kind, degree, camera, tuple(sets))
+        for kind, degrees in REGRESSION_FEATURES.items()
+        for degree in degrees
+    ]
+    run = run or (lambda function, items, desc: [function(item) for item in items])
+    return [row for rows in run(_regression_rows, tasks, "regression degrees") for row in rows]
+
+
+def _regression_rows(task) -> list[dict]:
+    # one feature family and degree (a task): the noise-free and the noisy fit
+    kind, degree, camera, sets = task
+    floor = XYZ_floor(kind, degree, camera, sets)
     rows = []
-    for kind, degrees in REGRESSION_FEATURES.items():
-        for degree in degrees:
-            floor = XYZ_floor(kind, degree, camera, sets)
-            for noise in (False, True):
-                model, in_sample = fit_target(kind, degree, camera, noise)
-                rows.append(
-                    {
-                        "features": kind,
-                        "degree": degree,
-                        "noise": noise,
-                        "ridge": model.ridge,
-                        "in_sample": in_sample,
-                        "held_out": held_out_figures(model.predict, camera, noise, sets),
-                        "xyz_floor": floor,
-                    }
-                )
+    for noise in (False, True):
+        model, in_sample = fit_target(kind, degree, camera, noise)
+        rows.append(
+            {
+                "features": kind,
+                "degree": degree,
+                "noise": noise,
+                "ridge": model.ridge,
+                "in_sample": in_sample,
+                "held_out": held_out_figures(model.predict, camera, noise, sets),
+                "xyz_floor": floor,
+            }
+        )
     return rows
 
 

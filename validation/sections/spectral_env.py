@@ -82,7 +82,8 @@ def spectral_environments(ctx: ReportContext | None = None) -> SectionData:
     quick = bool(ctx and ctx.quick)
     data = SectionData()
     data.results["camera"] = CAMERA
-    data.results["regression"] = regression_table(CAMERA, HELD_OUT_SETS)
+    run = ctx.run_tasks if ctx is not None else None
+    data.results["regression"] = regression_table(CAMERA, HELD_OUT_SETS, run)
     methods = [m for m in RECOVERY_METHODS if not (quick and m == "Jakob 2019")]
     data.results["recovery"] = {m: recovery_figures(m, (CC,))[CC] for m in methods}
     # Benchmark (make bench): spectralize throughput relative to the bare matrix product
