@@ -4,9 +4,12 @@ from shrm.polymer import MIRROR_FACTORS
 from validation.report.runner import REPORT_SECTIONS, SECTIONS, run_report
 
 
-def test_polymer_section_follows_shrm():
+def test_polymer_section_follows_the_shrm_sections():
+    # the polymer model shades from SHRMs: it comes right after them (the SHRM section and its
+    # full-resolution measurements)
     names = [s.name for s in SECTIONS]
-    assert names.index("polymer") == names.index("shrm") + 1
+    assert names.index("shrm-fullres") == names.index("shrm") + 1
+    assert names.index("polymer") == names.index("shrm-fullres") + 1
     assert REPORT_SECTIONS.lookup("polymer").title == "Herbert hybrid model"
 
 
