@@ -227,3 +227,27 @@ def test_report_sections_on_a_cluster_equal_serial(client, tmp_path):
     assert distributed["cases"] == serial["cases"]
     for got, want in zip(distributed["per_case"], serial["per_case"], strict=True):
         np.testing.assert_allclose(got["ratio"], want["ratio"], rtol=1e-12, atol=0)
+
+
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["impastor", "table1"],
+        ["phong", "table1", "--resolution", "8", "--entries", "8", "--repeats", "1"],
+        ["report", "--quick", "--only", "spectral-core", "--no-screenshot"],
+    ],
+    ids=["impastor-table1", "phong-table1", "report"],
+)
+def test_commands_refuse_an_unreachable_scheduler_in_one_line(command, tmp_path, capsys):
+    # every command with --scheduler: one line naming the address, exit 2, nothing written
+    from validation.cli import main
+
+    address = f"tcp://127.0.0.1:{_free_port()}"
+    out = tmp_path / "out"
+    extra = ["--out", str(out)] if command[0] == "report" else []
+    assert main([*command, *extra, "--scheduler", address]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1, err
+    assert address in err
+    assert "Traceback" not in err
+    assert not (out / "index.html").exists()
