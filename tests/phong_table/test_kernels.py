@@ -124,3 +124,21 @@ def test_merged_exponents_give_the_same_table(scene):
         table = build_table(model, 64, "error", compiled=compiled)
         exact = model.specular(table.nodes)
         np.testing.assert_allclose(table.values, exact, rtol=1e-13, atol=1e-300)
+
+
+def test_table_kernel_flushes_only_negligible_entries():
+    # R3's far table holds cubic coefficients near the smallest normal double (E38): the kernel
+    # reads them as 0 and still agrees with the NumPy reference (which keeps them); the table does
+    # hold such entries, so the flush is exercised
+    from phong_table._kernels import TABLE_FLUSH
+
+    model = SCENES.lookup("R3").build()
+    buffer = shading_buffer(sphere_gbuffer("far", 64), model)
+    table = build_table(
+        model, 200, "error", compiled=True, t_range=buffer.t_range, t_density=buffer.t_density
+    )
+    tiny = (np.abs(table.cubic) < TABLE_FLUSH) & (table.cubic != 0.0)
+    assert tiny.any()
+    compiled = shade_pixels(buffer, model, "table", table, "monotone")
+    reference = shade_pixels(buffer, model, "table", table, "monotone", compiled=False)
+    assert np.abs(compiled - reference).max() < 1e-12 * np.abs(reference).max()
