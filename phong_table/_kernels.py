@@ -117,9 +117,12 @@ def _linear(nodes, values, inv_width, i, t):
 
 @numba.njit(cache=False)
 def _monotone_records(nodes, values, inv_width, cubic):
-    """One row per interval: ``t_i``, ``1/h_i``, then per channel ``v_i``, the Horner cubic
-    ``c1, c2, c3`` and the interval's two values' min and max (what :func:`_monotone_packed`
-    reads); entries below :data:`TABLE_FLUSH` in magnitude are 0 (Erratum E38)."""
+    """The monotone cubics of a table, one row of 20 per interval (read by the table kernel).
+
+    Row ``i``: ``t_i``, ``1/h_i``, then per channel ``v_i``, the Horner cubic ``c1, c2, c3`` and
+    the interval's two values' min and max (what :func:`_monotone_packed` reads); entries below
+    :data:`TABLE_FLUSH` in magnitude are 0 (Erratum E38).
+    """
     m = nodes.size - 1
     records = np.empty((m, 20))
     for i in range(m):
