@@ -30,6 +30,7 @@ References
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -311,9 +312,9 @@ class SpectralPhong:
         """The exponents ``n(λ)``, shape ``(n_bands,)``."""
         return self.material.n
 
-    @property
+    @cached_property
     def an(self) -> float:
-        """The average exponent of Eq. (13), Wang et al. (Erratum E1)."""
+        """The average exponent of Eq. (13), Wang et al. (Erratum E1), computed once."""
         return average_exponent_Wang(self.material.n)
 
     @property

@@ -26,6 +26,8 @@ References
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from phong_table import _kernels
@@ -257,7 +259,7 @@ def seen_interval(t_range, entries: int) -> tuple[float, float, int]:
         return 0.0, 1.0, entries
     t_lo, t_hi = (float(x) for x in t_range)
     require(
-        np.isfinite(t_lo) and np.isfinite(t_hi) and 0.0 <= t_lo <= t_hi <= 1.0,
+        math.isfinite(t_lo) and math.isfinite(t_hi) and 0.0 <= t_lo <= t_hi <= 1.0,
         f"error table: t_range: must be 0 <= t_lo <= t_hi <= 1, got {t_range!r}",
     )
     inner = entries - 2 * (t_lo > 0.0) - 2 * (t_hi < 1.0)
