@@ -11,7 +11,12 @@ shows that the two agree to ~1e-12:
   error-equidistributing placement;
 - :func:`tabulate_kernel` ↔ ``phong_table.table.tabulate``: the table's values, slopes and index;
 - :func:`light_geometry_kernel` ↔ ``phong_table.render.light_geometry``: ``cos θ``, ``t`` and
-  ``f_att`` per pixel from the G-buffer (``phong_cosines``, ``attenuation_Wang``).
+  ``f_att`` per pixel from the G-buffer (``phong_cosines``, ``attenuation_Wang``);
+- the private ``_fine_weights_kernel`` ↔ ``phong_table.placement._fine_weights``,
+  ``_zero_below_kernel`` ↔ ``phong_table.table.zero_below`` and ``_increasing_kernel`` ↔
+  ``phong_table.table.increasing``: the small steps of a compiled table build, so that it runs no
+  NumPy array operation between its kernels (NumPy's AVX-512 loops lower the core's clock for a
+  while on this hardware, and the shading that follows ran up to 10 % slower).
 
 The private helpers (``_interval``, ``_linear``, ``_monotone_packed``, ``_parabolic``, ``_write``)
 are inlined into the render kernels; ``_monotone_records`` packs a table's monotone cubics once
@@ -577,3 +582,65 @@ def table_error_kernel(t_fine, C, n, entries, floor, p, hedge, grading):
     nodes[0] = t_fine[0]
     nodes[entries] = t_fine[F - 1]
     return nodes
+
+
+@numba.njit(cache=False)
+def _fine_weights_kernel(unit, t_lo, t_hi, r_lo, r_hi, cells):
+    """The fine grid on ``[t_lo, t_hi]`` and the pixel density at its midpoints.
+
+    Twin of ``phong_table.placement._fine_weights`` (``np.interp`` between the cell centres of
+    ``cells`` over ``[r_lo, r_hi]``, constant beyond the end centres, 0 outside the range); ``p``
+    is empty when ``cells`` is.
+    """
+    F = unit.size
+    t_fine = np.empty(F)
+    for q in range(F):
+        t_fine[q] = t_lo + (t_hi - t_lo) * unit[q]
+    K = cells.size
+    p = np.zeros(F - 1 if K > 0 else 0)
+    if K == 0:
+        return t_fine, p
+    span = r_hi - r_lo
+    first = r_lo + 0.5 * span / K
+    last = r_lo + (K - 0.5) * span / K
+    for q in range(F - 1):
+        x = 0.5 * (t_fine[q] + t_fine[q + 1])
+        if not (x >= r_lo and x <= r_hi):
+            continue
+        if x >= last:
+            p[q] = cells[K - 1]
+        elif x <= first:
+            p[q] = cells[0]
+        else:
+            k = min(max(int((x - r_lo) * K / span - 0.5), 0), K - 2)
+            while k > 0 and r_lo + (k + 0.5) * span / K > x:
+                k -= 1
+            while k < K - 2 and r_lo + (k + 1.5) * span / K <= x:
+                k += 1
+            x0 = r_lo + (k + 0.5) * span / K
+            x1 = r_lo + (k + 1.5) * span / K
+            p[q] = (cells[k + 1] - cells[k]) / (x1 - x0) * (x - x0) + cells[k]
+    return t_fine, p
+
+
+@numba.njit(cache=False)
+def _zero_below_kernel(nodes, values):
+    """Twin of ``phong_table.table.zero_below``: ``t_z`` with ``z`` two before the first nonzero."""
+    first = nodes.size
+    for q in range(values.shape[0]):
+        if values[q, 0] != 0.0 or values[q, 1] != 0.0 or values[q, 2] != 0.0:
+            first = q
+            break
+    z = first - 2
+    return nodes[z] if z >= 1 else -1.0
+
+
+@numba.njit(cache=False)
+def _increasing_kernel(nodes):
+    """Twin of ``phong_table.table.increasing``: strictly increasing from 0 to 1."""
+    if nodes[0] != 0.0 or nodes[nodes.size - 1] != 1.0:
+        return False
+    for q in range(nodes.size - 1):  # noqa: SIM110 (a loop numba compiles)
+        if not nodes[q + 1] > nodes[q]:
+            return False
+    return True
