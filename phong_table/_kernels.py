@@ -15,8 +15,9 @@ shows that the two agree to ~1e-12:
 - the private ``_fine_weights_kernel`` ↔ ``phong_table.placement._fine_weights``,
   ``_zero_below_kernel`` ↔ ``phong_table.table.zero_below`` and ``_increasing_kernel`` ↔
   ``phong_table.table.increasing``: the small steps of a compiled table build, so that it runs no
-  NumPy array operation between its kernels (NumPy's AVX-512 loops lower the core's clock for a
-  while on this hardware, and the shading that follows ran up to 10 % slower).
+  NumPy array operation between its kernels. With them, the shading that follows a build ran
+  ~10 % slower on the benchmark machine (Xeon, AVX-512); with NumPy's AVX-512 loops disabled
+  (``NPY_DISABLE_CPU_FEATURES``) most of that went, so we think they lower the core's clock.
 
 The private helpers (``_interval``, ``_linear``, ``_monotone_packed``, ``_parabolic``, ``_write``)
 are inlined into the render kernels; ``_monotone_records`` packs a table's monotone cubics once
