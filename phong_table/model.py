@@ -30,7 +30,6 @@ References
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import cached_property
 
 import numpy as np
 
@@ -312,9 +311,9 @@ class SpectralPhong:
         """The exponents ``n(λ)``, shape ``(n_bands,)``."""
         return self.material.n
 
-    @cached_property
+    @property
     def an(self) -> float:
-        """The average exponent of Eq. (13), Wang et al. (Erratum E1), computed once."""
+        """The average exponent of Eq. (13), Wang et al. (Erratum E1)."""
         return average_exponent_Wang(self.material.n)
 
     @property
