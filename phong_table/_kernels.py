@@ -11,10 +11,17 @@ shows that the two agree to ~1e-12:
   error-equidistributing placement;
 - :func:`tabulate_kernel` ↔ ``phong_table.table.tabulate``: the table's values, slopes and index;
 - :func:`light_geometry_kernel` ↔ ``phong_table.render.light_geometry``: ``cos θ``, ``t`` and
-  ``f_att`` per pixel from the G-buffer (``phong_cosines``, ``attenuation_Wang``).
+  ``f_att`` per pixel from the G-buffer (``phong_cosines``, ``attenuation_Wang``);
+- the private ``_fine_weights_kernel`` ↔ ``phong_table.placement._fine_weights``,
+  ``_zero_below_kernel`` ↔ ``phong_table.table.zero_below`` and ``_increasing_kernel`` ↔
+  ``phong_table.table.increasing``: the small steps of a compiled table build, so that it runs no
+  NumPy array operation between its kernels. With them, the shading that follows a build ran
+  ~10 % slower on the benchmark machine (Xeon, AVX-512); with NumPy's AVX-512 loops disabled
+  (``NPY_DISABLE_CPU_FEATURES``) most of that went, so we think they lower the core's clock.
 
-The private helpers (``_interval``, ``_linear``, ``_monotone``, ``_parabolic``, ``_write``) are
-inlined into the render kernels. No kernel sets ``fastmath``.
+The private helpers (``_interval``, ``_linear``, ``_monotone_packed``, ``_parabolic``, ``_write``)
+are inlined into the render kernels; ``_monotone_records`` packs a table's monotone cubics once
+per call. No kernel sets ``fastmath``.
 """
 
 from __future__ import annotations
@@ -27,6 +34,13 @@ import numpy as np
 #: ``exp(x)`` is below the smallest normal double for ``x`` under this; such terms are skipped,
 #: since a subnormal result takes the C library's slow path and the term is below 2.2e-308 anyway.
 LOG_SMALLEST_NORMAL = -708.39
+
+#: Entries of a monotone table row (values and Horner coefficients) smaller than this in magnitude
+#: are read as 0 by the table kernel (Erratum E38): products ``c s^k`` of such tiny coefficients
+#: land among the subnormal doubles, whose arithmetic is ~50x slower (the R3 far view took 2.5x as
+#: long with them), and each flushed entry moves a pixel by less than 1e-290 (peaks are ~1), as
+#: the exact kernel skips the terms below the smallest normal double.
+TABLE_FLUSH = 1e-290
 
 #: Interpolation codes the table kernel understands; ``INTERPOLATION_METHODS`` stores them.
 LINEAR, PARABOLIC, PARABOLIC_W, MONOTONE = 0, 1, 2, 3
@@ -107,24 +121,57 @@ def _linear(nodes, values, inv_width, i, t):
     )
 
 
-@numba.njit(cache=False, inline="always")
-def _monotone_channel(values, cubic, i, c, s):
-    """The Hermite cubic of interval ``i``, channel ``c``: ``v_i + s (c1 + s (c2 + s c3))``."""
-    v0 = values[i, c]
-    v1 = values[i + 1, c]
-    f = v0 + s * (cubic[i, c, 0] + s * (cubic[i, c, 1] + s * cubic[i, c, 2]))
-    # never outside the interval's two values (PCHIP is monotone there; this catches rounding)
-    return min(max(f, min(v0, v1)), max(v0, v1))
+@numba.njit(cache=False)
+def _monotone_records(nodes, values, inv_width, cubic):
+    """The monotone cubics of a table, one row of 20 per interval (read by the table kernel).
+
+    Row ``i``: ``t_i``, ``1/h_i``, then per channel ``v_i``, the Horner cubic ``c1, c2, c3`` and
+    the interval's two values' min and max (what :func:`_monotone_packed` reads); entries below
+    :data:`TABLE_FLUSH` in magnitude are 0 (Erratum E38).
+    """
+    m = nodes.size - 1
+    records = np.empty((m, 20))
+    for i in range(m):
+        records[i, 0] = nodes[i]
+        records[i, 1] = inv_width[i]
+        for c in range(3):
+            v0 = _flush(values[i, c])
+            v1 = _flush(values[i + 1, c])
+            records[i, 2 + c] = v0
+            records[i, 5 + c] = _flush(cubic[i, c, 0])
+            records[i, 8 + c] = _flush(cubic[i, c, 1])
+            records[i, 11 + c] = _flush(cubic[i, c, 2])
+            records[i, 14 + c] = min(v0, v1)
+            records[i, 17 + c] = max(v0, v1)
+    return records
 
 
 @numba.njit(cache=False, inline="always")
-def _monotone(nodes, values, inv_width, cubic, i, t):
-    """The monotone cubic of interval ``i`` at ``t`` (3 channels)."""
-    s = (t - nodes[i]) * inv_width[i]
+def _flush(x):
+    """``x``, or 0 when ``|x|`` is below :data:`TABLE_FLUSH`."""
+    return x if abs(x) >= TABLE_FLUSH else 0.0
+
+
+@numba.njit(cache=False, inline="always")
+def _monotone_packed_channel(records, i, c, s):
+    """The Hermite cubic of interval ``i``, channel ``c``: ``v_i + s (c1 + s (c2 + s c3))``.
+
+    Never outside the interval's two values (PCHIP is monotone there; this catches rounding).
+    """
+    f = records[i, 2 + c] + s * (
+        records[i, 5 + c] + s * (records[i, 8 + c] + s * records[i, 11 + c])
+    )
+    return min(max(f, records[i, 14 + c]), records[i, 17 + c])
+
+
+@numba.njit(cache=False, inline="always")
+def _monotone_packed(records, i, t):
+    """The monotone cubic of interval ``i`` at ``t`` (3 channels), from its packed row."""
+    s = (t - records[i, 0]) * records[i, 1]
     return (
-        _monotone_channel(values, cubic, i, 0, s),
-        _monotone_channel(values, cubic, i, 1, s),
-        _monotone_channel(values, cubic, i, 2, s),
+        _monotone_packed_channel(records, i, 0, s),
+        _monotone_packed_channel(records, i, 1, s),
+        _monotone_packed_channel(records, i, 2, s),
     )
 
 
@@ -238,12 +285,18 @@ def _shade_table_loop(
     D = diffuse_RGB[0], diffuse_RGB[1], diffuse_RGB[2]
     f_0 = values[0, 0], values[0, 1], values[0, 2]
     in_w = code == PARABOLIC_W
+    last = nodes.size - 2
+    # the monotone cubics packed one row per interval (:func:`_monotone_records`): one cache line
+    # or two per lookup instead of four arrays
+    records = _monotone_records(nodes, values, inv_width, cubic) if code == MONOTONE else values
     # Neighbouring pixels of a raster-ordered G-buffer see nearby t: the interval found last
     # (``hint``) is tried first, and :func:`_interval` runs only when it does not hold t. A branch,
     # not a conditional move, so that the CPU runs ahead over pixels that hit. ``hint`` changes only
     # on a miss: reassigned on every pixel (``i = near(..., i)``), the loop ran 2.5x slower, we
     # think because numba/LLVM then made the test a select. The interval found does not depend on
     # the pixel order.
+    # On a miss, t has mostly moved to a neighbouring interval (87-99 % of misses on the scenes'
+    # views with error tables): one branch-free step towards t is tried before :func:`_interval`.
     hint = 0
     for p in range(t.size):
         t_p = t[p]
@@ -254,12 +307,15 @@ def _shade_table_loop(
         else:
             i = hint
             if not (nodes[i] <= t_p and t_p < nodes[i + 1]):
-                i = _interval(nodes, guide, steps, uniform, t_p)
+                i += np.int64(nodes[i + 1] <= t_p) * np.int64(i < last)
+                i -= np.int64(nodes[i] > t_p) * np.int64(i > 0)
+                if not (nodes[i] <= t_p and t_p < nodes[i + 1]):
+                    i = _interval(nodes, guide, steps, uniform, t_p)
                 hint = i
             if code == LINEAR:
                 r, g, b = _linear(nodes, values, inv_width, i, t_p)
             elif code == MONOTONE:
-                r, g, b = _monotone(nodes, values, inv_width, cubic, i, t_p)
+                r, g, b = _monotone_packed(records, i, t_p)
             else:
                 r, g, b = _parabolic(nodes, values, in_w, a, i, t_p)
         _write(out, p, A, D, f_att[p], cos_theta[p], r, g, b)
@@ -527,3 +583,65 @@ def table_error_kernel(t_fine, C, n, entries, floor, p, hedge, grading):
     nodes[0] = t_fine[0]
     nodes[entries] = t_fine[F - 1]
     return nodes
+
+
+@numba.njit(cache=False)
+def _fine_weights_kernel(unit, t_lo, t_hi, r_lo, r_hi, cells):
+    """The fine grid on ``[t_lo, t_hi]`` and the pixel density at its midpoints.
+
+    Twin of ``phong_table.placement._fine_weights`` (``np.interp`` between the cell centres of
+    ``cells`` over ``[r_lo, r_hi]``, constant beyond the end centres, 0 outside the range); ``p``
+    is empty when ``cells`` is.
+    """
+    F = unit.size
+    t_fine = np.empty(F)
+    for q in range(F):
+        t_fine[q] = t_lo + (t_hi - t_lo) * unit[q]
+    K = cells.size
+    p = np.zeros(F - 1 if K > 0 else 0)
+    if K == 0:
+        return t_fine, p
+    span = r_hi - r_lo
+    first = r_lo + 0.5 * span / K
+    last = r_lo + (K - 0.5) * span / K
+    for q in range(F - 1):
+        x = 0.5 * (t_fine[q] + t_fine[q + 1])
+        if not (x >= r_lo and x <= r_hi):
+            continue
+        if x >= last:
+            p[q] = cells[K - 1]
+        elif x <= first:
+            p[q] = cells[0]
+        else:
+            k = min(max(int((x - r_lo) * K / span - 0.5), 0), K - 2)
+            while k > 0 and r_lo + (k + 0.5) * span / K > x:
+                k -= 1
+            while k < K - 2 and r_lo + (k + 1.5) * span / K <= x:
+                k += 1
+            x0 = r_lo + (k + 0.5) * span / K
+            x1 = r_lo + (k + 1.5) * span / K
+            p[q] = (cells[k + 1] - cells[k]) / (x1 - x0) * (x - x0) + cells[k]
+    return t_fine, p
+
+
+@numba.njit(cache=False)
+def _zero_below_kernel(nodes, values):
+    """Twin of ``phong_table.table.zero_below``: ``t_z`` with ``z`` two before the first nonzero."""
+    first = nodes.size
+    for q in range(values.shape[0]):
+        if values[q, 0] != 0.0 or values[q, 1] != 0.0 or values[q, 2] != 0.0:
+            first = q
+            break
+    z = first - 2
+    return nodes[z] if z >= 1 else -1.0
+
+
+@numba.njit(cache=False)
+def _increasing_kernel(nodes):
+    """Twin of ``phong_table.table.increasing``: strictly increasing from 0 to 1."""
+    if nodes[0] != 0.0 or nodes[nodes.size - 1] != 1.0:
+        return False
+    for q in range(nodes.size - 1):  # noqa: SIM110 (a loop numba compiles)
+        if not nodes[q + 1] > nodes[q]:
+            return False
+    return True

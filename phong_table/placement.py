@@ -26,6 +26,8 @@ References
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from phong_table import _kernels
@@ -236,6 +238,7 @@ def fine_grid(size: int = 256) -> np.ndarray:
 
 _FINE_GRID = fine_grid()
 _FINE_GRID.setflags(write=False)
+_NO_CELLS = np.zeros(0)
 
 
 def seen_interval(t_range, entries: int) -> tuple[float, float, int]:
@@ -257,7 +260,7 @@ def seen_interval(t_range, entries: int) -> tuple[float, float, int]:
         return 0.0, 1.0, entries
     t_lo, t_hi = (float(x) for x in t_range)
     require(
-        np.isfinite(t_lo) and np.isfinite(t_hi) and 0.0 <= t_lo <= t_hi <= 1.0,
+        math.isfinite(t_lo) and math.isfinite(t_hi) and 0.0 <= t_lo <= t_hi <= 1.0,
         f"error table: t_range: must be 0 <= t_lo <= t_hi <= 1, got {t_range!r}",
     )
     inner = entries - 2 * (t_lo > 0.0) - 2 * (t_hi < 1.0)
@@ -338,6 +341,15 @@ def _pixel_weight(t_mid, t_range, t_density) -> np.ndarray:
     centres = t_lo + (np.arange(cells.size) + 0.5) * (t_hi - t_lo) / cells.size
     inside = (t_mid >= t_lo) & (t_mid <= t_hi)
     return np.interp(t_mid, centres, cells) * inside
+
+
+def _fine_weights(t_lo, t_hi, t_range, t_density) -> tuple[np.ndarray, np.ndarray]:
+    """The fine grid mapped onto ``[t_lo, t_hi]`` and :func:`_pixel_weight` at its midpoints.
+
+    The compiled twin is ``phong_table._kernels._fine_weights_kernel``.
+    """
+    t_fine = t_lo + (t_hi - t_lo) * _FINE_GRID
+    return t_fine, _pixel_weight(0.5 * (t_fine[1:] + t_fine[:-1]), t_range, t_density)
 
 
 def table_error(
@@ -451,8 +463,7 @@ def table_error(
     grading = _grading(interpolation)
 
     def place(t_lo, t_hi, m):
-        t_fine = t_lo + (t_hi - t_lo) * _FINE_GRID
-        p = _pixel_weight(0.5 * (t_fine[1:] + t_fine[:-1]), t_range, t_density)
+        t_fine, p = _fine_weights(t_lo, t_hi, t_range, t_density)
         return _error_nodes(model, m, floor, t_fine, p, grading)
 
     return place_seen(place, m, t_range)
@@ -473,7 +484,8 @@ def check_density(t_density, t_range) -> None:
         return
     density = np.asarray(t_density, dtype=np.float64)
     ok = t_range is not None and density.ndim == 1 and density.size > 0
-    if not (ok and np.isfinite(density).all() and (density >= 0).all()):
+    # element by element: no NumPy array operation in the compiled build (phong_table._kernels)
+    if not (ok and all(math.isfinite(x) and x >= 0.0 for x in density.tolist())):
         # formatted only on failure (the check runs on every table build)
         require(False, f"error table: t_density: must be >= 0 (with a t_range), got {density}")
 
@@ -549,10 +561,12 @@ def _table_error_compiled(
     # the same f_sp with one power per distinct exponent (SpectralPhong.n_distinct)
     C, n = model.specular_weights_distinct, model.n_distinct
 
+    r_lo, r_hi = (0.0, 1.0) if t_range is None else (float(t_range[0]), float(t_range[1]))
+    cells = _NO_CELLS if t_density is None else np.asarray(t_density, dtype=np.float64)
+
     def place(t_lo, t_hi, m):
-        t_fine = t_lo + (t_hi - t_lo) * _FINE_GRID
+        t_fine, p = _kernels._fine_weights_kernel(_FINE_GRID, t_lo, t_hi, r_lo, r_hi, cells)
         floor = ERROR_DENSITY_FLOOR / (t_hi - t_lo)
-        p = _pixel_weight(0.5 * (t_fine[1:] + t_fine[:-1]), t_range, t_density)
         return _kernels.table_error_kernel(t_fine, C, n, m, floor, p, ERROR_HEDGE, grading)
 
     return place_seen(place, m, t_range)

@@ -29,6 +29,7 @@ __all__ = [
     "SpecularTable",
     "build_table",
     "check_interpolation",
+    "increasing",
     "tabulate",
     "zero_below",
 ]
@@ -196,6 +197,19 @@ def zero_below(nodes, values) -> float:
     return float(nodes[z]) if z >= 1 else -1.0
 
 
+def increasing(nodes) -> bool:
+    """Whether ``nodes`` rise strictly from 0 to 1 (what every table's nodes must do).
+
+    The compiled twin is ``phong_table._kernels._increasing_kernel``.
+
+    Examples
+    --------
+    >>> increasing(np.array([0.0, 0.5, 1.0])), increasing(np.array([0.0, 0.5, 0.5, 1.0]))
+    (True, False)
+    """
+    return bool(nodes[0] == 0.0 and nodes[-1] == 1.0 and (np.diff(nodes) > 0).all())
+
+
 def tabulate(nodes, C, n, cells_per_entry: int = GUIDE_CELLS_PER_ENTRY) -> tuple:
     """Everything a lookup needs at given nodes: values, slopes, widths, cubics and the index.
 
@@ -325,8 +339,9 @@ def build_table(
         check_interpolation(interpolation, m)
         seen["interpolation"] = interpolation
     nodes = np.ascontiguousarray(place(material, m, p, **seen), dtype=np.float64)
+    # the compiled build runs no NumPy array operation between its kernels (phong_table._kernels)
     require(
-        nodes[0] == 0.0 and nodes[-1] == 1.0 and bool((np.diff(nodes) > 0).all()),
+        _kernels._increasing_kernel(nodes) if compiled else increasing(nodes),
         f"{placement} table: nodes are not strictly increasing from 0 to 1 (m = {m}); use fewer "
         "entries",
     )
@@ -334,6 +349,7 @@ def build_table(
     # Eq. (11), Wang et al. at the nodes, one power per distinct exponent (the same sum)
     C, n = material.specular_weights_distinct, material.n_distinct
     values, slopes, inv_width, cubic, guide, steps = make(nodes, C, n, GUIDE_CELLS_PER_ENTRY)
+    zero = _kernels._zero_below_kernel(nodes, values) if compiled else zero_below(nodes, values)
     return SpecularTable(
         nodes=nodes,
         values=values,
@@ -346,5 +362,5 @@ def build_table(
         an=material.an,
         placement=placement,
         segments=p,
-        zero_below=zero_below(nodes, values),
+        zero_below=float(zero),
     )

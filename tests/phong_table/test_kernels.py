@@ -124,3 +124,71 @@ def test_merged_exponents_give_the_same_table(scene):
         table = build_table(model, 64, "error", compiled=compiled)
         exact = model.specular(table.nodes)
         np.testing.assert_allclose(table.values, exact, rtol=1e-13, atol=1e-300)
+
+
+def test_table_kernel_flushes_only_negligible_entries():
+    # R3's far table holds cubic coefficients near the smallest normal double (E38): the kernel
+    # reads them as 0 and still agrees with the NumPy reference (which keeps them); the table does
+    # hold such entries, so the flush is exercised
+    from phong_table._kernels import TABLE_FLUSH
+
+    model = SCENES.lookup("R3").build()
+    buffer = shading_buffer(sphere_gbuffer("far", 64), model)
+    table = build_table(
+        model, 200, "error", compiled=True, t_range=buffer.t_range, t_density=buffer.t_density
+    )
+    tiny = (np.abs(table.cubic) < TABLE_FLUSH) & (table.cubic != 0.0)
+    assert tiny.any()
+    compiled = shade_pixels(buffer, model, "table", table, "monotone")
+    reference = shade_pixels(buffer, model, "table", table, "monotone", compiled=False)
+    assert np.abs(compiled - reference).max() < 1e-12 * np.abs(reference).max()
+
+
+@pytest.mark.parametrize("view", ["far", "near"])
+def test_build_step_kernels_equal_numpy(view):
+    # the small steps of the compiled build (fine grid and pixel weights, the zero run, the node
+    # check) against their NumPy twins, on the views' pixel densities and on edge cases
+    from phong_table import _kernels
+    from phong_table.placement import _FINE_GRID, _fine_weights
+    from phong_table.table import increasing, zero_below
+
+    model = SCENES.lookup("R3").build()
+    buffer = shading_buffer(sphere_gbuffer(view, 48), model)
+    rng = np.random.default_rng(17)
+    r_lo, r_hi = buffer.t_range
+    cases = [
+        (0.0, 1.0, (r_lo, r_hi), buffer.t_density),
+        (r_lo, r_hi, (r_lo, r_hi), buffer.t_density),
+        (0.3, 0.9, (0.4, 0.8), rng.uniform(0.0, 3.0, 7)),
+        (0.0, 1.0, (0.25, 0.5), np.array([2.0])),  # one cell: constant inside the range
+        (0.1, 0.6, (0.2, 0.2), np.array([1.0, 3.0])),  # a single t
+        (0.0, 1.0, None, None),
+    ]
+    for t_lo, t_hi, t_range, density in cases:
+        t_fine, p = _fine_weights(t_lo, t_hi, t_range, density)
+        lo, hi = (0.0, 1.0) if t_range is None else t_range
+        cells = np.zeros(0) if density is None else np.asarray(density, dtype=np.float64)
+        k_fine, k_p = _kernels._fine_weights_kernel(_FINE_GRID, t_lo, t_hi, lo, hi, cells)
+        np.testing.assert_array_equal(k_fine, t_fine)
+        assert k_p.shape == p.shape
+        if p.size:
+            _close(k_p, p)
+        assert density is None or lo == hi or (p > 0).any()
+    for placement in ("uniform", "importance", "error"):
+        table = build_table(model, 64, placement)
+        assert _kernels._zero_below_kernel(table.nodes, table.values) == zero_below(
+            table.nodes, table.values
+        )
+    zeros = np.zeros((5, 3))
+    nodes = np.linspace(0.0, 1.0, 5)
+    assert _kernels._zero_below_kernel(nodes, zeros) == zero_below(nodes, zeros) == 0.75
+    assert build_table(model, 64, "error", compiled=True).zero_below > 0.0
+    for nodes in (
+        np.linspace(0.0, 1.0, 9),
+        [0.0, 0.5, 0.5, 1.0],
+        [0.0, 0.6, 0.4, 1.0],
+        [0.1, 0.5, 1.0],
+        [0.0, 0.5, 0.9],
+    ):
+        nodes = np.asarray(nodes, dtype=np.float64)
+        assert _kernels._increasing_kernel(nodes) == increasing(nodes)
