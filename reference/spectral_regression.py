@@ -9,11 +9,23 @@ specref implements that regression:
   ``root_polynomial`` — Finlayson et al.'s root-polynomials, the ``(a + b + c)``-th root of each
   monomial of degree ``<= d``, d = 1…4 (3, 6, 13, 22 distinct terms), which scale linearly with
   exposure.
-- **Ridge least squares**: with the feature columns scaled to unit RMS over the target,
-  ``W = argmin (1/n)·||X W − S||² + λ·||W||²`` for the n target spectra S (one column per band).
-  λ is chosen by k-fold cross-validation (:data:`CV_FOLDS` folds of a shuffle with seed
-  :data:`CV_SEED`) from :data:`RIDGE_GRID` (0 and 10^-12 … 10^0 in half decades), minimizing the
-  held-out spectral RMS; the scale is then folded into ``W``.
+- **Losses** (:data:`REGRESSION_LOSSES`, erratum E44). With the feature columns scaled to unit
+  RMS over the target (the scale is then folded into ``W``), for the n target spectra S:
+
+  - ``colorimetric`` (the default, :data:`DEFAULT_LOSS`): what ΔE94 measures, plus a spectral
+    term, ``W = argmin (1/n)·Σ_i [Σ_L ||G_iL r_i||² + (β/b)·||r_i||²] + λ·||W||²`` with the
+    residuals ``r_i = Wᵀx_i − s_i``; ``G_iL`` (3 × b) is ΔE94 linearised at patch i's
+    spectrum under the capture illuminant and under A (:func:`delta_E94_jacobian`), so
+    ``||G_iL r||`` is ΔE94 to first order in the spectral error r; the spectral term (b bands)
+    keeps the spectra near the target's where the eye does not constrain them (√β is the ΔE94
+    that a spectral RMS error of 1 costs).
+    λ and β are chosen by k-fold cross-validation (:data:`CV_FOLDS` folds of a shuffle with seed
+    :data:`CV_SEED`) from :data:`COLORIMETRIC_RIDGE_GRID` × :data:`SPECTRAL_WEIGHT_GRID`,
+    minimizing the :data:`CV_PERCENTILE`-th percentile of the held-out ΔE94 under both lights
+    (the targets are a peak and a mean, under two lights).
+  - ``spectral``: ridge least squares on the spectra, ``W = argmin (1/n)·||X W − S||² + λ·||W||²``,
+    λ from :data:`RIDGE_GRID` (0 and 10^-12 … 10^0 in half decades) by the same cross-validation,
+    minimizing the held-out spectral RMS.
 - **Exposure** (erratum E41): HDR texels are brighter than any target patch. A polynomial is
   applied to ``RGB / s`` and the result multiplied by ``s``, with ``s = max(1, max(R, G, B))``:
   texels inside the target's range are mapped as fitted, brighter ones keep their chromaticity.
@@ -31,6 +43,8 @@ References
 - G. D. Finlayson, M. Mackiewicz, A. Hurlbert, "Color Correction Using Root-Polynomial
   Regression", IEEE Transactions on Image Processing 24(5), 2015.
 - A. E. Hoerl, R. W. Kennard, "Ridge Regression", Technometrics 12(1), 1970.
+- CIE 116-1995, "Industrial colour-difference evaluation" (ΔE94); CIE 15:2004 (CIELAB).
+- M. A. Woodbury, "Inverting modified matrices", Memorandum Report 42, Princeton, 1950.
 """
 
 from __future__ import annotations
@@ -48,13 +62,20 @@ from reference.errors import SpecrefError, require
 from reference.registry import Registry
 
 __all__ = [
+    "COLORIMETRIC_RIDGE_GRID",
     "CV_FOLDS",
+    "CV_PERCENTILE",
     "CV_SEED",
+    "DEFAULT_LOSS",
     "MAX_RIDGE",
     "PIXELS_PER_BLOCK",
     "REGRESSION_FEATURES",
+    "REGRESSION_LOSSES",
+    "RELIT_ILLUMINANT",
     "RIDGE_GRID",
+    "SPECTRAL_WEIGHT_GRID",
     "SpectralRegression",
+    "delta_E94_jacobian",
     "feature_exponents",
     "feature_names",
     "features_RGB",
@@ -77,9 +98,27 @@ CV_SEED = 20040101
 RIDGE_GRID = (0.0, *(10.0 ** (k / 2.0) for k in range(-24, 1)))
 #: Largest ridge strength accepted from a user.
 MAX_RIDGE = 1.0
-#: Model-file format tag and version.
+#: Ridge strengths λ of the colorimetric loss tried by cross-validation (unit-RMS features, ΔE94²).
+COLORIMETRIC_RIDGE_GRID = (1e-5, 1e-4, 1e-3, 1e-2, 1e-1)
+#: Weights β of the spectral term of the colorimetric loss tried by cross-validation.
+SPECTRAL_WEIGHT_GRID = (1e2, 1e3, 1e4, 1e5)
+#: The colorimetric loss's cross-validated criterion: this percentile of held-out ΔE94.
+CV_PERCENTILE = 95.0
+#: The light a spectral panorama is relit under in issue 15's targets; the colorimetric loss
+#: measures ΔE94 under it beside the capture illuminant.
+RELIT_ILLUMINANT = "A"
+#: Model-file format tag and version (2: ``loss`` and ``spectral_weight``; version 1 files, all
+#: fitted with the spectral loss, are still read).
 FORMAT = "specref-spectral-regression"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
+_READABLE_VERSIONS = (1, 2)
+
+#: Losses of :func:`fit_regression` by key (module docstring).
+REGRESSION_LOSSES = Registry("regression losses")
+REGRESSION_LOSSES.register("ΔE94 (capture illuminant and A) plus β · spectral", "colorimetric")
+REGRESSION_LOSSES.register("spectral least squares", "spectral")
+#: The loss `specref env fit` and the shipped model use (erratum E44).
+DEFAULT_LOSS = "colorimetric"
 
 #: Feature families by key: the range of degrees each allows.
 REGRESSION_FEATURES = Registry("regression features")
@@ -258,7 +297,14 @@ class SpectralRegression:
     training_set : str
         The target's name.
     cv : dict
-        ``{"folds": k, "seed": ..., "grid": [...], "rms": [...]}`` (empty when λ was given).
+        The cross-validation: ``{"folds": k, "seed": ..., "grid": [...], "rms": [...]}`` for the
+        spectral loss; ``{"folds", "seed", "criterion", "ridge_grid", "spectral_weight_grid",
+        "scores"}`` (scores[i][j] for ridge i, weight j) for the colorimetric one (None when
+        nothing was chosen).
+    loss : str
+        A key of :data:`REGRESSION_LOSSES`: how the coefficients were fitted.
+    spectral_weight : float or None
+        β of the colorimetric loss (None for the spectral loss).
 
     Examples
     --------
@@ -276,8 +322,11 @@ class SpectralRegression:
     camera: str = ""
     training_set: str = ""
     cv: dict | None = None
+    loss: str = "spectral"
+    spectral_weight: float | None = None
 
     def __post_init__(self):
+        REGRESSION_LOSSES.lookup(self.loss)
         n_features = len(feature_exponents(self.kind, self.degree))
         coefficients = np.asarray(self.coefficients, dtype=np.float64)
         wavelengths = np.asarray(self.wavelengths_nm, dtype=np.float64)
@@ -351,6 +400,143 @@ def _ridge_solutions(X, S, ridges):
         yield Vt.T @ (d[:, None] * UtS)
 
 
+def delta_E94_jacobian(spectra, weights) -> np.ndarray:
+    """ΔE94 linearised at each spectrum: ``ΔE94(s, s + r) ≈ ||G r||`` for small spectral errors r.
+
+    CIE 116-1995 (ΔE94: ``ΔL/S_L``, ``ΔC/S_C``, ``ΔH/S_H`` with ``S_L = 1``,
+    ``S_C = 1 + 0.045 C``, ``S_H = 1 + 0.015 C`` of the reference) of CIE 15:2004 CIELAB, the
+    white the perfect diffuser under the weights' light; rows ``(ΔL, ΔC, ΔH)``.
+
+    Parameters
+    ----------
+    spectra : array_like, shape (n, b)
+        The reference spectra (reflectances on the weights' grid).
+    weights : ndarray, shape (b, 3)
+        Tristimulus band weights (``reference.colorimetry.band_weights``), Y = 1 for the white.
+
+    Returns
+    -------
+    ndarray, shape (n, 3, b)
+
+    Examples
+    --------
+    >>> from reference.colorimetry import band_weights
+    >>> from reference.spectra import GRID_41, spectrum_from_dataset
+    >>> import colour
+    >>> from reference.colorimetry import XYZ_to_Lab, white_XYZ
+    >>> W = band_weights(GRID_41, spectrum_from_dataset("illuminant", "D65"))
+    >>> s = np.linspace(0.2, 0.6, 41)[None]
+    >>> r = 1e-4 * np.cos(np.arange(41))[None]
+    >>> Lab = [XYZ_to_Lab(x @ W, white_XYZ(W)) for x in (s, s + r)]
+    >>> exact = colour.delta_E(*Lab, method="CIE 1994")[0]
+    >>> linear = np.linalg.norm(delta_E94_jacobian(s, W)[0] @ r[0])
+    >>> bool(abs(linear / exact - 1) < 1e-3)
+    True
+    """
+    S = np.asarray(spectra, dtype=np.float64)
+    white = weights.sum(axis=0)
+    t = (S @ weights) / white
+    # CIE 15:2004: f(t) = t^(1/3) above (6/29)³, linear below; Lab from f of X/Xn, Y/Yn, Z/Zn
+    delta = 6.0 / 29.0
+    above = t > delta**3
+    f = np.where(above, np.cbrt(np.maximum(t, 0.0)), t / (3 * delta**2) + 4.0 / 29.0)
+    df = np.where(above, 1.0 / (3.0 * np.maximum(f, 1e-300) ** 2), 1.0 / (3 * delta**2)) / white
+    J = np.zeros((len(S), 3, 3))  # ∂(L, a, b)/∂(X, Y, Z)
+    J[:, 0, 1] = 116.0 * df[:, 1]
+    J[:, 1, 0], J[:, 1, 1] = 500.0 * df[:, 0], -500.0 * df[:, 1]
+    J[:, 2, 1], J[:, 2, 2] = 200.0 * df[:, 1], -200.0 * df[:, 2]
+    a, b = 500.0 * (f[:, 0] - f[:, 1]), 200.0 * (f[:, 1] - f[:, 2])
+    C, h = np.hypot(a, b), np.arctan2(b, a)
+    # CIE 116-1995: ΔC = cos h Δa + sin h Δb, ΔH = −sin h Δa + cos h Δb, over S_L, S_C, S_H
+    R = np.zeros((len(S), 3, 3))
+    R[:, 0, 0] = 1.0
+    R[:, 1, 1], R[:, 1, 2] = np.cos(h) / (1 + 0.045 * C), np.sin(h) / (1 + 0.045 * C)
+    R[:, 2, 1], R[:, 2, 2] = -np.sin(h) / (1 + 0.015 * C), np.cos(h) / (1 + 0.015 * C)
+    return (R @ J) @ weights.T
+
+
+def _colorimetric_solutions(X, S, G, grid):
+    """Colorimetric-loss solutions ``W`` for each ``(λ, β)`` of ``grid`` (module docstring).
+
+    The normal equations ``(ZᵀZ + (β/(nb))·XᵀX ⊗ I + λI) vec W = r``, ``Z`` the rows
+    ``x_i ⊗ g_ij / √n`` of the ``m = 3·lights`` rows ``g_ij`` of ``G_i``, have ``k·b`` unknowns;
+    when ``n·m < k·b`` the Woodbury identity (Woodbury 1950) solves them through an
+    ``(n·m) × (n·m)`` system, the ``XᵀX ⊗ I + λI`` part being diagonal in the eigenvectors of
+    ``XᵀX``; otherwise they are solved as they stand.
+    """
+    n, b = S.shape
+    k, m = X.shape[1], G.shape[1]
+    direct = k * b <= n * m
+    eigenvalues, Q = np.linalg.eigh(X.T @ X)
+    eigenvalues = np.maximum(eigenvalues, 0.0)
+    Xq = X @ Q  # features in the eigenbasis of XᵀX
+    if direct:
+        Z = (X[:, None, :, None] * G[:, :, None, :]).reshape(n * m, k * b) / np.sqrt(n)
+        ZtZ = Z.T @ Z
+    else:
+        Gflat = G.reshape(n * m, b)
+        GG = (Gflat @ Gflat.T).reshape(n, m, n, m)
+    GS = np.einsum("imb,ib->im", G, S)
+    for ridge, weight in grid:
+        c = weight / (n * b)
+        d = np.maximum(c * eigenvalues + ridge, 1e-300)  # D = Q diag(d) Qᵀ ⊗ I
+
+        def D_inv(U, d=d):  # U: (k, b) in the original basis
+            return Q @ ((Q.T @ U) / d[:, None])
+
+        def Z_of(U):  # (n, m): x_iᵀ U g_ij / √n
+            return np.einsum("ib,imb->im", X @ U, G) / np.sqrt(n)
+
+        def Zt_of(V):  # (k, b): Σ_ij x_i ⊗ g_ij v_ij / √n
+            return X.T @ np.einsum("im,imb->ib", V, G) / np.sqrt(n)
+
+        rhs = Zt_of(GS / np.sqrt(n)) + c * (X.T @ S)
+        if direct:  # fewer unknowns than loss rows: the normal equations themselves
+            H = ZtZ + np.kron(c * (X.T @ X), np.eye(b))
+            H[np.diag_indices_from(H)] += ridge
+            yield np.linalg.solve(H, rhs.reshape(-1)).reshape(k, b)
+            continue
+        K = (Xq / d) @ Xq.T / n  # Z D⁻¹ Zᵀ = Kx[i, i'] · (g_ij · g_i'j')
+        system = (K[:, None, :, None] * GG).reshape(n * m, n * m)
+        system[np.diag_indices_from(system)] += 1.0
+        y = D_inv(rhs)
+        correction = np.linalg.solve(system, Z_of(y).reshape(-1)).reshape(n, m)
+        yield y - D_inv(Zt_of(correction))
+
+
+def _loss_jacobians(spectra, wavelengths, illuminant):
+    """``(n, 3·lights, b)``: :func:`delta_E94_jacobian` under the capture illuminant and A."""
+    from reference.colorimetry import band_weights
+    from reference.spectra import SpectralGrid, spectrum_from_dataset
+
+    step = float(wavelengths[1] - wavelengths[0]) if wavelengths.size > 1 else 0.0
+    uniform = step > 0 and np.allclose(np.diff(wavelengths), step)
+    require(
+        uniform,
+        "colorimetric loss: the target's wavelengths must be a uniform grid (or use the "
+        "spectral loss)",
+    )
+    grid = SpectralGrid(float(wavelengths[0]), float(wavelengths[-1]), step)
+    lights = dict.fromkeys((illuminant, RELIT_ILLUMINANT))
+    return np.concatenate(
+        [
+            delta_E94_jacobian(spectra, band_weights(grid, spectrum_from_dataset("illuminant", L)))
+            for L in lights
+        ],
+        axis=1,
+    ), [band_weights(grid, spectrum_from_dataset("illuminant", L)) for L in lights]
+
+
+def _delta_E94(truth, estimate, weights) -> np.ndarray:
+    import colour
+
+    from reference.colorimetry import XYZ_to_Lab
+
+    white = weights.sum(axis=0)
+    Lab_1, Lab_2 = XYZ_to_Lab(truth @ weights, white), XYZ_to_Lab(estimate @ weights, white)
+    return np.asarray(colour.delta_E(Lab_1, Lab_2, method="CIE 1994"))
+
+
 def fit_regression(
     RGB,
     spectra,
@@ -361,10 +547,13 @@ def fit_regression(
     illuminant: str = "D65",
     camera: str = "",
     training_set: str = "",
+    loss: str = DEFAULT_LOSS,
+    spectral_weight: float | None = None,
 ) -> SpectralRegression:
-    """Fit the regression of a target's spectra on its camera RGB (ridge, λ by cross-validation).
+    """Fit the regression of a target's spectra on its camera RGB (λ, β by cross-validation).
 
-    Herbert et al., §4; Finlayson et al. 2015 for the root-polynomial features.
+    Herbert et al., §4; Finlayson et al. 2015 for the root-polynomial features; the losses in
+    the module docstring (the colorimetric one: CIE 116-1995 ΔE94, erratum E44).
 
     Parameters
     ----------
@@ -377,8 +566,15 @@ def fit_regression(
         As in :func:`feature_exponents`.
     ridge : float, optional
         A fixed ridge strength in [0, :data:`MAX_RIDGE`]; None chooses it by cross-validation.
-    illuminant, camera, training_set : str
-        Recorded in the model.
+    illuminant : str
+        The capture illuminant (colour-science key; the colorimetric loss measures ΔE94 under it
+        and under :data:`RELIT_ILLUMINANT`). Recorded in the model, as are:
+    camera, training_set : str
+    loss : str
+        A key of :data:`REGRESSION_LOSSES`. The colorimetric loss needs a uniform grid within
+        360–780 nm.
+    spectral_weight : float, optional
+        β of the colorimetric loss, > 0; None chooses it by cross-validation.
 
     Returns
     -------
@@ -393,7 +589,7 @@ def fit_regression(
     --------
     >>> rng = np.random.default_rng(1)
     >>> RGB = rng.uniform(0, 1, (40, 3))
-    >>> model = fit_regression(RGB, RGB[:, ::-1], [450.0, 550.0, 650.0], degree=2)
+    >>> model = fit_regression(RGB, RGB[:, ::-1], [450.0, 550.0, 650.0], degree=2, loss="spectral")
     >>> model.predict([[0.2, 0.5, 0.9]]).round(3)
     array([[0.9, 0.5, 0.2]])
     """
@@ -417,19 +613,53 @@ def fit_regression(
     scale = np.sqrt((X**2).mean(axis=0))
     scale = np.where(scale > 0, scale, 1.0)
     X = X / scale
+    REGRESSION_LOSSES.lookup(loss)
+    if spectral_weight is not None:
+        require(
+            loss == "colorimetric" and np.isfinite(spectral_weight) and spectral_weight > 0,
+            f"spectral weight (colorimetric loss only) must be > 0, got {spectral_weight!r}",
+        )
+    folds = np.array_split(np.random.default_rng(CV_SEED).permutation(len(X)), CV_FOLDS)
     cv = None
-    if ridge is None:
-        # k-fold cross-validation over RIDGE_GRID: held-out spectral RMS per λ
-        folds = np.array_split(np.random.default_rng(CV_SEED).permutation(len(X)), CV_FOLDS)
-        sq = np.zeros(len(RIDGE_GRID))
-        for held in folds:
-            train = np.setdiff1d(np.arange(len(X)), held)
-            for i, W in enumerate(_ridge_solutions(X[train], spectra[train], RIDGE_GRID)):
-                sq[i] += ((X[held] @ W - spectra[held]) ** 2).sum()
-        rms = np.sqrt(sq / spectra.size)
-        ridge = float(RIDGE_GRID[int(np.argmin(rms))])
-        cv = {"folds": CV_FOLDS, "seed": CV_SEED, "grid": list(RIDGE_GRID), "rms": rms.tolist()}
-    (W,) = _ridge_solutions(X, spectra, [float(ridge)])
+    if loss == "colorimetric":
+        G, weights = _loss_jacobians(spectra, wavelengths, illuminant)
+        ridges = COLORIMETRIC_RIDGE_GRID if ridge is None else (float(ridge),)
+        betas = SPECTRAL_WEIGHT_GRID if spectral_weight is None else (float(spectral_weight),)
+        grid = [(r, w) for r in ridges for w in betas]
+        if len(grid) > 1:
+            # k-fold cross-validation: the CV_PERCENTILE-th percentile of held-out ΔE94, both lights
+            errors = [[] for _ in grid]
+            for held in folds:
+                train = np.setdiff1d(np.arange(len(X)), held)
+                solutions = _colorimetric_solutions(X[train], spectra[train], G[train], grid)
+                for i, W in enumerate(solutions):
+                    P = X[held] @ W
+                    errors[i].extend(_delta_E94(spectra[held], P, Wl) for Wl in weights)
+            scores = np.array([np.percentile(np.concatenate(e), CV_PERCENTILE) for e in errors])
+            ridge, spectral_weight = grid[int(np.argmin(scores))]
+            cv = {
+                "folds": CV_FOLDS,
+                "seed": CV_SEED,
+                "criterion": f"percentile {CV_PERCENTILE:g} of ΔE94 under "
+                + " and ".join(dict.fromkeys((illuminant, RELIT_ILLUMINANT))),
+                "ridge_grid": list(ridges),
+                "spectral_weight_grid": list(betas),
+                "scores": scores.reshape(len(ridges), len(betas)).tolist(),
+            }
+        ridge, spectral_weight = grid[0] if cv is None else (ridge, spectral_weight)
+        (W,) = _colorimetric_solutions(X, spectra, G, [(float(ridge), float(spectral_weight))])
+    else:
+        if ridge is None:
+            # k-fold cross-validation over RIDGE_GRID: held-out spectral RMS per λ
+            sq = np.zeros(len(RIDGE_GRID))
+            for held in folds:
+                train = np.setdiff1d(np.arange(len(X)), held)
+                for i, W in enumerate(_ridge_solutions(X[train], spectra[train], RIDGE_GRID)):
+                    sq[i] += ((X[held] @ W - spectra[held]) ** 2).sum()
+            rms = np.sqrt(sq / spectra.size)
+            ridge = float(RIDGE_GRID[int(np.argmin(rms))])
+            cv = {"folds": CV_FOLDS, "seed": CV_SEED, "grid": list(RIDGE_GRID), "rms": rms.tolist()}
+        (W,) = _ridge_solutions(X, spectra, [float(ridge)])
     return SpectralRegression(
         kind,
         int(degree),
@@ -440,6 +670,8 @@ def fit_regression(
         camera,
         training_set,
         cv,
+        loss,
+        None if spectral_weight is None else float(spectral_weight),
     )
 
 
@@ -465,7 +697,9 @@ def save_regression(model: SpectralRegression, path) -> Path:
         "feature_names": feature_names(model.kind, model.degree),
         "wavelengths_nm": model.wavelengths_nm.tolist(),
         "coefficients": model.coefficients.tolist(),
+        "loss": model.loss,
         "ridge": model.ridge,
+        "spectral_weight": model.spectral_weight,
         "cross_validation": model.cv,
         "illuminant": model.illuminant,
         "camera": model.camera,
@@ -493,10 +727,14 @@ def load_regression(path, wavelengths_nm=None) -> SpectralRegression:
     require(path.is_file(), f"{path}: file not found")
     try:
         document = json.loads(path.read_text(encoding="utf-8"))
+        require(document.get("format") == FORMAT, f"{path}: not a {FORMAT} file")
+        version = document.get("version")
         require(
-            document.get("format") == FORMAT and document.get("version") == FORMAT_VERSION,
-            f"{path}: not a {FORMAT} file of version {FORMAT_VERSION}",
+            version in _READABLE_VERSIONS,
+            f"{path}: {FORMAT} version {version!r}; this specref reads versions "
+            f"{', '.join(map(str, _READABLE_VERSIONS))} (refit with `specref env fit`)",
         )
+        weight = document["spectral_weight"] if version >= 2 else None
         model = SpectralRegression(
             document["features"],
             document["degree"],
@@ -507,6 +745,8 @@ def load_regression(path, wavelengths_nm=None) -> SpectralRegression:
             str(document["camera"]),
             str(document["training_set"]),
             document.get("cross_validation"),
+            str(document["loss"]) if version >= 2 else "spectral",  # version 1: spectral only
+            None if weight is None else float(weight),
         )
     except SpecrefError as error:
         raise SpecrefError(f"{path}: {error}".replace(f"{path}: {path}: ", f"{path}: ")) from None

@@ -13,6 +13,10 @@ from a camera's spectral sensitivities and reflectance sets that colour-science 
   patch the model was trained on would measure memory, not recovery.
 - **Held out** (:data:`HELD_OUT_SETS`): ColorChecker N Ohta (the issue's target), the CIE 2024 test
   colour samples and the NIST CQS 9.0 samples (Munsell papers). The design never sees them.
+- **A further test set** (:data:`OTHER_TEST_SET`, erratum E44): the 99 colour evaluation samples
+  of CIE 224:2017 (colour fidelity index; real objects chosen to cover colour space uniformly)
+  minus those with a look-alike in the training set (same thresholds), measured after every
+  design choice was made, to check that a choice did not fit the sets above.
 - **Cameras** (:data:`CAMERAS`): colour-science's ``MSDS_CAMERA_SENSITIVITIES`` (Nikon 5100 and
   Sigma SD Merrill, NPL measurements), and ``sRGB``: the CIE 1931 2° observer through the XYZ →
   linear sRGB matrix, i.e. the RGB of the sRGB-encoded maps scenes use.
@@ -42,6 +46,7 @@ __all__ = [
     "CAMERAS",
     "FINE_GRID",
     "HELD_OUT_SETS",
+    "OTHER_TEST_SET",
     "TRAINING_SET",
     "camera_RGB",
     "camera_noise",
@@ -69,6 +74,8 @@ def _colour_sets():
     }
 
 
+#: The CIE 2017 colour evaluation samples without a training look-alike (module docstring).
+OTHER_TEST_SET = "CIE 2017 TCS minus training look-alikes"
 #: Reflectance sets never used in training (and whose look-alikes are removed from training).
 HELD_OUT_SETS = ("ColorChecker N Ohta", "CIE 2024 TCS", "NIST CQS 9.0")
 # Further sets whose look-alikes are removed: the other ColorChecker measurements.
@@ -95,6 +102,17 @@ def _lab_D65(spectra_41: np.ndarray) -> np.ndarray:
     return XYZ_to_Lab(spectra_41 @ W, white_XYZ(W))
 
 
+def _has_lookalike(values: np.ndarray, references: np.ndarray) -> np.ndarray:
+    """Per spectrum (5 nm): within 0.03 spectral RMS or ΔE94 2.0 (D65) of a reference (E40)."""
+    import colour
+
+    coarse, ref = values[:, ::2], references[:, ::2]
+    rms = np.sqrt(((coarse[:, None] - ref[None]) ** 2).mean(axis=-1)).min(axis=1)
+    lab, lab_ref = _lab_D65(coarse), _lab_D65(ref)
+    dE = colour.delta_E(lab[:, None], lab_ref[None], method="CIE 1994").min(axis=1)
+    return (rms < _LOOKALIKE_RMS) | (dE < _LOOKALIKE_DELTA_E94)
+
+
 @functools.cache
 def _reflectance_set(name: str) -> tuple[tuple[str, ...], np.ndarray]:
     import colour
@@ -110,21 +128,23 @@ def _reflectance_set(name: str) -> tuple[tuple[str, ...], np.ndarray]:
                 for i in range(len(labels))
             ]
         )
-        coarse = values[:, ::2]
-        lab = _lab_D65(coarse)
-        keep = np.ones(len(labels), bool)
-        for other in _LOOKALIKE_SETS:
-            ref = _on_fine_grid(_colour_sets()[other])[1][:, ::2]
-            rms = np.sqrt(((coarse[:, None] - ref[None]) ** 2).mean(axis=-1)).min(axis=1)
-            dE = colour.delta_E(lab[:, None], _lab_D65(ref)[None], method="CIE 1994").min(axis=1)
-            keep &= (rms >= _LOOKALIKE_RMS) & (dE >= _LOOKALIKE_DELTA_E94)
+        refs = [_on_fine_grid(_colour_sets()[other])[1] for other in _LOOKALIKE_SETS]
+        keep = ~_has_lookalike(values, np.concatenate(refs))
         labels = [label for label, k in zip(labels, keep, strict=True) if k]
+        values = values[keep]
+    elif name == OTHER_TEST_SET:
+        # CIE 224:2017's 99 colour evaluation samples, as colour-science ships them (5 nm)
+        msds = colour.quality.cfi2017.load_TCS_CIE2017(colour.SpectralShape(380, 780, 5))
+        values = np.asarray(msds.values, dtype=np.float64).T.copy()
+        keep = ~_has_lookalike(values, _reflectance_set(TRAINING_SET)[1])
+        labels = [label for label, k in zip(msds.labels, keep, strict=True) if k]
         values = values[keep]
     else:
         sets = _colour_sets()
         require(
             name in sets,
-            f"unknown reflectance set {name!r}; allowed: {', '.join(sets)}, {TRAINING_SET}",
+            f"unknown reflectance set {name!r}; allowed: {', '.join(sets)}, {TRAINING_SET}, "
+            f"{OTHER_TEST_SET}",
         )
         labels, values = _on_fine_grid(sets[name])
     values.setflags(write=False)
@@ -132,7 +152,7 @@ def _reflectance_set(name: str) -> tuple[tuple[str, ...], np.ndarray]:
 
 
 def reflectance_set(name: str, grid: SpectralGrid = FINE_GRID) -> tuple[list[str], np.ndarray]:
-    """Labels and reflectances of a set: :data:`TRAINING_SET` or one of :data:`HELD_OUT_SETS`.
+    """Labels and reflectances: :data:`TRAINING_SET`, :data:`OTHER_TEST_SET` or a held-out set.
 
     Parameters
     ----------
@@ -150,8 +170,8 @@ def reflectance_set(name: str, grid: SpectralGrid = FINE_GRID) -> tuple[list[str
     >>> labels, spectra = reflectance_set("ColorChecker N Ohta", GRID_41)
     >>> len(labels), spectra.shape
     (24, (24, 41))
-    >>> len(reflectance_set(TRAINING_SET)[0])
-    156
+    >>> len(reflectance_set(TRAINING_SET)[0]), len(reflectance_set(OTHER_TEST_SET)[0])
+    (156, 87)
     """
     require(grid in (FINE_GRID, GRID_41), f"reflectance_set: grid must be 5 or 10 nm, got {grid}")
     labels, values = _reflectance_set(name)

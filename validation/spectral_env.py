@@ -14,6 +14,7 @@ import numpy as np
 from reference.colorimetry import XYZ_to_Lab, band_weights, white_XYZ
 from reference.spectra import GRID_41, spectrum_from_dataset
 from reference.spectral_regression import (
+    DEFAULT_LOSS,
     REGRESSION_FEATURES,
     features_RGB,
     fit_regression,
@@ -88,13 +89,17 @@ def fit_target(
     noise: bool = False,
     ridge=None,
     illuminant: str = "D65",
+    loss: str = DEFAULT_LOSS,
+    spectral_weight=None,
 ):
     """Fit on the training set (with camera noise if asked); the model and in-sample figures.
 
     Examples
     --------
     >>> model, in_sample = fit_target("root_polynomial", 4)
-    >>> round(in_sample["D65 mean"], 2)
+    >>> model.loss, round(in_sample["D65 mean"], 2)
+    ('colorimetric', 0.74)
+    >>> round(fit_target("root_polynomial", 4, loss="spectral")[1]["D65 mean"], 2)
     0.72
     """
     _, spectra = reflectance_set(TRAINING_SET)
@@ -111,6 +116,8 @@ def fit_target(
         illuminant,
         camera,
         TRAINING_SET,
+        loss,
+        spectral_weight,
     )
     return model, _stats(spectra[:, ::2], model.predict(RGB), illuminant)
 
@@ -284,6 +291,8 @@ def fit_file(
     degree: int = 4,
     ridge=None,
     noise: bool = False,
+    loss: str = DEFAULT_LOSS,
+    spectral_weight=None,
 ) -> dict:
     """What ``specref env fit`` runs: fit on a target file or the synthetic target, save, report.
 
@@ -312,20 +321,41 @@ def fit_file(
     if target is not None:
         RGB, truth = read_target(target, spectra)
         model = fit_regression(
-            RGB, truth, GRID_41.wavelengths_nm, kind, degree, ridge, illuminant, "", str(target)
+            RGB,
+            truth,
+            GRID_41.wavelengths_nm,
+            kind,
+            degree,
+            ridge,
+            illuminant,
+            "",
+            str(target),
+            loss,
+            spectral_weight,
         )
         in_sample = _stats(truth, model.predict(RGB), illuminant)
     else:
-        model, in_sample = fit_target(kind, degree, camera, noise, ridge, illuminant)
+        model, in_sample = fit_target(
+            kind, degree, camera, noise, ridge, illuminant, loss, spectral_weight
+        )
         held_out = held_out_figures(model.predict, camera, noise, HELD_OUT_SETS, illuminant)
     save_regression(model, out)
+    weight = (
+        "" if model.spectral_weight is None else f", spectral weight {model.spectral_weight:.3g}"
+    )
     lines = [
-        f"wrote {out}: {kind} degree {degree}, ridge {model.ridge:.3g}, {model.training_set}",
+        f"wrote {out}: {kind} degree {degree}, {model.loss} loss, ridge {model.ridge:.3g}{weight}, "
+        f"{model.training_set}",
         f"in-sample: {_format(in_sample, illuminant)}",
     ]
-    if model.cv:
+    if model.cv and "rms" in model.cv:
         best = min(model.cv["rms"])
         lines.append(f"cross-validated ({model.cv['folds']} folds) spectral RMS {best:.4f}")
+    elif model.cv:
+        best = min(min(row) for row in model.cv["scores"])
+        lines.append(
+            f"cross-validated ({model.cv['folds']} folds) {model.cv['criterion']}: {best:.2f}"
+        )
     for name, figures in (held_out or {}).items():
         lines.append(f"held out, {name}: {_format(figures, illuminant)}")
     return {"model": model, "in_sample": in_sample, "held_out": held_out, "lines": lines}

@@ -12,6 +12,8 @@ from reference.errors import SpecrefError
 from reference.spectral_regression import (
     REGRESSION_FEATURES,
     SpectralRegression,
+    _colorimetric_solutions,
+    delta_E94_jacobian,
     feature_exponents,
     feature_names,
     features_RGB,
@@ -59,7 +61,9 @@ def test_fit_recovers_a_model_in_its_span(rng):
     RGB = rng.uniform(0, 1, (60, 3))
     truth = rng.normal(size=(19, 5))
     spectra = features_RGB(RGB, "polynomial", 3) @ truth
-    model = fit_regression(RGB, spectra, np.arange(5) * 10.0 + 400, "polynomial", 3)
+    model = fit_regression(
+        RGB, spectra, np.arange(5) * 10.0 + 400, "polynomial", 3, loss="spectral"
+    )
     test = rng.uniform(0, 1, (10, 3))
     assert_allclose(model.predict(test), features_RGB(test, "polynomial", 3) @ truth, atol=1e-6)
     assert model.cv["folds"] == 5
@@ -74,7 +78,7 @@ def test_exposure_rule_above_one():
 
 def test_save_load_round_trip(tmp_path, rng):
     RGB = rng.uniform(0, 1, (30, 3))
-    model = fit_regression(RGB, RGB**2, WL, "root_polynomial", 2, training_set="t")
+    model = fit_regression(RGB, RGB**2, WL, "root_polynomial", 2, training_set="t", loss="spectral")
     path = save_regression(model, tmp_path / "m.json")
     back = load_regression(path, WL)
     assert_allclose(back.coefficients, model.coefficients, rtol=0, atol=0)
@@ -93,6 +97,104 @@ def test_load_refuses_another_grid(tmp_path):
     path = save_regression(SpectralRegression("polynomial", 1, np.eye(3), WL), tmp_path / "m.json")
     with pytest.raises(SpecrefError, match=r"m.json: model grid 450-650 nm, 3 bands; expected"):
         load_regression(path, np.arange(380.0, 781.0, 10.0))
+
+
+def _grid41_target(rng, n):
+    """Smooth random reflectances on 380-780 nm (41 bands) and RGB from three broad bands."""
+    from reference.spectra import GRID_41
+
+    wl = GRID_41.wavelengths_nm
+    centres = rng.uniform(400, 700, (n, 3))
+    spectra = 0.05 + 0.9 * np.exp(-(((wl - centres[:, :1]) / 60.0) ** 2))
+    spectra = np.clip(spectra + 0.3 * np.exp(-(((wl - centres[:, 1:2]) / 40.0) ** 2)), 0, 1)
+    bands = np.stack([np.exp(-(((wl - c) / 40.0) ** 2)) for c in (600, 540, 450)], 1)
+    return spectra @ bands / bands.sum(axis=0), spectra, wl
+
+
+def test_delta_E94_jacobian_against_colour_science(rng):
+    # Source: colour-science's CIE 1994 ΔE of the exact Lab (XYZ_to_Lab) of s and s + r: the
+    # linearisation agrees to first order (dark, light and saturated patches).
+    import colour
+
+    from reference.colorimetry import XYZ_to_Lab, band_weights, white_XYZ
+    from reference.spectra import GRID_41, spectrum_from_dataset
+
+    _, spectra, _ = _grid41_target(rng, 12)
+    spectra[:3] *= 0.02  # L* below 8 %: the linear part of CIELAB's f
+    for light in ("D65", "A"):
+        W = band_weights(GRID_41, spectrum_from_dataset("illuminant", light))
+        G = delta_E94_jacobian(spectra, W)
+        r = 1e-5 * rng.normal(size=spectra.shape)
+        Lab = [XYZ_to_Lab(x @ W, white_XYZ(W)) for x in (spectra, spectra + r)]
+        exact = colour.delta_E(*Lab, method="CIE 1994")
+        assert_allclose(np.linalg.norm(np.einsum("nmb,nb->nm", G, r), axis=1), exact, rtol=1e-3)
+
+
+@pytest.mark.parametrize("n", [40, 400])
+def test_colorimetric_solution_solves_the_normal_equations(rng, n):
+    # Both paths (Woodbury for few patches, the normal equations for many) against the normal
+    # equations of the colorimetric loss written out term by term (module docstring).
+    k, b, m = 6, 41, 6
+    X = rng.normal(size=(n, k))
+    S = rng.uniform(size=(n, b))
+    G = rng.normal(size=(n, m, b))
+    ridge, weight = 1e-3, 1e3
+    (W,) = _colorimetric_solutions(X, S, G, [(ridge, weight)])
+    H = sum(np.kron(np.outer(x, x), g.T @ g) for x, g in zip(X, G, strict=True)) / n
+    H += np.kron(X.T @ X, np.eye(b)) * weight / (n * b) + ridge * np.eye(k * b)
+    rhs = sum(np.kron(x, g.T @ g @ s) for x, g, s in zip(X, G, S, strict=True)) / n
+    rhs += (X.T @ S).reshape(-1) * weight / (n * b)
+    assert_allclose(W.reshape(-1), np.linalg.solve(H, rhs), rtol=1e-7, atol=1e-9)
+
+
+def test_colorimetric_fit_records_its_choice(rng):
+    RGB, spectra, wl = _grid41_target(rng, 60)
+    model = fit_regression(RGB, spectra, wl, "root_polynomial", 2)
+    assert model.loss == "colorimetric"
+    scores = np.array(model.cv["scores"])
+    i, j = np.unravel_index(np.argmin(scores), scores.shape)
+    assert (model.ridge, model.spectral_weight) == (
+        model.cv["ridge_grid"][i],
+        model.cv["spectral_weight_grid"][j],
+    )
+
+
+def test_colorimetric_loss_lowers_in_sample_delta_E(rng):
+    # The loss is ΔE94² to first order: at equal λ the colorimetric fit's in-sample ΔE94 under D65
+    # is below the spectral least-squares fit's.
+    from reference.colorimetry import band_weights
+    from reference.spectra import GRID_41, spectrum_from_dataset
+    from reference.spectral_regression import _delta_E94
+
+    RGB, spectra, wl = _grid41_target(rng, 80)
+    W = band_weights(GRID_41, spectrum_from_dataset("illuminant", "D65"))
+    error = {}
+    for loss, weight in (("colorimetric", 1e2), ("spectral", None)):
+        model = fit_regression(
+            RGB, spectra, wl, "root_polynomial", 2, 1e-6, loss=loss, spectral_weight=weight
+        )
+        error[loss] = _delta_E94(spectra, model.predict(RGB), W).mean()
+    assert error["colorimetric"] < error["spectral"]
+
+
+def test_colorimetric_loss_refuses_an_irregular_grid(rng):
+    RGB = rng.uniform(0, 1, (20, 3))
+    with pytest.raises(SpecrefError, match=r"uniform grid \(or use the spectral loss\)"):
+        fit_regression(RGB, RGB, [450.0, 500.0, 650.0], "polynomial", 1)
+
+
+def test_load_reads_version_1_and_refuses_unknown_versions(tmp_path):
+    # Version 1 files (before the colorimetric loss) hold spectral-loss models: still read.
+    path = save_regression(SpectralRegression("polynomial", 1, np.eye(3), WL), tmp_path / "m.json")
+    document = json.loads(path.read_text())
+    for key in ("loss", "spectral_weight"):
+        del document[key]
+    path.write_text(json.dumps({**document, "version": 1}))
+    back = load_regression(path)
+    assert (back.loss, back.spectral_weight) == ("spectral", None)
+    path.write_text(json.dumps({**document, "version": 3}))
+    with pytest.raises(SpecrefError, match=r"m.json: specref-spectral-regression version 3; this "):
+        load_regression(path)
 
 
 def test_load_refuses_malformed(tmp_path):
@@ -122,7 +224,9 @@ def test_fit_bad_input(RGB, spectra, kind, degree, ridge, message):
 
 def test_spectralize_blocks_equal_predict(rng):
     RGB = rng.uniform(0, 3, (7, 10, 3))
-    model = fit_regression(RGB.reshape(-1, 3), RGB.reshape(-1, 3), WL, "polynomial", 3)
+    model = fit_regression(
+        RGB.reshape(-1, 3), RGB.reshape(-1, 3), WL, "polynomial", 3, loss="spectral"
+    )
     blocks = [(row0, b.copy()) for row0, b in spectralize_blocks(model, RGB, rows_per_block=3)]
     assert [row0 for row0, _ in blocks] == [0, 3, 6]
     whole = np.concatenate([b for _, b in blocks])

@@ -13,6 +13,7 @@ def test_report_spectral_env_section_quick(tmp_path, shared_data, monkeypatch):
     rows = section["regression"]
     assert len(rows) == 2 * (5 + 4)  # every degree of both families, with and without noise
     assert set(section["recovery"]) == {"Mallett 2019", "Otsu 2018", "Smits 1999"}
+    assert set(section["losses"]) == {"colorimetric", "spectral"}  # erratum E44
     names = [c["name"] for c in results["checks"] if c["section"] == "spectral-env"]
     assert len(names) == 4
     images = sorted(p.name for p in (tmp_path / "r" / "images").iterdir())

@@ -50,11 +50,28 @@ def test_held_out_colorchecker_mean_D65_and_A(root4):
 
 @pytest.mark.xfail(
     strict=True,
-    reason="erratum E44: held-out ColorChecker max ΔE94 is 1.83 > 1.5; the direct RGB->XYZ "
-    "floor on the same features is 1.49, so this training set leaves no margin",
+    reason="erratum E44: held-out ColorChecker max ΔE94 is 1.51 > 1.5 with the colorimetric loss "
+    "(1.83 with the spectral one); the cyan patch, an extrapolation of this training set",
 )
 def test_held_out_colorchecker_max(root4):
     assert root4[2][CC]["D65 max"] <= 1.5
+
+
+def test_colorimetric_loss_improves_on_the_spectral_loss_held_out(root4):
+    # Erratum E44: the default loss (ΔE94 under D65 and A, λ and β by CV on the training set)
+    # against spectral least squares, on every set the design never saw, the CIE 2017 samples
+    # (measured after the choice was made) included: relit under A the mean is lower on each, and
+    # the peak under D65 is lower on the ColorChecker and the NIST CQS samples.
+    from reference.spectral_target import OTHER_TEST_SET
+
+    sets = (*HELD_OUT_SETS, OTHER_TEST_SET)
+    assert root4[0].loss == "colorimetric"
+    new = held_out_figures(root4[0].predict, sets=sets)
+    old = held_out_figures(fit_target("root_polynomial", 4, loss="spectral")[0].predict, sets=sets)
+    for name in sets:
+        assert new[name]["A mean"] < old[name]["A mean"], name
+    for name in (CC, "NIST CQS 9.0"):
+        assert new[name]["D65 max"] < old[name]["D65 max"], name
 
 
 @pytest.mark.parametrize("name", HELD_OUT_SETS[1:])

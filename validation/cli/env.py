@@ -18,6 +18,8 @@ def _cmd_env_fit(args) -> int:
         args.degree,
         args.ridge,
         args.noise,
+        args.loss,
+        args.spectral_weight,
     )
     for line in report["lines"]:
         print(line)
@@ -54,7 +56,7 @@ def _cmd_env_convert(args) -> int:
 
 def add_parser(sub) -> None:
     """Add ``specref env fit|spectralize|convert`` to the subcommand parsers ``sub``."""
-    from reference.spectral_regression import REGRESSION_FEATURES
+    from reference.spectral_regression import DEFAULT_LOSS, REGRESSION_FEATURES, REGRESSION_LOSSES
     from reference.spectral_target import CAMERAS
 
     p = sub.add_parser("env", help="spectral environments: camera-target regression (Herbert §4)")
@@ -68,7 +70,14 @@ def add_parser(sub) -> None:
         f, "--features", REGRESSION_FEATURES, "regression features", default="root_polynomial"
     )
     f.add_argument("--degree", type=int, default=4, help="1-5 (polynomial), 1-4 (root)")
+    registry_option(f, "--loss", REGRESSION_LOSSES, "fitted loss (E44)", default=DEFAULT_LOSS)
     f.add_argument("--ridge", type=float, default=None, help="fixed ridge strength (default: CV)")
+    f.add_argument(
+        "--spectral-weight",
+        type=float,
+        default=None,
+        help="β of the colorimetric loss (default: CV)",
+    )
     f.add_argument("--noise", action="store_true", help="add 0.5 %% + 0.1 %% camera noise")
     f.add_argument("-o", "--out", required=True, help="output model .json")
     f.set_defaults(func=_cmd_env_fit)

@@ -3,8 +3,9 @@
 The "camera" is linear sRGB (the CIE 1931 2° observer through the XYZ → sRGB matrix,
 ``reference.spectral_target.CAMERAS["sRGB"]``), the capture illuminant D65 (the sRGB white), the
 target the training set of ``reference.spectral_target`` (rawtoaces-190 minus the look-alikes of
-every held-out set), the features Finlayson's root-polynomials of degree 4, the ridge strength
-chosen by 5-fold cross-validation (``reference.spectral_regression``). It is what the
+every held-out set), the features Finlayson's root-polynomials of degree 4, the colorimetric loss
+(ΔE94 under D65 and A plus a spectral term, erratum E44) with the ridge strength and the spectral
+weight chosen by 5-fold cross-validation (``reference.spectral_regression``). It is what the
 ``regression`` key of ``reference.upsampling.UPSAMPLING_METHODS`` uses.
 
 Run: ``.venv/bin/python -m validation.precompute.spectral_regression`` (a few seconds).
