@@ -37,6 +37,7 @@ from impastor.specular_lighting import (
     _flat,
     specular_brute_force,
     specular_fis,
+    specular_mis,
     specular_point_lights,
 )
 from reference.brdf import brdf_ward_duer_specular
@@ -45,6 +46,9 @@ from reference.registry import Method, Registry
 
 __all__ = [
     "CHOOSE_RATIO",
+    "FAILSAFE_PIXELS",
+    "FAILSAFE_SAMPLES",
+    "FAILSAFE_SEED",
     "SECOND_SET_SHIFT",
     "SPECULAR_METHODS",
     "hybrid_error_estimates",
@@ -172,6 +176,43 @@ SECOND_SET_SHIFT = (0.6180339887498949, 0.41421356237309515)
 #: Where the estimated errors differ by more than this factor, or cannot explain the methods'
 #: disagreement, the hybrid takes the method with the smaller error instead of blending.
 CHOOSE_RATIO = 3.0
+
+
+#: The fail-safe's unbiased estimate (:func:`impastor.specular_lighting.specular_mis`): samples of
+#: each technique per pixel, pixels per group of similar α at most (an even stride through the
+#: group), and the generator's seed.
+FAILSAFE_SAMPLES = 128
+FAILSAFE_PIXELS = 256
+FAILSAFE_SEED = 22
+
+
+def _failsafe(P, N, V, a, light, lights, vis, backend, I_pl, I_fis, w_pl):
+    """Per group of pixels with α within a half octave: which of the three to keep.
+
+    Returns ``choice`` per pixel: 0 the hybrid, 1 the point lights, 2 FIS. Each is measured
+    against an unbiased estimate ``U`` (:func:`specular_mis`) on a stride of the group's pixels:
+    ``Σ (X − U)²`` is an unbiased estimate of ``Σ (X − I)² + Σ var U``, with the same second term
+    for every X, so the smallest sum marks the smallest squared error (erratum E17).
+    """
+    choice = np.zeros(P.shape[0], dtype=np.int64)
+    group = np.floor(2.0 * np.log2(a)).astype(np.int64)
+    for g in np.unique(group):
+        members = np.flatnonzero(group == g)
+        subset = members[:: -(-members.size // FAILSAFE_PIXELS)]
+        U, _ = specular_mis(
+            P[subset], N[subset], V[subset], a[subset], light, FAILSAFE_SAMPLES,
+            FAILSAFE_SEED + int(g),
+        )  # fmt: skip
+        pl = I_pl[subset]
+        if vis is not None:
+            # U sees no shadows: compare the point lights' integration without them too
+            pl = specular_point_lights(P[subset], N[subset], V[subset], a[subset], lights,
+                                       None, backend=backend)  # fmt: skip
+        w = w_pl[subset, None]
+        candidates = (w * pl + (1.0 - w) * I_fis[subset], pl, I_fis[subset])
+        sums = [float(np.sum((X - U).mean(axis=-1) ** 2)) for X in candidates]
+        choice[members] = int(np.argmin(sums))
+    return choice
 
 
 def _hybrid_parts(P, N, V, a, light, lights, K, vis, backend):
@@ -322,7 +363,9 @@ def specular_hybrid_parts(
     -------
     dict
         ``hybrid``, ``point_lights``, ``fis``: shape (..., C); ``e_point_lights``, ``e_fis``
-        (absolute, channel mean) and ``w_point_lights`` (the point lights' weight): shape (...,).
+        (absolute, channel mean), ``w_point_lights`` (the point lights' weight, after the
+        fail-safe) and ``failsafe`` (0: the per-pixel hybrid kept, 1: the point lights, 2: FIS):
+        shape (...,).
 
     Examples
     --------
@@ -331,8 +374,10 @@ def specular_hybrid_parts(
     >>> lights = point_lights_from_plane(plane, "median_cut", 4)
     >>> up = np.array([0.0, 1.0, 0.0])
     >>> parts = specular_hybrid_parts(np.zeros(3), up, up, 0.05, plane, lights, 16)
-    >>> sorted(parts), bool(0.0 <= parts["w_point_lights"] <= 1.0)
-    (['e_fis', 'e_point_lights', 'fis', 'hybrid', 'point_lights', 'w_point_lights'], True)
+    >>> sorted(parts)
+    ['e_fis', 'e_point_lights', 'failsafe', 'fis', 'hybrid', 'point_lights', 'w_point_lights']
+    >>> bool(0.0 <= parts["w_point_lights"] <= 1.0), int(parts["failsafe"])
+    (True, 0)
     """
     shape, I_pl, I_fis, e_pl, e_fis, choose = _evaluate(
         points, normals, views, alpha, light, lights, n_samples, visibility, backend
@@ -342,6 +387,11 @@ def specular_hybrid_parts(
     w_pl = np.where(total > 0, e_fis**2 / np.where(total > 0, total, 1.0), 0.0)
     # The fail-safe: a choice, not a blend, where the estimates disagree.
     w_pl = np.where(choose, (e_pl < e_fis).astype(np.float64), w_pl)
+    # The fail-safe: the hybrid, the point lights or FIS, whichever an unbiased estimate favours
+    P, N, V, a, _ = _flat(points, normals, views, alpha)
+    vis = _visibility(visibility, shape, P.shape[0], len(lights.regions))
+    failsafe = _failsafe(P, N, V, a, light, lights, vis, backend, I_pl, I_fis, w_pl)
+    w_pl = np.select([failsafe == 1, failsafe == 2], [1.0, 0.0], w_pl)
     I_hybrid = w_pl[:, None] * I_pl + (1.0 - w_pl[:, None]) * I_fis
     return {
         "hybrid": I_hybrid.reshape((*shape, -1)),
@@ -350,6 +400,7 @@ def specular_hybrid_parts(
         "e_point_lights": e_pl.reshape(shape),
         "e_fis": e_fis.reshape(shape),
         "w_point_lights": w_pl.reshape(shape),
+        "failsafe": failsafe.reshape(shape),
     }
 
 

@@ -15,7 +15,12 @@ from impastor.specular_hybrid import (
     specular_hybrid,
     specular_hybrid_parts,
 )
-from impastor.specular_lighting import specular_brute_force, specular_fis, specular_point_lights
+from impastor.specular_lighting import (
+    specular_brute_force,
+    specular_fis,
+    specular_mis,
+    specular_point_lights,
+)
 
 
 def _plane(kind="fluorescent"):
@@ -94,6 +99,41 @@ def test_hybrid_parts_are_the_two_methods_and_their_weighted_mean():
     mean = w * parts["point_lights"] + (1.0 - w) * parts["fis"]
     np.testing.assert_allclose(parts["hybrid"], mean, rtol=1e-15)
     assert ((w >= 0.0) & (w <= 1.0)).all()
+
+
+@pytest.mark.parametrize("light", ["fluorescent", "env:studio_small_03_1k.hdr:40"])
+@pytest.mark.parametrize("alpha", [0.03, 0.3])
+def test_mis_estimate_is_unbiased_with_an_honest_standard_error(light, alpha):
+    # The fail-safe's arbiter: over 40 seeds its mean is the brute force (converged, 12² sub-pixels)
+    # within 4 standard errors of that mean, and its own standard error matches the seeds' spread.
+    from impastor.painting import impasto_painting, painting_samples
+    from validation.impastor_hybrid import case_light
+
+    P, N, V = painting_samples(3, impasto_painting(64, seed=3))
+    plane = case_light(light, 32, 16)
+    a = np.full(len(P), alpha)
+    truth = specular_brute_force(P, N, V, a, plane, 12, "numba")[:, 0]
+    runs = [specular_mis(P, N, V, a, plane, 64, seed) for seed in range(40)]
+    estimates = np.array([r[0][:, 0] for r in runs])
+    spread = estimates.std(axis=0, ddof=1)
+    z = (estimates.mean(axis=0) - truth) / (spread / np.sqrt(len(runs)))
+    assert np.abs(z).max() < 4.0, z.round(2)
+    stated = np.median([r[1] for r in runs], axis=0)
+    lit = truth > 1e-3 * truth.max()
+    assert (stated[lit] > 0.3 * spread[lit]).all() and (stated[lit] < 2.0 * spread[lit]).all()
+
+
+@pytest.mark.slow
+def test_failsafe_keeps_the_point_lights_where_fis_fails_on_a_peaked_ceiling():
+    # A design case of the fail-safe (E17): the studio ceiling holds its power in a few pixels,
+    # FIS is 200-260 % off at alpha 0.15-0.2 and the per-pixel estimates alone came out 26-28x
+    # worse than the point lights (0.9-2.6 %); with the fail-safe the image is the point lights'.
+    from validation.impastor_hybrid import HybridCase, hybrid_case_ratios
+
+    case = HybridCase(541, "env:studio_small_03_1k.hdr:348", 64, 32)
+    result = hybrid_case_ratios(case, (0.15, 0.2), supersample=4)
+    assert np.asarray(result["fis"]).min() > 10 * np.asarray(result["median_cut"]).max()
+    assert max(result["ratio"]) <= 1.1, result["ratio"]
 
 
 # Held-out cases for issue 22: painting seeds, lamp seeds and ceiling azimuths that the design
