@@ -46,7 +46,11 @@ from reference.registry import Method, Registry
 
 __all__ = [
     "CHOOSE_RATIO",
+    "FAILSAFE_MARGIN",
     "FAILSAFE_PIXELS",
+    "FAILSAFE_REFINE_PIXELS",
+    "FAILSAFE_REFINE_SAMPLES",
+    "FAILSAFE_ROUNDS",
     "FAILSAFE_SAMPLES",
     "FAILSAFE_SEED",
     "SECOND_SET_SHIFT",
@@ -184,6 +188,27 @@ CHOOSE_RATIO = 3.0
 FAILSAFE_SAMPLES = 128
 FAILSAFE_PIXELS = 256
 FAILSAFE_SEED = 22
+#: Refinement: while the choice is within this many standard deviations of the runner-up, up to
+#: this many rounds add this many samples to this many pixels (those that add most to its variance).
+FAILSAFE_MARGIN = 2.0
+FAILSAFE_ROUNDS = 3
+FAILSAFE_REFINE_PIXELS = 8
+FAILSAFE_REFINE_SAMPLES = 2048
+
+
+def _closest(candidates, U, se) -> tuple[int, int, float]:
+    """The candidate with the smallest ``Σ (X − U)²``, the runner-up, and the margin in σ."""
+    sums = [float(np.sum((X - U) ** 2)) for X in candidates]
+    best, runner_up, margin = int(np.argmin(sums)), -1, np.inf
+    for k, X in enumerate(candidates):
+        if k != best:
+            B = candidates[best]
+            # Σ(X − U)² − Σ(B − U)² = Σ (X − B)(X + B − 2U): its variance is 4 Σ (X − B)² var U
+            sigma = 2.0 * np.sqrt(np.sum((X - B) ** 2 * se**2))
+            z = (sums[k] - sums[best]) / sigma if sigma > 0 else np.inf
+            if z < margin:
+                runner_up, margin = k, z
+    return best, runner_up, margin
 
 
 def _failsafe(P, N, V, a, light, lights, vis, backend, I_pl, I_fis, w_pl):
@@ -192,26 +217,43 @@ def _failsafe(P, N, V, a, light, lights, vis, backend, I_pl, I_fis, w_pl):
     Returns ``choice`` per pixel: 0 the hybrid, 1 the point lights, 2 FIS. Each is measured
     against an unbiased estimate ``U`` (:func:`specular_mis`) on a stride of the group's pixels:
     ``Σ (X − U)²`` is an unbiased estimate of ``Σ (X − I)² + Σ var U``, with the same second term
-    for every X, so the smallest sum marks the smallest squared error (erratum E17).
+    for every X, so the smallest sum marks the smallest squared error. The few bright pixels that
+    carry the sums' noise get more samples until the choice is clear (erratum E17).
     """
     choice = np.zeros(P.shape[0], dtype=np.int64)
     group = np.floor(2.0 * np.log2(a)).astype(np.int64)
     for g in np.unique(group):
         members = np.flatnonzero(group == g)
-        subset = members[:: -(-members.size // FAILSAFE_PIXELS)]
-        U, _ = specular_mis(
-            P[subset], N[subset], V[subset], a[subset], light, FAILSAFE_SAMPLES,
-            FAILSAFE_SEED + int(g),
-        )  # fmt: skip
-        pl = I_pl[subset]
+        sub = members[:: -(-members.size // FAILSAFE_PIXELS)]
+        seed = 1000 * (int(g) + 1000) + FAILSAFE_SEED  # non-negative for any α in use
+        U, se = specular_mis(P[sub], N[sub], V[sub], a[sub], light, FAILSAFE_SAMPLES, seed)
+        U, m = U.mean(axis=-1), np.full(sub.size, float(FAILSAFE_SAMPLES))
+        pl = I_pl[sub].mean(axis=-1)
         if vis is not None:
             # U sees no shadows: compare the point lights' integration without them too
-            pl = specular_point_lights(P[subset], N[subset], V[subset], a[subset], lights,
-                                       None, backend=backend)  # fmt: skip
-        w = w_pl[subset, None]
-        candidates = (w * pl + (1.0 - w) * I_fis[subset], pl, I_fis[subset])
-        sums = [float(np.sum((X - U).mean(axis=-1) ** 2)) for X in candidates]
-        choice[members] = int(np.argmin(sums))
+            pl = specular_point_lights(
+                P[sub], N[sub], V[sub], a[sub], lights, None, backend=backend
+            ).mean(axis=-1)
+        fis = I_fis[sub].mean(axis=-1)
+        candidates = (w_pl[sub] * pl + (1.0 - w_pl[sub]) * fis, pl, fis)
+        best, runner_up, margin = _closest(candidates, U, se)
+        for round_ in range(1, FAILSAFE_ROUNDS + 1):
+            if margin > FAILSAFE_MARGIN:
+                break
+            # the pixels that carry most of the variance of the choice against the runner-up
+            spread = (candidates[best] - candidates[runner_up]) ** 2 * se**2
+            top = np.argsort(-spread, kind="stable")[:FAILSAFE_REFINE_PIXELS]
+            more, more_se = specular_mis(
+                P[sub][top], N[sub][top], V[sub][top], a[sub][top], light,
+                FAILSAFE_REFINE_SAMPLES, seed + round_,
+            )  # fmt: skip
+            # pool the two unbiased estimates by their sample counts
+            m_0, m_1 = m[top], float(FAILSAFE_REFINE_SAMPLES)
+            U[top] = (m_0 * U[top] + m_1 * more.mean(axis=-1)) / (m_0 + m_1)
+            se[top] = np.hypot(m_0 * se[top], m_1 * more_se) / (m_0 + m_1)
+            m[top] = m_0 + m_1
+            best, runner_up, margin = _closest(candidates, U, se)
+        choice[members] = best
     return choice
 
 
