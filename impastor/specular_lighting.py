@@ -421,7 +421,7 @@ def specular_mis(
     d = np.linalg.norm(x - Pm, axis=-1)
     wi = (x - Pm) / d[..., None]
     g_light = weighted(wi, d, texel, np.ones(d.shape, dtype=bool))
-    # Technique 2: Ward's lobe, the light pixel the direction meets (Eqs. (5)-(8), Ferwerda)
+    # Technique 2: Ward's lobe, the light pixel it meets (light_plane_uv: Eq. (8), Ferwerda)
     u = rng.random((n_P, M, 2))
     wi = sample_ward_duer_lobe(*(np.broadcast_to(x, (n_P, M, 3)) for x in (Vm, Nm)), am, u)
     a_uv, b_uv, d = light_plane_uv(light, np.broadcast_to(Pm, (n_P, M, 3)), wi)

@@ -88,6 +88,31 @@ def _errors(Y, truth) -> tuple[float, float]:
     )
 
 
+#: Samples of the Monte Carlo estimator's timing run, from which its equal-time count is scaled.
+MC_CALIBRATION_SAMPLES = 256
+#: The estimator's seed.
+MC_SEED = 21
+
+
+def _equal_time_mc(env, renderer, n, v, split_seconds, truth_Y, y) -> dict:
+    """Importance-sampled Monte Carlo (``shrm.montecarlo``) given the split's time per frame."""
+    from shrm.montecarlo import environment_mc
+    from shrm.shrm_oracles import env_quadrature
+
+    quadrature = env_quadrature(env)
+    run = lambda m: environment_mc(quadrature, renderer.brdf, renderer.params, n, v, m, MC_SEED)  # noqa: E731
+    start = time.perf_counter()
+    run(MC_CALIBRATION_SAMPLES)
+    per_sample = (time.perf_counter() - start) / MC_CALIBRATION_SAMPLES
+    # Equal time (erratum E58): the sample count whose run takes the split's frame time
+    samples = max(1, round(split_seconds / per_sample))
+    start = time.perf_counter()
+    out = run(samples)
+    seconds = time.perf_counter() - start
+    pct, mean = _errors(out @ y, truth_Y)
+    return {"pct_of_peak": pct, "mean_rel_pct": mean, "shade_seconds": seconds, "samples": samples}
+
+
 def fullres_case(task) -> dict:
     """One map × BRDF × α: the split, the SHRM alone and the brute force, errors and seconds.
 
@@ -105,8 +130,10 @@ def fullres_case(task) -> dict:
         ``env_rows``; per method
         (``split``, ``shrm``, ``shrm_half_F``) its ``pct_of_peak``, ``mean_rel_pct``,
         ``create_seconds`` (the first frame's maps) and ``shade_seconds`` (a frame after the
-        first); ``bruteforce_seconds``; the split's ``F``, ``P``,
-        ``size``, ``residual_texels``, ``promised_pct_of_peak`` and ``meets_tolerance``.
+        first); ``mc`` (importance-sampled Monte Carlo given the split's frame time: its
+        errors, ``shade_seconds`` and ``samples`` per point); ``bruteforce_seconds``; the
+        split's ``F``, ``P``, ``size``, ``residual_texels``, ``promised_pct_of_peak`` and
+        ``meets_tolerance``.
 
     Examples
     --------
@@ -162,6 +189,7 @@ def fullres_case(task) -> dict:
         "create_seconds": create_s,
         "shade_seconds": shade_s,
     }
+    row["mc"] = _equal_time_mc(env, renderer, n, v, shade_s, truth, y)
     # The SHRM alone: no residual (τ = ∞), at the split's settings and at half its F
     for key, F in (("shrm", s.F), ("shrm_half_F", max(s.F // 2, 1))):
         alone = dataclasses.replace(s, F=F, tau=float("inf"), residual_texels=0)

@@ -29,6 +29,9 @@ def test_the_split_beats_the_shrm_alone_under_a_sun(sun_map):
     # what the split promised holds (an upper bound of its error)
     assert row["split"]["pct_of_peak"] <= row["promised_pct_of_peak"]
     assert row["pixels"] == len(sphere_points(8)[0])
+    # the Monte Carlo estimator of equal time: at least one sample, an error that is measured
+    assert row["mc"]["samples"] >= 1
+    assert np.isfinite(row["mc"]["pct_of_peak"])
 
 
 def test_checks_follow_the_targets_and_quick_mode_has_none(sun_map, tmp_path):

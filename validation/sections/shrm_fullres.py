@@ -98,6 +98,7 @@ def _chart(ctx: ReportContext, rows: list):
         "split": ("SH + angular split (default)", "o"),
         "shrm": ("SHRM alone, same settings", "s"),
         "shrm_half_F": ("SHRM alone, half F", "^"),
+        "mc": ("Monte Carlo, importance-sampled, split's time", "D"),
     }
     for key, (label, marker) in styles.items():
         x = [1e3 * r[key]["shade_seconds"] / r["pixels"] for r in rows]
@@ -138,6 +139,8 @@ def present(ctx: ReportContext, data: SectionData) -> list:
             "yes" if r["meets_tolerance"] else "no",
             r["shrm"]["pct_of_peak"],
             r["shrm_half_F"]["pct_of_peak"],
+            r["mc"]["pct_of_peak"],
+            r["mc"]["samples"],
             f"{r['F']}/{r['P']}/{r['size']}",
             r["residual_texels"],
             r["bruteforce_seconds"] / r["split"]["shade_seconds"],
@@ -168,6 +171,8 @@ def present(ctx: ReportContext, data: SectionData) -> list:
                 "meets tolerance",
                 "SHRM alone: % of peak",
                 "SHRM half F: % of peak",
+                "MC equal time: % of peak",
+                "MC samples per point",
                 "F/P/cube",
                 "residual texels",
                 "frame speed-up vs brute force",
