@@ -28,13 +28,15 @@ __all__ = ["FULLRES_BRDFS", "GRID", "environment_radiance", "fullres_case", "sph
 GRID = SpectralGrid(410.0, 710.0, 50.0)
 
 #: BRDFs and widths of the full study: GGX and Ward from α 0.1 to 0.5 (issue 21, item 4) and the
-#: thin-film effect pigment. ``rho_d`` 0 and ``F_0`` 1 for GGX, as in the issue.
+#: thin-film effect pigment. ``rho_d`` 0 and ``F_0`` 1 for GGX, as in the issue; ``table`` is a
+#: BRDF table (:func:`tabulated_ggx` of that α).
 FULLRES_BRDFS = (
     ("ggx", 0.1),
     ("ggx", 0.3),
     ("ggx", 0.5),
     ("ward_isotropic", 0.3),
     ("effect_pigment", 0.15),
+    ("table", 0.3),
 )
 
 
@@ -86,6 +88,30 @@ def _errors(Y, truth) -> tuple[float, float]:
         float(100 * np.abs(Y - truth).max() / peak),
         float(100 * np.mean(np.abs(Y - truth)[bright] / truth[bright])),
     )
+
+
+def tabulated_ggx(alpha: float):
+    """GGX (ρ_d 0, F_0 1) of roughness ``alpha`` as a BRDF table: 5° in θ, 15° in Δφ.
+
+    The full-resolution set's tabulated BRDF (``brdf = "table"`` of a scene file, read through
+    ``docs/brdf-format.md``), at the resolution of that format's examples; the split and the
+    brute force both evaluate the table (its interpolation), so the comparison is of the
+    rendering path, not of the tabulation.
+
+    Examples
+    --------
+    >>> tabulated_ggx(0.3).values.shape
+    (19, 19, 13, 7)
+    """
+    from reference.brdf import BRDF_METHODS
+    from reference.brdf_table import tabulate_brdf
+    from shrm.orbit import brdf_params_on_grid
+
+    params = brdf_params_on_grid("ggx", GRID, {"alpha": alpha, "rho_d": 0.0, "F_0": 1.0})
+    return tabulate_brdf(
+        BRDF_METHODS.lookup("ggx").reference, params, np.arange(0.0, 91.0, 5.0),
+        np.arange(0.0, 181.0, 15.0), GRID.wavelengths_nm, name=f"GGX alpha {alpha:g}",
+    )  # fmt: skip
 
 
 #: Samples of the Monte Carlo estimator's timing run, from which its equal-time count is scaled.
@@ -156,7 +182,10 @@ def fullres_case(task) -> dict:
     y = ShadingContext(GRID).weights(None)[:, 1]
     n, v = sphere_points(pixels)
     extra = {"rho_d": 0.0, "F_0": 1.0} if brdf == "ggx" else {}
-    params = brdf_params_on_grid(brdf, GRID, {"alpha": alpha, **extra})
+    if brdf == "table":
+        params = {"table": tabulated_ggx(alpha)}
+    else:
+        params = brdf_params_on_grid(brdf, GRID, {"alpha": alpha, **extra})
     start = time.perf_counter()
     renderer = split_renderer(env, brdf, params, y, n, v, tol)
     create_s = time.perf_counter() - start
