@@ -10,7 +10,6 @@ scales give); a second edit goes through the page's JS model (the ``data`` of th
 import shutil
 import subprocess
 import sys
-import time
 
 import numpy as np
 import pytest
@@ -53,12 +52,10 @@ def test_an_edit_in_the_browser_renders_and_saves(tmp_path):
         assert dragged == pytest.approx(0.95, abs=0.02)  # one pixel of the plot is ~0.005
         wait_for(driver, lambda d: image_checksum(d) != image0, 30, "the new image")
         rms1 = wait_for(driver, lambda d: rms_shown(d) != rms0 and rms_shown(d), 30, "new RMS")
-        # One edit through the page's JS model, timed from the edit to the new image on the page.
+        # One edit through the page's JS model (its latency is a benchmark's, not this test's).
         frame1, image1 = page_value(driver, "frame"), image_checksum(driver)
-        edited = time.perf_counter()
         set_control_point(driver, "n", 0, 3000.0)
         wait_for(driver, lambda d: image_checksum(d) != image1, 30, "the image of the n edit")
-        latency = time.perf_counter() - edited
         assert page_value(driver, "frame") != frame1
         rms2 = wait_for(
             driver,
@@ -67,7 +64,7 @@ def test_an_edit_in_the_browser_renders_and_saves(tmp_path):
             "the n edit's RMS",
         )
         figures = " -> ".join(text.split()[1] for text in (rms0, rms1, rms2))
-        print(f"\nedit-to-image latency: {latency * 1e3:.0f} ms; RMS {figures}")  # noqa: T201
+        print(f"\nRMS {figures}")  # noqa: T201
         # Save to a new file through the page's path field and its "save" button.
         saved = tmp_path / "saved.toml"
         set_widget(driver, "path", "value", str(saved))
