@@ -357,7 +357,7 @@ def hybrid_error_estimates(
     >>> bool(e_fis[0] < e_pl[0]), bool(e_fis[1] > e_pl[1])
     (True, True)
     """
-    shape, _, I_fis, e_pl, e_fis, _ = _evaluate(
+    shape, _, I_fis, e_pl, e_fis, _, _ = _evaluate(
         points, normals, views, alpha, light, lights, n_samples, visibility, backend
     )
     scale = np.maximum(np.abs(I_fis.mean(axis=-1)), 1e-300)
@@ -370,7 +370,7 @@ def _evaluate(points, normals, views, alpha, light, lights, n_samples, visibilit
     K = require_positive_int(n_samples, "hybrid: n_samples", 1 << 20)
     require(K >= 2, f"hybrid: n_samples: must be >= 2 (the error estimate uses K/2), got {K}")
     vis = _visibility(visibility, shape, P.shape[0], len(lights.regions))
-    return (shape, *_hybrid_parts(P, N, V, a, light, lights, K, vis, backend))
+    return (shape, *_hybrid_parts(P, N, V, a, light, lights, K, vis, backend), (P, N, V, a, vis))
 
 
 def _visibility(visibility, shape, n_points, n_lights):
@@ -421,7 +421,7 @@ def specular_hybrid_parts(
     >>> bool(0.0 <= parts["w_point_lights"] <= 1.0), int(parts["failsafe"])
     (True, 0)
     """
-    shape, I_pl, I_fis, e_pl, e_fis, choose = _evaluate(
+    shape, I_pl, I_fis, e_pl, e_fis, choose, flat = _evaluate(
         points, normals, views, alpha, light, lights, n_samples, visibility, backend
     )
     total = e_pl**2 + e_fis**2
@@ -430,8 +430,7 @@ def specular_hybrid_parts(
     # The fail-safe: a choice, not a blend, where the estimates disagree.
     w_pl = np.where(choose, (e_pl < e_fis).astype(np.float64), w_pl)
     # The fail-safe: the hybrid, the point lights or FIS, whichever an unbiased estimate favours
-    P, N, V, a, _ = _flat(points, normals, views, alpha)
-    vis = _visibility(visibility, shape, P.shape[0], len(lights.regions))
+    P, N, V, a, vis = flat  # the inputs as _evaluate checked and flattened them
     failsafe = _failsafe(P, N, V, a, light, lights, vis, backend, I_pl, I_fis, w_pl)
     w_pl = np.select([failsafe == 1, failsafe == 2], [1.0, 0.0], w_pl)
     I_hybrid = w_pl[:, None] * I_pl + (1.0 - w_pl[:, None]) * I_fis
