@@ -104,6 +104,14 @@ def _expect_error(capsys, argv, message):
 
 def test_bad_input_one_line_exit_2(tmp_path, rng, capsys):
     pano, _ = _panorama(tmp_path, rng)
+    # the colorimetric loss's spectral weight: NaN, negative and overflowing values
+    for weight in ("nan", "-1", "1e400"):
+        _expect_error(
+            capsys,
+            ["env", "fit", "--spectral-weight", weight, "-o", str(tmp_path / "w.json")],
+            "spectral weight (colorimetric loss only) must be > 0",
+        )
+    assert not (tmp_path / "w.json").exists()
     # a target whose patch counts differ between RGB and spectra
     (tmp_path / "rgb.csv").write_text("R,G,B\n0.1,0.2,0.3\n0.3,0.2,0.1\n")
     (tmp_path / "spec.csv").write_text("380,780\n0.1,0.2\n")
