@@ -24,7 +24,8 @@ degree l of ``L_low`` and ``κ_l`` the largest power of degree l of the kernel o
 falls with τ, and ``τ = 0`` (everything residual) is the brute force. Clamping the SH part at
 zero never moves it further from the truth, which is non-negative, so the clamp keeps the bound
 and no pixel is ever negative. ``B`` does not cover the view order P (chosen from the BRDF's view
-tail, :func:`shrm.brdf_sh.choose_orders`) nor the cube-map interpolation; the tests measure them.
+tail) nor the cube-map interpolation: :func:`split_renderer` spot-checks the renderer against
+brute force at a few points, the most grazing among them, and states that error too.
 
 References
 ----------
@@ -307,12 +308,15 @@ def truncation_bound(env_power, env_tail, kernel_power, kernel_tail, F: int) -> 
 
 #: Residual fractions of the texels tried by :func:`choose_split_settings`, smallest first.
 RESIDUAL_FRACTIONS = (0.0, 1e-4, 2e-4, 5e-4, 1e-3, 2e-3, 5e-3, 1e-2, 2e-2)
-#: Highest kernel degree measured, the largest F, the view orders allowed (§5.5: 2-10).
-KERNEL_ORDER, F_MAX, P_MAX = 128, 32, 10
+#: Highest kernel degree measured, the largest F, the largest view order (§5.5 uses 2-10; 18
+#: here: at 10 grazing pixels miss 1 % of the peak, E92) and the order the view tail is measured to.
+KERNEL_ORDER, F_MAX, P_MAX, P_FIT = 128, 32, 18, 20
 #: Relative L2 tails of the kernel (lighting) and of the BRDF coefficients (view) (E92).
 F_TAIL, P_TAIL = 0.02, 0.01
 #: Pixels sampled for the lower bound of the image's peak.
 PEAK_SAMPLES = 128
+#: Points of the spot check against brute force (half the most grazing, half spread) (E92).
+CHECK_POINTS = 8
 
 
 @dataclass(frozen=True)
@@ -339,7 +343,14 @@ class SplitSettings:
     meets_tolerance : bool
         ``bound_Y <= tol · peak_lower_bound``; when False the render says so (E92).
     view_tail : float
-        The BRDF coefficients' relative L2 tail beyond P (not in the bound).
+        The BRDF coefficients' relative L2 tail beyond P, measured to :data:`P_FIT` (not in the
+        bound).
+    check_points : int
+        Points of the spot check (0: not run).
+    check_error : float
+        The largest |ΔY| of the split against brute force at those points, relative to
+        ``peak_lower_bound`` (covers P and the cube interpolation, which ``bound_Y`` does not).
+        ``meets_tolerance`` also needs it to be at most ``tol``.
     """
 
     F: int
@@ -355,6 +366,8 @@ class SplitSettings:
     tol: float
     meets_tolerance: bool
     view_tail: float
+    check_points: int = 0
+    check_error: float = 0.0
 
     def metadata(self) -> dict:
         """The settings as plain data for render metadata (``RenderResult.records["shrm"]``)."""
@@ -372,14 +385,14 @@ def _lighting_order(kernel_power) -> int:
 
 
 def _view_order(brdf, expand, F: int, frame: str, view_power: float):
-    """The smallest P in 2-10 whose relative view tail is below :data:`P_TAIL`, and that tail."""
+    """The smallest P <= :data:`P_MAX` whose view tail (to :data:`P_FIT`) is <= :data:`P_TAIL`."""
     from shrm.brdf_sh import brdf_sh_coefficients
 
-    rho = brdf_sh_coefficients(brdf, expand, F, P_MAX, frame, view_power=view_power)
+    rho = brdf_sh_coefficients(brdf, expand, F, P_FIT, frame, view_power=view_power)
     weight = np.where(np.arange(rho.shape[3]) > 0, 2.0, 1.0)
     per_p = (rho**2 * weight).sum(axis=(0, 1, 3))
     tail = np.sqrt(np.maximum(per_p.sum() - np.cumsum(per_p), 0.0) / max(per_p.sum(), 1e-300))
-    below = np.flatnonzero(tail[2:] <= P_TAIL)
+    below = np.flatnonzero(tail[2 : P_MAX + 1] <= P_TAIL)
     P = int(2 + below[0]) if below.size else P_MAX
     return P, float(tail[P]), rho
 
@@ -461,7 +474,7 @@ def _choose(radiance, brdf_name, params, y_weights, normals, views, tol, frame):
         bool(bound <= tol * peak),
         view_tail,
     )
-    # The sphere fit of order P is the truncation of the one of order P_MAX (reflection frame)
+    # The sphere fit of order P is the truncation of the one of order P_FIT (reflection frame)
     reusable = frame == "reflection"
     return settings, (rho[:, :, : P + 1, : min(F, P) + 1] if reusable else None)
 
@@ -537,7 +550,9 @@ def split_create(
     return SplitRenderer(s, shrm, residual, brdf, dict(params))
 
 
-def split_shade(renderer: SplitRenderer, normals, views) -> tuple[np.ndarray, int]:
+def split_shade(
+    renderer: SplitRenderer, normals, views, distant_view=None
+) -> tuple[np.ndarray, int]:
     """Reflected radiance: the SHRM of the low part (clamped at 0) plus the residual in angles.
 
     §9, Herbert et al.; §5.6, Herbert et al. for the SHRM half, which reads one distant view
@@ -548,6 +563,8 @@ def split_shade(renderer: SplitRenderer, normals, views) -> tuple[np.ndarray, in
     renderer : SplitRenderer
     normals, views : ndarray, shape (N, 3)
         Unit normals and directions towards the viewer.
+    distant_view : ndarray, shape (3,), optional
+        The SHRM half's view (default: the mean of ``views``).
 
     Returns
     -------
@@ -571,7 +588,7 @@ def split_shade(renderer: SplitRenderer, normals, views) -> tuple[np.ndarray, in
 
     normals = np.asarray(normals, dtype=np.float64)
     views = np.asarray(views, dtype=np.float64)
-    v = views.mean(axis=0)
+    v = views.mean(axis=0) if distant_view is None else np.asarray(distant_view, np.float64)
     v = v / np.linalg.norm(v)
     # §5.6, Herbert et al.: extract for the viewpoint, then shade per point
     low = shade_shrm(renderer.shrm, shrm_extract(renderer.shrm, v), normals, v)
@@ -597,7 +614,10 @@ def split_renderer(
     face ``2F`` (16-64), then the largest τ (the fewest residual texels among
     :data:`RESIDUAL_FRACTIONS`) whose bound B is at most ``tol`` times a lower bound of the
     image's peak. When even the largest residual fraction cannot meet it, that fraction is used
-    and ``meets_tolerance`` is False.
+    and ``meets_tolerance`` is False. B does not cover P nor the cube interpolation, so the
+    renderer is then spot-checked against brute force at :data:`CHECK_POINTS` points (the most
+    grazing among them) and ``meets_tolerance`` also needs that error within ``tol``
+    (``settings.check_error``).
 
     Parameters
     ----------
@@ -629,4 +649,41 @@ def split_renderer(
     (1, True)
     """
     settings, rho = _choose(radiance, brdf_name, params, y_weights, normals, views, tol, frame)
-    return split_create(radiance, brdf_name, params, y_weights, settings, rho)
+    renderer = split_create(radiance, brdf_name, params, y_weights, settings, rho)
+    return _spot_check(renderer, radiance, y_weights, normals, views)
+
+
+def _spot_check(renderer: SplitRenderer, radiance, y_weights, normals, views) -> SplitRenderer:
+    """The renderer with its settings' spot check against brute force filled in (E92).
+
+    :data:`CHECK_POINTS` points: half the most grazing (where the view order P falls short
+    first), half spread over the points. The split is shaded there as the render will shade it
+    (the SHRM half at the mean of all views) and compared in Y with :func:`angular_sum` over
+    every texel, relative to the larger of two lower bounds of the peak.
+    """
+    from dataclasses import replace
+
+    from shrm.shrm_oracles import env_quadrature
+
+    normals = np.asarray(normals, dtype=np.float64)
+    views = np.asarray(views, dtype=np.float64)
+    nv = np.einsum("ij,ij->i", normals, views)
+    grazing = np.argsort(nv)[: CHECK_POINTS // 2]
+    rest = np.setdiff1d(np.arange(len(nv)), grazing)
+    k = min(CHECK_POINTS - grazing.size, rest.size)
+    pick = np.concatenate([grazing, rest[np.linspace(0, rest.size - 1, k).astype(int)]])
+    y = np.asarray(y_weights, dtype=np.float64)
+    out = split_shade(renderer, normals[pick], views[pick], distant_view=views.mean(axis=0))[0]
+    truth = angular_sum(
+        env_quadrature(radiance), renderer.brdf, renderer.params, normals[pick], views[pick]
+    )
+    s = renderer.settings
+    peak = max(s.peak_lower_bound, float((truth @ y).max(initial=0.0)), 1e-300)
+    error = float(np.abs((out - truth) @ y).max(initial=0.0) / peak)
+    settings = replace(
+        s,
+        check_points=int(pick.size),
+        check_error=error,
+        meets_tolerance=bool(s.meets_tolerance and error <= s.tol),
+    )
+    return replace(renderer, settings=settings)

@@ -158,8 +158,8 @@ def fullres_case(task) -> dict:
         ``create_seconds`` (the first frame's maps) and ``shade_seconds`` (a frame after the
         first); ``mc`` (importance-sampled Monte Carlo given the split's frame time: its
         errors, ``shade_seconds`` and ``samples`` per point); ``bruteforce_seconds``; the
-        split's ``F``, ``P``, ``size``, ``residual_texels``, ``promised_pct_of_peak`` and
-        ``meets_tolerance``.
+        split's ``F``, ``P``, ``size``, ``residual_texels``, ``promised_pct_of_peak``,
+        ``check_pct_of_peak`` (its spot check against brute force) and ``meets_tolerance``.
 
     Examples
     --------
@@ -209,6 +209,7 @@ def fullres_case(task) -> dict:
         "residual_texels": int(s.residual_texels),
         "promised_pct_of_peak": float(100 * s.bound_Y / s.peak_lower_bound),
         "meets_tolerance": bool(s.meets_tolerance),
+        "check_pct_of_peak": float(100 * s.check_error),
         "bruteforce_seconds": brute_s,
     }
     pct, mean = _errors(out @ y, truth)
