@@ -34,7 +34,9 @@ FULLRES_BRDFS = (
     ("ggx", 0.1),
     ("ggx", 0.3),
     ("ggx", 0.5),
+    ("ward_isotropic", 0.1),
     ("ward_isotropic", 0.3),
+    ("ward_isotropic", 0.5),
     ("effect_pigment", 0.15),
     ("table", 0.3),
 )

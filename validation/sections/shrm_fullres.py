@@ -43,7 +43,11 @@ SETTINGS = {
         "label": "full resolution",
         "targets": True,
         # a finer sphere where the grazing pixels are hardest (the view order runs out there)
-        "extra": (("venice_sunset_1k.hdr", "ggx", 0.3, 16),),
+        "extra": (
+            ("venice_sunset_1k.hdr", "ggx", 0.3, 16),
+            ("venice_sunset_1k.hdr", "ggx", 0.3, 32),
+            ("studio_small_03_1k.hdr", "ggx", 0.1, 32),
+        ),
     },
     "quick": {
         "rows": 32,
@@ -140,12 +144,12 @@ def _panels(ctx: ReportContext, rows: list):
         "mc": ("Monte Carlo, split's time", "D"),
     }
     maps = sorted({r["map"] for r in rows})
-    cases = list(dict.fromkeys(_case_label(r) for r in rows))
+    cases = list(dict.fromkeys((_case_label(r), r["side"]) for r in rows))
     fig, axes = plt.subplots(
         len(maps), len(cases), figsize=(2.3 * len(cases), 2.0 * len(maps)), squeeze=False
     )
     for r in rows:
-        ax = axes[maps.index(r["map"]), cases.index(_case_label(r))]
+        ax = axes[maps.index(r["map"]), cases.index((_case_label(r), r["side"]))]
         for key, (label, marker) in styles.items():
             ms = 1e3 * r[key]["shade_seconds"] / r["pixels"]
             ax.scatter(ms, max(r[key]["pct_of_peak"], 1e-4), marker=marker, label=label)
@@ -156,6 +160,9 @@ def _panels(ctx: ReportContext, rows: list):
         ax.set_yscale("log")
         ax.set_title(f"{r['map'][:20]}, {r['side']}²\n{_case_label(r)}", fontsize=7)
         ax.tick_params(labelsize=6)
+    for ax in axes.flat:
+        if not ax.collections:  # no case of this map at this BRDF and size
+            ax.set_axis_off()
     for ax in axes[-1]:
         ax.set_xlabel("ms per point", fontsize=7)
     for ax in axes[:, 0]:
