@@ -25,7 +25,10 @@ falls with τ, and ``τ = 0`` (everything residual) is the brute force. Clamping
 zero never moves it further from the truth, which is non-negative, so the clamp keeps the bound
 and no pixel is ever negative. ``B`` does not cover the view order P (chosen from the BRDF's view
 tail) nor the cube-map interpolation: :func:`split_renderer` spot-checks the renderer against
-brute force at a few points, the most grazing among them, and states that error too.
+brute force at a few points, the most grazing among them, and states that error too. Where the
+view is grazing (``n·v <`` :data:`NV_ANGULAR`) the reflection frame's view order runs out, and
+there the low part is summed in angular space as well, over its texels merged into blocks
+(:func:`merge_texels`, erratum E94).
 
 References
 ----------
@@ -348,7 +351,8 @@ class SplitSettings:
     tol : float
         The per-pixel tolerance, relative to the peak.
     meets_tolerance : bool
-        ``bound_Y <= tol · peak_lower_bound``; when False the render says so (E92).
+        ``bound_Y <= tol · peak_lower_bound`` and ``check_error <= tol``; when False the render
+        says so (E92).
     view_tail : float
         The BRDF coefficients' relative L2 tail beyond P, measured to :data:`P_FIT` (not in the
         bound).
