@@ -163,23 +163,24 @@ def test_scene_files_take_tabulated_brdfs(tmp_path):
     "at grazing pixels (F is capped at 7 by the map)",
 )
 def test_tabulated_brdf_split_within_one_percent_of_the_peak(tmp_path):
+    _, Y, Yo = _table_default_and_oracle(tmp_path)
+    assert np.abs(Y - Yo).max() <= 0.01 * Yo.max()
+
+
+def _table_default_and_oracle(tmp_path):
+    """The table scene's default render, and its Y and the oracle's over the covered pixels."""
     scene = _table_scene(tmp_path)
     fast = render_scene(scene)
     oracle = render_scene(scene, options={"environment": "bruteforce"})
     mask = oracle.gbuffer.mask
-    Y, Yo = fast.XYZ[..., 1][mask], oracle.XYZ[..., 1][mask]
-    assert np.abs(Y - Yo).max() <= 0.01 * Yo.max()
+    return fast, fast.XYZ[..., 1][mask], oracle.XYZ[..., 1][mask]
 
 
 def test_tabulated_brdf_split_says_where_it_misses(tmp_path):
     # The miss of the strict xfail above is not quiet: the renderer's spot check against brute
     # force (E92) sees more than the tolerance where the lighting bound promised less, and the
     # render's records say that the tolerance is not met.
-    scene = _table_scene(tmp_path)
-    fast = render_scene(scene)
-    oracle = render_scene(scene, options={"environment": "bruteforce"})
-    mask = oracle.gbuffer.mask
-    Y, Yo = fast.XYZ[..., 1][mask], oracle.XYZ[..., 1][mask]
+    fast, Y, Yo = _table_default_and_oracle(tmp_path)
     chose = fast.records["shrm"]
     assert np.abs(Y - Yo).max() > 0.01 * Yo.max()
     assert chose["check_points"] == 8
