@@ -444,7 +444,11 @@ def choose_split_settings(
 
 
 def _choose(radiance, brdf_name, params, y_weights, normals, views, tol, frame):
-    """The settings of :func:`split_renderer` and the BRDF coefficients (reflection frame)."""
+    """The settings of :func:`split_renderer`, the BRDF coefficients and the map's quadrature.
+
+    The coefficients are those of the reflection frame (None otherwise); the quadrature
+    (``env_quadrature``) serves the spot check.
+    """
     from shrm.brdf_sh import shrm_brdf_parts
     from shrm.shrm_oracles import env_quadrature
 
@@ -487,7 +491,7 @@ def _choose(radiance, brdf_name, params, y_weights, normals, views, tol, frame):
     )
     # The sphere fit of order P is the truncation of the one of order P_FIT (reflection frame)
     reusable = frame == "reflection"
-    return settings, (rho[:, :, : P + 1, : min(F, P) + 1] if reusable else None)
+    return settings, (rho[:, :, : P + 1, : min(F, P) + 1] if reusable else None), env
 
 
 @dataclass(frozen=True)
@@ -721,22 +725,21 @@ def split_renderer(
     >>> r.settings.residual_texels, float(split_shade(r, n, n)[0].min()) > 0
     (1, True)
     """
-    settings, rho = _choose(radiance, brdf_name, params, y_weights, normals, views, tol, frame)
+    settings, rho, env = _choose(radiance, brdf_name, params, y_weights, normals, views, tol, frame)
     renderer = split_create(radiance, brdf_name, params, y_weights, settings, rho)
-    return _spot_check(renderer, radiance, y_weights, normals, views)
+    return _spot_check(renderer, env, y_weights, normals, views)
 
 
-def _spot_check(renderer: SplitRenderer, radiance, y_weights, normals, views) -> SplitRenderer:
+def _spot_check(renderer: SplitRenderer, env, y_weights, normals, views) -> SplitRenderer:
     """The renderer with its settings' spot check against brute force filled in (E92).
 
     :data:`CHECK_POINTS` points: half the most grazing of those the SHRM shades (where the view
     order P falls short first), half spread over the points. The split is shaded there as the
     render will shade it (the SHRM half at the mean of all views) and compared in Y with
-    :func:`angular_sum` over every texel, relative to the larger of two lower bounds of the peak.
+    :func:`angular_sum` over every texel (``env``: the map's quadrature), relative to the larger
+    of two lower bounds of the peak.
     """
     from dataclasses import replace
-
-    from shrm.shrm_oracles import env_quadrature
 
     normals = np.asarray(normals, dtype=np.float64)
     views = np.asarray(views, dtype=np.float64)
@@ -749,9 +752,7 @@ def _spot_check(renderer: SplitRenderer, radiance, y_weights, normals, views) ->
     pick = np.concatenate([grazing, rest[np.linspace(0, rest.size - 1, k).astype(int)]])
     y = np.asarray(y_weights, dtype=np.float64)
     out = split_shade(renderer, normals[pick], views[pick], distant_view=views.mean(axis=0))[0]
-    truth = angular_sum(
-        env_quadrature(radiance), renderer.brdf, renderer.params, normals[pick], views[pick]
-    )
+    truth = angular_sum(env, renderer.brdf, renderer.params, normals[pick], views[pick])
     s = renderer.settings
     peak = max(s.peak_lower_bound, float((truth @ y).max(initial=0.0)), 1e-300)
     error = float(np.abs((out - truth) @ y).max(initial=0.0) / peak)
