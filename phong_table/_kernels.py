@@ -19,7 +19,8 @@ shows that the two agree to ~1e-12:
   ~10 % slower on the benchmark machine (Xeon, AVX-512); with NumPy's AVX-512 loops disabled
   (``NPY_DISABLE_CPU_FEATURES``) most of that went, so we think they lower the core's clock.
 
-The private helpers (``_interval``, ``_linear``, ``_monotone_packed``, ``_parabolic``, ``_write``)
+The private helpers (``_interval``, ``_linear``, ``_monotone_row``, ``_monotone_channel``,
+``_parabolic``, ``_write``)
 are inlined into the render kernels; ``_monotone_records`` packs a table's monotone cubics once
 per call. No kernel sets ``fastmath``.
 """
@@ -126,7 +127,7 @@ def _monotone_records(nodes, values, inv_width, cubic):
     """The monotone cubics of a table, one row of 20 per interval (read by the table kernel).
 
     Row ``i``: ``t_i``, ``1/h_i``, then per channel ``v_i``, the Horner cubic ``c1, c2, c3`` and
-    the interval's two values' min and max (what :func:`_monotone_packed` reads); entries below
+    the interval's two values' min and max (what :func:`_monotone_row` reads); entries below
     :data:`TABLE_FLUSH` in magnitude are 0 (Erratum E38).
     """
     m = nodes.size - 1
@@ -153,26 +154,30 @@ def _flush(x):
 
 
 @numba.njit(cache=False, inline="always")
-def _monotone_packed_channel(records, i, c, s):
-    """The Hermite cubic of interval ``i``, channel ``c``: ``v_i + s (c1 + s (c2 + s c3))``.
+def _monotone_row(records, i):
+    """Row ``i`` of :func:`_monotone_records`: ``1/h``, then 3-tuples ``v_i``, c1, c2, c3, min, max.
 
-    Never outside the interval's two values (PCHIP is monotone there; this catches rounding).
+    The loop holds them in registers while the pixels stay in interval ``i``.
     """
-    f = records[i, 2 + c] + s * (
-        records[i, 5 + c] + s * (records[i, 8 + c] + s * records[i, 11 + c])
+    return (
+        records[i, 1],
+        (records[i, 2], records[i, 3], records[i, 4]),
+        (records[i, 5], records[i, 6], records[i, 7]),
+        (records[i, 8], records[i, 9], records[i, 10]),
+        (records[i, 11], records[i, 12], records[i, 13]),
+        (records[i, 14], records[i, 15], records[i, 16]),
+        (records[i, 17], records[i, 18], records[i, 19]),
     )
-    return min(max(f, records[i, 14 + c]), records[i, 17 + c])
 
 
 @numba.njit(cache=False, inline="always")
-def _monotone_packed(records, i, t):
-    """The monotone cubic of interval ``i`` at ``t`` (3 channels), from its packed row."""
-    s = (t - records[i, 0]) * records[i, 1]
-    return (
-        _monotone_packed_channel(records, i, 0, s),
-        _monotone_packed_channel(records, i, 1, s),
-        _monotone_packed_channel(records, i, 2, s),
-    )
+def _monotone_channel(v, c1, c2, c3, low, high, s):
+    """The Hermite cubic of one channel: ``v_i + s (c1 + s (c2 + s c3))``.
+
+    Never outside the interval's two values ``low`` and ``high`` (PCHIP is monotone there; this
+    catches rounding).
+    """
+    return min(max(v + s * (c1 + s * (c2 + s * c3)), low), high)
 
 
 @numba.njit(cache=False, inline="always")
@@ -260,6 +265,59 @@ def shade_exact_kernel(cos_theta, t, f_att, diffuse_RGB, C, n, ambient_RGB, out)
 
 
 @numba.njit(cache=False, inline="always")
+def _shade_monotone_loop(
+    cos_theta,
+    t,
+    f_att,
+    diffuse_RGB,
+    ambient_RGB,
+    nodes,
+    values,
+    records,
+    guide,
+    steps,
+    uniform,
+    zero_below,
+    out,
+):
+    """The pixel loop of :func:`shade_table_kernel` for the monotone cubic (the default).
+
+    As :func:`_shade_table_loop`, with the hinted interval's ends and packed row
+    (:func:`_monotone_records`) held in registers until the next miss: read from the arrays on
+    every pixel, they are reloaded after each store to ``out`` (which numba cannot prove apart
+    from them), and the loop was bound by those loads (10-15 % slower).
+    """
+    A = ambient_RGB[0], ambient_RGB[1], ambient_RGB[2]
+    D = diffuse_RGB[0], diffuse_RGB[1], diffuse_RGB[2]
+    f_0 = values[0, 0], values[0, 1], values[0, 2]
+    last = nodes.size - 2
+    hint = 0
+    t_i, t_next = nodes[0], nodes[1]
+    inv_h, v, c1, c2, c3, low, high = _monotone_row(records, 0)
+    for p in range(t.size):
+        t_p = t[p]
+        if t_p < zero_below:
+            r, g, b = 0.0, 0.0, 0.0
+        elif t_p == 0.0:
+            r, g, b = f_0
+        else:
+            if not (t_i <= t_p and t_p < t_next):
+                i = hint
+                i += np.int64(nodes[i + 1] <= t_p) * np.int64(i < last)
+                i -= np.int64(nodes[i] > t_p) * np.int64(i > 0)
+                if not (nodes[i] <= t_p and t_p < nodes[i + 1]):
+                    i = _interval(nodes, guide, steps, uniform, t_p)
+                hint = i
+                t_i, t_next = nodes[i], nodes[i + 1]
+                inv_h, v, c1, c2, c3, low, high = _monotone_row(records, i)
+            s = (t_p - t_i) * inv_h
+            r = _monotone_channel(v[0], c1[0], c2[0], c3[0], low[0], high[0], s)
+            g = _monotone_channel(v[1], c1[1], c2[1], c3[1], low[1], high[1], s)
+            b = _monotone_channel(v[2], c1[2], c2[2], c3[2], low[2], high[2], s)
+        _write(out, p, A, D, f_att[p], cos_theta[p], r, g, b)
+
+
+@numba.njit(cache=False, inline="always")
 def _shade_table_loop(
     cos_theta,
     t,
@@ -286,9 +344,6 @@ def _shade_table_loop(
     f_0 = values[0, 0], values[0, 1], values[0, 2]
     in_w = code == PARABOLIC_W
     last = nodes.size - 2
-    # the monotone cubics packed one row per interval (:func:`_monotone_records`): one cache line
-    # or two per lookup instead of four arrays
-    records = _monotone_records(nodes, values, inv_width, cubic) if code == MONOTONE else values
     # Neighbouring pixels of a raster-ordered G-buffer see nearby t: the interval found last
     # (``hint``) is tried first, and :func:`_interval` runs only when it does not hold t. A branch,
     # not a conditional move, so that the CPU runs ahead over pixels that hit. ``hint`` changes only
@@ -297,7 +352,10 @@ def _shade_table_loop(
     # the pixel order.
     # On a miss, t has mostly moved to a neighbouring interval (87-99 % of misses on the scenes'
     # views with error tables): one branch-free step towards t is tried before :func:`_interval`.
+    # The hinted interval's ends are held in registers until the next miss: read from ``nodes`` on
+    # every pixel, they are reloaded after each store to ``out`` (which numba cannot prove apart).
     hint = 0
+    t_i, t_next = nodes[0], nodes[1]
     for p in range(t.size):
         t_p = t[p]
         if t_p < zero_below:
@@ -305,19 +363,18 @@ def _shade_table_loop(
         elif t_p == 0.0:
             r, g, b = f_0
         else:
-            i = hint
-            if not (nodes[i] <= t_p and t_p < nodes[i + 1]):
+            if not (t_i <= t_p and t_p < t_next):
+                i = hint
                 i += np.int64(nodes[i + 1] <= t_p) * np.int64(i < last)
                 i -= np.int64(nodes[i] > t_p) * np.int64(i > 0)
                 if not (nodes[i] <= t_p and t_p < nodes[i + 1]):
                     i = _interval(nodes, guide, steps, uniform, t_p)
                 hint = i
+                t_i, t_next = nodes[i], nodes[i + 1]
             if code == LINEAR:
-                r, g, b = _linear(nodes, values, inv_width, i, t_p)
-            elif code == MONOTONE:
-                r, g, b = _monotone_packed(records, i, t_p)
+                r, g, b = _linear(nodes, values, inv_width, hint, t_p)
             else:
-                r, g, b = _parabolic(nodes, values, in_w, a, i, t_p)
+                r, g, b = _parabolic(nodes, values, in_w, a, hint, t_p)
         _write(out, p, A, D, f_att[p], cos_theta[p], r, g, b)
 
 
@@ -348,8 +405,44 @@ def shade_table_kernel(
     there) skip the lookup, as the exact kernel skips the bands whose ``t^n`` underflows; the
     result is the same to the bit.
     """
-    # one loop per lookup (uniform or not), so that neither tests the table kind per pixel
-    if uniform:
+    # one loop per lookup (uniform or not) and for the monotone cubic, so that none tests the
+    # table kind or the interpolation per pixel
+    if code == MONOTONE:
+        # the monotone cubics packed one row per interval: one cache line or two per miss
+        records = _monotone_records(nodes, values, inv_width, cubic)
+        if uniform:
+            _shade_monotone_loop(
+                cos_theta,
+                t,
+                f_att,
+                diffuse_RGB,
+                ambient_RGB,
+                nodes,
+                values,
+                records,
+                guide,
+                steps,
+                True,
+                zero_below,
+                out,
+            )
+        else:
+            _shade_monotone_loop(
+                cos_theta,
+                t,
+                f_att,
+                diffuse_RGB,
+                ambient_RGB,
+                nodes,
+                values,
+                records,
+                guide,
+                steps,
+                False,
+                zero_below,
+                out,
+            )
+    elif uniform:
         _shade_table_loop(
             cos_theta,
             t,
