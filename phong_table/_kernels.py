@@ -589,6 +589,22 @@ def table_error_kernel(t_fine, C, n, entries, floor, p, hedge, grading):
     F = t_fine.size
     n_bands = n.size
     weighted = p.size > 0
+    # per band, out of the point loop: the exponent n − 3 and C n(n−1), C n(n−1)(n−2) by channel;
+    # bands with n(n−1) = 0 (no curvature) are left out
+    e = np.empty(n_bands)
+    W = np.empty((n_bands, 6))
+    kept = 0
+    for k in range(n_bands):
+        nk = n[k]
+        f2 = nk * (nk - 1.0)
+        if f2 == 0.0:
+            continue
+        f3 = f2 * (nk - 2.0)
+        e[kept] = nk - 3.0
+        for c in range(3):
+            W[kept, c] = C[k, c] * f2
+            W[kept, 3 + c] = C[k, c] * f3
+        kept += 1
     rho2 = np.zeros(F - 1)
     rho3 = np.zeros(F - 1)
     rho2p = np.zeros(F - 1)
@@ -597,26 +613,20 @@ def table_error_kernel(t_fine, C, n, entries, floor, p, hedge, grading):
         t = 0.5 * (t_fine[q] + t_fine[q + 1])
         log_t = math.log(t)
         d2r, d2g, d2b, d3r, d3g, d3b = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-        for k in range(n_bands):
-            nk = n[k]
-            f2 = nk * (nk - 1.0)
-            if f2 == 0.0:
-                continue
-            x = (nk - 3.0) * log_t
+        for k in range(kept):
+            x = e[k] * log_t
             if x < LOG_SMALLEST_NORMAL:
                 continue
-            f3 = f2 * (nk - 2.0)
+            # Eq. (11), Wang et al., differentiated: Σ C n(n−1) t^(n−3) and Σ C n(n−1)(n−2) t^(n−3)
             power = math.exp(x)
-            # Eq. (11), Wang et al., differentiated: C n(n−1) t^(n−2) and C n(n−1)(n−2) t^(n−3)
-            a2 = f2 * power * t
-            a3 = f3 * power
-            d2r += C[k, 0] * a2
-            d2g += C[k, 1] * a2
-            d2b += C[k, 2] * a2
-            d3r += C[k, 0] * a3
-            d3g += C[k, 1] * a3
-            d3b += C[k, 2] * a3
-        f2 = max(abs(d2r), abs(d2g), abs(d2b))
+            d2r += W[k, 0] * power
+            d2g += W[k, 1] * power
+            d2b += W[k, 2] * power
+            d3r += W[k, 3] * power
+            d3g += W[k, 4] * power
+            d3b += W[k, 5] * power
+        # the second derivative is t times its sum: Σ C n(n−1) t^(n−2)
+        f2 = t * max(abs(d2r), abs(d2g), abs(d2b))
         f3 = max(abs(d3r), abs(d3g), abs(d3b))
         # largest error: |f^(k)|^(1/k); pixels' mean square error: (p |f^(k)|²)^(1/(2k+1))
         rho2[q] = math.sqrt(f2)
@@ -718,6 +728,45 @@ def _fine_weights_kernel(unit, t_lo, t_hi, r_lo, r_hi, cells):
 
 
 @numba.njit(cache=False)
+def _place_seen_error_kernel(
+    unit, t_lo, t_hi, entries, r_lo, r_hi, cells, C, n, floor, hedge, grading
+):
+    """Twin of ``phong_table.placement.place_seen`` with the error placement as ``place``.
+
+    ``t_lo, t_hi`` from ``seen_interval``; ``floor`` is ``ERROR_DENSITY_FLOOR`` (divided here by
+    the width placed over, as ``_table_error_compiled`` did). One call places the whole table, so
+    that a compiled build runs no Python between its placements.
+    """
+    # a gap to 0 or 1 narrower than the mean seen interval is taken at once (saves a placement)
+    m = entries - 2 * (t_lo > 0.0) - 2 * (t_hi < 1.0)
+    mean = (t_hi - t_lo) / m
+    t_lo = 0.0 if t_lo < mean else t_lo
+    t_hi = 1.0 if 1.0 - t_hi < mean else t_hi
+    m = entries - 2 * (t_lo > 0.0) - 2 * (t_hi < 1.0)
+    low, high = 0.0, 1.0
+    nodes = np.empty(0)
+    for _ in range(3):
+        t_fine, p = _fine_weights_kernel(unit, t_lo, t_hi, r_lo, r_hi, cells)
+        nodes = table_error_kernel(t_fine, C, n, m, floor / (t_hi - t_lo), p, hedge, grading)
+        low = t_lo - (nodes[1] - nodes[0]) if t_lo > 0.0 else 0.0
+        high = t_hi + (nodes[m] - nodes[m - 1]) if t_hi < 1.0 else 1.0
+        if (low > 0.0 or t_lo == 0.0) and (high < 1.0 or t_hi == 1.0):
+            break
+        # a margin reaches 0 or 1: the seen interval takes that end and the margin's intervals
+        t_lo = t_lo if low > 0.0 else 0.0
+        t_hi = t_hi if high < 1.0 else 1.0
+        m = entries - 2 * (t_lo > 0.0) - 2 * (t_hi < 1.0)
+    below = 2 if t_lo > 0.0 else 0
+    out = np.empty(entries + 1)
+    if below:
+        out[0], out[1] = 0.0, low
+    out[below : below + m + 1] = nodes
+    if t_hi < 1.0:
+        out[entries - 1], out[entries] = high, 1.0
+    return out
+
+
+@numba.njit(cache=False)
 def _zero_below_kernel(nodes, values):
     """Twin of ``phong_table.table.zero_below``: ``t_z`` with ``z`` two before the first nonzero."""
     first = nodes.size
@@ -727,6 +776,15 @@ def _zero_below_kernel(nodes, values):
             break
     z = first - 2
     return nodes[z] if z >= 1 else -1.0
+
+
+@numba.njit(cache=False)
+def _finite_nonnegative_kernel(values):
+    """Every value finite and >= 0 (the check of ``phong_table.placement.check_density``)."""
+    for x in values:  # noqa: SIM110 (a loop numba compiles)
+        if not (math.isfinite(x) and x >= 0.0):
+            return False
+    return True
 
 
 @numba.njit(cache=False)

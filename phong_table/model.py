@@ -264,6 +264,7 @@ class SpectralPhong:
     ambient_RGB: np.ndarray = field(init=False, repr=False)
     n_distinct: np.ndarray = field(init=False, repr=False)
     specular_weights_distinct: np.ndarray = field(init=False, repr=False)
+    _an: float = field(init=False, repr=False)
 
     def __post_init__(self):
         m = self.material
@@ -301,6 +302,8 @@ class SpectralPhong:
             value = np.ascontiguousarray(value, dtype=np.float64)
             value.setflags(write=False)
             object.__setattr__(self, key, value)
+        # computed once: every table build reads it
+        object.__setattr__(self, "_an", float(average_exponent_Wang(m.n)))
 
     def _spectra_to_RGB(self, spectrum) -> np.ndarray:
         W = band_weights(self.grid, spectrum, self.weights_method, self.observer)
@@ -313,8 +316,8 @@ class SpectralPhong:
 
     @property
     def an(self) -> float:
-        """The average exponent of Eq. (13), Wang et al. (Erratum E1)."""
-        return average_exponent_Wang(self.material.n)
+        """The average exponent of Eq. (13), Wang et al. (Erratum E1), computed once."""
+        return self._an
 
     @property
     def name(self) -> str:

@@ -484,8 +484,8 @@ def check_density(t_density, t_range) -> None:
         return
     density = np.asarray(t_density, dtype=np.float64)
     ok = t_range is not None and density.ndim == 1 and density.size > 0
-    # element by element: no NumPy array operation in the compiled build (phong_table._kernels)
-    if not (ok and all(math.isfinite(x) and x >= 0.0 for x in density.tolist())):
+    # compiled: no NumPy array operation in the compiled build (phong_table._kernels)
+    if not (ok and _kernels._finite_nonnegative_kernel(density)):
         # formatted only on failure (the check runs on every table build)
         require(False, f"error table: t_density: must be >= 0 (with a t_range), got {density}")
 
@@ -563,13 +563,22 @@ def _table_error_compiled(
 
     r_lo, r_hi = (0.0, 1.0) if t_range is None else (float(t_range[0]), float(t_range[1]))
     cells = _NO_CELLS if t_density is None else np.asarray(t_density, dtype=np.float64)
-
-    def place(t_lo, t_hi, m):
-        t_fine, p = _kernels._fine_weights_kernel(_FINE_GRID, t_lo, t_hi, r_lo, r_hi, cells)
-        floor = ERROR_DENSITY_FLOOR / (t_hi - t_lo)
-        return _kernels.table_error_kernel(t_fine, C, n, m, floor, p, ERROR_HEDGE, grading)
-
-    return place_seen(place, m, t_range)
+    t_lo, t_hi, _ = seen_interval(t_range, m)
+    # place_seen with the error placement, in one compiled call
+    return _kernels._place_seen_error_kernel(
+        _FINE_GRID,
+        t_lo,
+        t_hi,
+        m,
+        r_lo,
+        r_hi,
+        cells,
+        C,
+        n,
+        ERROR_DENSITY_FLOOR,
+        ERROR_HEDGE,
+        grading,
+    )
 
 
 def _example_inputs(rng):
