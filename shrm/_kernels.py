@@ -310,3 +310,30 @@ def rough_specular_samples_kernel(N, V, radiance, alpha, n, u, total, total_sq):
             for band in range(nb):
                 total[p, band] += x[band]
                 total_sq[p, band] += x[band] * x[band]
+
+
+@numba.njit(cache=False)
+def polymer_shade_parts_kernel(E_d, S, B, L, E_effect, D_Tint, Col_B, Col_L, gloss, Mod, out):
+    """Twin of ``shrm.polymer_material.polymer_shade_parts``: Eq. (1), Herbert et al., one pass.
+
+    ``D_Tint = D_polymer Tint_polymer``, ``Col_B = Col_trans (1 − u)``, ``Col_L = Col_trans u``
+    (n_bands,); ``Mod`` (1,) or (N,); ``L`` and ``E_effect`` are read only where their weight is
+    nonzero (an empty array: never). The NumPy reference makes a pass over the pixels per term;
+    here each pixel's bands are read once and written once (the frame is memory-bound).
+    """
+    N, n_bands = E_d.shape
+    use_L = L.shape[0] == N
+    use_effect = E_effect.shape[0] == N
+    for p in range(N):
+        m = Mod[0] if Mod.size == 1 else Mod[p]
+        for b in range(n_bands):
+            # Eq. (2), Herbert et al.: E_d D_polymer Tint_polymer (1 − Mod_effect), then Eq. (1),
+            # Herbert et al.: + gloss S + Col_trans ((1 − u) B + u L)
+            I = E_d[p, b] * (D_Tint[b] * (1.0 - m)) + S[p, b] * gloss + B[p, b] * Col_B[b]
+            if use_L:
+                I += L[p, b] * Col_L[b]
+            # Eq. (3), Herbert et al.: + E_effect Mod_effect
+            if use_effect:
+                I += E_effect[p, b] * m
+            out[p, b] = I
+    return out

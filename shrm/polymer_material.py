@@ -42,7 +42,7 @@ import numpy as np
 from reference.errors import SpecrefError, require
 from reference.lights import EnvironmentLight
 from reference.materials import MATERIAL_TYPES, MaterialType
-from reference.registry import Method
+from reference.registry import Method, Registry
 from reference.shading import SHADERS, Surface
 from reference.spectra import SpectralGrid
 from shrm.characterization import Characterization, characterize_model, read_characterization
@@ -51,6 +51,7 @@ from shrm.polymer import MIRROR_FACTORS, PolymerLook, PolymerMaps, polymer_look,
 
 __all__ = [
     "POLYMER_DEFAULTS",
+    "POLYMER_KERNELS",
     "PolymerMaterial",
     "chip_lookup",
     "modulation_at",
@@ -396,7 +397,9 @@ def polymer_pixel_parts(normal, view, maps: PolymerMaps, fresnel, mirror="fresne
     return {"E_d": E_d, "S": S, "B": B, "L": L, "E_effect": effect}
 
 
-def polymer_shade_parts(parts: dict, look: PolymerLook, Mod_effect=0.0) -> np.ndarray:
+def polymer_shade_parts(
+    parts: dict, look: PolymerLook, Mod_effect=0.0, compiled: bool = False
+) -> np.ndarray:
     """Eq. (1), Herbert et al. from the per-pixel parts and the per-frame look: (N, n_bands).
 
     ``I_result = E_d D Tint (1 − Mod) + E_effect Mod + gloss S + Col_trans ((1 − u) B + u L)``
@@ -410,6 +413,9 @@ def polymer_shade_parts(parts: dict, look: PolymerLook, Mod_effect=0.0) -> np.nd
         Its ``fresnel`` and ``mirror`` are not read (they are in the parts).
     Mod_effect : float or ndarray, shape (N,)
         In [0, 1].
+    compiled : bool
+        Shade with the numba twin ``shrm._kernels.polymer_shade_parts_kernel`` (one pass over the
+        pixels; the session's frame).
 
     Returns
     -------
@@ -431,6 +437,8 @@ def polymer_shade_parts(parts: dict, look: PolymerLook, Mod_effect=0.0) -> np.nd
         bool(np.all((Mod >= 0) & (Mod <= 1))), "polymer: Mod_effect: must be in [0, 1], not NaN"
     )
     u = look.unscattered
+    if compiled:
+        return _shade_parts_compiled(parts, look, Mod)
     # Eq. (2), Herbert et al.: E_d D_polymer Tint_polymer (1 − Mod_effect)
     if Mod.ndim == 0:
         out = parts["E_d"] * (look.D_polymer * look.Tint_polymer * (1.0 - float(Mod)))
@@ -446,6 +454,59 @@ def polymer_shade_parts(parts: dict, look: PolymerLook, Mod_effect=0.0) -> np.nd
     if np.any(Mod > 0):
         out += parts["E_effect"] * (Mod if Mod.ndim == 0 else Mod[:, None])
     return out
+
+
+def _shade_parts_compiled(parts: dict, look: PolymerLook, Mod: np.ndarray) -> np.ndarray:
+    """:func:`polymer_shade_parts` through its numba twin (``Mod`` validated)."""
+    from shrm._kernels import polymer_shade_parts_kernel
+
+    E_d = parts["E_d"]
+    u = np.asarray(look.unscattered, dtype=np.float64)
+    unused = np.zeros((0, E_d.shape[1]))
+    L = parts["L"] if np.any(u > 0) else unused
+    E_effect = parts["E_effect"] if np.any(Mod > 0) else unused
+    return polymer_shade_parts_kernel(
+        *(np.ascontiguousarray(a, dtype=np.float64) for a in (E_d, parts["S"], parts["B"], L)),
+        np.ascontiguousarray(E_effect, dtype=np.float64),
+        np.asarray(look.D_polymer * look.Tint_polymer, dtype=np.float64),
+        np.asarray(look.Col_trans * (1.0 - u), dtype=np.float64),
+        np.asarray(look.Col_trans * u, dtype=np.float64),
+        float(look.gloss),
+        np.ascontiguousarray(np.atleast_1d(Mod), dtype=np.float64),
+        np.empty(E_d.shape),
+    )
+
+
+def _shade_parts_example(rng):
+    from shrm.characterization import characterize_model
+    from shrm.polymer import polymer_look
+
+    N, n_bands = 7, 41
+    parts = {k: rng.uniform(0, 2, (N, n_bands)) for k in ("E_d", "S", "B", "L", "E_effect")}
+    look = polymer_look(characterize_model(), 1.2, 0.4, unscattered=0.3)
+    return parts, look, rng.uniform(0, 1, N)
+
+
+#: The per-frame shading of the polymer pixels and its numba twin (tests check the pair).
+POLYMER_KERNELS = Registry("polymer shading kernel")
+
+
+def _register_kernels():
+    from shrm._kernels import polymer_shade_parts_kernel
+
+    POLYMER_KERNELS.register(
+        Method(
+            "shade_parts",
+            polymer_shade_parts,
+            polymer_shade_parts_kernel,
+            "Eq. (1), Herbert et al.",
+            _shade_parts_example,
+            extra={"compiled": functools.partial(polymer_shade_parts, compiled=True)},
+        )
+    )
+
+
+_register_kernels()
 
 
 #: SHRM settings of the effect pigment's term (a small preview: the pigment is a mixed-in term,

@@ -619,7 +619,8 @@ def _stage_polymer_shade(state, inputs):
         Mod = modulation_at(Mod, pixels["uv"])
     # The radiance of the covered pixels only (N, n_bands), in the order of g.normal[mask]: no
     # image is scattered per frame (the display step reads the pixels it needs)
-    return {"pixels": polymer_shade_parts(pixels["parts"], look, Mod), "mask": pixels["mask"]}
+    shaded = polymer_shade_parts(pixels["parts"], look, Mod, compiled=True)
+    return {"pixels": shaded, "mask": pixels["mask"]}
 
 
 #: The render loop of §5.2, Herbert et al., for the hybrid polymer, Eq. (1), Herbert et al. (module

@@ -1,5 +1,7 @@
 """The ``polymer`` scene material: keys, the shader against closed forms, the map cache, errors."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -15,6 +17,7 @@ from shrm.characterization import characterize_model, write_characterization
 from shrm.environment import environment_spectral_radiance
 from shrm.orbit import IsotropicBRDFMaterial, brdf_params_on_grid, shade_isotropic_brdf_environment
 from shrm.polymer_material import (
+    POLYMER_KERNELS,
     PolymerMaterial,
     modulation_at,
     polymer_material_look,
@@ -23,6 +26,22 @@ from shrm.polymer_material import (
 from shrm.tint import read_tint_library
 
 GRID = SpectralGrid(400.0, 700.0, 20.0)
+
+
+@pytest.mark.parametrize("name", POLYMER_KERNELS.names())
+@pytest.mark.parametrize("case", ["mod per pixel", "no mod, no transparency"])
+def test_shading_kernel_matches_reference(name, case, rng):
+    method = POLYMER_KERNELS.lookup(name)
+    parts, look, Mod = method.example_inputs(rng)
+    if case != "mod per pixel":
+        # the kernel then never reads L and E_effect: poisoned, they must not reach the pixels
+        look = dataclasses.replace(look, unscattered=np.zeros_like(look.unscattered))
+        Mod = 0.0
+        parts = {**parts, "L": np.full_like(parts["L"], np.nan), "E_effect": parts["L"] * np.nan}
+    expected = method.reference(parts, look, Mod)
+    got = method.extra["compiled"](parts, look, Mod)
+    assert np.isfinite(got).all()
+    np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-14)
 
 
 @pytest.fixture
