@@ -20,8 +20,8 @@ shows that the two agree to ~1e-12:
   (``NPY_DISABLE_CPU_FEATURES``) most of that went, so we think they lower the core's clock.
 
 The private helpers (``_interval``, ``_linear``, ``_monotone_row``, ``_monotone_channel``,
-``_parabolic``, ``_write``)
-are inlined into the render kernels; ``_monotone_records`` packs a table's monotone cubics once
+``_parabolic_row``, ``_parabolic``, ``_write``) are inlined into the render kernels;
+``_monotone_records`` and ``_parabolic_records`` pack a table's monotone cubics and t-parabolas once
 per call. No kernel sets ``fastmath``.
 """
 
@@ -145,6 +145,42 @@ def _monotone_records(nodes, values, inv_width, cubic):
             records[i, 14 + c] = min(v0, v1)
             records[i, 17 + c] = max(v0, v1)
     return records
+
+
+@numba.njit(cache=False)
+def _parabolic_records(nodes, values):
+    """The t-parabolas of a table, one row of 10 per stencil node ``j`` in [1, m − 1].
+
+    Row ``j``: ``t_j``, then per channel ``y_j``, ``B`` and ``C`` of the Lagrange parabola through
+    nodes ``j − 1, j, j + 1`` written about ``t_j``: ``P(t_j + d) = y_j + d (B + d C)`` (Newton's
+    divided differences: ``C = f[t_{j−1}, t_j, t_{j+1}]``, ``B = f[t_{j−1}, t_j] + h_{j−1} C``).
+    Entries below :data:`TABLE_FLUSH` are 0 (Erratum E38). Rows 0 and ``m`` are not read.
+    """
+    m = nodes.size - 1
+    records = np.zeros((m + 1, 10))
+    for j in range(1, m):
+        h0 = nodes[j] - nodes[j - 1]
+        h1 = nodes[j + 1] - nodes[j]
+        records[j, 0] = nodes[j]
+        for c in range(3):
+            f01 = (values[j, c] - values[j - 1, c]) / h0
+            f12 = (values[j + 1, c] - values[j, c]) / h1
+            C = (f12 - f01) / (h0 + h1)
+            records[j, 1 + c] = _flush(values[j, c])
+            records[j, 4 + c] = _flush(f01 + h0 * C)
+            records[j, 7 + c] = _flush(C)
+    return records
+
+
+@numba.njit(cache=False, inline="always")
+def _parabolic_row(records, j):
+    """Row ``j`` of :func:`_parabolic_records`: ``t_j`` and the 3-tuples ``y_j``, ``B``, ``C``."""
+    return (
+        records[j, 0],
+        (records[j, 1], records[j, 2], records[j, 3]),
+        (records[j, 4], records[j, 5], records[j, 6]),
+        (records[j, 7], records[j, 8], records[j, 9]),
+    )
 
 
 @numba.njit(cache=False, inline="always")
@@ -318,6 +354,68 @@ def _shade_monotone_loop(
 
 
 @numba.njit(cache=False, inline="always")
+def _shade_parabolic_loop(
+    cos_theta,
+    t,
+    f_att,
+    diffuse_RGB,
+    ambient_RGB,
+    nodes,
+    values,
+    records,
+    guide,
+    steps,
+    uniform,
+    zero_below,
+    out,
+):
+    """The pixel loop of :func:`shade_table_kernel` for the t-parabola (``PARABOLIC``).
+
+    As :func:`_shade_monotone_loop`: while the pixels stay in interval ``i``, its ends and the
+    rows (:func:`_parabolic_records`) of its two possible stencils, ``max(i, 1)`` and
+    ``min(i + 1, m − 1)``, are held in registers; the nearer end picks one, as
+    :func:`_parabolic` does.
+    """
+    A = ambient_RGB[0], ambient_RGB[1], ambient_RGB[2]
+    D = diffuse_RGB[0], diffuse_RGB[1], diffuse_RGB[2]
+    f_0 = values[0, 0], values[0, 1], values[0, 2]
+    last = nodes.size - 2
+    hint = 0
+    t_i, t_next = nodes[0], nodes[1]
+    x_lo, y_lo, B_lo, C_lo = _parabolic_row(records, 1)
+    x_hi, y_hi, B_hi, C_hi = _parabolic_row(records, min(1, last))
+    for p in range(t.size):
+        t_p = t[p]
+        if t_p < zero_below:
+            r, g, b = 0.0, 0.0, 0.0
+        elif t_p == 0.0:
+            r, g, b = f_0
+        else:
+            if not (t_i <= t_p and t_p < t_next):
+                i = hint
+                i += np.int64(nodes[i + 1] <= t_p) * np.int64(i < last)
+                i -= np.int64(nodes[i] > t_p) * np.int64(i > 0)
+                if not (nodes[i] <= t_p and t_p < nodes[i + 1]):
+                    i = _interval(nodes, guide, steps, uniform, t_p)
+                hint = i
+                t_i, t_next = nodes[i], nodes[i + 1]
+                x_lo, y_lo, B_lo, C_lo = _parabolic_row(records, max(i, 1))
+                x_hi, y_hi, B_hi, C_hi = _parabolic_row(records, min(i + 1, last))
+            # the stencil of the nearest node (kept in [1, m − 1])
+            if t_p - t_i <= t_next - t_p:
+                d = t_p - x_lo
+                r = y_lo[0] + d * (B_lo[0] + d * C_lo[0])
+                g = y_lo[1] + d * (B_lo[1] + d * C_lo[1])
+                b = y_lo[2] + d * (B_lo[2] + d * C_lo[2])
+            else:
+                d = t_p - x_hi
+                r = y_hi[0] + d * (B_hi[0] + d * C_hi[0])
+                g = y_hi[1] + d * (B_hi[1] + d * C_hi[1])
+                b = y_hi[2] + d * (B_hi[2] + d * C_hi[2])
+        _write(out, p, A, D, f_att[p], cos_theta[p], r, g, b)
+
+
+@numba.njit(cache=False, inline="always")
 def _shade_table_loop(
     cos_theta,
     t,
@@ -428,6 +526,41 @@ def shade_table_kernel(
             )
         else:
             _shade_monotone_loop(
+                cos_theta,
+                t,
+                f_att,
+                diffuse_RGB,
+                ambient_RGB,
+                nodes,
+                values,
+                records,
+                guide,
+                steps,
+                False,
+                zero_below,
+                out,
+            )
+    elif code == PARABOLIC:
+        # the t-parabolas written about their middle node, one row per stencil
+        records = _parabolic_records(nodes, values)
+        if uniform:
+            _shade_parabolic_loop(
+                cos_theta,
+                t,
+                f_att,
+                diffuse_RGB,
+                ambient_RGB,
+                nodes,
+                values,
+                records,
+                guide,
+                steps,
+                True,
+                zero_below,
+                out,
+            )
+        else:
+            _shade_parabolic_loop(
                 cos_theta,
                 t,
                 f_att,
