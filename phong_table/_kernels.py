@@ -20,9 +20,10 @@ shows that the two agree to ~1e-12:
   (``NPY_DISABLE_CPU_FEATURES``) most of that went, so we think they lower the core's clock.
 
 The private helpers (``_interval``, ``_linear``, ``_monotone_row``, ``_monotone_channel``,
-``_parabolic_row``, ``_parabolic``, ``_write``) are inlined into the render kernels;
-``_monotone_records`` and ``_parabolic_records`` pack a table's monotone cubics and t-parabolas once
-per call. No kernel sets ``fastmath``.
+``_parabolic_row``, ``_parabolic_w_row``, ``_write``) are inlined into the render kernels;
+``_monotone_records``, ``_parabolic_records`` and ``_parabolic_w_records`` pack a table's monotone
+cubics and parabolas once per call, and one pixel loop per interpolation reads them. No kernel
+sets ``fastmath``.
 """
 
 from __future__ import annotations
@@ -172,6 +173,60 @@ def _parabolic_records(nodes, values):
     return records
 
 
+@numba.njit(cache=False)
+def _parabolic_w_records(nodes, values, a):
+    """The w-parabolas of a table (``interpolate_parabolic_w``): per stencil and per interval.
+
+    ``stencils``, one row of 12 per stencil node ``j`` in [1, m − 1]: the middle abscissa, ``ln``
+    of the top node, 1 if the parabola is taken in ``ŵ = exp(a (ln x − ln t_{j+1}))`` (else in t,
+    below :data:`W_RESOLUTION`), then per channel ``y_j``, ``B``, ``C`` of the parabola about the
+    middle abscissa (as :func:`_parabolic_records`). ``intervals``, one row per interval ``i``:
+    ``ln t_{i+1}`` and ``ŵ(t_i)`` relative to it, with which the nearest node in w is found.
+    """
+    m = nodes.size - 1
+    stencils = np.zeros((m + 1, 12))
+    intervals = np.zeros((m, 2))
+    for i in range(m):
+        log_top = math.log(nodes[i + 1])
+        intervals[i, 0] = log_top
+        intervals[i, 1] = math.exp(a * (math.log(nodes[i]) - log_top)) if nodes[i] > 0.0 else 0.0
+    for j in range(1, m):
+        x0, x1, x2 = nodes[j - 1], nodes[j], nodes[j + 1]
+        # Eq. (14), Wang et al.: w = t^(an+1), relative to the top node (Erratum E19)
+        log_top = math.log(x2)
+        y0 = math.exp(a * (math.log(x0) - log_top)) if x0 > 0.0 else 0.0
+        y1 = math.exp(a * (math.log(x1) - log_top))
+        in_w = min(y1 - y0, 1.0 - y1) >= W_RESOLUTION
+        if in_w:
+            x0, x1, x2 = y0, y1, 1.0
+        stencils[j, 0] = x1
+        stencils[j, 1] = log_top
+        stencils[j, 2] = 1.0 if in_w else 0.0
+        h0 = x1 - x0
+        h1 = x2 - x1
+        for c in range(3):
+            f01 = (values[j, c] - values[j - 1, c]) / h0
+            f12 = (values[j + 1, c] - values[j, c]) / h1
+            C = (f12 - f01) / (h0 + h1)
+            stencils[j, 3 + c] = _flush(values[j, c])
+            stencils[j, 6 + c] = _flush(f01 + h0 * C)
+            stencils[j, 9 + c] = _flush(C)
+    return stencils, intervals
+
+
+@numba.njit(cache=False, inline="always")
+def _parabolic_w_row(stencils, j):
+    """Row ``j`` of :func:`_parabolic_w_records`: abscissa, ln top, in w, ``y``, ``B``, ``C``."""
+    return (
+        stencils[j, 0],
+        stencils[j, 1],
+        stencils[j, 2] > 0.0,
+        (stencils[j, 3], stencils[j, 4], stencils[j, 5]),
+        (stencils[j, 6], stencils[j, 7], stencils[j, 8]),
+        (stencils[j, 9], stencils[j, 10], stencils[j, 11]),
+    )
+
+
 @numba.njit(cache=False, inline="always")
 def _parabolic_row(records, j):
     """Row ``j`` of :func:`_parabolic_records`: ``t_j`` and the 3-tuples ``y_j``, ``B``, ``C``."""
@@ -214,40 +269,6 @@ def _monotone_channel(v, c1, c2, c3, low, high, s):
     catches rounding).
     """
     return min(max(v + s * (c1 + s * (c2 + s * c3)), low), high)
-
-
-@numba.njit(cache=False, inline="always")
-def _parabolic(nodes, values, in_w, a, i, t):
-    """3-point Lagrange parabola through the nearest node and its neighbours, in t or in w."""
-    m = nodes.size - 1
-    t0 = nodes[i]
-    t1 = nodes[i + 1]
-    # the nearest node j (in w for the w reading), kept in [1, m − 1]
-    if in_w:
-        log_top = math.log(t1)
-        w = math.exp(a * (math.log(t) - log_top)) if t > 0.0 else 0.0
-        w0 = math.exp(a * (math.log(t0) - log_top)) if t0 > 0.0 else 0.0
-        j = i if w - w0 <= 1.0 - w else i + 1
-    else:
-        j = i if t - t0 <= t1 - t else i + 1
-    j = min(max(j, 1), m - 1)
-    x0, x1, x2, x = nodes[j - 1], nodes[j], nodes[j + 1], t
-    if in_w:
-        # Lagrange weights are unchanged by scaling w, so w is taken relative to the top node
-        log_top = math.log(x2)
-        y0 = math.exp(a * (math.log(x0) - log_top)) if x0 > 0.0 else 0.0
-        y1 = math.exp(a * (math.log(x1) - log_top))
-        if min(y1 - y0, 1.0 - y1) >= W_RESOLUTION:
-            y = math.exp(a * (math.log(t) - log_top)) if t > 0.0 else 0.0
-            x0, x1, x2, x = y0, y1, 1.0, y
-    l0 = (x - x1) * (x - x2) / ((x0 - x1) * (x0 - x2))
-    l1 = (x - x0) * (x - x2) / ((x1 - x0) * (x1 - x2))
-    l2 = (x - x0) * (x - x1) / ((x2 - x0) * (x2 - x1))
-    return (
-        l0 * values[j - 1, 0] + l1 * values[j, 0] + l2 * values[j + 1, 0],
-        l0 * values[j - 1, 1] + l1 * values[j, 1] + l2 * values[j + 1, 1],
-        l0 * values[j - 1, 2] + l1 * values[j, 2] + l2 * values[j + 1, 2],
-    )
 
 
 @numba.njit(cache=False, inline="always")
@@ -318,7 +339,7 @@ def _shade_monotone_loop(
 ):
     """The pixel loop of :func:`shade_table_kernel` for the monotone cubic (the default).
 
-    As :func:`_shade_table_loop`, with the hinted interval's ends and packed row
+    As :func:`_shade_linear_loop`, with the hinted interval's ends and packed row
     (:func:`_monotone_records`) held in registers until the next miss: read from the arrays on
     every pixel, they are reloaded after each store to ``out`` (which numba cannot prove apart
     from them), and the loop was bound by those loads (10-15 % slower).
@@ -374,7 +395,7 @@ def _shade_parabolic_loop(
     As :func:`_shade_monotone_loop`: while the pixels stay in interval ``i``, its ends and the
     rows (:func:`_parabolic_records`) of its two possible stencils, ``max(i, 1)`` and
     ``min(i + 1, m − 1)``, are held in registers; the nearer end picks one, as
-    :func:`_parabolic` does.
+    ``phong_table.interpolation.interpolate_parabolic`` does.
     """
     A = ambient_RGB[0], ambient_RGB[1], ambient_RGB[2]
     D = diffuse_RGB[0], diffuse_RGB[1], diffuse_RGB[2]
@@ -416,7 +437,73 @@ def _shade_parabolic_loop(
 
 
 @numba.njit(cache=False, inline="always")
-def _shade_table_loop(
+def _shade_parabolic_w_loop(
+    cos_theta,
+    t,
+    f_att,
+    diffuse_RGB,
+    ambient_RGB,
+    nodes,
+    values,
+    stencils,
+    intervals,
+    guide,
+    steps,
+    uniform,
+    a,
+    zero_below,
+    out,
+):
+    """The pixel loop of :func:`shade_table_kernel` for the w-parabola (``PARABOLIC_W``).
+
+    As :func:`_shade_parabolic_loop`, with the rows of :func:`_parabolic_w_records`: one ``ln t``
+    and one ``exp`` find the nearest node in w, and a second ``exp`` gives ``ŵ`` only where the
+    stencil's top node is not the interval's (the Lagrange weights from the nodes took five ``ln``
+    and four ``exp`` a pixel).
+    """
+    A = ambient_RGB[0], ambient_RGB[1], ambient_RGB[2]
+    D = diffuse_RGB[0], diffuse_RGB[1], diffuse_RGB[2]
+    f_0 = values[0, 0], values[0, 1], values[0, 2]
+    last = nodes.size - 2
+    hint = 0
+    t_i, t_next = nodes[0], nodes[1]
+    log_top, w_i = intervals[0, 0], intervals[0, 1]
+    lo = _parabolic_w_row(stencils, 1)
+    hi = _parabolic_w_row(stencils, min(1, last))
+    for p in range(t.size):
+        t_p = t[p]
+        if t_p < zero_below:
+            r, g, b = 0.0, 0.0, 0.0
+        elif t_p == 0.0:
+            r, g, b = f_0
+        else:
+            if not (t_i <= t_p and t_p < t_next):
+                i = hint
+                i += np.int64(nodes[i + 1] <= t_p) * np.int64(i < last)
+                i -= np.int64(nodes[i] > t_p) * np.int64(i > 0)
+                if not (nodes[i] <= t_p and t_p < nodes[i + 1]):
+                    i = _interval(nodes, guide, steps, uniform, t_p)
+                hint = i
+                t_i, t_next = nodes[i], nodes[i + 1]
+                log_top, w_i = intervals[i, 0], intervals[i, 1]
+                lo = _parabolic_w_row(stencils, max(i, 1))
+                hi = _parabolic_w_row(stencils, min(i + 1, last))
+            # Eq. (14), Wang et al.: the nearest node in w, relative to the interval's top node
+            log_t = math.log(t_p)
+            w = math.exp(a * (log_t - log_top))
+            x1, top, in_w, y, B, C = lo if w - w_i <= 1.0 - w else hi
+            x = t_p
+            if in_w:
+                x = w if top == log_top else math.exp(a * (log_t - top))
+            d = x - x1
+            r = y[0] + d * (B[0] + d * C[0])
+            g = y[1] + d * (B[1] + d * C[1])
+            b = y[2] + d * (B[2] + d * C[2])
+        _write(out, p, A, D, f_att[p], cos_theta[p], r, g, b)
+
+
+@numba.njit(cache=False, inline="always")
+def _shade_linear_loop(
     cos_theta,
     t,
     f_att,
@@ -425,22 +512,21 @@ def _shade_table_loop(
     nodes,
     values,
     inv_width,
-    cubic,
     guide,
     steps,
     uniform,
-    code,
-    a,
     zero_below,
     out,
 ):
-    """The pixel loop of :func:`shade_table_kernel` for one lookup and one interpolation."""
+    """The pixel loop of :func:`shade_table_kernel` for linear interpolation.
+
+    The lookup of every interpolation's loop is this one's.
+    """
     # below ``zero_below`` every interpolation returns exactly 0 (SpecularTable.zero_below); at
     # t = 0 every interpolation returns the first tabulated value exactly (unlit pixels)
     A = ambient_RGB[0], ambient_RGB[1], ambient_RGB[2]
     D = diffuse_RGB[0], diffuse_RGB[1], diffuse_RGB[2]
     f_0 = values[0, 0], values[0, 1], values[0, 2]
-    in_w = code == PARABOLIC_W
     last = nodes.size - 2
     # Neighbouring pixels of a raster-ordered G-buffer see nearby t: the interval found last
     # (``hint``) is tried first, and :func:`_interval` runs only when it does not hold t. A branch,
@@ -452,6 +538,7 @@ def _shade_table_loop(
     # views with error tables): one branch-free step towards t is tried before :func:`_interval`.
     # The hinted interval's ends are held in registers until the next miss: read from ``nodes`` on
     # every pixel, they are reloaded after each store to ``out`` (which numba cannot prove apart).
+    # (Written out in each loop: moved into an inlined helper, the monotone loop ran 25 % slower.)
     hint = 0
     t_i, t_next = nodes[0], nodes[1]
     for p in range(t.size):
@@ -469,10 +556,7 @@ def _shade_table_loop(
                     i = _interval(nodes, guide, steps, uniform, t_p)
                 hint = i
                 t_i, t_next = nodes[i], nodes[i + 1]
-            if code == LINEAR:
-                r, g, b = _linear(nodes, values, inv_width, hint, t_p)
-            else:
-                r, g, b = _parabolic(nodes, values, in_w, a, hint, t_p)
+            r, g, b = _linear(nodes, values, inv_width, hint, t_p)
         _write(out, p, A, D, f_att[p], cos_theta[p], r, g, b)
 
 
@@ -503,116 +587,57 @@ def shade_table_kernel(
     there) skip the lookup, as the exact kernel skips the bands whose ``t^n`` underflows; the
     result is the same to the bit.
     """
-    # one loop per lookup (uniform or not) and for the monotone cubic, so that none tests the
-    # table kind or the interpolation per pixel
+    # one loop per interpolation and lookup (uniform or not), so that none tests either per pixel
+    # or on a miss (with the lookup's kind a runtime value, the uniform tables' loops ran up to 25 %
+    # slower; the eight loops take ~6 s to compile, against ~3.5 s for four)
     if code == MONOTONE:
         # the monotone cubics packed one row per interval: one cache line or two per miss
         records = _monotone_records(nodes, values, inv_width, cubic)
         if uniform:
             _shade_monotone_loop(
-                cos_theta,
-                t,
-                f_att,
-                diffuse_RGB,
-                ambient_RGB,
-                nodes,
-                values,
-                records,
-                guide,
-                steps,
-                True,
-                zero_below,
-                out,
-            )
+                cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, records, guide, steps,
+                True, zero_below, out,
+            )  # fmt: skip
         else:
             _shade_monotone_loop(
-                cos_theta,
-                t,
-                f_att,
-                diffuse_RGB,
-                ambient_RGB,
-                nodes,
-                values,
-                records,
-                guide,
-                steps,
-                False,
-                zero_below,
-                out,
-            )
+                cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, records, guide, steps,
+                False, zero_below, out,
+            )  # fmt: skip
     elif code == PARABOLIC:
         # the t-parabolas written about their middle node, one row per stencil
         records = _parabolic_records(nodes, values)
         if uniform:
             _shade_parabolic_loop(
-                cos_theta,
-                t,
-                f_att,
-                diffuse_RGB,
-                ambient_RGB,
-                nodes,
-                values,
-                records,
-                guide,
-                steps,
-                True,
-                zero_below,
-                out,
-            )
+                cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, records, guide, steps,
+                True, zero_below, out,
+            )  # fmt: skip
         else:
             _shade_parabolic_loop(
-                cos_theta,
-                t,
-                f_att,
-                diffuse_RGB,
-                ambient_RGB,
-                nodes,
-                values,
-                records,
-                guide,
-                steps,
-                False,
-                zero_below,
-                out,
-            )
+                cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, records, guide, steps,
+                False, zero_below, out,
+            )  # fmt: skip
+    elif code == PARABOLIC_W:
+        stencils, intervals = _parabolic_w_records(nodes, values, a)
+        if uniform:
+            _shade_parabolic_w_loop(
+                cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, stencils, intervals,
+                guide, steps, True, a, zero_below, out,
+            )  # fmt: skip
+        else:
+            _shade_parabolic_w_loop(
+                cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, stencils, intervals,
+                guide, steps, False, a, zero_below, out,
+            )  # fmt: skip
     elif uniform:
-        _shade_table_loop(
-            cos_theta,
-            t,
-            f_att,
-            diffuse_RGB,
-            ambient_RGB,
-            nodes,
-            values,
-            inv_width,
-            cubic,
-            guide,
-            steps,
-            True,
-            code,
-            a,
-            zero_below,
-            out,
-        )
+        _shade_linear_loop(
+            cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, inv_width, guide, steps,
+            True, zero_below, out,
+        )  # fmt: skip
     else:
-        _shade_table_loop(
-            cos_theta,
-            t,
-            f_att,
-            diffuse_RGB,
-            ambient_RGB,
-            nodes,
-            values,
-            inv_width,
-            cubic,
-            guide,
-            steps,
-            False,
-            code,
-            a,
-            zero_below,
-            out,
-        )
+        _shade_linear_loop(
+            cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, inv_width, guide, steps,
+            False, zero_below, out,
+        )  # fmt: skip
     return out
 
 

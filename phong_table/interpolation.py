@@ -15,8 +15,9 @@ specref offers both readings and two alternatives; :data:`INTERPOLATION_METHODS`
   within its two tabulated values, so it never overshoots.
 
 Each reference takes ``(nodes, values, t, an)`` and returns ``(..., 3)``; the compiled twins are the
-helpers ``_linear``, ``_monotone`` and ``_parabolic`` of ``phong_table._kernels``, used by
-``shade_table_kernel``.
+pixel loops of ``phong_table._kernels.shade_table_kernel``, one per interpolation (the cubics and
+parabolas packed once per call: ``_monotone_records``, ``_parabolic_records``,
+``_parabolic_w_records``).
 
 **Lookup.** The interval of ``t`` is ``i = searchsorted(nodes, t, "right") − 1`` clipped to
 ``[0, m − 1]``. The kernel finds it in O(1) for uniform tables (``i = ⌊t m⌋``) and, for other
