@@ -150,27 +150,38 @@ def _monotone_records(nodes, values, inv_width, cubic):
 
 @numba.njit(cache=False)
 def _parabolic_records(nodes, values):
-    """The t-parabolas of a table, one row of 10 per stencil node ``j`` in [1, m − 1].
+    """The t-parabolas of a table (Wang et al., §5), one row of 10 per stencil node ``j``.
 
-    Row ``j``: ``t_j``, then per channel ``y_j``, ``B`` and ``C`` of the Lagrange parabola through
-    nodes ``j − 1, j, j + 1`` written about ``t_j``: ``P(t_j + d) = y_j + d (B + d C)`` (Newton's
-    divided differences: ``C = f[t_{j−1}, t_j, t_{j+1}]``, ``B = f[t_{j−1}, t_j] + h_{j−1} C``).
-    Entries below :data:`TABLE_FLUSH` are 0 (Erratum E38). Rows 0 and ``m`` are not read.
+    Row ``j`` (in [1, m − 1]): ``t_j``, then per channel ``y_j``, ``B`` and ``C`` of the Lagrange
+    parabola through nodes ``j − 1, j, j + 1``, written about ``t_j`` as
+    ``P(t_j + d) = y_j + d (B + d C)`` with Newton's divided differences
+    (``C = f[t_{j−1}, t_j, t_{j+1}]``, ``B = f[t_{j−1}, t_j] + h_{j−1} C``). Entries below
+    :data:`TABLE_FLUSH` are 0 (Erratum E38). Rows 0 and ``m`` are not read.
     """
     m = nodes.size - 1
     records = np.zeros((m + 1, 10))
     for j in range(1, m):
-        h0 = nodes[j] - nodes[j - 1]
-        h1 = nodes[j + 1] - nodes[j]
         records[j, 0] = nodes[j]
-        for c in range(3):
-            f01 = (values[j, c] - values[j - 1, c]) / h0
-            f12 = (values[j + 1, c] - values[j, c]) / h1
-            C = (f12 - f01) / (h0 + h1)
-            records[j, 1 + c] = _flush(values[j, c])
-            records[j, 4 + c] = _flush(f01 + h0 * C)
-            records[j, 7 + c] = _flush(C)
+        _write_parabola(records, j, 1, nodes[j - 1], nodes[j], nodes[j + 1], values)
     return records
+
+
+@numba.njit(cache=False, inline="always")
+def _write_parabola(records, j, first, x0, x1, x2, values):
+    """Write stencil ``j``'s parabola about ``x1``: ``y_j``, ``B``, ``C`` from column ``first``.
+
+    The parabola goes through ``(x0, x1, x2)`` and the values of nodes ``j − 1, j, j + 1``.
+    """
+    h0 = x1 - x0
+    h1 = x2 - x1
+    for c in range(3):
+        # Newton's divided differences: f[x0, x1], f[x1, x2] and C = f[x0, x1, x2]
+        f01 = (values[j, c] - values[j - 1, c]) / h0
+        f12 = (values[j + 1, c] - values[j, c]) / h1
+        C = (f12 - f01) / (h0 + h1)
+        records[j, first + c] = _flush(values[j, c])
+        records[j, first + 3 + c] = _flush(f01 + h0 * C)
+        records[j, first + 6 + c] = _flush(C)
 
 
 @numba.njit(cache=False)
@@ -202,15 +213,7 @@ def _parabolic_w_records(nodes, values, a):
         stencils[j, 0] = x1
         stencils[j, 1] = log_top
         stencils[j, 2] = 1.0 if in_w else 0.0
-        h0 = x1 - x0
-        h1 = x2 - x1
-        for c in range(3):
-            f01 = (values[j, c] - values[j - 1, c]) / h0
-            f12 = (values[j + 1, c] - values[j, c]) / h1
-            C = (f12 - f01) / (h0 + h1)
-            stencils[j, 3 + c] = _flush(values[j, c])
-            stencils[j, 6 + c] = _flush(f01 + h0 * C)
-            stencils[j, 9 + c] = _flush(C)
+        _write_parabola(stencils, j, 3, x0, x1, x2, values)
     return stencils, intervals
 
 
