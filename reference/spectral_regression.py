@@ -62,6 +62,7 @@ from reference.errors import SpecrefError, require
 from reference.registry import Registry
 
 __all__ = [
+    "AUGMENT_WEIGHT_GRID",
     "COLORIMETRIC_RIDGE_GRID",
     "CV_FOLDS",
     "CV_PERCENTILE",
@@ -104,14 +105,16 @@ COLORIMETRIC_RIDGE_GRID = (1e-5, 1e-4, 1e-3, 1e-2, 1e-1)
 SPECTRAL_WEIGHT_GRID = (1e2, 1e3, 1e4, 1e5)
 #: The colorimetric loss's cross-validated criterion: this percentile of held-out ΔE94.
 CV_PERCENTILE = 95.0
+#: The augmentation's total weight against the target's patches (0: none), by CV (erratum E44).
+AUGMENT_WEIGHT_GRID = (0.0, 1.0, 2.0, 4.0)
 #: The light a spectral panorama is relit under in issue 15's targets; the colorimetric loss
 #: measures ΔE94 under it beside the capture illuminant.
 RELIT_ILLUMINANT = "A"
-#: Model-file format tag and version (2: ``loss`` and ``spectral_weight``; version 1 files, all
-#: fitted with the spectral loss, are still read).
+#: Model-file format tag and version (3: ``augmentation``; 2: ``loss`` and ``spectral_weight``;
+#: version 1 files, all fitted with the spectral loss, and version 2 files are still read).
 FORMAT = "specref-spectral-regression"
-FORMAT_VERSION = 2
-_READABLE_VERSIONS = (1, 2)
+FORMAT_VERSION = 3
+_READABLE_VERSIONS = (1, 2, 3)
 
 #: Losses of :func:`fit_regression` by key (module docstring).
 REGRESSION_LOSSES = Registry("regression losses")
@@ -305,6 +308,9 @@ class SpectralRegression:
         A key of :data:`REGRESSION_LOSSES`: how the coefficients were fitted.
     spectral_weight : float or None
         β of the colorimetric loss (None for the spectral loss).
+    augmentation : dict or None
+        ``{"method", "weight", "patches"}`` when the target was augmented (erratum E44; weight 0
+        when cross-validation declined it), None otherwise.
 
     Examples
     --------
@@ -324,6 +330,7 @@ class SpectralRegression:
     cv: dict | None = None
     loss: str = "spectral"
     spectral_weight: float | None = None
+    augmentation: dict | None = None
 
     def __post_init__(self):
         REGRESSION_LOSSES.lookup(self.loss)
@@ -455,6 +462,54 @@ def delta_E94_jacobian(spectra, weights) -> np.ndarray:
     return (R @ J) @ weights.T
 
 
+#: Patches per block when the colorimetric normal equations are summed (memory ~ block · k² · 8 B).
+TERMS_BLOCK = 2048
+
+
+def _colorimetric_terms(X, S, G) -> tuple[np.ndarray, ...]:
+    """The sums the colorimetric normal equations are made of (module docstring).
+
+    ``Σ_i (x_i x_iᵀ) ⊗ (G_iᵀG_i)`` as a ``(k·b, k·b)`` matrix, ``Σ_i x_i ⊗ G_iᵀG_i s_i`` as
+    ``(k, b)``, ``XᵀX`` and ``XᵀS``: summed over blocks of patches, never as the ``(n·m, k·b)``
+    matrix of the loss rows. Sums of two sets of patches weigh them (:func:`_colorimetric_solve`).
+    """
+    n, b = S.shape
+    k = X.shape[1]
+    ZtZ = np.zeros((k * k, b * b))
+    GtGS = np.zeros((k, b))
+    for start in range(0, n, TERMS_BLOCK):
+        block = slice(start, start + TERMS_BLOCK)
+        x, g, s = X[block], G[block], S[block]
+        GtG = np.einsum("imb,imc->ibc", g, g)
+        ZtZ += (x[:, :, None] * x[:, None, :]).reshape(len(x), -1).T @ GtG.reshape(len(x), -1)
+        GtGS += x.T @ np.einsum("ibc,ic->ib", GtG, s)
+    # (p, q, a, c) -> (p, a, q, c): the Kronecker layout of vec W (feature-major)
+    ZtZ = ZtZ.reshape(k, k, b, b).transpose(0, 2, 1, 3).reshape(k * b, k * b)
+    return ZtZ, GtGS, X.T @ X, X.T @ S
+
+
+def _colorimetric_solve(terms, n: int, b: int, grid):
+    """Solutions ``W`` for each ``(λ, β)`` of ``grid`` from :func:`_colorimetric_terms` (n patches).
+
+    ``H vec W = r`` with ``H = (1/n)[Σ (x xᵀ) ⊗ (GᵀG) + (β/b) XᵀX ⊗ I] + λI`` and
+    ``r = (1/n)[Σ x ⊗ GᵀG s + (β/b) XᵀS]``.
+    """
+    import scipy.linalg
+
+    ZtZ, GtGS, XtX, XtS = terms
+    k = XtX.shape[0]
+    spectral = np.kron(XtX, np.eye(b))
+    for ridge, weight in grid:
+        H = (ZtZ + spectral * (weight / b)) / n
+        H[np.diag_indices_from(H)] += ridge
+        rhs = ((GtGS + XtS * (weight / b)) / n).reshape(-1)
+        try:  # H is symmetric positive definite when λ > 0 or the patches determine W
+            W = scipy.linalg.cho_solve(scipy.linalg.cho_factor(H, check_finite=False), rhs)
+        except np.linalg.LinAlgError:
+            W = np.linalg.lstsq(H, rhs, rcond=None)[0]
+        yield W.reshape(k, b)
+
+
 def _colorimetric_solutions(X, S, G, grid):
     """Colorimetric-loss solutions ``W`` for each ``(λ, β)`` of ``grid`` (module docstring).
 
@@ -462,20 +517,18 @@ def _colorimetric_solutions(X, S, G, grid):
     ``x_i ⊗ g_ij / √n`` of the ``m = 3·lights`` rows ``g_ij`` of ``G_i``, have ``k·b`` unknowns;
     when ``n·m < k·b`` the Woodbury identity (Woodbury 1950) solves them through an
     ``(n·m) × (n·m)`` system, the ``XᵀX ⊗ I + λI`` part being diagonal in the eigenvectors of
-    ``XᵀX``; otherwise they are solved as they stand.
+    ``XᵀX``; otherwise they are solved as they stand (:func:`_colorimetric_solve`).
     """
     n, b = S.shape
     k, m = X.shape[1], G.shape[1]
-    direct = k * b <= n * m
+    if k * b <= n * m:  # fewer unknowns than loss rows: the normal equations themselves
+        yield from _colorimetric_solve(_colorimetric_terms(X, S, G), n, b, grid)
+        return
     eigenvalues, Q = np.linalg.eigh(X.T @ X)
     eigenvalues = np.maximum(eigenvalues, 0.0)
     Xq = X @ Q  # features in the eigenbasis of XᵀX
-    if direct:
-        Z = (X[:, None, :, None] * G[:, :, None, :]).reshape(n * m, k * b) / np.sqrt(n)
-        ZtZ = Z.T @ Z
-    else:
-        Gflat = G.reshape(n * m, b)
-        GG = (Gflat @ Gflat.T).reshape(n, m, n, m)
+    Gflat = G.reshape(n * m, b)
+    GG = (Gflat @ Gflat.T).reshape(n, m, n, m)
     GS = np.einsum("imb,ib->im", G, S)
     for ridge, weight in grid:
         c = weight / (n * b)
@@ -491,11 +544,6 @@ def _colorimetric_solutions(X, S, G, grid):
             return X.T @ np.einsum("im,imb->ib", V, G) / np.sqrt(n)
 
         rhs = Zt_of(GS / np.sqrt(n)) + c * (X.T @ S)
-        if direct:  # fewer unknowns than loss rows: the normal equations themselves
-            H = ZtZ + np.kron(c * (X.T @ X), np.eye(b))
-            H[np.diag_indices_from(H)] += ridge
-            yield np.linalg.solve(H, rhs.reshape(-1)).reshape(k, b)
-            continue
         K = (Xq / d) @ Xq.T / n  # Z D⁻¹ Zᵀ = Kx[i, i'] · (g_ij · g_i'j')
         system = (K[:, None, :, None] * GG).reshape(n * m, n * m)
         system[np.diag_indices_from(system)] += 1.0
@@ -549,6 +597,8 @@ def fit_regression(
     training_set: str = "",
     loss: str = DEFAULT_LOSS,
     spectral_weight: float | None = None,
+    augment=None,
+    augment_weight: float | None = None,
 ) -> SpectralRegression:
     """Fit the regression of a target's spectra on its camera RGB (λ, β by cross-validation).
 
@@ -575,6 +625,14 @@ def fit_regression(
         360–780 nm.
     spectral_weight : float, optional
         β of the colorimetric loss, > 0; None chooses it by cross-validation.
+    augment : callable, optional
+        ``augment(train, held) -> (RGB, spectra)``: extra patches made from the patches of index
+        ``train``, none of them a look-alike of the patches ``held`` (None for the final fit);
+        its ``name`` is recorded. Only a target whose camera is known can be augmented
+        (``reference.spectral_target.product_augmentation``, erratum E44).
+    augment_weight : float, optional
+        The extra patches' total weight against the target's (0: none); None chooses it from
+        :data:`AUGMENT_WEIGHT_GRID` by the same cross-validation.
 
     Returns
     -------
@@ -619,47 +677,117 @@ def fit_regression(
             loss == "colorimetric" and np.isfinite(spectral_weight) and spectral_weight > 0,
             f"spectral weight (colorimetric loss only) must be > 0, got {spectral_weight!r}",
         )
-    folds = np.array_split(np.random.default_rng(CV_SEED).permutation(len(X)), CV_FOLDS)
-    cv = None
-    if loss == "colorimetric":
-        G, weights = _loss_jacobians(spectra, wavelengths, illuminant)
+    require(
+        augment_weight is None
+        or (augment is not None and np.isfinite(augment_weight) and augment_weight >= 0),
+        f"augmentation weight (with an augmentation only) must be >= 0, got {augment_weight!r}",
+    )
+    if augment is None:
+        weights_grid = (0.0,)
+    else:
+        weights_grid = AUGMENT_WEIGHT_GRID if augment_weight is None else (float(augment_weight),)
+    colorimetric = loss == "colorimetric"
+    if colorimetric:
+        G, lights = _loss_jacobians(spectra, wavelengths, illuminant)
         ridges = COLORIMETRIC_RIDGE_GRID if ridge is None else (float(ridge),)
         betas = SPECTRAL_WEIGHT_GRID if spectral_weight is None else (float(spectral_weight),)
         grid = [(r, w) for r in ridges for w in betas]
-        if len(grid) > 1:
-            # k-fold cross-validation: the CV_PERCENTILE-th percentile of held-out ΔE94, both lights
-            errors = [[] for _ in grid]
-            for held in folds:
-                train = np.setdiff1d(np.arange(len(X)), held)
-                solutions = _colorimetric_solutions(X[train], spectra[train], G[train], grid)
-                for i, W in enumerate(solutions):
+    else:
+        grid = RIDGE_GRID if ridge is None else (float(ridge),)
+
+    def extra_rows(train, held):
+        """Features and spectra of the augmentation made from ``train`` (and its loss terms)."""
+        if augment is None or max(weights_grid) == 0:
+            return None
+        RGB_e, S_e = augment(train, held)
+        RGB_e, S_e = _check_target(RGB_e, S_e)
+        X_e = features_RGB(RGB_e, kind, degree) / scale
+        if not colorimetric:
+            return X_e, S_e, None
+        G_e = _loss_jacobians(S_e, wavelengths, illuminant)[0]
+        return X_e, S_e, _colorimetric_terms(X_e, S_e, G_e)
+
+    def solutions(train, extra, a, grid=grid):
+        """The solutions over ``grid`` on the patches ``train`` plus the extra ones at weight a."""
+        if not (a > 0 and extra is not None and len(extra[0])):
+            if colorimetric:
+                return _colorimetric_solutions(X[train], spectra[train], G[train], grid)
+            return _ridge_solutions(X[train], spectra[train], grid)
+        # E44: the n_e extra patches weigh a·n_t in total against the n_t patches' n_t, the
+        # weights scaled to a mean of 1 over the N = n_t + n_e rows
+        n_t, n_e = len(train), len(extra[0])
+        N = n_t + n_e
+        w_t = N / (n_t * (1.0 + a))
+        w_e = a * n_t / n_e * w_t
+        if colorimetric:
+            own = _colorimetric_terms(X[train], spectra[train], G[train])
+            terms = [w_t * t + w_e * e for t, e in zip(own, extra[2], strict=True)]
+            return _colorimetric_solve(terms, N, spectra.shape[1], grid)
+        root = np.sqrt(np.concatenate([np.full(n_t, w_t), np.full(n_e, w_e)]))[:, None]
+        Xw = np.concatenate([X[train], extra[0]]) * root
+        return _ridge_solutions(Xw, np.concatenate([spectra[train], extra[1]]) * root, grid)
+
+    folds = np.array_split(np.random.default_rng(CV_SEED).permutation(len(X)), CV_FOLDS)
+    cv = None
+    if len(grid) * len(weights_grid) > 1:
+        # k-fold cross-validation over augmentation weight × grid; the folds' held-out patches
+        # are the target's own, the augmentation is made from the other folds' (E44)
+        errors = [[[] for _ in grid] for _ in weights_grid]
+        sq = np.zeros((len(weights_grid), len(grid)))
+        for held in folds:
+            train = np.setdiff1d(np.arange(len(X)), held)
+            extra = extra_rows(train, held)
+            for i, a in enumerate(weights_grid):
+                for j, W in enumerate(solutions(train, extra, a)):
                     P = X[held] @ W
-                    errors[i].extend(_delta_E94(spectra[held], P, Wl) for Wl in weights)
-            scores = np.array([np.percentile(np.concatenate(e), CV_PERCENTILE) for e in errors])
-            ridge, spectral_weight = grid[int(np.argmin(scores))]
-            cv = {
-                "folds": CV_FOLDS,
-                "seed": CV_SEED,
+                    if colorimetric:
+                        # the CV_PERCENTILE-th percentile of held-out ΔE94, both lights
+                        errors[i][j].extend(_delta_E94(spectra[held], P, Wl) for Wl in lights)
+                    else:
+                        sq[i, j] += ((P - spectra[held]) ** 2).sum()
+        if colorimetric:
+            scores = np.array(
+                [[np.percentile(np.concatenate(e), CV_PERCENTILE) for e in row] for row in errors]
+            )
+        else:
+            scores = np.sqrt(sq / spectra.size)  # held-out spectral RMS
+        i, j = np.unravel_index(int(np.argmin(scores)), scores.shape)
+        cv = {"folds": CV_FOLDS, "seed": CV_SEED}
+        if colorimetric:
+            ridge, spectral_weight = grid[j]
+            cv |= {
                 "criterion": f"percentile {CV_PERCENTILE:g} of ΔE94 under "
                 + " and ".join(dict.fromkeys((illuminant, RELIT_ILLUMINANT))),
                 "ridge_grid": list(ridges),
                 "spectral_weight_grid": list(betas),
-                "scores": scores.reshape(len(ridges), len(betas)).tolist(),
+                "scores": scores[i].reshape(len(ridges), len(betas)).tolist(),
             }
-        ridge, spectral_weight = grid[0] if cv is None else (ridge, spectral_weight)
-        (W,) = _colorimetric_solutions(X, spectra, G, [(float(ridge), float(spectral_weight))])
+        else:
+            ridge = float(grid[j])
+            cv |= {"grid": list(grid), "rms": scores[i].tolist()}
+        if augment is not None:
+            cv |= {
+                "augment_weight_grid": list(weights_grid),
+                "augment_scores": scores.min(axis=1).tolist(),
+            }
+        a = weights_grid[i]
     else:
-        if ridge is None:
-            # k-fold cross-validation over RIDGE_GRID: held-out spectral RMS per λ
-            sq = np.zeros(len(RIDGE_GRID))
-            for held in folds:
-                train = np.setdiff1d(np.arange(len(X)), held)
-                for i, W in enumerate(_ridge_solutions(X[train], spectra[train], RIDGE_GRID)):
-                    sq[i] += ((X[held] @ W - spectra[held]) ** 2).sum()
-            rms = np.sqrt(sq / spectra.size)
-            ridge = float(RIDGE_GRID[int(np.argmin(rms))])
-            cv = {"folds": CV_FOLDS, "seed": CV_SEED, "grid": list(RIDGE_GRID), "rms": rms.tolist()}
-        (W,) = _ridge_solutions(X, spectra, [float(ridge)])
+        a = weights_grid[0]
+        if colorimetric:
+            ridge, spectral_weight = grid[0]
+        else:
+            ridge = float(grid[0])
+    everything = np.arange(len(X))
+    extra = extra_rows(everything, None) if a > 0 else None
+    chosen = [(float(ridge), float(spectral_weight))] if colorimetric else [float(ridge)]
+    (W,) = solutions(everything, extra, a, chosen)
+    augmentation = None
+    if augment is not None:
+        augmentation = {
+            "method": getattr(augment, "name", "custom"),
+            "weight": float(a),
+            "patches": 0 if extra is None else len(extra[0]),
+        }
     return SpectralRegression(
         kind,
         int(degree),
@@ -672,6 +800,7 @@ def fit_regression(
         cv,
         loss,
         None if spectral_weight is None else float(spectral_weight),
+        augmentation,
     )
 
 
@@ -701,6 +830,7 @@ def save_regression(model: SpectralRegression, path) -> Path:
         "ridge": model.ridge,
         "spectral_weight": model.spectral_weight,
         "cross_validation": model.cv,
+        "augmentation": model.augmentation,
         "illuminant": model.illuminant,
         "camera": model.camera,
         "training_set": model.training_set,
@@ -747,6 +877,7 @@ def load_regression(path, wavelengths_nm=None) -> SpectralRegression:
             document.get("cross_validation"),
             str(document["loss"]) if version >= 2 else "spectral",  # version 1: spectral only
             None if weight is None else float(weight),
+            document["augmentation"] if version >= 3 else None,
         )
     except SpecrefError as error:
         raise SpecrefError(f"{path}: {error}".replace(f"{path}: {path}: ", f"{path}: ")) from None

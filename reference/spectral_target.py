@@ -44,12 +44,16 @@ from reference.spectra import GRID_41, SpectralGrid
 
 __all__ = [
     "CAMERAS",
+    "DEFAULT_AUGMENTATION",
     "FINE_GRID",
     "HELD_OUT_SETS",
     "OTHER_TEST_SET",
+    "TARGET_AUGMENTATIONS",
     "TRAINING_SET",
     "camera_RGB",
     "camera_noise",
+    "product_augmentation",
+    "product_patches",
     "read_target",
     "reflectance_set",
 ]
@@ -107,15 +111,27 @@ def _has_lookalike(values: np.ndarray, references: np.ndarray) -> np.ndarray:
     import colour
 
     coarse, ref = values[:, ::2], references[:, ::2]
-    rms = np.sqrt(((coarse[:, None] - ref[None]) ** 2).mean(axis=-1)).min(axis=1)
+    # squared distances as |a|² + |b|² − 2a·b: no (n, m, bands) array for thousands of spectra
+    sq = (coarse**2).sum(1)[:, None] + (ref**2).sum(1)[None] - 2.0 * coarse @ ref.T
+    rms = np.sqrt(np.maximum(sq, 0.0) / coarse.shape[1]).min(axis=1)
     lab, lab_ref = _lab_D65(coarse), _lab_D65(ref)
     dE = colour.delta_E(lab[:, None], lab_ref[None], method="CIE 1994").min(axis=1)
     return (rms < _LOOKALIKE_RMS) | (dE < _LOOKALIKE_DELTA_E94)
 
 
 @functools.cache
-def _reflectance_set(name: str) -> tuple[tuple[str, ...], np.ndarray]:
+def _cie2017_samples() -> tuple[tuple[str, ...], np.ndarray]:
+    """CIE 224:2017's 99 colour evaluation samples, as colour-science ships them (5 nm)."""
     import colour
+
+    msds = colour.quality.cfi2017.load_TCS_CIE2017(colour.SpectralShape(380, 780, 5))
+    values = np.asarray(msds.values, dtype=np.float64).T.copy()
+    values.setflags(write=False)
+    return tuple(msds.labels), values
+
+
+@functools.cache
+def _reflectance_set(name: str) -> tuple[tuple[str, ...], np.ndarray]:
 
     if name == TRAINING_SET:
         from colour.characterisation import read_training_data_rawtoaces_v1
@@ -133,11 +149,9 @@ def _reflectance_set(name: str) -> tuple[tuple[str, ...], np.ndarray]:
         labels = [label for label, k in zip(labels, keep, strict=True) if k]
         values = values[keep]
     elif name == OTHER_TEST_SET:
-        # CIE 224:2017's 99 colour evaluation samples, as colour-science ships them (5 nm)
-        msds = colour.quality.cfi2017.load_TCS_CIE2017(colour.SpectralShape(380, 780, 5))
-        values = np.asarray(msds.values, dtype=np.float64).T.copy()
+        all_labels, values = _cie2017_samples()
         keep = ~_has_lookalike(values, _reflectance_set(TRAINING_SET)[1])
-        labels = [label for label, k in zip(msds.labels, keep, strict=True) if k]
+        labels = [label for label, k in zip(all_labels, keep, strict=True) if k]
         values = values[keep]
     else:
         sets = _colour_sets()
@@ -220,6 +234,11 @@ def camera_RGB(reflectances, camera: str, illuminant: str = "D65") -> np.ndarray
     >>> camera_RGB(np.ones(81), "Nikon 5100 (NPL)").round(6)
     array([1., 1., 1.])
     """
+    return np.maximum(_camera_response(reflectances, camera, illuminant), 0.0)
+
+
+def _camera_response(reflectances, camera: str, illuminant: str) -> np.ndarray:
+    """:func:`camera_RGB` before negative values are clipped."""
     from reference.spectra import resample_spectrum, spectrum_from_dataset
 
     s = CAMERAS.lookup(camera)()
@@ -227,7 +246,7 @@ def camera_RGB(reflectances, camera: str, illuminant: str = "D65") -> np.ndarray
     R = np.asarray(reflectances, dtype=np.float64)
     require(R.shape[-1] == FINE_GRID.n_bands, f"camera_RGB: expected (..., 81), got {R.shape}")
     response = E[:, None] * s
-    return np.maximum(R @ response / response.sum(axis=0), 0.0)
+    return R @ response / response.sum(axis=0)
 
 
 def camera_noise(RGB, rng: np.random.Generator, multiplicative=0.005, additive=0.001):
@@ -242,6 +261,108 @@ def camera_noise(RGB, rng: np.random.Generator, multiplicative=0.005, additive=0
     RGB = np.asarray(RGB, dtype=np.float64)
     noisy = RGB * (1.0 + multiplicative * rng.standard_normal(RGB.shape))
     return np.maximum(noisy + additive * rng.standard_normal(RGB.shape), 0.0)
+
+
+def product_patches(reflectances, avoid=None) -> np.ndarray:
+    """Every product ``R_i · R_j`` (i < j) of the reflectances, less the look-alikes of ``avoid``.
+
+    A product is the reflectance of a transparent layer of double-pass transmittance ``R_j``
+    over an opaque ``R_i``: a physically realizable reflectance, darker and more saturated than
+    both. They extend a training set of n patches by n(n − 1)/2 patches where it is thin (the
+    saturated colours that a regression otherwise reaches only by extrapolation); erratum E44.
+
+    Parameters
+    ----------
+    reflectances : array_like, shape (n, 81)
+        On :data:`FINE_GRID`.
+    avoid : array_like, shape (m, 81), optional
+        Spectra whose look-alikes (E40's thresholds) are left out.
+
+    Returns
+    -------
+    ndarray, shape (k, 81)
+
+    Examples
+    --------
+    >>> R = np.stack([np.full(81, 0.5), np.linspace(0.2, 0.8, 81), np.full(81, 0.9)])
+    >>> product_patches(R).shape, float(product_patches(R)[0, 0])
+    ((3, 81), 0.1)
+    >>> product_patches(R, avoid=np.full((1, 81), 0.45)).shape   # 0.5 × 0.9 is left out
+    (2, 81)
+    """
+    R = np.asarray(reflectances, dtype=np.float64)
+    require(R.ndim == 2 and R.shape[1] == FINE_GRID.n_bands, f"expected (n, 81), got {R.shape}")
+    i, j = np.triu_indices(len(R), 1)
+    products = R[i] * R[j]
+    if avoid is not None and len(avoid):
+        products = products[~_has_lookalike(products, np.asarray(avoid, dtype=np.float64))]
+    return products
+
+
+def product_augmentation(
+    reflectances, camera: str, illuminant: str = "D65", noise_rng=None, grid: SpectralGrid = GRID_41
+):
+    """The augmentation that ``fit_regression(augment=...)`` takes: products of training patches.
+
+    ``augment(train, held)`` returns the camera RGB and spectra (on ``grid``) of
+    :func:`product_patches` of the patches ``train`` of ``reflectances``, less the look-alikes of
+    every held-out set, of the other ColorChecker measurements, of CIE 224:2017's 99 samples
+    (:data:`OTHER_TEST_SET` is drawn from them) and of the patches ``held`` (a
+    cross-validation fold's held-out patches: the fold must not see their look-alikes either).
+    With ``noise_rng`` the RGB gets :func:`camera_noise`. Erratum E44.
+
+    Parameters
+    ----------
+    reflectances : array_like, shape (n, 81)
+        The target's reflectances on :data:`FINE_GRID`.
+    camera, illuminant : str
+        As in :func:`camera_RGB`.
+    noise_rng : numpy.random.Generator, optional
+    grid : SpectralGrid
+        The grid of the spectra returned (:data:`FINE_GRID` or ``GRID_41``).
+
+    Returns
+    -------
+    callable
+        With ``name`` ``"products"``.
+
+    Examples
+    --------
+    >>> _, R = reflectance_set(TRAINING_SET)
+    >>> RGB, spectra = product_augmentation(R[:20], "Nikon 5100 (NPL)")(np.arange(20), None)
+    >>> RGB.shape[1], spectra.shape[1], len(RGB) <= 190
+    (3, 41, True)
+    """
+    R = np.asarray(reflectances, dtype=np.float64)
+    require(
+        grid in (FINE_GRID, GRID_41), f"product_augmentation: grid must be 5 or 10 nm, got {grid}"
+    )
+    references = np.concatenate(
+        [_on_fine_grid(_colour_sets()[s])[1] for s in _LOOKALIKE_SETS] + [_cie2017_samples()[1]]
+    )
+
+    def augment(train, held=None):
+        avoid = references if held is None else np.concatenate([references, R[held]])
+        products = product_patches(R[train], avoid)
+        # a product the camera cannot record (a channel below 0: outside the sRGB "camera"'s
+        # gamut) would teach the clipped RGB; it is left out
+        RGB = _camera_response(products, camera, illuminant)
+        recorded = (RGB >= 0).all(axis=1)
+        RGB, products = RGB[recorded], products[recorded]
+        if noise_rng is not None:
+            RGB = camera_noise(RGB, noise_rng)
+        return RGB, products if grid == FINE_GRID else products[:, ::2]
+
+    augment.name = "products"
+    return augment
+
+
+#: How a synthetic target may be augmented, by key (``specref env fit --augment``; E44).
+TARGET_AUGMENTATIONS = Registry("target augmentation")
+TARGET_AUGMENTATIONS.register(product_augmentation, "products")
+TARGET_AUGMENTATIONS.register(None, "none")
+#: The augmentation of ``specref env fit`` and the shipped model (its weight by cross-validation).
+DEFAULT_AUGMENTATION = "products"
 
 
 def _read_csv(path) -> tuple[list[str], list[list[str]]]:

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from reference.colorimetry import XYZ_to_Lab, band_weights, white_XYZ
+from reference.errors import require
 from reference.spectra import GRID_41, spectrum_from_dataset
 from reference.spectral_regression import (
     DEFAULT_LOSS,
@@ -20,7 +21,9 @@ from reference.spectral_regression import (
     fit_regression,
 )
 from reference.spectral_target import (
+    DEFAULT_AUGMENTATION,
     HELD_OUT_SETS,
+    TARGET_AUGMENTATIONS,
     TRAINING_SET,
     camera_noise,
     camera_RGB,
@@ -91,21 +94,30 @@ def fit_target(
     illuminant: str = "D65",
     loss: str = DEFAULT_LOSS,
     spectral_weight=None,
+    augmentation: str = DEFAULT_AUGMENTATION,
 ):
     """Fit on the training set (with camera noise if asked); the model and in-sample figures.
+
+    ``augmentation``: a key of ``TARGET_AUGMENTATIONS`` (products of training patches by default,
+    their weight by cross-validation, erratum E44). In-sample figures are on the target's patches.
 
     Examples
     --------
     >>> model, in_sample = fit_target("root_polynomial", 4)
-    >>> model.loss, round(in_sample["D65 mean"], 2)
-    ('colorimetric', 0.74)
-    >>> round(fit_target("root_polynomial", 4, loss="spectral")[1]["D65 mean"], 2)
-    0.72
+    >>> model.loss, model.augmentation["weight"], round(in_sample["D65 mean"], 2)
+    ('colorimetric', 2.0, 0.76)
+    >>> round(fit_target("root_polynomial", 4, augmentation="none")[1]["D65 mean"], 2)
+    0.74
     """
     _, spectra = reflectance_set(TRAINING_SET)
     RGB = camera_RGB(spectra, camera, illuminant)
     if noise:
         RGB = camera_noise(RGB, np.random.default_rng(NOISE_SEED))
+    make = TARGET_AUGMENTATIONS.lookup(augmentation)
+    augment = None
+    if make is not None:
+        rng = np.random.default_rng(NOISE_SEED + 2) if noise else None
+        augment = make(spectra, camera, illuminant, rng)
     model = fit_regression(
         RGB,
         spectra[:, ::2],
@@ -118,6 +130,7 @@ def fit_target(
         TRAINING_SET,
         loss,
         spectral_weight,
+        augment,
     )
     return model, _stats(spectra[:, ::2], model.predict(RGB), illuminant)
 
@@ -155,8 +168,8 @@ def regression_table(camera: str = CAMERA, sets=HELD_OUT_SETS, run=None) -> list
     Returns
     -------
     list of dict
-        ``{"features", "degree", "noise", "ridge", "in_sample": {...}, "held_out": {set: {...}},
-        "xyz_floor": {set: {...}}}``.
+        ``{"features", "degree", "noise", "augment_weight", "ridge", "in_sample": {...},
+        "held_out": {set: {...}}, "xyz_floor": {set: {...}}}``.
     """
     tasks = [
         (kind, degree, camera, tuple(sets))
@@ -179,6 +192,7 @@ def _regression_rows(task) -> list[dict]:
                 "features": kind,
                 "degree": degree,
                 "noise": noise,
+                "augment_weight": (model.augmentation or {}).get("weight", 0.0),
                 "ridge": model.ridge,
                 "in_sample": in_sample,
                 "held_out": held_out_figures(model.predict, camera, noise, sets),
@@ -293,12 +307,15 @@ def fit_file(
     noise: bool = False,
     loss: str = DEFAULT_LOSS,
     spectral_weight=None,
+    augmentation: str | None = None,
 ) -> dict:
     """What ``specref env fit`` runs: fit on a target file or the synthetic target, save, report.
 
     With ``target`` (``reference.spectral_target.read_target``) the figures are in-sample and the
     cross-validated spectral RMS; without it the synthetic target of ``camera`` under
-    ``illuminant`` is used, and the held-out sets are measured too.
+    ``illuminant`` is used, and the held-out sets are measured too. ``augmentation`` (a key of
+    ``TARGET_AUGMENTATIONS``; None: products for the synthetic target, none for a file) needs the
+    camera's sensitivities, so a target file is never augmented (erratum E44).
 
     Returns
     -------
@@ -318,7 +335,14 @@ def fit_file(
     from reference.spectral_target import read_target
 
     held_out = None
+    if augmentation is not None:
+        TARGET_AUGMENTATIONS.lookup(augmentation)
     if target is not None:
+        require(
+            augmentation in (None, "none"),
+            f"{target}: --augment {augmentation}: a target file cannot be augmented (the "
+            "products' camera RGB needs the camera's sensitivities); allowed with --target: none",
+        )
         RGB, truth = read_target(target, spectra)
         model = fit_regression(
             RGB,
@@ -336,13 +360,24 @@ def fit_file(
         in_sample = _stats(truth, model.predict(RGB), illuminant)
     else:
         model, in_sample = fit_target(
-            kind, degree, camera, noise, ridge, illuminant, loss, spectral_weight
+            kind,
+            degree,
+            camera,
+            noise,
+            ridge,
+            illuminant,
+            loss,
+            spectral_weight,
+            augmentation or DEFAULT_AUGMENTATION,
         )
         held_out = held_out_figures(model.predict, camera, noise, HELD_OUT_SETS, illuminant)
     save_regression(model, out)
     weight = (
         "" if model.spectral_weight is None else f", spectral weight {model.spectral_weight:.3g}"
     )
+    extra = model.augmentation
+    if extra:
+        weight += f", {extra['method']} at weight {extra['weight']:g} ({extra['patches']} patches)"
     lines = [
         f"wrote {out}: {kind} degree {degree}, {model.loss} loss, ridge {model.ridge:.3g}{weight}, "
         f"{model.training_set}",

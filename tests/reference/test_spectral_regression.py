@@ -130,10 +130,14 @@ def test_delta_E94_jacobian_against_colour_science(rng):
         assert_allclose(np.linalg.norm(np.einsum("nmb,nb->nm", G, r), axis=1), exact, rtol=1e-3)
 
 
-@pytest.mark.parametrize("n", [40, 400])
-def test_colorimetric_solution_solves_the_normal_equations(rng, n):
-    # Both paths (Woodbury for few patches, the normal equations for many) against the normal
-    # equations of the colorimetric loss written out term by term (module docstring).
+@pytest.mark.parametrize(("n", "block"), [(40, 2048), (400, 2048), (400, 64)])
+def test_colorimetric_solution_solves_the_normal_equations(rng, n, block, monkeypatch):
+    # Both paths (Woodbury for few patches, the normal equations for many, summed over one or
+    # several blocks of patches) against the normal equations of the colorimetric loss written
+    # out term by term (module docstring).
+    import reference.spectral_regression as sr
+
+    monkeypatch.setattr(sr, "TERMS_BLOCK", block)
     k, b, m = 6, 41, 6
     X = rng.normal(size=(n, k))
     S = rng.uniform(size=(n, b))
@@ -145,6 +149,88 @@ def test_colorimetric_solution_solves_the_normal_equations(rng, n):
     rhs = sum(np.kron(x, g.T @ g @ s) for x, g, s in zip(X, G, S, strict=True)) / n
     rhs += (X.T @ S).reshape(-1) * weight / (n * b)
     assert_allclose(W.reshape(-1), np.linalg.solve(H, rhs), rtol=1e-7, atol=1e-9)
+
+
+def _augmentation(extra):
+    """An augmentation of the ``_grid41_target`` kind that records how it was called."""
+    calls = []
+
+    def augment(train, held):
+        calls.append((np.asarray(train).copy(), None if held is None else np.asarray(held).copy()))
+        return extra
+
+    augment.name = "test"
+    return augment, calls
+
+
+@pytest.mark.parametrize("loss", ["colorimetric", "spectral"])
+def test_augmented_fit_solves_the_weighted_problem(rng, loss):
+    # The extra patches weigh a·n in total against the n target patches (weights of mean 1):
+    # the same fit as the weighted rows solved directly (Woodbury / SVD on √w-scaled rows), and
+    # weight 0 is the fit without augmentation.
+    from reference.spectral_regression import (
+        _colorimetric_solutions,
+        _loss_jacobians,
+        _ridge_solutions,
+    )
+
+    RGB, S, wl = _grid41_target(rng, 50)
+    RGB_e, S_e, _ = _grid41_target(rng, 300)
+    augment, calls = _augmentation((RGB_e, S_e))
+    fixed = {"ridge": 1e-3, "spectral_weight": 100.0} if loss == "colorimetric" else {"ridge": 1e-4}
+    a = 2.0
+    model = fit_regression(
+        RGB, S, wl, "root_polynomial", 2, loss=loss, augment=augment, augment_weight=a, **fixed
+    )
+    assert model.augmentation == {"method": "test", "weight": a, "patches": 300}
+    assert len(calls) == 1
+    assert calls[0][1] is None
+    assert len(calls[0][0]) == 50
+    X = features_RGB(np.concatenate([RGB, RGB_e]), "root_polynomial", 2)
+    scale = np.sqrt((features_RGB(RGB, "root_polynomial", 2) ** 2).mean(axis=0))
+    w = np.concatenate([np.ones(50), np.full(300, a * 50 / 300)])
+    root = np.sqrt(w * len(w) / w.sum())[:, None]
+    Xw, Sw = X / scale * root, np.concatenate([S, S_e]) * root
+    if loss == "colorimetric":
+        G = _loss_jacobians(np.concatenate([S, S_e]), wl, "D65")[0]
+        (W,) = _colorimetric_solutions(Xw, Sw, G, [(1e-3, 100.0)])
+    else:
+        (W,) = _ridge_solutions(Xw, Sw, [1e-4])
+    assert_allclose(model.coefficients, W / scale[:, None], rtol=1e-8, atol=1e-10)
+    plain = fit_regression(RGB, S, wl, "root_polynomial", 2, loss=loss, **fixed)
+    none = fit_regression(
+        RGB, S, wl, "root_polynomial", 2, loss=loss, augment=augment, augment_weight=0.0, **fixed
+    )
+    assert_allclose(none.coefficients, plain.coefficients, rtol=1e-12)
+    assert none.augmentation["weight"] == 0.0
+    assert none.augmentation["patches"] == 0
+
+
+def test_augmentation_weight_by_cross_validation(rng):
+    # The weight is chosen with λ and β by the same folds: each fold's augmentation is made from
+    # the other folds' patches and told which patches it must not resemble; the record holds
+    # the best score per weight and the choice is its minimum.
+    from reference.spectral_regression import AUGMENT_WEIGHT_GRID, CV_FOLDS
+
+    RGB, S, wl = _grid41_target(rng, 60)
+    RGB_e, S_e, _ = _grid41_target(rng, 200)
+    augment, calls = _augmentation((RGB_e, S_e))
+    model = fit_regression(RGB, S, wl, "root_polynomial", 2, augment=augment)
+    assert len(calls) == CV_FOLDS + (model.augmentation["weight"] > 0)
+    for train, held in calls[:CV_FOLDS]:
+        assert held is not None
+        assert not np.intersect1d(train, held).size
+        assert len(train) + len(held) == 60
+    scores = model.cv["augment_scores"]
+    assert model.cv["augment_weight_grid"] == list(AUGMENT_WEIGHT_GRID)
+    assert model.augmentation["weight"] == AUGMENT_WEIGHT_GRID[int(np.argmin(scores))]
+    assert min(min(row) for row in model.cv["scores"]) == pytest.approx(min(scores))
+
+
+def test_augmentation_weight_needs_an_augmentation(rng):
+    RGB, S, wl = _grid41_target(rng, 20)
+    with pytest.raises(SpecrefError, match=r"augmentation weight .* must be >= 0, got 1\.0"):
+        fit_regression(RGB, S, wl, "root_polynomial", 2, augment_weight=1.0)
 
 
 def test_colorimetric_fit_records_its_choice(rng):
@@ -183,17 +269,32 @@ def test_colorimetric_loss_refuses_an_irregular_grid(rng):
         fit_regression(RGB, RGB, [450.0, 500.0, 650.0], "polynomial", 1)
 
 
-def test_load_reads_version_1_and_refuses_unknown_versions(tmp_path):
-    # Version 1 files (before the colorimetric loss) hold spectral-loss models: still read.
-    path = save_regression(SpectralRegression("polynomial", 1, np.eye(3), WL), tmp_path / "m.json")
+def test_load_reads_versions_1_and_2_and_refuses_unknown_versions(tmp_path):
+    # Version 1 files (before the colorimetric loss) hold spectral-loss models, version 2 files
+    # (before the augmentation) colorimetric ones without it: both still read.
+    model = SpectralRegression(
+        "polynomial",
+        1,
+        np.eye(3),
+        WL,
+        loss="colorimetric",
+        spectral_weight=100.0,
+        augmentation={"method": "products", "weight": 2.0, "patches": 10},
+    )
+    path = save_regression(model, tmp_path / "m.json")
+    assert load_regression(path).augmentation == model.augmentation
     document = json.loads(path.read_text())
+    del document["augmentation"]
+    path.write_text(json.dumps({**document, "version": 2}))
+    back = load_regression(path)
+    assert (back.loss, back.spectral_weight, back.augmentation) == ("colorimetric", 100.0, None)
     for key in ("loss", "spectral_weight"):
         del document[key]
     path.write_text(json.dumps({**document, "version": 1}))
     back = load_regression(path)
     assert (back.loss, back.spectral_weight) == ("spectral", None)
-    path.write_text(json.dumps({**document, "version": 3}))
-    with pytest.raises(SpecrefError, match=r"m.json: specref-spectral-regression version 3; this "):
+    path.write_text(json.dumps({**document, "version": 4}))
+    with pytest.raises(SpecrefError, match=r"m.json: specref-spectral-regression version 4; this "):
         load_regression(path)
 
 

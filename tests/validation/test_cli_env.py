@@ -77,6 +77,9 @@ def test_fit_saves_a_model_that_loads(tmp_path, capsys):
     assert "held out, ColorChecker N Ohta: ΔE94 D65 mean" in printed
     model = load_regression(out, np.arange(380.0, 781.0, 10.0))
     assert (model.kind, model.degree, model.camera) == ("polynomial", 2, "Nikon 5100 (NPL)")
+    # the synthetic target is augmented by default (weight by cross-validation, erratum E44)
+    assert model.augmentation["method"] == "products"
+    assert f"products at weight {model.augmentation['weight']:g}" in printed
 
 
 def test_fit_from_a_target_file(tmp_path, rng, capsys):
@@ -136,6 +139,27 @@ def test_bad_input_one_line_exit_2(tmp_path, rng, capsys):
         ["env", "fit", "--target", str(tmp_path / "short.csv"), "-o", str(tmp_path / "m.json")],
         "do not cover the scene grid 380-780/10",
     )
+    # an augmentation asked of a target file (its products' RGB needs the camera), a wrong key
+    _expect_error(
+        capsys,
+        [
+            "env",
+            "fit",
+            "--target",
+            str(tmp_path / "short.csv"),
+            "--augment",
+            "products",
+            "-o",
+            str(tmp_path / "m.json"),
+        ],
+        "short.csv: --augment products: a target file cannot be augmented",
+    )
+    _expect_error(
+        capsys,
+        ["env", "fit", "--augment", "glaze", "-o", str(tmp_path / "m.json")],
+        "unknown target augmentation 'glaze'; allowed: none, products",
+    )
+    assert not (tmp_path / "m.json").exists()
     # negative or NaN RGB
     (tmp_path / "neg.csv").write_text("R,G,B,380,780\n-0.1,0.2,0.3,0.1,0.2\n")
     _expect_error(

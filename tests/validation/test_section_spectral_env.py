@@ -13,7 +13,14 @@ def test_report_spectral_env_section_quick(tmp_path, shared_data, monkeypatch):
     rows = section["regression"]
     assert len(rows) == 2 * (5 + 4)  # every degree of both families, with and without noise
     assert set(section["recovery"]) == {"Mallett 2019", "Otsu 2018", "Smits 1999"}
-    assert set(section["losses"]) == {"colorimetric", "spectral"}  # erratum E44
+    # erratum E44: each loss with and without the products; the shipped row is the table's row
+    fits = {(f["loss"], f["augmentation"]): f for f in section["losses"]}
+    assert set(fits) == {(a, b) for a in ("colorimetric", "spectral") for b in ("products", "none")}
+    assert fits["colorimetric", "none"]["augment_weight"] == 0.0
+    shipped = next(
+        r for r in rows if (r["features"], r["degree"], r["noise"]) == ("root_polynomial", 4, False)
+    )
+    assert shipped["augment_weight"] == fits["colorimetric", "products"]["augment_weight"] > 0
     names = [c["name"] for c in results["checks"] if c["section"] == "spectral-env"]
     assert len(names) == 4
     images = sorted(p.name for p in (tmp_path / "r" / "images").iterdir())

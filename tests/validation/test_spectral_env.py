@@ -48,30 +48,55 @@ def test_held_out_colorchecker_mean_D65_and_A(root4):
     assert figures["A mean"] <= 1.0
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="erratum E44: held-out ColorChecker max ΔE94 is 1.51 > 1.5 with the colorimetric loss "
-    "(1.83 with the spectral one); the cyan patch, an extrapolation of this training set",
-)
 def test_held_out_colorchecker_max(root4):
+    # Issue 15 target: held-out ColorChecker max ΔE94 <= 1.5 (D65); with the products of the
+    # training patches (erratum E44; 1.51 without them).
     assert root4[2][CC]["D65 max"] <= 1.5
 
 
-def test_colorimetric_loss_improves_on_the_spectral_loss_held_out(root4):
-    # Erratum E44: the default loss (ΔE94 under D65 and A, λ and β by CV on the training set)
-    # against spectral least squares, on every set the design never saw, the CIE 2017 samples
-    # (measured after the choice was made) included: relit under A the mean is lower on each, and
-    # the peak under D65 is lower on the ColorChecker and the NIST CQS samples.
+@pytest.fixture(scope="module")
+def unaugmented():
+    return fit_target("root_polynomial", 4, augmentation="none")[0]
+
+
+def test_colorimetric_loss_improves_on_the_spectral_loss_held_out(unaugmented):
+    # Erratum E44: the colorimetric loss (ΔE94 under D65 and A, λ and β by CV on the training
+    # set) against spectral least squares, both on the training patches alone, on every set the
+    # design never saw, the CIE 2017 samples (measured after the choice was made) included:
+    # relit under A the mean is lower on each, and the peak under D65 is lower on the
+    # ColorChecker and the NIST CQS samples.
     from reference.spectral_target import OTHER_TEST_SET
 
     sets = (*HELD_OUT_SETS, OTHER_TEST_SET)
-    assert root4[0].loss == "colorimetric"
-    new = held_out_figures(root4[0].predict, sets=sets)
-    old = held_out_figures(fit_target("root_polynomial", 4, loss="spectral")[0].predict, sets=sets)
+    assert unaugmented.loss == "colorimetric"
+    assert unaugmented.augmentation is None
+    new = held_out_figures(unaugmented.predict, sets=sets)
+    spectral = fit_target("root_polynomial", 4, loss="spectral", augmentation="none")[0]
+    old = held_out_figures(spectral.predict, sets=sets)
     for name in sets:
         assert new[name]["A mean"] < old[name]["A mean"], name
     for name in (CC, "NIST CQS 9.0"):
         assert new[name]["D65 max"] < old[name]["D65 max"], name
+
+
+def test_products_chosen_by_cross_validation_lower_the_peaks(root4, unaugmented):
+    # Erratum E44: cross-validation on the training patches gives the products a nonzero weight
+    # (its held-out folds' 95th percentile of ΔE94 falls), and the peak under D65 falls on the
+    # ColorChecker, the CIE 2024 samples and the CIE 2017 samples (measured after the choice);
+    # the means under D65 stay within 0.02.
+    from reference.spectral_target import OTHER_TEST_SET
+
+    model = root4[0]
+    scores = model.cv["augment_scores"]
+    assert model.augmentation["weight"] > 0
+    assert min(scores) < scores[0] - 0.05
+    sets = (*HELD_OUT_SETS, OTHER_TEST_SET)
+    new = held_out_figures(model.predict, sets=sets)
+    old = held_out_figures(unaugmented.predict, sets=sets)
+    for name in (CC, "CIE 2024 TCS", OTHER_TEST_SET):
+        assert new[name]["D65 max"] < old[name]["D65 max"], name
+    for name in sets:
+        assert new[name]["D65 mean"] <= old[name]["D65 mean"] + 0.02, name
 
 
 @pytest.mark.parametrize("name", HELD_OUT_SETS[1:])
@@ -84,8 +109,9 @@ def test_noise_hurts_high_degrees_more():
     # 0.5 % multiplicative + 0.1 % additive noise: the degree-5 polynomial loses more than degree 1.
     loss = {}
     for degree in (1, 5):
-        clean = held_out_figures(fit_target("polynomial", degree)[0].predict)[CC]["D65 mean"]
-        model, _ = fit_target("polynomial", degree, noise=True)
+        clean = fit_target("polynomial", degree, augmentation="none")[0]
+        clean = held_out_figures(clean.predict)[CC]["D65 mean"]
+        model, _ = fit_target("polynomial", degree, noise=True, augmentation="none")
         noisy = held_out_figures(model.predict, noise=True)[CC]["D65 mean"]
         loss[degree] = noisy - clean
     assert loss[5] > loss[1]

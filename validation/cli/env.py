@@ -20,6 +20,7 @@ def _cmd_env_fit(args) -> int:
         args.noise,
         args.loss,
         args.spectral_weight,
+        args.augment,
     )
     for line in report["lines"]:
         print(line)
@@ -57,7 +58,7 @@ def _cmd_env_convert(args) -> int:
 def add_parser(sub) -> None:
     """Add ``specref env fit|spectralize|convert`` to the subcommand parsers ``sub``."""
     from reference.spectral_regression import DEFAULT_LOSS, REGRESSION_FEATURES, REGRESSION_LOSSES
-    from reference.spectral_target import CAMERAS
+    from reference.spectral_target import CAMERAS, TARGET_AUGMENTATIONS
 
     p = sub.add_parser("env", help="spectral environments: camera-target regression (Herbert §4)")
     env = p.add_subparsers(dest="env_command", required=True, parser_class=Parser)
@@ -77,6 +78,14 @@ def add_parser(sub) -> None:
         type=float,
         default=None,
         help="β of the colorimetric loss (default: CV)",
+    )
+    registry_option(
+        f,
+        "--augment",
+        TARGET_AUGMENTATIONS,
+        "augmentation of the synthetic target, weight by CV (E44; default products, none with "
+        "--target)",
+        default=None,
     )
     f.add_argument("--noise", action="store_true", help="add 0.5 %% + 0.1 %% camera noise")
     f.add_argument("-o", "--out", required=True, help="output model .json")

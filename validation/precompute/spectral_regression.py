@@ -6,7 +6,9 @@ target the training set of ``reference.spectral_target`` (rawtoaces-190 minus th
 every held-out set), the features Finlayson's root-polynomials of degree 4, the colorimetric loss
 (ΔE94 under D65 and A plus a spectral term, erratum E44) with the ridge strength and the spectral
 weight chosen by 5-fold cross-validation (``reference.spectral_regression``). It is what the
-``regression`` key of ``reference.upsampling.UPSAMPLING_METHODS`` uses.
+``regression`` key of ``reference.upsampling.UPSAMPLING_METHODS`` uses. It is fitted on the
+training patches alone, without the products that ``specref env fit`` adds by default: for this
+"camera" their cross-validated gain did not carry to the held-out sets (erratum E44).
 
 Run: ``.venv/bin/python -m validation.precompute.spectral_regression`` (a few seconds).
 """
