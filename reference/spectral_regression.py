@@ -475,16 +475,23 @@ def _colorimetric_terms(X, S, G) -> tuple[np.ndarray, ...]:
     """
     n, b = S.shape
     k = X.shape[1]
-    ZtZ = np.zeros((k * k, b * b))
+    # x xᵀ and GᵀG are symmetric: sum their upper triangles only, then mirror (4× fewer flops)
+    p, q = np.triu_indices(k)
+    a, c = np.triu_indices(b)
+    upper = np.zeros((p.size, a.size))
     GtGS = np.zeros((k, b))
     for start in range(0, n, TERMS_BLOCK):
         block = slice(start, start + TERMS_BLOCK)
         x, g, s = X[block], G[block], S[block]
         GtG = np.einsum("imb,imc->ibc", g, g)
-        ZtZ += (x[:, :, None] * x[:, None, :]).reshape(len(x), -1).T @ GtG.reshape(len(x), -1)
+        upper += (x[:, p] * x[:, q]).T @ GtG[:, a, c]
         GtGS += x.T @ np.einsum("ibc,ic->ib", GtG, s)
+    full = np.empty((k, k, b, b))
+    for first, second in ((p, q), (q, p)):
+        full[first[:, None], second[:, None], a[None], c[None]] = upper
+        full[first[:, None], second[:, None], c[None], a[None]] = upper
     # (p, q, a, c) -> (p, a, q, c): the Kronecker layout of vec W (feature-major)
-    ZtZ = ZtZ.reshape(k, k, b, b).transpose(0, 2, 1, 3).reshape(k * b, k * b)
+    ZtZ = full.transpose(0, 2, 1, 3).reshape(k * b, k * b)
     return ZtZ, GtGS, X.T @ X, X.T @ S
 
 

@@ -337,24 +337,45 @@ def product_augmentation(
     require(
         grid in (FINE_GRID, GRID_41), f"product_augmentation: grid must be 5 or 10 nm, got {grid}"
     )
-    references = np.concatenate(
-        [_on_fine_grid(_colour_sets()[s])[1] for s in _LOOKALIKE_SETS] + [_cie2017_samples()[1]]
-    )
+    require(R.ndim == 2 and R.shape[1] == FINE_GRID.n_bands, f"expected (n, 81), got {R.shape}")
+    i, j, products, response, usable = _all_products(R.tobytes(), len(R), camera, illuminant)
 
     def augment(train, held=None):
-        avoid = references if held is None else np.concatenate([references, R[held]])
-        products = product_patches(R[train], avoid)
-        # a product the camera cannot record (a channel below 0: outside the sRGB "camera"'s
-        # gamut) would teach the clipped RGB; it is left out
-        RGB = _camera_response(products, camera, illuminant)
-        recorded = (RGB >= 0).all(axis=1)
-        RGB, products = RGB[recorded], products[recorded]
+        inside = np.zeros(len(R), dtype=bool)
+        inside[np.asarray(train)] = True
+        pick = usable & inside[i] & inside[j]  # the products of the patches `train`, in order
+        P, RGB = products[pick], response[pick]
+        if held is not None and len(held):
+            other = ~_has_lookalike(P, R[np.asarray(held)])
+            P, RGB = P[other], RGB[other]
         if noise_rng is not None:
             RGB = camera_noise(RGB, noise_rng)
-        return RGB, products if grid == FINE_GRID else products[:, ::2]
+        return RGB, P if grid == FINE_GRID else P[:, ::2]
 
     augment.name = "products"
     return augment
+
+
+@functools.lru_cache(maxsize=4)
+def _all_products(data: bytes, n: int, camera: str, illuminant: str):
+    """Every product of ``n`` reflectances (``data``: their float64 bytes) and what is usable.
+
+    Returns the pair indices ``i < j``, the products, their camera response and a mask: not a
+    look-alike of a held-out set, another ColorChecker measurement or a CIE 2017 sample, and
+    recorded by the camera (no channel below 0: a product outside the sRGB "camera"'s gamut
+    would teach the clipped RGB). Cached, so that every fold and fit of a study shares them.
+    """
+    R = np.frombuffer(data, dtype=np.float64).reshape(n, FINE_GRID.n_bands)
+    i, j = np.triu_indices(n, 1)
+    products = R[i] * R[j]
+    references = np.concatenate(
+        [_on_fine_grid(_colour_sets()[s])[1] for s in _LOOKALIKE_SETS] + [_cie2017_samples()[1]]
+    )
+    response = _camera_response(products, camera, illuminant)
+    usable = ~_has_lookalike(products, references) & (response >= 0).all(axis=1)
+    for array in (i, j, products, response, usable):
+        array.setflags(write=False)
+    return i, j, products, response, usable
 
 
 #: How a synthetic target may be augmented, by key (``specref env fit --augment``; E44).

@@ -159,11 +159,14 @@ def XYZ_floor(kind: str, degree: int, camera: str = CAMERA, sets=HELD_OUT_SETS) 
     return found
 
 
-def regression_table(camera: str = CAMERA, sets=HELD_OUT_SETS, run=None) -> list[dict]:
+def regression_table(
+    camera: str = CAMERA, sets=HELD_OUT_SETS, run=None, leave_out=()
+) -> list[dict]:
     """Every feature family and degree, noise-free and noisy: in-sample and held-out figures.
 
     Each feature family and degree is one task of ``run(function, tasks, desc)`` (default: in
-    this process; the report passes ``ReportContext.run_tasks``).
+    this process; the report passes ``ReportContext.run_tasks``); ``(kind, degree)`` pairs in
+    ``leave_out`` are left out (the report's quick mode).
 
     Returns
     -------
@@ -175,6 +178,7 @@ def regression_table(camera: str = CAMERA, sets=HELD_OUT_SETS, run=None) -> list
         (kind, degree, camera, tuple(sets))
         for kind, degrees in REGRESSION_FEATURES.items()
         for degree in degrees
+        if (kind, degree) not in leave_out
     ]
     run = run or (lambda function, items, desc: [function(item) for item in items])
     return [row for rows in run(_regression_rows, tasks, "regression degrees") for row in rows]

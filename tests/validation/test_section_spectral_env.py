@@ -11,7 +11,9 @@ def test_report_spectral_env_section_quick(tmp_path, shared_data, monkeypatch):
     results = run_report(tmp_path / "r", quick=True, only=["spectral-env"], progress=False)
     section = results["sections"]["spectral-env"]
     rows = section["regression"]
-    assert len(rows) == 2 * (5 + 4)  # every degree of both families, with and without noise
+    # every degree of both families but polynomial 4 and 5 (quick mode), with and without noise
+    assert len(rows) == 2 * (3 + 4)
+    assert section["left_out"] == [["polynomial", 4], ["polynomial", 5]]
     assert set(section["recovery"]) == {"Mallett 2019", "Otsu 2018", "Smits 1999"}
     # erratum E44: each loss with and without the products; the shipped row is the table's row
     fits = {(f["loss"], f["augmentation"]): f for f in section["losses"]}
