@@ -26,6 +26,12 @@ specref implements that regression:
   - ``spectral``: ridge least squares on the spectra, ``W = argmin (1/n)·||X W − S||² + λ·||W||²``,
     λ from :data:`RIDGE_GRID` (0 and 10^-12 … 10^0 in half decades) by the same cross-validation,
     minimizing the held-out spectral RMS.
+- **Augmentation** (erratum E44): ``fit_regression(augment=...)`` adds extra patches made from
+  the target's (``reference.spectral_target.product_augmentation``: the products of pairs of its
+  patches, for a synthetic target whose camera is known), weighing ``a·n`` in total against the
+  n patches' ``n``; ``a`` is chosen from :data:`AUGMENT_WEIGHT_GRID` with λ and β by the same
+  cross-validation, each fold's extra patches made from the other folds' patches and scored on
+  the fold's own patches only.
 - **Exposure** (erratum E41): HDR texels are brighter than any target patch. A polynomial is
   applied to ``RGB / s`` and the result multiplied by ``s``, with ``s = max(1, max(R, G, B))``:
   texels inside the target's range are mapped as fitted, brighter ones keep their chromaticity.

@@ -367,7 +367,7 @@ def _all_products(data: bytes, n: int, camera: str, illuminant: str):
     """
     R = np.frombuffer(data, dtype=np.float64).reshape(n, FINE_GRID.n_bands)
     i, j = np.triu_indices(n, 1)
-    products = R[i] * R[j]
+    products = product_patches(R)  # the pairs (i, j) in this order
     references = np.concatenate(
         [_on_fine_grid(_colour_sets()[s])[1] for s in _LOOKALIKE_SETS] + [_cie2017_samples()[1]]
     )
