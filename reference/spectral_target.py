@@ -132,7 +132,6 @@ def _cie2017_samples() -> tuple[tuple[str, ...], np.ndarray]:
 
 @functools.cache
 def _reflectance_set(name: str) -> tuple[tuple[str, ...], np.ndarray]:
-
     if name == TRAINING_SET:
         from colour.characterisation import read_training_data_rawtoaces_v1
 
@@ -382,7 +381,8 @@ def _all_products(data: bytes, n: int, camera: str, illuminant: str):
 TARGET_AUGMENTATIONS = Registry("target augmentation")
 TARGET_AUGMENTATIONS.register(product_augmentation, "products")
 TARGET_AUGMENTATIONS.register(None, "none")
-#: The augmentation of ``specref env fit`` and the shipped model (its weight by cross-validation).
+#: The augmentation of ``specref env fit`` and the report (its weight by cross-validation); the
+#: shipped sRGB model is fitted without it (``validation.precompute.spectral_regression``).
 DEFAULT_AUGMENTATION = "products"
 
 
