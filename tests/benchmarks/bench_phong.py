@@ -1,5 +1,7 @@
 """Benchmarks of the Phong tables: shading (build included) against the exact shading, same run."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -52,6 +54,22 @@ def test_table(benchmark, scene, view, placement, interpolation):
 
     run()
     benchmark(run)
+
+
+@pytest.mark.parametrize("t_value", ["image", "every t = 0", "every t = 0.5"])
+def test_table_loop_bound(benchmark, t_value):
+    # what bounds the monotone loop (E39): the image's t, then no cubic (every pixel takes the
+    # t = 0 branch) and one interval for every pixel (no lookup, no miss, a cubic per pixel)
+    model, buffer, out = _setup("rising5000", "far")
+    seen = {"t_range": buffer.t_range, "t_density": buffer.t_density}
+    table = build_table(model, 200, "error", compiled=True, **seen)
+    if t_value != "image":
+        t = np.full_like(buffer.t, 0.0 if t_value == "every t = 0" else 0.5)
+        buffer = dataclasses.replace(buffer, t=t)
+    benchmark.group = "phong loop rising5000 far"
+    shade = compiled_shader(model, table, "monotone")
+    shade(buffer, out)
+    benchmark(shade, buffer, out)
 
 
 @pytest.mark.parametrize("method", ["binary search", "inverse-map index"])
