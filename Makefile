@@ -11,7 +11,7 @@ export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 export MPLBACKEND ?= Agg
 
-.PHONY: install demo test bench bench-json results equations coverage lint clean
+.PHONY: install demo test test-wheel bench bench-json results equations coverage lint clean
 
 $(STAMP): setup.cfg pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -28,6 +28,10 @@ demo: $(STAMP)
 ## make test: install, then run the whole suite (doctests and docs examples included, benchmarks off)
 test: $(STAMP)
 	$(PY) -m pytest -q --durations=15
+
+## make test-wheel: build the wheel, install it in a fresh venv outside the repository, use it there
+test-wheel: $(STAMP)
+	$(PY) -m pytest -q -m wheel tests/test_wheel.py
 
 ## make bench-json: run the pytest-benchmark suite and save bench.json
 bench-json: $(STAMP)

@@ -24,14 +24,12 @@ matplotlib.use("Agg")
 np.set_printoptions(legacy=False)
 
 ROOT = Path(__file__).resolve().parent
-#: Shared data beside the repository (``../shared/data``), or where SPECREF_SHARED_DATA points.
-SHARED_DATA = Path(os.environ.get("SPECREF_SHARED_DATA", ROOT.parent / "shared" / "data"))
 
 # Benchmarks run only under `make bench` (SPECREF_BENCH=1); the ordinary suite does not collect
 # them.
 collect_ignore = [] if os.environ.get("SPECREF_BENCH") else ["tests/benchmarks"]
 # ``python -m validation.cli`` runs the command on import: never collect it for doctests.
-collect_ignore.append("validation/cli/__main__.py")
+collect_ignore += ["validation/cli/__main__.py", "phong_table/editor/__main__.py"]
 
 
 @pytest.fixture
@@ -41,13 +39,11 @@ def rng():
 
 
 @pytest.fixture(scope="session")
-def shared_data() -> Path:
-    """``../shared/data``: real environment maps and measured spectra (see its PROVENANCE.md)."""
-    if not SHARED_DATA.is_dir():
-        raise FileNotFoundError(
-            f"shared data not found at {SHARED_DATA}; set SPECREF_SHARED_DATA to ../shared/data"
-        )
-    return SHARED_DATA
+def package_data() -> Path:
+    """The data shipped with specref (``reference/data``: environment maps, measured spectra)."""
+    from reference.data import data_root
+
+    return data_root()
 
 
 @pytest.fixture(autouse=True)

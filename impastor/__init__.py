@@ -3,7 +3,7 @@
 Users write ``impastor.render_painting``, ``impastor.median_cut``, ``impastor.specular_fis``; the
 modules hold the equations (``docs/impastor.md`` walks through the pipeline). The display model of
 §3.4 (Eq. (1), Ferwerda) is shared with Herbert et al.'s calibration and lives in
-``reference.display_model``.
+``reference.display.model``.
 
 - :mod:`impastor.multispectral`: six-channel sampling designs (``MULTISPECTRAL_DESIGNS``), spectra
   to channels and channels to XYZ (Table 1, §3.1).

@@ -91,7 +91,7 @@ def specular_fis_kernel(
     wi = np.empty(3)
     for p in range(P.shape[0]):
         n0, n1, n2 = N[p, 0], N[p, 1], N[p, 2]
-        # Tangent frame (Duff et al. 2017), as reference.brdf.frame_from_normal.
+        # Tangent frame (Duff et al. 2017), as reference.materials.brdf.frame_from_normal.
         sign = 1.0 if n2 >= 0.0 else -1.0
         a_ = -1.0 / (sign + n2)
         c_ = n0 * n1 * a_

@@ -14,7 +14,7 @@ pixel has area ``A/P = l_A l_B / (H W)``. The light emits from the side of ``n_l
 or any per-channel radiance ``(H, W, C)``; the light's spectrum is applied separately (Eq. (3),
 Ferwerda).
 
-Lat-long lights follow ``reference.envmap``'s convention (see ``impastor.point_lights``).
+Lat-long lights follow ``reference.geometry.envmap``'s convention (see ``impastor.point_lights``).
 
 References
 ----------

@@ -39,9 +39,9 @@ from pathlib import Path
 
 import numpy as np
 
+from reference.colour.spectra import SpectralGrid, Spectrum, resample_spectrum
 from reference.errors import require, require_nonnegative
 from reference.registry import Method, Registry
-from reference.spectra import SpectralGrid, Spectrum, resample_spectrum
 
 __all__ = [
     "DESIGNS_FILE",
@@ -201,13 +201,13 @@ def light_to_channels(light, design: SamplingDesign) -> np.ndarray:
 
     Examples
     --------
-    >>> from reference.spectra import spectrum_from_dataset
+    >>> from reference.colour.spectra import spectrum_from_dataset
     >>> d = design_box(6)
     >>> S6 = light_to_channels(spectrum_from_dataset("illuminant", "D65"), d)
     >>> float(channels_to_XYZ(S6, d)[1]).__round__(2)
     1.0
     """
-    from reference.colorimetry import band_weights
+    from reference.colour.colorimetry import band_weights
 
     S = _spectra_on_grid(light, "light")
     y_bar = band_weights(MS_GRID, None)[:, 1]
@@ -266,7 +266,7 @@ def render_channels(reflectance, light, design: SamplingDesign) -> np.ndarray:
 
     Examples
     --------
-    >>> from reference.spectra import spectrum_from_dataset
+    >>> from reference.colour.spectra import spectrum_from_dataset
     >>> d = design_optimized(6)
     >>> XYZ = render_channels(np.ones(81), spectrum_from_dataset("illuminant", "A"), d)
     >>> XYZ.round(2)

@@ -41,11 +41,12 @@ from impastor.multispectral import (
 from impastor.point_lights import illuminance_point_lights, point_lights_from_plane
 from impastor.specular_hybrid import specular_hybrid
 from impastor.specular_lighting import specular_fis, specular_point_lights
-from reference.colorimetry import XYZ_to_display_RGB
-from reference.display import linear_to_display
+from reference.colour.colorimetry import XYZ_to_display_RGB
+from reference.colour.spectra import resample_spectrum, spectrum_from_csv, spectrum_from_dataset
+from reference.data import measured_spectra_folder
+from reference.display.encodings import linear_to_display
 from reference.errors import require, require_positive_int
 from reference.registry import Method, Registry
-from reference.spectra import resample_spectrum, spectrum_from_csv, spectrum_from_dataset
 
 __all__ = [
     "EYE",
@@ -63,7 +64,7 @@ __all__ = [
     "render_painting",
 ]
 
-#: Measured reflectances used for the painting's strokes (``../shared/data/spectra``).
+#: Measured reflectances used for the painting's strokes (shipped: ``reference.data``).
 PAINT_SPECTRA = (
     "lemon",
     "orange",
@@ -103,13 +104,21 @@ def _booth_kind(light: str) -> str:
     return "incandescent" if light == "A" else "fluorescent"
 
 
-def load_paint_spectra(shared_data=None, names=PAINT_SPECTRA) -> dict:
-    """Measured reflectances from ``../shared/data/spectra/physicallybased`` on the 5 nm grid.
+def load_paint_spectra(folder=None, names=PAINT_SPECTRA) -> dict:
+    """Measured reflectances (Nix Spectro 2 exports) on the 5 nm grid, by name.
+
+    Parameters
+    ----------
+    folder : str or Path, optional
+        A folder of ``<name>__nix_export.csv`` files; default the shipped ones
+        (:func:`reference.data.measured_spectra_folder`).
+    names : sequence of str
+        The materials to read.
 
     Raises
     ------
     SpecrefError
-        When the folder is missing, naming it and how to point at it.
+        When a file is missing, naming it.
 
     Examples
     --------
@@ -117,22 +126,12 @@ def load_paint_spectra(shared_data=None, names=PAINT_SPECTRA) -> dict:
     >>> spectra["lemon"].shape
     (81,)
     """
-    import os
-
-    root = Path(
-        shared_data
-        or os.environ.get("SPECREF_SHARED_DATA")
-        or Path(__file__).resolve().parents[1].parent / "shared" / "data"
-    )
-    folder = root / "spectra" / "physicallybased"
-    require(
-        folder.is_dir(),
-        f"{folder}: measured spectra not found; the ImpastoR painting needs ../shared/data "
-        "(set SPECREF_SHARED_DATA to the shared data folder)",
-    )
+    folder = Path(folder) if folder is not None else measured_spectra_folder()
     out = {}
     for name in names:
-        spectrum = spectrum_from_csv(folder / f"{name}__nix_export.csv", name=name)
+        path = folder / f"{name}__nix_export.csv"
+        require(path.is_file(), f"{path}: measured spectrum not found")
+        spectrum = spectrum_from_csv(path, name=name)
         out[name] = resample_spectrum(spectrum, MS_GRID, extrapolation="constant")
     return out
 
@@ -210,9 +209,9 @@ def impasto_painting(size: int = 256, seed: int = 1, width_m: float = 0.3, n_str
 
 
 def _painting_gbuffer(size: int, width_m: float):
-    from reference.camera import Camera
-    from reference.gbuffer import render_gbuffer
-    from reference.geometry import Plane
+    from reference.geometry.camera import Camera
+    from reference.geometry.gbuffer import render_gbuffer
+    from reference.geometry.shapes import Plane
 
     plane = Plane((0.0, 0.0, 0.0), (0.0, 1.0, 0.0), (1.0, 0.0, 0.0), size=(width_m, width_m))
     camera = Camera(eye=EYE, target=(0.0, 0.0, 0.0), fov_deg=25.0)

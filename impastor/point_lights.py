@@ -10,8 +10,8 @@ minimises the summed energy-weighted spatial variance of the two halves. Each re
 light at its energy centroid carrying the region's summed radiance, so the lights' total equals
 the image's total exactly (power conservation).
 
-Lat-long lights follow ``reference.envmap``'s convention; their point lights are directional and
-carry ``Σ L dω`` per channel (irradiance at normal incidence).
+Lat-long lights follow ``reference.geometry.envmap``'s convention; their point lights are
+directional and carry ``Σ L dω`` per channel (irradiance at normal incidence).
 
 References
 ----------
@@ -28,8 +28,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from impastor.arealights import PlaneLight, check_light_image
-from reference.envmap import check_latlong_shape, latlong_pixel_directions
 from reference.errors import require, require_positive_int
+from reference.geometry.envmap import check_latlong_shape, latlong_pixel_directions
 from reference.registry import Method, Registry
 
 __all__ = [
@@ -397,7 +397,7 @@ def point_lights_from_latlong(image, method: str = "median_cut", n_lights: int =
     >>> float(lights.L.sum()).__round__(10) == round(4 * np.pi, 10)
     True
     """
-    from reference.envmap import latlong_pixel_solid_angles
+    from reference.geometry.envmap import latlong_pixel_solid_angles
 
     image = check_light_image(image, "lat-long light")
     check_latlong_shape(image.shape, "lat-long light")

@@ -40,8 +40,8 @@ from impastor.specular_lighting import (
     specular_mis,
     specular_point_lights,
 )
-from reference.brdf import brdf_ward_duer_specular
 from reference.errors import require, require_positive_int
+from reference.materials.brdf import brdf_ward_duer_specular
 from reference.registry import Method, Registry
 
 __all__ = [

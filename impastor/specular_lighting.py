@@ -45,13 +45,13 @@ from impastor._kernels import (
 )
 from impastor.arealights import PlaneLight, light_plane_uv
 from impastor.point_lights import PointLights
-from reference.brdf import (
+from reference.errors import require, require_choice, require_nonnegative, require_positive_int
+from reference.materials.brdf import (
     brdf_ward_duer_specular,
     frame_from_normal,
     pdf_ward_duer_lobe,
     sample_ward_duer_lobe,
 )
-from reference.errors import require, require_choice, require_nonnegative, require_positive_int
 
 __all__ = [
     "BACKENDS",
@@ -357,12 +357,12 @@ def specular_mis(
     Eq. (4), Ferwerda, over the light plane as :func:`specular_brute_force` integrates it (each
     light pixel constant), estimated by multiple importance sampling with the balance heuristic
     (Veach & Guibas 1995): ``n_samples`` points on the light drawn in proportion to the pixels'
-    power (channel mean) and uniformly inside a pixel, and ``n_samples`` directions from Ward's
-    lobe sampler (:func:`reference.brdf.sample_ward_duer_lobe`). With ``M`` samples of each
+    power (channel mean) and uniformly inside a pixel, and ``n_samples`` directions from Ward's lobe
+    sampler (:func:`reference.materials.brdf.sample_ward_duer_lobe`). With ``M`` samples of each
     technique, ``I = (1/M) Σ f L cos θ_s / (p_light + p_lobe)`` over all ``2M`` samples, both
     densities per unit solid angle. Not one of ImpastoR's methods: the hybrid's fail-safe
-    (``impastor.specular_hybrid``) measures the other methods against it (erratum E17). NumPy
-    only: the hybrid evaluates it on a bounded number of pixels.
+    (``impastor.specular_hybrid``) measures the other methods against it (erratum E17). NumPy only:
+    the hybrid evaluates it on a bounded number of pixels.
 
     Parameters
     ----------

@@ -13,6 +13,8 @@ method).
 - :mod:`phong_table.scenes`: the reconstructed scenes R1-R3, the failure cases and the views.
 - :mod:`phong_table.shader`: the ``"table"`` Phong shader for scenes (``options["phong"]``).
 - :mod:`phong_table.materialfile`: TOML material files for ``specref phong --material``.
+- :mod:`phong_table.editor`: the WYSIWYG material editor of §1 and §5 (``specref phong edit``; Bokeh
+  is imported only when the page is served).
 """
 
 from phong_table import shader  # noqa: F401  (registers the table shader)

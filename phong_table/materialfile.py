@@ -5,9 +5,9 @@ The format is documented in ``docs/scene-format.md`` ("Phong material files"). A
 ``[light]`` table (``spectrum``, ``position``, ``intensity``, ``attenuation``) and an optional
 ``[spectral]`` table; the sphere, the camera and the views are those of the scenes
 (``phong_table.scenes``). Spectra, the ``[spectral]`` table and the error messages are those of
-scene files: the values are read by ``reference.scene_values.SceneReader`` (every form of
-``reference.scene_values.SPECTRUM_FORMS``) and ``reference.scene.parse_spectral``, so every error
-names the file and the key.
+scene files: the values are read by ``reference.scene.values.SceneReader`` (every form of
+``reference.scene.values.SPECTRUM_FORMS``) and ``reference.scene.loader.parse_spectral``, so every
+error names the file and the key.
 """
 
 from __future__ import annotations
@@ -16,10 +16,10 @@ from pathlib import Path
 
 from phong_table.model import SpectralPhong
 from phong_table.scenes import LIGHT_ATTENUATION, LIGHT_POSITION
-from reference.lights import PointLight
-from reference.materials import PhongMaterial
-from reference.scene import parse_spectral, read_toml_file
-from reference.scene_values import SceneReader
+from reference.materials.types import PhongMaterial
+from reference.scene.lights import PointLight
+from reference.scene.loader import parse_spectral, read_toml_file
+from reference.scene.values import SceneReader
 
 __all__ = ["load_material_file"]
 

@@ -33,11 +33,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from reference.colorimetry import DEFAULT_OBSERVER, band_weights, spectra_to_RGB_matrix
+from reference.colour.colorimetry import DEFAULT_OBSERVER, band_weights, spectra_to_RGB_matrix
+from reference.colour.spectra import DEFAULT_GRID, SpectralGrid
 from reference.errors import require
-from reference.lights import AmbientLight, PointLight
-from reference.materials import PhongMaterial
-from reference.spectra import DEFAULT_GRID, SpectralGrid
+from reference.materials.types import PhongMaterial
+from reference.scene.lights import AmbientLight, PointLight
 
 __all__ = [
     "SpectralPhong",
@@ -60,7 +60,7 @@ def diffuse_RGB_Wang(k_d, spectra_to_RGB, intensity: float = 1.0) -> np.ndarray:
     k_d : ndarray, shape (n_bands,)
         Diffuse coefficient per band.
     spectra_to_RGB : ndarray, shape (n_bands, 3)
-        From :func:`reference.colorimetry.spectra_to_RGB_matrix` (light folded in).
+        From :func:`reference.colour.colorimetry.spectra_to_RGB_matrix` (light folded in).
     intensity : float
         The light's scale.
 

@@ -430,11 +430,11 @@ def table_error(
     |f^(k)|² ρ^(−2k) dt``, which under ``∫ρ = m`` is smallest (a Lagrange multiplier) for ``ρ ∝
     (p |f^(k)|²)^{1/(2k+1)}``. Pixels bunch where the view sees the highlight (the near view has
     most of its pixels at ``t > 0.9``), where the max-norm density alone puts too few nodes. The
-    density is then the largest of the four normalised densities (``k = 2, 3``, pixel-weighted,
-    and max-norm at the weight :data:`ERROR_HEDGE`): the pixel-weighted ones lead, and the
-    max-norm ones take over only where they ask for more than twice as many nodes, which guards
-    against a histogram of few pixels (a small frame). ``tests/validation/test_phong.py`` checks
-    the result against uniform and importance tables on measured materials.
+    density is then the largest of the four normalised densities (``k = 2, 3``, pixel-weighted, and
+    max-norm at the weight :data:`ERROR_HEDGE`): the pixel-weighted ones lead, and the max-norm ones
+    take over only where they ask for more than twice as many nodes, which guards against a
+    histogram of few pixels (a small frame). ``tests/validation/studies/test_phong.py`` checks the
+    result against uniform and importance tables on measured materials.
 
     **Grading for the parabola** (Erratum E85). The parabola of the interval around node ``j``
     goes through ``t_{j-1}, t_j, t_{j+1}``; its error is ``|f^(3)| |(t - t_{j-1})(t - t_j)(t -

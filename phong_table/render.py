@@ -14,7 +14,7 @@ RGB, ``(N, 3)`` per pixel:
 :data:`RENDER_METHODS` lists the two paths with their numba twins
 (``phong_table._kernels.shade_exact_kernel``, ``shade_table_kernel``); :func:`render_sphere` is the
 public entry point. The per-pixel geometry (:func:`light_geometry`) is computed as
-``reference.shading.phong_cosines`` and ``reference.lights.attenuation_Wang`` do.
+``reference.scene.shading.phong_cosines`` and ``reference.scene.lights.attenuation_Wang`` do.
 """
 
 from __future__ import annotations
@@ -30,12 +30,13 @@ from phong_table.model import SpectralPhong
 from phong_table.placement import pixel_density
 from phong_table.scenes import SPHERE, view_camera
 from phong_table.table import SpecularTable, build_table, check_interpolation, tabulate
-from reference.camera import MAX_RESOLUTION
+from reference.display.encodings import linear_to_display
 from reference.errors import require, require_choice
-from reference.gbuffer import GBuffer, render_gbuffer
-from reference.lights import attenuation_Wang, point_light_vectors
+from reference.geometry.camera import MAX_RESOLUTION
+from reference.geometry.gbuffer import GBuffer, render_gbuffer
 from reference.registry import Method, Registry
-from reference.shading import phong_cosines
+from reference.scene.lights import attenuation_Wang, point_light_vectors
+from reference.scene.shading import phong_cosines
 
 __all__ = [
     "RENDER_METHODS",
@@ -46,6 +47,7 @@ __all__ = [
     "light_geometry",
     "render_sphere",
     "render_sphere_gbuffer",
+    "rms_8bit",
     "shade_exact",
     "shade_pixels",
     "shade_table",
@@ -124,8 +126,8 @@ def sphere_gbuffer(view: str, resolution: int = 512) -> SphereGeometry:
 def light_geometry(position, normal, view, light_position, attenuation) -> np.ndarray:
     """``cos θ``, ``t`` and ``f_att`` of G-buffer pixels under a point light (NumPy reference).
 
-    Eq. (1), Wang et al. (Figure 1 and Erratum E2), by ``reference.shading.phong_cosines`` and
-    ``reference.lights.attenuation_Wang``.
+    Eq. (1), Wang et al. (Figure 1 and Erratum E2), by ``reference.scene.shading.phong_cosines`` and
+    ``reference.scene.lights.attenuation_Wang``.
 
     Parameters
     ----------
@@ -517,3 +519,37 @@ def render_sphere(
         check_interpolation(interpolation, table.entries)
     pixels = shade_pixels(buffer, material, method, table, interpolation, compiled)
     return geometry.to_image(pixels)
+
+
+def rms_8bit(RGB, RGB_exact, encoding: str = "srgb", exact_encoded=None) -> tuple[float, float]:
+    """RMS error in 8-bit units over pixels and channels: display (clipped, encoded) and linear.
+
+    Parameters
+    ----------
+    RGB, RGB_exact : ndarray, shape (N, 3)
+        Linear display RGB of the method and of the exact render, same pixels.
+    encoding : str
+        Display encoding (``reference.display.encodings.ENCODINGS``).
+    exact_encoded : ndarray, shape (N, 3), optional
+        ``linear_to_display(RGB_exact)``, if already computed.
+
+    Returns
+    -------
+    rms_display, rms_linear : float
+        ``255 · sqrt(mean((enc(clip(RGB)) − enc(clip(RGB_exact)))²))`` and
+        ``255 · sqrt(mean((RGB − RGB_exact)²))``; ``inf`` if ``RGB`` is not finite.
+
+    Examples
+    --------
+    >>> [round(x, 6) for x in rms_8bit(np.array([[0.5, 0.5, -0.1]]), np.array([[0.5, 0.5, 0.0]]))]
+    [0.0, 14.722432]
+    """
+    RGB = np.asarray(RGB, dtype=np.float64)
+    if not np.isfinite(RGB).all():
+        return float("inf"), float("inf")
+    if exact_encoded is None:
+        exact_encoded = linear_to_display(RGB_exact, encoding)
+    display = linear_to_display(RGB, encoding)
+    rms_display = 255.0 * float(np.sqrt(np.mean((display - exact_encoded) ** 2)))
+    rms_linear = 255.0 * float(np.sqrt(np.mean((RGB - RGB_exact) ** 2)))
+    return rms_display, rms_linear

@@ -32,13 +32,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from phong_table.model import SpectralPhong
-from reference.camera import Camera
+from reference.colour.spectra import DEFAULT_GRID, SpectralGrid, spectrum_from_dataset
 from reference.errors import require
-from reference.geometry import Sphere
-from reference.lights import PointLight
-from reference.materials import PhongMaterial
+from reference.geometry.camera import Camera
+from reference.geometry.shapes import Sphere
+from reference.materials.types import PhongMaterial
 from reference.registry import Registry
-from reference.spectra import DEFAULT_GRID, SpectralGrid, spectrum_from_dataset
+from reference.scene.lights import PointLight
 
 __all__ = [
     "EYE",

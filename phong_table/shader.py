@@ -1,8 +1,8 @@
 """The table shader: scenes render Phong materials through a table by ``options["phong"]``.
 
-``reference.shading.shade_phong_point`` dispatches on ``ctx.options["phong"]["method"]``; this
-module registers ``"table"`` in ``reference.shading.PHONG_POINT_METHODS``. The exact shader stays
-the default. Keys of ``options["phong"]`` read here:
+``reference.scene.shading.shade_phong_point`` dispatches on ``ctx.options["phong"]["method"]``; this
+module registers ``"table"`` in ``reference.scene.shading.PHONG_POINT_METHODS``. The exact shader
+stays the default. Keys of ``options["phong"]`` read here:
 
 - ``method``: ``"table"`` (``"exact"``, the default, is the exact spectral shader);
 - ``placement``: a key of ``PLACEMENT_METHODS`` (default ``"error"``);
@@ -24,7 +24,7 @@ from phong_table.render import ShadingBuffer, compiled_shader
 from phong_table.table import build_table, check_interpolation
 from reference.errors import require
 from reference.registry import Method
-from reference.shading import PHONG_POINT_METHODS
+from reference.scene.shading import PHONG_POINT_METHODS
 
 __all__ = ["OPTION_KEYS", "shade_phong_point_table"]
 
@@ -47,9 +47,9 @@ def shade_phong_point_table(surface, material, light, ctx) -> np.ndarray:
 
     Examples
     --------
-    >>> from reference.lights import PointLight
-    >>> from reference.materials import PhongMaterial
-    >>> from reference.shading import ShadingContext, Surface, shade_phong_point
+    >>> from reference.scene.lights import PointLight
+    >>> from reference.materials.types import PhongMaterial
+    >>> from reference.scene.shading import ShadingContext, Surface, shade_phong_point
     >>> m = PhongMaterial(np.full(41, 0.3), np.full(41, 0.5), np.full(41, 40.0))
     >>> z = np.array([[0.0, 0.0, 1.0]])
     >>> s = Surface(np.zeros((1, 3)), z, z, np.zeros((1, 2)))

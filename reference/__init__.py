@@ -4,12 +4,10 @@ Users write ``reference.band_weights``, ``reference.Camera``; the modules hold t
 their citations. ``reference`` imports none of ``phong_table``, ``shrm`` or ``validation``.
 """
 
-import reference.brdf_isotropic
-import reference.brdf_table
-import reference.thinfilm  # noqa: F401  (registers the effect pigment)
-from reference.camera import MAX_RESOLUTION, PROJECTIONS, Camera, downsample_box
-from reference.colorchecker import ColorCheckerMaterial, colorchecker_material
-from reference.colorimetry import (
+import reference.materials.isotropic
+import reference.materials.table
+import reference.materials.thinfilm  # noqa: F401  (registers the effect pigment)
+from reference.colour.colorimetry import (
     BAND_WEIGHT_METHODS,
     DEFAULT_OBSERVER,
     OBSERVERS,
@@ -25,59 +23,7 @@ from reference.colorimetry import (
     spectra_to_XYZ,
     white_XYZ,
 )
-from reference.compare import compare_images
-from reference.display import ENCODINGS, display_to_linear, linear_to_display, to_8bit
-from reference.envmap import (
-    check_latlong_shape,
-    direction_to_latlong_uv,
-    latlong_lookup_bilinear,
-    latlong_pixel_directions,
-    latlong_pixel_solid_angles,
-    latlong_uv_to_direction,
-)
-from reference.errors import SpecrefError, SpecrefWarning, require
-from reference.gbuffer import PRIMITIVES, GBuffer, empty_gbuffer, render_gbuffer
-from reference.geometry import Plane, Sphere, intersect_plane, intersect_sphere
-from reference.images import (
-    atomic_write,
-    read_exr,
-    read_hdr,
-    read_image,
-    read_png,
-    write_exr,
-    write_png,
-)
-from reference.lights import (
-    AmbientLight,
-    EnvironmentLight,
-    PointLight,
-    attenuation_Wang,
-    point_light_vectors,
-)
-from reference.materials import MATERIAL_TYPES, LambertMaterial, PhongMaterial, make_material
-from reference.mesh import TriangleMesh, grid_mesh, mesh_from_obj, mesh_to_obj, uv_sphere_mesh
-from reference.raster import RASTER_METHODS, pixel_coverage, rasterize_mesh
-from reference.registry import Method, Registry
-from reference.render import RenderResult, render_scene, render_scene_file, write_render
-from reference.render_metadata import RENDER_OUTPUTS, render_metadata
-from reference.scene import (
-    LIGHT_TYPES,
-    MAX_RENDER_SAMPLES,
-    OBJECT_TYPES,
-    Scene,
-    load_scene,
-    loads_scene,
-)
-from reference.scene_values import SPECTRUM_FORMS
-from reference.shading import (
-    SHADERS,
-    ShadingContext,
-    Surface,
-    phong_cosines,
-    phong_spectral_exact,
-    shade_gbuffer,
-)
-from reference.spectra import (
+from reference.colour.spectra import (
     DEFAULT_GRID,
     GRID_31,
     GRID_41,
@@ -90,6 +36,59 @@ from reference.spectra import (
     spectrum_from_csv,
     spectrum_from_dataset,
 )
+from reference.display.encodings import ENCODINGS, display_to_linear, linear_to_display, to_8bit
+from reference.errors import SpecrefError, SpecrefWarning, require
+from reference.files import atomic_write
+from reference.geometry.camera import MAX_RESOLUTION, PROJECTIONS, Camera, downsample_box
+from reference.geometry.envmap import (
+    check_latlong_shape,
+    direction_to_latlong_uv,
+    latlong_lookup_bilinear,
+    latlong_pixel_directions,
+    latlong_pixel_solid_angles,
+    latlong_uv_to_direction,
+)
+from reference.geometry.gbuffer import PRIMITIVES, GBuffer, empty_gbuffer, render_gbuffer
+from reference.geometry.mesh import (
+    TriangleMesh,
+    grid_mesh,
+    mesh_from_obj,
+    mesh_to_obj,
+    uv_sphere_mesh,
+)
+from reference.geometry.raster import RASTER_METHODS, pixel_coverage, rasterize_mesh
+from reference.geometry.shapes import Plane, Sphere, intersect_plane, intersect_sphere
+from reference.images.formats import read_exr, read_hdr, read_image, read_png, write_exr, write_png
+from reference.materials.types import MATERIAL_TYPES, LambertMaterial, PhongMaterial, make_material
+from reference.registry import Method, Registry
+from reference.scene.colorchecker import ColorCheckerMaterial, colorchecker_material
+from reference.scene.compare import compare_images
+from reference.scene.lights import (
+    AmbientLight,
+    EnvironmentLight,
+    PointLight,
+    attenuation_Wang,
+    point_light_vectors,
+)
+from reference.scene.loader import (
+    LIGHT_TYPES,
+    MAX_RENDER_SAMPLES,
+    OBJECT_TYPES,
+    Scene,
+    load_scene,
+    loads_scene,
+)
+from reference.scene.metadata import RENDER_OUTPUTS, render_metadata
+from reference.scene.render import RenderResult, render_scene, render_scene_file, write_render
+from reference.scene.shading import (
+    SHADERS,
+    ShadingContext,
+    Surface,
+    phong_cosines,
+    phong_spectral_exact,
+    shade_gbuffer,
+)
+from reference.scene.values import SPECTRUM_FORMS
 
 __all__ = [
     "BAND_WEIGHT_METHODS",

@@ -1,6 +1,14 @@
-"""Spherical harmonics, prefiltering and SH reflection maps after Herbert et al.
+"""Herbert et al.: spherical harmonics, prefiltering, SH reflection maps and the polymer model.
 
-Importing ``shrm`` registers the environment-light shaders in ``reference.shading.SHADERS``
+The SH modules (``sh``, ``transform``, ``streamed``, ``windows``, ``rotation``, ``lobes``,
+``prefilter``, ``accuracy``), the SHRMs (``brdf_sh``, ``shrm``, ``shrm_oracles``, ``split``,
+``montecarlo``), the map cache (``cache``) and the render session (``session``, ``orbit``) sit here;
+the polymer family (Kubelka–Munk, characterization, tint, Eqs. (1)–(5), Herbert et al., its scene
+material and its physical oracle) is the sub-package :mod:`shrm.polymer`. Spectral environments (§4)
+and display calibration (§6) are in the shared core (``reference.colour``, ``reference.display``),
+which the renderer of every paper uses.
+
+Importing ``shrm`` registers the environment-light shaders in ``reference.scene.shading.SHADERS``
 (``shrm.environment``).
 """
 
@@ -8,8 +16,15 @@ from shrm import environment  # noqa: F401  (registers the environment-light sha
 from shrm.accuracy import accuracy_order, bright_texels
 from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts, shrm_orders
 from shrm.cache import Cache, cache_key, default_cache_dir
-from shrm.characterization import characterize_model, read_characterization, write_characterization
-from shrm.kubelka_munk import (
+from shrm.lobes import PREFILTER_KERNELS, adaptive_order, parse_kernel
+from shrm.orbit import render_orbit
+from shrm.polymer.characterization import (
+    characterize_model,
+    read_characterization,
+    write_characterization,
+)
+from shrm.polymer.hybrid import MIRROR_FACTORS, polymer_look, polymer_maps, polymer_terms
+from shrm.polymer.kubelka_munk import (
     PolymerConstituents,
     km_invert,
     km_slab,
@@ -17,10 +32,7 @@ from shrm.kubelka_munk import (
     polymer_K_S,
     slab_measured,
 )
-from shrm.lobes import PREFILTER_KERNELS, adaptive_order, parse_kernel
-from shrm.orbit import render_orbit
-from shrm.polymer import MIRROR_FACTORS, polymer_look, polymer_maps, polymer_terms
-from shrm.polymer_material import PolymerMaterial
+from shrm.polymer.material import PolymerMaterial
 from shrm.prefilter import prefilter_bruteforce, prefilter_coefficients, prefilter_environment
 from shrm.rotation import rotate_coefficients, rotation_matrix, sh_rotation_blocks
 from shrm.session import HERBERT_STAGES, RenderSession

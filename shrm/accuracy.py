@@ -32,7 +32,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from reference.errors import require
-from reference.render_metadata import DEFAULT_ACCURACY, LIT_FRACTION, MAX_FACTOR, check_accuracy
+from reference.scene.metadata import DEFAULT_ACCURACY, LIT_FRACTION, MAX_FACTOR, check_accuracy
 from shrm.lobes import parse_kernel
 from shrm.sh import SH_MAX_ORDER, n_coefficients
 from shrm.transform import project_latlong, synthesize_latlong
@@ -117,7 +117,7 @@ def bright_texels(luminance) -> BrightTexels:
     >>> b.index.tolist(), float(b.scale[3, 5])
     ([53], 1e-05)
     """
-    from reference.envmap import latlong_pixel_directions
+    from reference.geometry.envmap import latlong_pixel_directions
     from shrm.sh import fejer1_weights
 
     Y = np.asarray(luminance, dtype=np.float64)
@@ -339,7 +339,7 @@ def accuracy_order(
     L_max = min(luminance.shape[1] // 2 - 1, ESTIMATE_MAX_ORDER, SH_MAX_ORDER)
     exact_map, residual = None, luminance
     if bright is not None and bright.index.size:
-        from reference.envmap import latlong_pixel_directions
+        from reference.geometry.envmap import latlong_pixel_directions
 
         residual = luminance * bright.scale
         grid = latlong_pixel_directions(L_max + 1, 2 * L_max + 2).reshape(-1, 3)

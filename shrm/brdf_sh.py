@@ -102,8 +102,8 @@ def transfer_function(
     Parameters
     ----------
     brdf : callable
-        ``brdf(wi, wo, normal, **params) -> (..., C)`` (the :data:`reference.brdf.BRDF_METHODS`
-        convention).
+        ``brdf(wi, wo, normal, **params) -> (..., C)`` (the
+        :data:`reference.materials.brdf.BRDF_METHODS` convention).
     params : dict
         Its parameters.
     wi, wo : ndarray, shape (..., 3)
@@ -118,7 +118,7 @@ def transfer_function(
 
     Examples
     --------
-    >>> from reference.brdf import brdf_lambert
+    >>> from reference.materials.brdf import brdf_lambert
     >>> y = np.array([0.0, 1.0, 0.0])
     >>> transfer_function(brdf_lambert, {"rho_d": [np.pi]}, y, y, "normal")
     array([1.])
@@ -228,7 +228,7 @@ def shrm_brdf_parts(name: str, params: dict, split: bool = True):
 
     R&H 2002 handle the Lambertian part of a BRDF with irradiance maps (Eq. (7), Ramamoorthi &
     Hanrahan 2001) and expand only the rest. A registry entry of
-    :data:`reference.brdf.BRDF_METHODS` declares
+    :data:`reference.materials.brdf.BRDF_METHODS` declares
 
     - ``extra["lambert"]``: the name of its Lambertian albedo parameter (``ρ_d/π`` is added to
       the rest of the model), which is split off and set to 0 in the part to expand;
@@ -268,7 +268,7 @@ def shrm_brdf_parts(name: str, params: dict, split: bool = True):
     >>> expand["rho_d"], lambert, k
     (0.0, array([0.2]), 0.5)
     """
-    from reference.brdf import BRDF_METHODS
+    from reference.materials.brdf import BRDF_METHODS
 
     method = BRDF_METHODS.lookup(name)
     require(
@@ -350,7 +350,7 @@ def brdf_sh_coefficients(
 
     Examples
     --------
-    >>> from reference.brdf import brdf_lambert
+    >>> from reference.materials.brdf import brdf_lambert
     >>> rho = brdf_sh_coefficients(brdf_lambert, {"rho_d": [1.0]}, 2, 2, "normal")
     >>> rho.shape, round(float(rho[0, 0, 0, 0]), 4)   # ∫∫ ρ̃ Y00 Y00 = (1/4π) · 1 · 4π
     ((1, 3, 3, 3), 1.0)

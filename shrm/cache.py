@@ -12,7 +12,7 @@ map reuse." specref's scheme:
   arrays' raw bytes, 64-byte aligned. A hit maps them without copies (read-only arrays) and no
   pickle is ever involved.
 - **Atomic writes.** An entry is written to a temporary file in the cache folder, synced and renamed
-  into place (:func:`reference.images.atomic_write`). A writer killed at any point leaves either no
+  into place (:func:`reference.files.atomic_write`). A writer killed at any point leaves either no
   entry or a whole one. Two processes writing the same key both succeed; the last rename wins and
   leaves one valid entry.
 - **Corruption.** A truncated or corrupted entry (bad checksum, short file, bad header) is reported
@@ -64,7 +64,7 @@ from pathlib import Path
 import numpy as np
 
 from reference.errors import SpecrefError, SpecrefWarning, require
-from reference.images import atomic_write, output_error
+from reference.files import atomic_write, output_error
 
 __all__ = [
     "CACHE_MAGIC",
@@ -505,7 +505,7 @@ class Cache:
             return False
         except (SpecrefError, OSError) as error:
             # a read-only folder or home, a full disk, a file where the folder should be
-            # (reference.images.output_error): one warning, then no cache
+            # (reference.files.output_error): one warning, then no cache
             self._give_up(_reason(error))
             return False
         self.evict()
@@ -640,7 +640,7 @@ class Cache:
 
 
 def _reason(error: Exception) -> str:
-    """The short reason of a write refusal: the parenthesis of reference.images.output_error."""
+    """The short reason of a write refusal: the parenthesis of reference.files.output_error."""
     if isinstance(error, OSError):
         translated = output_error("", error)
         if translated is None:
@@ -669,5 +669,5 @@ def _is_stale_temp(path: Path, now: float) -> bool:
 
 
 def _is_our_temp(name: str) -> bool:
-    """Whether ``name`` is an entry's temporary file (:func:`reference.images.atomic_write`)."""
+    """Whether ``name`` is an entry's temporary file (:func:`reference.files.atomic_write`)."""
     return name.startswith(".") and name.endswith(".tmp") and f"{_SUFFIX}." in name

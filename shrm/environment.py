@@ -1,6 +1,6 @@
 """Shading with environment light: prefiltered maps looked up per pixel (Herbert et al. §5.4).
 
-Importing ``shrm`` registers two shaders in ``reference.shading.SHADERS``:
+Importing ``shrm`` registers two shaders in ``reference.scene.shading.SHADERS``:
 
 - ``LambertMaterial/EnvironmentLight``: reflected radiance ``k_d(λ) E(n, λ) / π`` with E the
   prefiltered irradiance map (kernel ``lambert``), looked up by the normal.
@@ -20,8 +20,8 @@ pixels), and cached per environment. Each choice and the bound it promises is re
 the whole map instead (:func:`shrm.prefilter.prefilter_bruteforce`).
 
 A spectral environment (one channel per band) is resampled linearly onto the scene's grid; an RGB
-one is upsampled with ``reference.upsampling.RGB_to_radiance_spectra`` (Mallett & Yuksel 2019 by
-default, times the colourspace's white illuminant, so a white texel becomes a D65-shaped spectrum
+one is upsampled with ``reference.colour.upsampling.RGB_to_radiance_spectra`` (Mallett & Yuksel 2019
+by default, times the colourspace's white illuminant, so a white texel becomes a D65-shaped spectrum
 and renders white; options ``ctx.options["upsampling"]`` and, for ``"regression"``,
 ``ctx.options["upsampling_model"]``, a model file). XYZ uses the equal-energy band weights:
 radiance spectra carry no light to fold in.
@@ -39,16 +39,16 @@ import weakref
 
 import numpy as np
 
-from reference.colorimetry import band_weights
-from reference.cubemap import cubemap_lookup_bilinear, cubemap_texel_directions
+from reference.colour.colorimetry import band_weights
+from reference.colour.spectra import SpectralGrid
+from reference.colour.upsampling import DEFAULT_UPSAMPLING, RGB_to_radiance_spectra
 from reference.errors import require
-from reference.lights import EnvironmentLight
-from reference.materials import LambertMaterial, PhongMaterial
+from reference.geometry.cubemap import cubemap_lookup_bilinear, cubemap_texel_directions
+from reference.materials.types import LambertMaterial, PhongMaterial
 from reference.registry import Method
-from reference.render_metadata import DEFAULT_ACCURACY, check_accuracy
-from reference.shading import SHADERS, Surface
-from reference.spectra import SpectralGrid
-from reference.upsampling import DEFAULT_UPSAMPLING, RGB_to_radiance_spectra
+from reference.scene.lights import EnvironmentLight
+from reference.scene.metadata import DEFAULT_ACCURACY, check_accuracy
+from reference.scene.shading import SHADERS, Surface
 from shrm.accuracy import accuracy_order, bright_texels, sparse_convolution
 from shrm.lobes import adaptive_order, kernel_phong, parse_kernel
 from shrm.prefilter import prefilter_bruteforce, prefilter_coefficients
@@ -80,7 +80,7 @@ def environment_spectral_radiance(
 
     Examples
     --------
-    >>> from reference.spectra import GRID_31
+    >>> from reference.colour.spectra import GRID_31
     >>> env = EnvironmentLight(np.full((2, 4, 3), 0.5))
     >>> environment_spectral_radiance(env, GRID_31).shape
     (2, 4, 31)
@@ -121,7 +121,7 @@ def cached_spectral_radiance(light: EnvironmentLight, ctx) -> np.ndarray:
 
     Examples
     --------
-    >>> from reference.shading import ShadingContext
+    >>> from reference.scene.shading import ShadingContext
     >>> env = EnvironmentLight(np.full((2, 4, 3), 0.5))
     >>> cached_spectral_radiance(env, ShadingContext()) is cached_spectral_radiance(
     ...     env, ShadingContext())
@@ -249,7 +249,7 @@ def shade_lambert_environment(
 
     Examples
     --------
-    >>> from reference.shading import ShadingContext
+    >>> from reference.scene.shading import ShadingContext
     >>> env = EnvironmentLight(np.ones((16, 32, 3)))
     >>> s = Surface(np.zeros((1, 3)), np.array([[0.0, 1.0, 0.0]]), np.array([[0.0, 1.0, 0.0]]),
     ...             np.zeros((1, 2)))
@@ -273,7 +273,7 @@ def shade_phong_environment(
 
     Examples
     --------
-    >>> from reference.shading import ShadingContext
+    >>> from reference.scene.shading import ShadingContext
     >>> env = EnvironmentLight(np.ones((16, 32, 3)))
     >>> s = Surface(np.zeros((1, 3)), np.array([[0.0, 1.0, 0.0]]), np.array([[0.0, 1.0, 0.0]]),
     ...             np.zeros((1, 2)))

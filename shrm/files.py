@@ -1,10 +1,10 @@
 """File-level SH jobs behind ``specref sh project`` and ``specref sh prefilter``.
 
-Maps are read with ``reference.spectral_images.read_environment_file`` (``.hdr`` RGBE, ``.exr`` RGB
+Maps are read with ``reference.images.spectral.read_environment_file`` (``.hdr`` RGBE, ``.exr`` RGB
 or spectral with one channel per band, spectral float ``.tif`` from ``specref env spectralize``).
-``bands="spectral"`` turns an RGB map into spectra on the 41-band grid (``reference.upsampling``,
-Mallett & Yuksel 2019); ``bands="rgb"`` turns a spectral map into linear
-sRGB (equal-energy band weights); the default keeps the map as it is.
+``bands="spectral"`` turns an RGB map into spectra on the 41-band grid
+(``reference.colour.upsampling``, Mallett & Yuksel 2019); ``bands="rgb"`` turns a spectral map into
+linear sRGB (equal-energy band weights); the default keeps the map as it is.
 """
 
 from __future__ import annotations
@@ -13,11 +13,11 @@ from pathlib import Path
 
 import numpy as np
 
-from reference.colorimetry import band_weights, spectra_to_RGB_matrix
+from reference.colour.colorimetry import band_weights, spectra_to_RGB_matrix
+from reference.colour.spectra import DEFAULT_GRID
+from reference.colour.upsampling import RGB_to_spectra
 from reference.errors import require, require_choice
-from reference.images import spectral_channel_names, write_exr
-from reference.spectra import DEFAULT_GRID
-from reference.upsampling import RGB_to_spectra
+from reference.images.formats import spectral_channel_names, write_exr
 
 __all__ = ["prefilter_file", "project_file", "read_environment"]
 
@@ -37,8 +37,8 @@ def read_environment(path, bands: str | None = None) -> tuple[np.ndarray, list[s
     ...
     reference.errors.SpecrefError: /nonexistent.hdr: file not found
     """
-    from reference.envmap import check_latlong_shape
-    from reference.spectral_images import read_environment_file
+    from reference.geometry.envmap import check_latlong_shape
+    from reference.images.spectral import read_environment_file
 
     path = Path(path)
     image, names = read_environment_file(path)
@@ -75,12 +75,12 @@ def project_file(path, order: int, out, window=None, bands=None, backend: str = 
     """
     import io
 
-    from reference.images import write_bytes_atomic
+    from reference.files import write_bytes_atomic
     from shrm.transform import project_latlong
 
     if Path(path).suffix.lower() == ".zarr" and bands is None:
         # a chunked store is projected block by block, never read whole (shrm.streamed)
-        from reference.zarr_images import open_zarr_image
+        from reference.images.zarr_store import open_zarr_image
         from shrm.streamed import project_zarr
         from shrm.windows import apply_window
 
@@ -112,7 +112,7 @@ def prefilter_file(
     """Prefilter a map file and write the result as EXR (cube: faces stacked vertically).
 
     §5.4, Herbert et al. The cube layout is ``(6·S, S)``: faces +x, −x, +y, −y, +z, −z from top to
-    bottom, each in the orientation of ``reference.cubemap``.
+    bottom, each in the orientation of ``reference.geometry.cubemap``.
 
     Examples
     --------

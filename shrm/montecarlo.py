@@ -81,7 +81,7 @@ def environment_mc(
     A white furnace: every estimate of a Lambertian surface under a constant sky is its albedo
     (the sampler follows the weights, and the integrand is the cosine).
 
-    >>> from reference.brdf import brdf_lambert
+    >>> from reference.materials.brdf import brdf_lambert
     >>> from shrm.shrm_oracles import env_quadrature
     >>> n = np.array([[0.0, 1.0, 0.0]])
     >>> sky = env_quadrature(np.ones((32, 64, 1)))

@@ -8,8 +8,8 @@ from a scene file (:func:`scene_state`, docs/scene-format.md) whose objects shar
 ``isotropic_brdf`` material lit by one environment light.
 
 Importing this module registers the scene-file material type ``isotropic_brdf`` (a registered
-isotropic 3-D BRDF of ``reference.brdf.BRDF_METHODS`` and its parameters) and its shader for
-environment lights, ``IsotropicBRDFMaterial/EnvironmentLight``, which renders through a SHRM
+isotropic 3-D BRDF of ``reference.materials.brdf.BRDF_METHODS`` and its parameters) and its shader
+for environment lights, ``IsotropicBRDFMaterial/EnvironmentLight``, which renders through a SHRM
 (§5.5-5.6, Herbert et al.) with the distant-viewer approximation of global SHRMs: one view
 direction, the mean over the shaded points.
 """
@@ -22,10 +22,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from reference.errors import require
-from reference.lights import EnvironmentLight
-from reference.materials import MATERIAL_TYPES, MaterialType
+from reference.materials.types import MATERIAL_TYPES, MaterialType
 from reference.registry import Method
-from reference.shading import SHADERS, Surface
+from reference.scene.lights import EnvironmentLight
+from reference.scene.shading import SHADERS, Surface
 
 __all__ = [
     "IsotropicBRDFMaterial",
@@ -46,7 +46,7 @@ class IsotropicBRDFMaterial:
     Attributes
     ----------
     brdf : str
-        A key of ``reference.brdf.BRDF_METHODS`` with ``extra["isotropic"]``.
+        A key of ``reference.materials.brdf.BRDF_METHODS`` with ``extra["isotropic"]``.
     params : dict
         Its parameters on the scene's grid (spectral ones per band, :func:`brdf_params_on_grid`).
     name : str
@@ -58,7 +58,7 @@ class IsotropicBRDFMaterial:
 
 
 def analytic_isotropic_brdf_names() -> list[str]:
-    """Keys of ``reference.brdf.BRDF_METHODS`` that ``isotropic_brdf`` materials and orbits take.
+    """Keys of ``reference.materials.brdf.BRDF_METHODS`` that ``isotropic_brdf`` materials take.
 
     The isotropic 3-D BRDFs given by formulas (``extra["isotropic"]``), not the tabulated one,
     which needs a file.
@@ -68,7 +68,7 @@ def analytic_isotropic_brdf_names() -> list[str]:
     >>> "ggx" in analytic_isotropic_brdf_names(), "table" in analytic_isotropic_brdf_names()
     (True, False)
     """
-    from reference.brdf import BRDF_METHODS
+    from reference.materials.brdf import BRDF_METHODS
 
     return [
         n
@@ -78,7 +78,7 @@ def analytic_isotropic_brdf_names() -> list[str]:
 
 
 def _isotropic_method(brdf: str):
-    from reference.brdf import BRDF_METHODS
+    from reference.materials.brdf import BRDF_METHODS
 
     method = BRDF_METHODS.lookup(brdf)
     allowed = analytic_isotropic_brdf_names()
@@ -97,7 +97,7 @@ def brdf_params_on_grid(brdf: str, grid, params: dict | None = None) -> dict:
 
     Examples
     --------
-    >>> from reference.spectra import SpectralGrid
+    >>> from reference.colour.spectra import SpectralGrid
     >>> p = brdf_params_on_grid("ggx", SpectralGrid(380.0, 780.0, 200.0), {"alpha": 0.3})
     >>> p["rho_d"].tolist(), p["alpha"]
     ([0.5, 0.3, 0.1], 0.3)
@@ -150,7 +150,7 @@ def _parse_isotropic_brdf(reader, table: dict, key: str, name: str):
 
 def _table_on_grid(reader, table: dict, key: str) -> dict:
     """``{"table": BRDFTable}`` of a material's ``file``, resampled onto the scene's grid."""
-    from reference.brdf_table import BRDFTable, read_brdf_table
+    from reference.materials.table import BRDFTable, read_brdf_table
 
     reader.table(table, key, ("type", "brdf", "file"))
     if "file" not in table:
@@ -186,7 +186,7 @@ def _working_environment(light: EnvironmentLight, rows: int) -> EnvironmentLight
     """The light with its map box-filtered to at most ``rows`` rows (2:1 lat-long)."""
     from dataclasses import replace
 
-    from reference.camera import downsample_box
+    from reference.geometry.camera import downsample_box
 
     image = light.image
     factor = max(1, image.shape[0] // rows)
@@ -228,8 +228,8 @@ def shade_isotropic_brdf_environment(
 
     Examples
     --------
-    >>> from reference.shading import ShadingContext
-    >>> from reference.spectra import SpectralGrid
+    >>> from reference.scene.shading import ShadingContext
+    >>> from reference.colour.spectra import SpectralGrid
     >>> ctx = ShadingContext(SpectralGrid(400.0, 700.0, 20.0))
     >>> m = IsotropicBRDFMaterial("ggx", brdf_params_on_grid("ggx", ctx.grid))
     >>> env = EnvironmentLight(np.ones((16, 32, 3)))
@@ -261,7 +261,7 @@ def shade_isotropic_brdf_environment(
 
 def _full_brdf(material: IsotropicBRDFMaterial):
     """The material's whole BRDF (Lambertian part included) and its parameters."""
-    from reference.brdf import BRDF_METHODS
+    from reference.materials.brdf import BRDF_METHODS
 
     return BRDF_METHODS.lookup(material.brdf).reference, material.params
 
@@ -290,14 +290,14 @@ def orbit_camera(frame: int, frames: int, radius: float = 5.0, elevation_deg: fl
 
     Returns
     -------
-    reference.camera.Camera
+    reference.geometry.camera.Camera
 
     Examples
     --------
     >>> orbit_camera(0, 4, elevation_deg=0.0).eye
     (0.0, 0.0, 5.0)
     """
-    from reference.camera import Camera
+    from reference.geometry.camera import Camera
 
     a = 2.0 * np.pi * frame / frames
     e = np.radians(elevation_deg)
@@ -321,8 +321,8 @@ def demo_state(
 ) -> dict:
     """A built-in scene for the orbit and the report: a sphere under a shared environment.
 
-    The environment (default ``venice_sunset_1k.hdr`` from ``../shared/data/environments``, else
-    a synthetic sky) is box-filtered to ``env_height`` rows and turned into spectra by replicating
+    The environment (default ``data:environments/venice_sunset_1k.hdr``, shipped with specref)
+    is box-filtered to ``env_height`` rows and turned into spectra by replicating
     its luminance over the grid (an equal-energy spectral environment); the illuminant is CIE D65.
 
     Parameters
@@ -332,8 +332,9 @@ def demo_state(
     env_height : int
         Rows of the working environment (a power-of-two fraction of the file's height).
     brdf : str
-        A key of :data:`reference.brdf.BRDF_METHODS` (isotropic), with its default parameters.
-    grid : reference.spectra.SpectralGrid, optional
+        A key of :data:`reference.materials.brdf.BRDF_METHODS` (isotropic), with its default
+        parameters.
+    grid : reference.colour.spectra.SpectralGrid, optional
         Default a 16-band 400-700 nm grid (20 nm), which keeps the demo quick.
     size : int
         Cube face size of the maps.
@@ -355,34 +356,25 @@ def demo_state(
     """
     from pathlib import Path
 
-    from reference.camera import downsample_box
-    from reference.geometry import Sphere
-    from reference.images import read_image
-    from reference.spectra import SpectralGrid, spectrum_from_dataset
+    from reference.colour.spectra import SpectralGrid, spectrum_from_dataset
+    from reference.data import data_path
+    from reference.geometry.camera import downsample_box
+    from reference.geometry.shapes import Sphere
+    from reference.images.formats import read_image
 
     grid = grid or SpectralGrid(400.0, 700.0, 20.0)
-    default = Path(__file__).resolve().parents[2] / "shared/data/environments/venice_sunset_1k.hdr"
+    default = data_path("environments/venice_sunset_1k.hdr")
     path = Path(environment_path) if environment_path else default
-    # A missing file the user named is an error; only the missing default falls back to a sky.
-    require(
-        environment_path is None or path.is_file(), f"{path}: environment file not found (--env)"
-    )
-    if path.is_file():
-        image = read_image(path)
-        H, W = image.shape[:2]
-        require(W == 2 * H, f"{path}: a lat-long map must be 2:1 (width = 2 × height), got {W}×{H}")
-        factor = max(1, image.shape[0] // env_height)
-        image = downsample_box(image[: factor * env_height, : factor * 2 * env_height], factor)
-    else:  # a synthetic sky: bright zenith, a warm sun, a dark ground
-        from reference.envmap import latlong_pixel_directions
-
-        d = latlong_pixel_directions(env_height, 2 * env_height)
-        sun = np.exp((d @ np.array([0.6, 0.5, 0.62]) - 1.0) * 40.0)
-        image = (0.2 + 0.8 * np.maximum(d[..., 1], 0.0) + 20.0 * sun)[..., None] * np.ones(3)
+    require(path.is_file(), f"{path}: environment file not found (--env)")
+    image = read_image(path)
+    H, W = image.shape[:2]
+    require(W == 2 * H, f"{path}: a lat-long map must be 2:1 (width = 2 × height), got {W}×{H}")
+    factor = max(1, image.shape[0] // env_height)
+    image = downsample_box(image[: factor * env_height, : factor * 2 * env_height], factor)
     luminance = image @ np.array([0.2126, 0.7152, 0.0722])
     environment = np.repeat(luminance[..., None], grid.n_bands, axis=-1)
     illuminant = spectrum_from_dataset("illuminant", "D65")
-    from reference.spectra import resample_spectrum
+    from reference.colour.spectra import resample_spectrum
 
     D65 = np.asarray(resample_spectrum(illuminant, grid), dtype=np.float64)
     params = brdf_params_on_grid(brdf, grid)
@@ -409,7 +401,7 @@ def turn_camera(camera, angle: float):
 
     Examples
     --------
-    >>> from reference.camera import Camera
+    >>> from reference.geometry.camera import Camera
     >>> turn_camera(Camera(eye=(0.0, 1.0, 5.0)), np.pi / 2).eye
     (5.0, 1.0, 0.0)
     """
@@ -432,7 +424,7 @@ def scene_state(scene, env_height: int = 32, size: int = 16, **config) -> dict:
 
     Parameters
     ----------
-    scene : reference.scene.Scene
+    scene : reference.scene.loader.Scene
     env_height : int
         Rows of the working environment.
     size : int
@@ -451,7 +443,7 @@ def scene_state(scene, env_height: int = 32, size: int = 16, **config) -> dict:
 
     Examples
     --------
-    >>> from reference.scene import loads_scene
+    >>> from reference.scene.loader import loads_scene
     >>> scene = loads_scene('''
     ... [materials.m]
     ... type = "isotropic_brdf"
@@ -540,11 +532,12 @@ def render_orbit(session, frames: int, out_dir=None, progress: bool = True):
 
     from tqdm import tqdm
 
-    from reference.colorimetry import XYZ_to_display_RGB, band_weights, spectra_to_XYZ
-    from reference.display import linear_to_display
+    from reference.colour.colorimetry import XYZ_to_display_RGB, band_weights, spectra_to_XYZ
+    from reference.colour.spectra import SpectralGrid
+    from reference.display.encodings import linear_to_display
     from reference.errors import require_positive_int
-    from reference.images import check_output_folder, write_png, write_text_atomic
-    from reference.spectra import SpectralGrid
+    from reference.files import check_output_folder, write_text_atomic
+    from reference.images.formats import write_png
 
     frames = require_positive_int(frames, "orbit --frames", 100000)
     if out_dir is not None:

@@ -166,7 +166,7 @@ def prefilter_environment(
     >>> r.order, r.values.shape, round(float(r.values.mean()), 6)    # E = π under L = 1
     (14, (30, 60, 1), 3.141593)
     """
-    from reference.cubemap import cubemap_texel_directions
+    from reference.geometry.cubemap import cubemap_texel_directions
 
     image = np.asarray(image, dtype=np.float64)
     require(
@@ -215,7 +215,7 @@ def prefilter_bruteforce(image, kernel, directions, backend: str = "numba") -> n
     >>> E.round(3)                                  # π under uniform unit radiance
     array([[3.142]])
     """
-    from reference.envmap import latlong_pixel_directions
+    from reference.geometry.envmap import latlong_pixel_directions
 
     image = np.asarray(image, dtype=np.float64)
     require(image.ndim == 3, f"prefilter_bruteforce: expected (H, W, C), got {image.shape}")

@@ -26,7 +26,7 @@ time is counted (:attr:`RenderSession.executions`, :attr:`RenderSession.hits`,
 :attr:`RenderSession.frame_times`).
 
 :data:`POLYMER_STAGES` is the same loop for the hybrid polymer (Eq. (1), Herbert et al.;
-``shrm.polymer_material``): the Lambert and Phong maps, a Fresnel table for the ``index``, the
+``shrm.polymer.material``): the Lambert and Phong maps, a Fresnel table for the ``index``, the
 effect pigment's SHRM for the ``brdf`` (None: no effect pigment), the per-pixel angle look-ups
 (``polymer_pixels``) and the per-frame shading with the dynamic parameters. Which state key each
 polymer parameter lives in is :data:`POLYMER_PARAMETERS`; its stages are
@@ -345,7 +345,7 @@ def _stage_sh_project(state, inputs):
 
 
 def _prefiltered_cube(coeffs, kernel, c):
-    from reference.cubemap import cubemap_texel_directions
+    from reference.geometry.cubemap import cubemap_texel_directions
     from shrm.lobes import adaptive_order, parse_kernel
     from shrm.prefilter import prefilter_coefficients
     from shrm.sh import order_of, sh_evaluate
@@ -373,7 +373,7 @@ def _stage_brdf_coeffs(state, inputs):
     brdf = state["brdf"]
     method, params = brdf["name"], brdf.get("params")
     if params is None:
-        from reference.brdf import BRDF_METHODS
+        from reference.materials.brdf import BRDF_METHODS
 
         params = dict(BRDF_METHODS.lookup(method).extra["params"])
     # R&H 2002: the Lambertian part goes to an irradiance map, the rest is expanded
@@ -434,7 +434,7 @@ def _view_of(camera) -> np.ndarray:
 
 
 def _stage_gbuffer(state, inputs):
-    from reference.gbuffer import render_gbuffer
+    from reference.geometry.gbuffer import render_gbuffer
 
     c = _config(state)
     camera = state["viewpoint"]
@@ -451,7 +451,7 @@ def _stage_extract(state, inputs):
 
 
 def _stage_shade(state, inputs):
-    from reference.cubemap import cubemap_lookup_bilinear
+    from reference.geometry.cubemap import cubemap_lookup_bilinear
     from shrm.shrm import _index_directions, shade_shrm
 
     d = {"k_d": 0.0, "k_s": 0.0, "k_e": 1.0, **state["dynamic"]}
@@ -520,8 +520,8 @@ POLYMER_PARAMETERS = {
 
 
 def _stage_fresnel_lut(state, inputs):
-    from reference.fresnel import fresnel_lut
-    from shrm.kubelka_munk import saunderson_constants
+    from reference.materials.fresnel import fresnel_lut
+    from shrm.polymer.kubelka_munk import saunderson_constants
 
     n = np.asarray(state["index"], dtype=np.float64)
     # Eq. (1), Herbert et al.: the F_r table, and the chip surface's k_1 of D_polymer (E31)
@@ -540,8 +540,8 @@ def _effect_stage(stage):
 
 
 def _stage_polymer_pixels(state, inputs):
-    from shrm.polymer import PolymerMaps
-    from shrm.polymer_material import polymer_pixel_parts
+    from shrm.polymer.hybrid import PolymerMaps
+    from shrm.polymer.material import polymer_pixel_parts
     from shrm.shrm import shade_shrm
 
     c = _config(state)
@@ -570,7 +570,7 @@ def _stage_polymer_pixels(state, inputs):
 def _polymer_tint(tint, grid) -> np.ndarray:
     """Tint_polymer on the grid: a number, a spectrum on the grid, or a spot-colour name."""
     if isinstance(tint, str):
-        from shrm.tint import read_tint_library
+        from shrm.polymer.tint import read_tint_library
 
         library = read_tint_library()
         return np.interp(grid.wavelengths_nm, library.wavelengths_nm, library.tint(tint))
@@ -578,9 +578,9 @@ def _polymer_tint(tint, grid) -> np.ndarray:
 
 
 def _stage_polymer_shade(state, inputs):
-    from reference.spectra import SpectralGrid
-    from shrm.polymer import PolymerLook, _spectrum01
-    from shrm.polymer_material import (
+    from reference.colour.spectra import SpectralGrid
+    from shrm.polymer.hybrid import PolymerLook, _spectrum01
+    from shrm.polymer.material import (
         chip_lookup,
         modulation_at,
         polymer_characterization,

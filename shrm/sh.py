@@ -22,7 +22,7 @@ to the *scaled* recurrence: the same arithmetic, with the running values kept in
 Featherstone's 10^-280 scaling does. Orders above :data:`SH_MAX_ORDER` are refused.
 
 The real, orthonormal basis (``docs/conventions.md``), with ``(θ, φ)`` the lat-long angles of
-``reference.envmap`` (y up, Mitsuba 3 orientation):
+``reference.geometry.envmap`` (y up, Mitsuba 3 orientation):
 
     Y_l0 = λ_l0(cos θ),  Y_lm = √2 λ_lm(cos θ) cos(mφ),  Y_l,-m = √2 λ_lm(cos θ) sin(mφ)   (m > 0)
 
@@ -49,8 +49,8 @@ import functools
 
 import numpy as np
 
-from reference.envmap import direction_to_latlong_uv
 from reference.errors import require, require_choice
+from reference.geometry.envmap import direction_to_latlong_uv
 
 __all__ = [
     "PLAIN_ORDER_LIMIT",
@@ -160,7 +160,8 @@ def sh_degrees_orders(order: int) -> tuple[np.ndarray, np.ndarray]:
 def directions_to_theta_phi(directions) -> tuple[np.ndarray, np.ndarray]:
     """Polar angle θ from +y and azimuth φ of unit directions, in the lat-long convention.
 
-    ``θ = π v`` and ``φ = 2π u`` with ``(u, v)`` of ``reference.envmap.direction_to_latlong_uv``.
+    ``θ = π v`` and ``φ = 2π u`` with ``(u, v)`` of
+    ``reference.geometry.envmap.direction_to_latlong_uv``.
 
     Examples
     --------

@@ -236,7 +236,7 @@ def shrm_create(
 
     Examples
     --------
-    >>> from reference.brdf import brdf_lambert
+    >>> from reference.materials.brdf import brdf_lambert
     >>> from shrm.brdf_sh import brdf_sh_coefficients
     >>> rho = brdf_sh_coefficients(brdf_lambert, {"rho_d": [1.0]}, 4, 2, "normal")
     >>> env = np.zeros((1, 25)); env[0, 0] = np.sqrt(4 * np.pi)        # L = 1 everywhere
@@ -310,7 +310,7 @@ def shrm_create(
     B_world = np.moveaxis(A[0] @ cos_phi.T + A[1] @ sin_phi.T, -1, 1)  # (H, W, C, (P+1)²)
     B_world = _polar_rotate_each(B_world, -phi[None, :, None, None], P)
     # B_pq(n) is band-limited to F + P: project exactly (Fejér-1), synthesize at the texels
-    from reference.cubemap import cubemap_texel_directions
+    from reference.geometry.cubemap import cubemap_texel_directions
 
     grid = B_world.reshape(H, W, C * P1 * P1)
     coeffs_n = project_latlong(grid, K, backend=backend, where="SHRM")
@@ -410,7 +410,7 @@ def shade_shrm(shrm: SHRM, E, normal, view) -> np.ndarray:
     >>> shade_shrm(s, np.full((6, 1, 1, 1), 0.5), np.array([[0.0, 0.0, 1.0]]), [0.6, 0.0, 0.8])
     array([[2.625]])
     """
-    from reference.cubemap import cubemap_lookup_bilinear
+    from reference.geometry.cubemap import cubemap_lookup_bilinear
 
     v = np.asarray(view, dtype=np.float64)
     out = cubemap_lookup_bilinear(E, _index_directions(shrm.frame, normal, v))
@@ -432,7 +432,7 @@ def render_shrm(gbuffer, shrm: SHRM, view, material_id: int = 0, E=None) -> np.n
 
     Parameters
     ----------
-    gbuffer : reference.gbuffer.GBuffer
+    gbuffer : reference.geometry.gbuffer.GBuffer
         Visible surfaces.
     shrm : SHRM
     view : array_like, shape (3,)
@@ -449,7 +449,7 @@ def render_shrm(gbuffer, shrm: SHRM, view, material_id: int = 0, E=None) -> np.n
 
     Examples
     --------
-    >>> from reference.gbuffer import empty_gbuffer
+    >>> from reference.geometry.gbuffer import empty_gbuffer
     >>> s = SHRM(np.ones((6, 1, 1, 1, 9)), "normal", 2, 2)
     >>> render_shrm(empty_gbuffer(2, 2), s, [0.0, 0.0, 1.0]).shape
     (2, 2, 1)

@@ -63,7 +63,7 @@ def env_quadrature(image):
     >>> d.shape, round(float(w.sum() / np.pi), 12), L.shape
     ((32, 3), 4.0, (32, 1))
     """
-    from reference.envmap import latlong_pixel_directions
+    from reference.geometry.envmap import latlong_pixel_directions
 
     H, W = image.shape[:2]
     d = latlong_pixel_directions(H, W).reshape(-1, 3)
@@ -100,7 +100,7 @@ def reflected_bruteforce(
 
     Examples
     --------
-    >>> from reference.brdf import brdf_lambert
+    >>> from reference.materials.brdf import brdf_lambert
     >>> y = np.array([[0.0, 1.0, 0.0]])
     >>> env = env_quadrature(np.ones((16, 32, 1)))
     >>> reflected_bruteforce(brdf_lambert, {"rho_d": [1.0]}, "normal", y, y, env).round(3)
@@ -172,7 +172,7 @@ def shrm_texels_angular(
 
     Examples
     --------
-    >>> from reference.brdf import brdf_lambert
+    >>> from reference.materials.brdf import brdf_lambert
     >>> B = shrm_texels_angular(np.ones((4, 8, 1)), brdf_lambert, {"rho_d": [1.0]}, 2,
     ...                         [[0.0, 0.0, 1.0]], "normal")
     >>> B.shape, round(float(B[0, 0, 0] * np.sqrt(1 / (4 * np.pi))), 6)   # B_00 Y_00 = ρ_d
@@ -182,7 +182,7 @@ def shrm_texels_angular(
     >>> round(float(B[0, 0, 0] * np.sqrt(1 / (4 * np.pi))), 6)
     1.0
     """
-    from reference.envmap import latlong_pixel_directions
+    from reference.geometry.envmap import latlong_pixel_directions
 
     view_fit = default_view_fit(frame, view_fit)
     env = env_quadrature(image)
@@ -252,13 +252,13 @@ def shrm_create_angular(
 
     Examples
     --------
-    >>> from reference.brdf import brdf_lambert
+    >>> from reference.materials.brdf import brdf_lambert
     >>> from shrm.shrm import shrm_extract
     >>> s = shrm_create_angular(np.ones((4, 8, 1)), brdf_lambert, {"rho_d": [1.0]}, 2, "normal", 1)
     >>> float(shrm_extract(s, [0.0, 0.0, 1.0])[4, 0, 0, 0]).__round__(6)   # facing +z: ρ_d
     1.0
     """
-    from reference.cubemap import cubemap_texel_directions
+    from reference.geometry.cubemap import cubemap_texel_directions
 
     texels = cubemap_texel_directions(size).reshape(-1, 3)
     out = shrm_texels_angular(image, brdf, params, P, texels, frame, view_power, view_fit)
@@ -274,7 +274,7 @@ def render_bruteforce(gbuffer, image, brdf, params: dict, view, material_id: int
 
     Parameters
     ----------
-    gbuffer : reference.gbuffer.GBuffer
+    gbuffer : reference.geometry.gbuffer.GBuffer
     image : ndarray, shape (H, 2H, C)
         Environment radiance.
     brdf, params
@@ -289,8 +289,8 @@ def render_bruteforce(gbuffer, image, brdf, params: dict, view, material_id: int
 
     Examples
     --------
-    >>> from reference.brdf import brdf_lambert
-    >>> from reference.gbuffer import empty_gbuffer
+    >>> from reference.materials.brdf import brdf_lambert
+    >>> from reference.geometry.gbuffer import empty_gbuffer
     >>> g = empty_gbuffer(1, 1)
     >>> g.mask[0, 0] = True; g.material_id[0, 0] = 0; g.normal[0, 0] = [0.0, 0.0, 1.0]
     >>> render_bruteforce(g, np.ones((8, 16, 1)), brdf_lambert, {"rho_d": [0.5]},

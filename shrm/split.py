@@ -90,7 +90,7 @@ def angular_sum(env, brdf, params: dict, normals, views) -> np.ndarray:
 
     Examples
     --------
-    >>> from reference.brdf import brdf_lambert
+    >>> from reference.materials.brdf import brdf_lambert
     >>> from shrm.shrm_oracles import env_quadrature
     >>> n = np.array([[0.0, 1.0, 0.0]])
     >>> angular_sum(env_quadrature(np.ones((32, 64, 1))), brdf_lambert, {"rho_d": [1.0]}, n,
@@ -262,12 +262,12 @@ def kernel_spectrum(brdf, params: dict, order: int, rows: int = 256, views: int 
 
     Examples
     --------
-    >>> from reference.brdf import brdf_lambert
+    >>> from reference.materials.brdf import brdf_lambert
     >>> p, t = kernel_spectrum(brdf_lambert, {"rho_d": [np.pi]}, 2, rows=128, views=2)
     >>> p.round(3).tolist()        # max(cos θ, 0): sqrt(π)/2, sqrt(π/3), sqrt(5π)/8
     [[0.886, 1.023, 0.495]]
     """
-    from reference.envmap import latlong_pixel_directions
+    from reference.geometry.envmap import latlong_pixel_directions
 
     require(order < rows, f"kernel spectrum: order {order} needs more than {rows} rows")
     omega = latlong_pixel_directions(rows, 2 * rows)

@@ -112,14 +112,14 @@ def project_zarr(
     Examples
     --------
     >>> import tempfile, os
-    >>> from reference.zarr_images import write_zarr_image
+    >>> from reference.images.zarr_store import write_zarr_image
     >>> with tempfile.TemporaryDirectory() as d:
     ...     path = os.path.join(d, "m.zarr")
     ...     _ = write_zarr_image(path, np.ones((8, 16, 1)), ["Y"], rows_per_chunk=3)
     ...     project_zarr(path, 2, backend="numpy")[0, 0].round(6)
     np.float64(3.544908)
     """
-    from reference.zarr_images import open_zarr_image
+    from reference.images.zarr_store import open_zarr_image
 
     image = open_zarr_image(path)
     blocks = image.row_blocks(rows)

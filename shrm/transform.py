@@ -23,8 +23,8 @@ import functools
 
 import numpy as np
 
-from reference.envmap import check_latlong_shape
 from reference.errors import require, require_choice
+from reference.geometry.envmap import check_latlong_shape
 from reference.registry import Method, Registry
 from shrm.sh import (
     SH_MAX_ORDER,
@@ -361,7 +361,7 @@ def project_function(
     >>> project_function(lambda d: d[..., 1], 1).round(6)  # y = sqrt(4π/3) Y_10
     array([[0.      , 0.      , 2.046653, 0.      ]])
     """
-    from reference.envmap import latlong_pixel_directions
+    from reference.geometry.envmap import latlong_pixel_directions
 
     L = check_order(order)
     H = 2 * L + 2 if height is None else int(height)

@@ -1,4 +1,4 @@
-"""Every docs example runs: each docs/examples/*.toml renders, each *.py runs main(quick=True)."""
+"""Every example runs: each shipped scene (data:examples/*.toml) renders, each script runs."""
 
 from __future__ import annotations
 
@@ -10,11 +10,12 @@ import pytest
 
 import phong_table  # noqa: F401  (registers its shaders, as `specref render` does)
 import shrm  # noqa: F401  (registers the environment-light shaders)
-from reference.render import render_scene
-from reference.scene import load_scene
+from reference.data import data_path
+from reference.scene.loader import load_scene
+from reference.scene.render import render_scene
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "docs" / "examples"
-SCENES = sorted(EXAMPLES.glob("*.toml"))
+SCENES = sorted(data_path("examples").glob("*.toml"))
 SCRIPTS = sorted(EXAMPLES.glob("*.py"))
 
 

@@ -183,6 +183,89 @@ def test_imports_point_one_way():
     assert not offenders, "; ".join(offenders)
 
 
+#: The shared core's sub-packages and the others each may import (the core modules of
+#: ``reference/`` itself -- errors, registry, files, tasks, browser, data -- import no sub-package
+#: and may be imported by all). The cut follows the imports; CONTRIBUTING.md's map shows it.
+CORE_LAYERS = {
+    "colour": set(),
+    "geometry": set(),
+    "display": set(),
+    "materials": set(),
+    "images": {"colour", "geometry", "display"},
+    "scene": {"colour", "geometry", "display", "materials", "images"},
+}
+
+
+def _module_name(path: Path) -> str:
+    parts = path.relative_to(ROOT).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _imported_modules(path: Path) -> set[str]:
+    """The specref modules a file imports, at module or function level (``from p import m`` too)."""
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            found |= {a.name for a in node.names if a.name.split(".")[0] in PACKAGES}
+        elif (
+            isinstance(node, ast.ImportFrom)
+            and node.level == 0
+            and node.module
+            and node.module.split(".")[0] in PACKAGES
+        ):
+            found.add(node.module)
+            found |= {f"{node.module}.{a.name}" for a in node.names}
+    return found
+
+
+def _core_part(module: str) -> str | None:
+    """The sub-package of ``reference`` that ``module`` is in, ``""`` for the core, else None."""
+    parts = module.split(".")
+    if parts[0] != "reference":
+        return None
+    return parts[1] if len(parts) > 2 and parts[1] in CORE_LAYERS else ""
+
+
+def test_shared_core_layers_point_one_way():
+    assert set(CORE_LAYERS) == {
+        p.name for p in (ROOT / "reference").iterdir() if (p / "__init__.py").is_file()
+    } - {"data"}
+    offenders = []
+    for path in (ROOT / "reference").rglob("*.py"):
+        here = _core_part(_module_name(path))
+        if path.name == "__init__.py" and here in ("", None):
+            continue  # the package __init__ re-exports the sub-packages
+        allowed = CORE_LAYERS.get(here, set()) | {"", here}
+        for imported in _imported_modules(path):
+            part = _core_part(imported)
+            if part is not None and part not in allowed:
+                offenders.append(f"{path.relative_to(ROOT)} imports {imported}")
+    assert not offenders, "; ".join(sorted(offenders))
+
+
+def test_no_import_circles_between_modules():
+    # Function-level imports count: two modules that import each other are one family of
+    # equations cut in two, or a lower layer reaching up.
+    modules = {_module_name(p): p for p in SOURCES if p.name != "__init__.py"}
+    graph = {
+        name: {m for m in _imported_modules(path) if m in modules and m != name}
+        for name, path in modules.items()
+    }
+    circles, done = [], set()
+    for start in sorted(graph):
+        stack, seen = [(start, [start])], set()
+        while stack:
+            node, trail = stack.pop()
+            for nxt in sorted(graph[node]):
+                if nxt == start:
+                    circles.append(" -> ".join([*trail, start]))
+                elif nxt not in seen and nxt not in done:
+                    seen.add(nxt)
+                    stack.append((nxt, [*trail, nxt]))
+        done.add(start)
+    assert not circles, "; ".join(circles)
+
+
 def _cli_actions(parser=None, prefix="specref"):
     import argparse
 
@@ -232,7 +315,7 @@ def test_no_cli_option_spells_registry_keys_by_hand():
 def test_report_section_functions_stay_short():
     # Sections read as compute -> present -> checks, in functions a reader can follow (issue 13).
     long = []
-    for path in sorted((ROOT / "validation" / "sections").glob("*.py")):
+    for path in sorted((ROOT / "validation" / "report" / "sections").glob("*.py")):
         for node in ast.walk(ast.parse(path.read_text())):
             if isinstance(node, ast.FunctionDef) and node.end_lineno - node.lineno + 1 > 80:
                 long.append(f"{path.name}:{node.name} ({node.end_lineno - node.lineno + 1} lines)")

@@ -1,23 +1,21 @@
-"""Render a docs example scene through the Python API, re-shade it under another light, compare.
+"""Render a shipped example scene through the Python API, re-shade it under another light, compare.
 
-Loads colorchecker-d65.toml, renders it, writes the PNG and linear EXR, then swaps the lamp for
-illuminant A and re-shades the cached G-buffer (no re-rasterizing). Prints the white patch's XYZ
-under each light beside colour-science's ASTM E308 value for the same patch and light.
+Loads the shipped colorchecker-d65.toml (``data:examples``), renders it, writes the PNG and linear
+EXR, then swaps the lamp for illuminant A and re-shades the cached G-buffer (no re-rasterizing).
+Prints the white patch's XYZ under each light beside colour-science's ASTM E308 value for the same
+patch and light.
 """
 
 import dataclasses
-from pathlib import Path
 
 import colour
 import numpy as np
 
-from reference.camera import downsample_box
-from reference.colorchecker import colorchecker_patch_pixels
-from reference.render import render_scene, write_render
-from reference.scene import load_scene
-from reference.spectra import spectrum_from_dataset
-
-HERE = Path(__file__).resolve().parent
+from reference.colour.spectra import spectrum_from_dataset
+from reference.geometry.camera import downsample_box
+from reference.scene.colorchecker import colorchecker_patch_pixels
+from reference.scene.loader import load_scene
+from reference.scene.render import render_scene, write_render
 
 
 def white_patch_XYZ(result) -> np.ndarray:
@@ -33,7 +31,7 @@ def white_patch_XYZ(result) -> np.ndarray:
 
 
 def main(quick: bool = False):
-    scene = load_scene(HERE / "colorchecker-d65.toml")
+    scene = load_scene("data:examples/colorchecker-d65.toml")
     size = {"width": 66, "height": 44, "supersample": 1} if quick else {}
     d65 = render_scene(scene, **size)
     write_render(d65, png="colorchecker-d65.png", exr="colorchecker-d65.exr")

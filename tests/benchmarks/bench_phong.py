@@ -8,7 +8,7 @@ import pytest
 from phong_table import INTERPOLATION_METHODS, PLACEMENT_METHODS, SCENES, VIEWS, build_table
 from phong_table.interpolation import interval_index
 from phong_table.render import compiled_shader, shading_buffer, sphere_gbuffer
-from validation.phong import rising_material
+from validation.studies.phong import rising_material
 
 #: Materials outside R1-R3 (issue 17 §6): the exponent rises steadily across the spectrum to a
 #: few thousand (every band its own power), linearly and quadratically

@@ -16,25 +16,24 @@ dragging a thickness, TiO2, tint, transparency or Mod_effect slider. Groups (rep
 """
 
 import itertools
-import os
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from reference.camera import Camera, downsample_box
-from reference.colorimetry import band_weights
-from reference.geometry import Sphere
-from reference.images import read_image
-from reference.lights import EnvironmentLight
-from reference.materials import LambertMaterial
-from reference.shading import ShadingContext, surface_of
-from reference.spectra import SpectralGrid
+from reference.colour.colorimetry import band_weights
+from reference.colour.spectra import SpectralGrid
+from reference.data import data_path
+from reference.geometry.camera import Camera, downsample_box
+from reference.geometry.shapes import Sphere
+from reference.images.formats import read_image
+from reference.materials.types import LambertMaterial
+from reference.scene.lights import EnvironmentLight
+from reference.scene.shading import ShadingContext, surface_of
 from shrm.environment import shade_lambert_environment
 from shrm.session import POLYMER_STAGES, RenderSession
 
 ROOT = Path(__file__).resolve().parents[2]
-SHARED = Path(os.environ.get("SPECREF_SHARED_DATA", ROOT.parent / "shared" / "data"))
 GRID = SpectralGrid(400.0, 700.0, 20.0)
 SIZE = 512
 _THICKNESS = itertools.count()
@@ -42,7 +41,7 @@ _THICKNESS = itertools.count()
 
 @pytest.fixture(scope="module")
 def image():
-    hdr = read_image(SHARED / "environments/venice_sunset_1k.hdr")
+    hdr = read_image(data_path("environments/venice_sunset_1k.hdr"))
     return downsample_box(hdr, hdr.shape[0] // 64)
 
 

@@ -12,11 +12,11 @@ Groups (the report's "Rasterizer" section reads them, as ratios to each group's 
 import numpy as np
 import pytest
 
-from reference.camera import Camera
-from reference.gbuffer import render_gbuffer
-from reference.geometry import Sphere
-from reference.mesh import uv_sphere_mesh
-from reference.raster import RASTER_METHODS, rasterize_mesh
+from reference.geometry.camera import Camera
+from reference.geometry.gbuffer import render_gbuffer
+from reference.geometry.mesh import uv_sphere_mesh
+from reference.geometry.raster import RASTER_METHODS, rasterize_mesh
+from reference.geometry.shapes import Sphere
 
 CAMERA = Camera(eye=(0.7, 1.1, 3.3), target=(0.0, 0.0, 0.0), fov_deg=40)
 SIZE = 512

@@ -14,8 +14,8 @@ Group ``scaleout-zarr`` (throughput of the out-of-core path >= 70 % of the in-me
 - ``in-memory``: ``shrm.transform.project_latlong`` of a 1024×2048×41 float32 map in memory,
   L = 100 (ducc0);
 - ``zarr-streamed``: ``shrm.streamed.project_zarr`` of the same map from a Zarr store (64-row
-  chunks, ``blosc-lz4``: the defaults of ``reference.zarr_images`` for this width; random data,
-  which does not compress, the worst case for reading), a reader thread reading the next chunk
+  chunks, ``blosc-lz4``: the defaults of ``reference.images.zarr_store`` for this width; random
+  data, which does not compress, the worst case for reading), a reader thread reading the next chunk
   while this one is projected, and its peak Python memory (tracemalloc).
 - ``zarr-streamed-no-readahead``: the same without the reader thread (each chunk read, then
   projected, in one thread), to show what the overlap buys.
@@ -88,8 +88,8 @@ HEIGHT = 1024
 
 @pytest.fixture(scope="module")
 def zarr_map(tmp_path_factory):
-    from reference.images import spectral_channel_names
-    from reference.zarr_images import write_zarr_blocks
+    from reference.images.formats import spectral_channel_names
+    from reference.images.zarr_store import write_zarr_blocks
 
     rng = np.random.default_rng(18)
     names = spectral_channel_names(np.arange(380.0, 790.0, 10.0))
@@ -133,7 +133,7 @@ def test_projection_zarr_streamed(benchmark, zarr_map):
 
 @pytest.mark.benchmark(group="scaleout-zarr")
 def test_projection_zarr_streamed_no_readahead(benchmark, zarr_map):
-    from reference.zarr_images import open_zarr_image
+    from reference.images.zarr_store import open_zarr_image
     from shrm.streamed import project_latlong_blocks
 
     path, image = zarr_map

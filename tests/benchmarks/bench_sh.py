@@ -12,7 +12,7 @@ the shared 2-core machines (docs/dependencies.md). Groups:
   baseline) on the same input and texels; targets ≤ 20 ms, ≤ 1.5 s, ≥ 500× faster than brute force.
 - ``sh-bandwidth``: ``np.copyto`` of a 41-band float32 1024×512 map (the baseline),
   ``latlong_to_cubemap`` to 6×256² into a reused buffer (target ≥ 25 % of the copy bandwidth) and
-  ``reference.colorimetry.spectra_to_XYZ`` of the map in float32 (band weights,
+  ``reference.colour.colorimetry.spectra_to_XYZ`` of the map in float32 (band weights,
   ``(..., 41) @ (41, 3)`` on its two row blocks; target ≥ 50 %); ``latlong_to_cubemap`` runs on
   one thread. ``extra_info``
   records the bytes each moves (input + output).
@@ -22,11 +22,11 @@ import numpy as np
 import pytest
 from threadpoolctl import threadpool_limits
 
-from reference.colorimetry import band_weights, spectra_to_XYZ
-from reference.cubemap import cubemap_texel_directions, latlong_to_cubemap
-from reference.images import read_hdr
-from reference.spectra import GRID_41
-from reference.upsampling import RGB_to_spectra
+from reference.colour.colorimetry import band_weights, spectra_to_XYZ
+from reference.colour.spectra import GRID_41
+from reference.colour.upsampling import RGB_to_spectra
+from reference.geometry.cubemap import cubemap_texel_directions, latlong_to_cubemap
+from reference.images.formats import read_hdr
 from shrm.lobes import parse_kernel
 from shrm.prefilter import prefilter_bruteforce, prefilter_coefficients
 from shrm.sh import sh_evaluate
@@ -40,8 +40,8 @@ def _one_blas_thread():
 
 
 @pytest.fixture(scope="module")
-def venice(shared_data):
-    return read_hdr(shared_data / "environments" / "venice_sunset_1k.hdr")
+def venice(package_data):
+    return read_hdr(package_data / "environments" / "venice_sunset_1k.hdr")
 
 
 @pytest.fixture(scope="module")

@@ -32,22 +32,23 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from reference.camera import downsample_box
-from reference.cubemap import cubemap_texel_directions
-from reference.images import read_image
+from reference.data import data_path
+from reference.geometry.camera import downsample_box
+from reference.geometry.cubemap import cubemap_texel_directions
+from reference.images.formats import read_image
 from shrm.brdf_sh import brdf_sh_coefficients, shrm_brdf_parts
 from shrm.cache import Cache, cache_key
 from shrm.sh import sh_basis
 from shrm.shrm import shrm_create, shrm_extract
 from shrm.shrm_oracles import env_quadrature, reflected_bruteforce, shrm_texels_angular
 from shrm.transform import project_latlong
-from validation.sections.shrm_study import SUITE, study_params
+from validation.report.sections.shrm_study import SUITE, study_params
 
 ROOT = Path(__file__).resolve().parents[2]
 #: Normal frame, F 16, P 12: the setting the report's study picked for GGX under 1 % of peak with
 #: the projection over all views; with the hemisphere view fit (the normal frame's default) P 8
-#: suffices for every BRDF of the study (tests/validation/test_section_shrm.py), so this is the
-#: heavier end, kept so that the ratios compare with earlier runs.
+#: suffices for every BRDF of the study (tests/validation/report/sections/test_shrm.py), so this
+#: is the heavier end, kept so that the ratios compare with earlier runs.
 P, F, SMALL, FRAME = 12, 16, 8, "normal"
 #: Texels the angular oracle integrates (a spread over the front of the cube).
 N_ANGULAR = 4
@@ -56,7 +57,7 @@ VIEW = np.array([0.3, 0.4, 0.866]) / np.linalg.norm([0.3, 0.4, 0.866])
 
 @pytest.fixture(scope="module")
 def env():
-    image = read_image(ROOT.parent / "shared/data/environments/venice_sunset_1k.hdr")
+    image = read_image(data_path("environments/venice_sunset_1k.hdr"))
     return downsample_box(image, image.shape[0] // 32)
 
 
@@ -163,15 +164,15 @@ def test_cache_hit(benchmark, shrm_64, tmp_path):
 
 @pytest.fixture(scope="module")
 def split_case():
-    from reference.lights import EnvironmentLight
-    from reference.shading import ShadingContext
-    from reference.spectra import SpectralGrid
+    from reference.colour.spectra import SpectralGrid
+    from reference.scene.lights import EnvironmentLight
+    from reference.scene.shading import ShadingContext
     from shrm.environment import environment_spectral_radiance
     from shrm.orbit import brdf_params_on_grid
     from shrm.split import split_renderer
 
     grid = SpectralGrid(400.0, 700.0, 20.0)
-    image = read_image(ROOT.parent / "shared/data/environments/studio_small_03_1k.hdr")
+    image = read_image(data_path("environments/studio_small_03_1k.hdr"))
     radiance = environment_spectral_radiance(EnvironmentLight(image), grid)
     y = ShadingContext(grid).weights(None)[:, 1]
     x, z = np.meshgrid((np.arange(16) + 0.5) / 8 - 1, (np.arange(16) + 0.5) / 8 - 1)

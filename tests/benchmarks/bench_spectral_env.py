@@ -4,7 +4,8 @@ Group ``spectral-env-2k`` (target of issue 15: spectralize throughput >= 50 % of
 
 - ``baseline``: ``np.matmul`` of the panorama's precomputed feature matrix (shipped model:
   root-polynomial degree 4, 22 features, float64) by the coefficients, into a preallocated output;
-- ``spectralize``: :func:`reference.spectral_regression.spectralize_blocks` (RGB checks, feature
+- ``spectralize``: :func:`reference.colour.spectral_regression.spectralize_blocks` (RGB checks,
+  feature
   expansion and product in float32, erratum E45) by its default blocks (2^17 pixels, 64 rows) into
   a preallocated float32 panorama.
 """
@@ -12,8 +13,8 @@ Group ``spectral-env-2k`` (target of issue 15: spectralize throughput >= 50 % of
 import numpy as np
 import pytest
 
-from reference.spectral_regression import features_RGB, spectralize_blocks
-from reference.upsampling import default_regression
+from reference.colour.spectral_regression import features_RGB, spectralize_blocks
+from reference.colour.upsampling import default_regression
 
 HEIGHT, WIDTH = 1024, 2048
 

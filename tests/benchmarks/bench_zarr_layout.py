@@ -2,17 +2,17 @@
 
 Group ``scaleout-zarr-read``: reading a whole 512×1024×41 float32 store chunk by chunk (what a
 streamed operation does, without the conversion to float64), for each compression of
-``reference.zarr_images.ZARR_COMPRESSIONS`` and chunks of 32, 128 and 256 rows (5.4, 21.5 and
+``reference.images.zarr_store.ZARR_COMPRESSIONS`` and chunks of 32, 128 and 256 rows (5.4, 21.5 and
 43 MB), on two maps:
 
 - ``spectral``: ``studio_small_03_1k.hdr`` (Poly Haven, CC0) spectralized by the shipped
-  regression (``reference.upsampling.default_regression``): a real panorama's structure;
+  regression (``reference.colour.upsampling.default_regression``): a real panorama's structure;
 - ``random``: uniform random bands, which do not compress (the worst case, as in the
   ``scaleout-zarr`` throughput benchmark).
 
 ``extra_info`` holds the compression ratio (float32 bytes / stored bytes). The defaults of
-``reference.zarr_images`` (blosc-lz4, :data:`~reference.zarr_images.CHUNK_BYTES`) follow from
-these figures (docs/scale-out.md, erratum E48).
+``reference.images.zarr_store`` (blosc-lz4, :data:`~reference.images.zarr_store.CHUNK_BYTES`) follow
+from these figures (docs/scale-out.md, erratum E48).
 """
 
 from __future__ import annotations
@@ -27,12 +27,12 @@ COMPRESSIONS = ("none", "blosc-lz4", "zstd")
 
 
 @pytest.fixture(scope="module")
-def maps(shared_data):
-    from reference.images import read_hdr
-    from reference.spectral_regression import spectralize_blocks
-    from reference.upsampling import default_regression
+def maps(package_data):
+    from reference.colour.spectral_regression import spectralize_blocks
+    from reference.colour.upsampling import default_regression
+    from reference.images.formats import read_hdr
 
-    RGB = read_hdr(shared_data / "environments" / "studio_small_03_1k.hdr")
+    RGB = read_hdr(package_data / "environments" / "studio_small_03_1k.hdr")
     model = default_regression()
     spectral = np.concatenate([b.copy() for _, b in spectralize_blocks(model, RGB)])
     random = np.random.default_rng(18).random(spectral.shape, dtype=np.float32)
@@ -44,8 +44,8 @@ def maps(shared_data):
 @pytest.mark.parametrize("compression", COMPRESSIONS)
 @pytest.mark.parametrize("data", ["spectral", "random"])
 def test_read_store(benchmark, maps, tmp_path, data, compression, rows):
-    from reference.images import spectral_channel_names
-    from reference.zarr_images import open_zarr_image, write_zarr_image
+    from reference.images.formats import spectral_channel_names
+    from reference.images.zarr_store import open_zarr_image, write_zarr_image
 
     images, wavelengths = maps
     image = images[data]

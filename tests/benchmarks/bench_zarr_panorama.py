@@ -67,8 +67,8 @@ def _peak_rss() -> int:
 
 
 def _generate(store: str) -> dict:
-    from reference.images import spectral_channel_names
-    from reference.zarr_images import rows_per_chunk_for, write_zarr_blocks
+    from reference.images.formats import spectral_channel_names
+    from reference.images.zarr_store import rows_per_chunk_for, write_zarr_blocks
 
     wavelengths = np.arange(380.0, 790.0, 10.0)
     width = 2 * HEIGHT

@@ -146,7 +146,7 @@ def test_horizon_map_within_two_percent_at_raking_light_on_high_relief():
     # The fast part of the issue 22 target: relief ×4 on held-out painting seed 33, at the two
     # elevations where the first version was worst (10° and 30°), two azimuths.
     from impastor.painting import HORIZON_SECTORS
-    from validation.impastor_lighting import shadow_agreement
+    from validation.studies.impastor_lighting import shadow_agreement
 
     fields = (("relief ×4", 4.0, 0.0),)
     result = shadow_agreement((HORIZON_SECTORS,), 256, (10.0, 30.0), 2, fields=fields, seed=33)
@@ -163,7 +163,7 @@ def test_horizon_map_agrees_with_ray_marching_at_every_elevation(seed):
     # painting seeds 31 and 32: the design (step, interpolation, 36 sectors) used seed 11 and the
     # report uses seed 4.
     from impastor.painting import HORIZON_SECTORS
-    from validation.impastor_lighting import shadow_agreement
+    from validation.studies.impastor_lighting import shadow_agreement
 
     fields = (("default", 1.0, 0.0), ("relief ×4", 4.0, 0.0))
     result = shadow_agreement(

@@ -20,8 +20,8 @@ from impastor.multispectral import (
     render_channels,
     spectra_to_channels,
 )
+from reference.colour.spectra import spectrum_from_dataset
 from reference.errors import SpecrefError
-from reference.spectra import spectrum_from_dataset
 
 
 @pytest.mark.parametrize("method", MULTISPECTRAL_DESIGNS.values(), ids=attrgetter("name"))
@@ -39,9 +39,10 @@ def test_designs_are_normalised_and_non_negative(method, rng):
 )
 @pytest.mark.parametrize("light", ["D65", "D50", "A"])
 def test_colorchecker_targets(design, mean_max, max_max, light):
-    # Source: colour.sd_to_XYZ on the 5 nm N Ohta data (validation.metrics.colorchecker_truth);
-    # targets from issue 6 (one matrix for all three lights; the chart is held out of the fit).
-    from validation.impastor import design_delta_E
+    # Source: colour.sd_to_XYZ on the 5 nm N Ohta data
+    # (validation.studies.metrics.colorchecker_truth); targets from issue 6 (one matrix for all
+    # three lights; the chart is held out of the fit).
+    from validation.studies.impastor import design_delta_E
 
     dE = design_delta_E(design, 6, light)
     assert dE.mean() <= mean_max, dE.mean()

@@ -25,10 +25,24 @@ def test_render_painting_small(tmp_path):
     assert ratio_a > 1.5 * ratio_d65
 
 
-def test_missing_shared_data_fails_clearly(tmp_path, monkeypatch):
-    monkeypatch.setenv("SPECREF_SHARED_DATA", str(tmp_path))
-    with pytest.raises(SpecrefError, match="measured spectra not found"):
-        imp.load_paint_spectra()
+def test_missing_spectrum_fails_clearly(tmp_path):
+    with pytest.raises(SpecrefError, match=r"lemon__nix_export.csv: measured spectrum not found"):
+        imp.load_paint_spectra(tmp_path, names=("lemon",))
+
+
+def test_paint_spectra_are_the_shipped_measurements():
+    # Source: reference/data/spectra/physicallybased/lemon__nix_export.csv, its "R550 nm" column
+    # read here with the csv module (Nix Spectro 2 export); 550 nm lies on both grids.
+    import csv
+
+    from reference.data import measured_spectra_folder
+
+    with open(measured_spectra_folder() / "lemon__nix_export.csv", newline="") as handle:
+        rows = list(csv.reader(handle, delimiter=";"))
+    at = next(i for i, row in enumerate(rows) if "R550 nm" in row)  # the header row
+    expected = float(rows[at + 1][rows[at].index("R550 nm")])
+    lemon = imp.load_paint_spectra(names=("lemon",))["lemon"]
+    assert lemon[(550 - 380) // 5] == pytest.approx(expected, rel=1e-12)
 
 
 def test_horizon_map_is_computed_once_per_height_field(monkeypatch):

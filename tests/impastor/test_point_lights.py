@@ -90,7 +90,7 @@ def test_point_lights_conserve_power(method):
     assert lights.L.sum() == pytest.approx(plane.image.sum(), rel=1e-12)
     env = np.random.default_rng(3).random((16, 32, 3))
     directional = point_lights_from_latlong(env, method, 12)
-    from reference.envmap import latlong_pixel_solid_angles
+    from reference.geometry.envmap import latlong_pixel_solid_angles
 
     expected = (env * latlong_pixel_solid_angles(16, 32)[..., None]).sum(axis=(0, 1))
     np.testing.assert_allclose(directional.L.sum(axis=0), expected, rtol=1e-12)

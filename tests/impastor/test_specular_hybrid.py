@@ -107,7 +107,7 @@ def test_mis_estimate_is_unbiased_with_an_honest_standard_error(light, alpha):
     # The fail-safe's arbiter: over 40 seeds its mean is the brute force (converged, 12² sub-pixels)
     # within 4 standard errors of that mean, and its own standard error matches the seeds' spread.
     from impastor.painting import impasto_painting, painting_samples
-    from validation.impastor_hybrid import case_light
+    from validation.studies.impastor_hybrid import case_light
 
     P, N, V = painting_samples(3, impasto_painting(64, seed=3))
     plane = case_light(light, 32, 16)
@@ -129,7 +129,7 @@ def test_failsafe_keeps_the_point_lights_where_fis_fails_on_a_peaked_ceiling():
     # A design case of the fail-safe (E17): the studio ceiling holds its power in a few pixels,
     # FIS is 200-260 % off at alpha 0.15-0.2 and the per-pixel estimates alone came out 26-28x
     # worse than the point lights (0.9-2.6 %); with the fail-safe the image is the point lights'.
-    from validation.impastor_hybrid import HybridCase, hybrid_case_ratios
+    from validation.studies.impastor_hybrid import HybridCase, hybrid_case_ratios
 
     case = HybridCase(541, "env:studio_small_03_1k.hdr:348", 64, 32)
     result = hybrid_case_ratios(case, (0.15, 0.2), supersample=4)
@@ -138,8 +138,8 @@ def test_failsafe_keeps_the_point_lights_where_fis_fails_on_a_peaked_ceiling():
 
 
 # Held-out cases for issue 22: painting seeds, lamp seeds and ceiling azimuths that the design
-# (validation.impastor_hybrid.TRAINING: painting seeds 2, 5, 7, ceilings at azimuth 0°, lamp 0)
-# never used. The peaked ceiling is cut from studio_small_03_1k.hdr (dynamic range ~10⁶).
+# (validation.studies.impastor_hybrid.TRAINING: painting seeds 2, 5, 7, ceilings at azimuth 0°, lamp
+# 0) never used. The peaked ceiling is cut from studio_small_03_1k.hdr (dynamic range ~10⁶).
 HELD_OUT_SUBSET = (
     # before the fail-safe (E17): 2.34x at alpha = 0.03
     ("env:studio_small_03_1k.hdr:75", 301, 32, 32),
@@ -153,7 +153,7 @@ HELD_OUT_SUBSET = (
 @pytest.mark.slow
 @pytest.mark.parametrize(("light", "seed", "N", "K"), HELD_OUT_SUBSET)
 def test_hybrid_within_one_and_a_half_of_the_better_method_on_held_out_cases(light, seed, N, K):
-    from validation.impastor_hybrid import HybridCase, hybrid_case_ratios
+    from validation.studies.impastor_hybrid import HybridCase, hybrid_case_ratios
 
     result = hybrid_case_ratios(
         HybridCase(seed, light, N, K), (0.01, 0.03, 0.1, 0.3), n_side=4, light_resolution=(32, 16),
@@ -171,7 +171,11 @@ def test_hybrid_on_the_held_out_sweep():
     # The whole held-out sweep of issue 22: 24 painting seeds (201-224), both booth lights, the
     # lamp and panel, a ceiling cut from each shipped map, N in {8, 32, 64}, K in {16, 32, 64},
     # the report's alpha grid, 36 points, 64 x 32 light images.
-    from validation.impastor_hybrid import held_out_cases, hybrid_case_ratios, ratio_distribution
+    from validation.studies.impastor_hybrid import (
+        held_out_cases,
+        hybrid_case_ratios,
+        ratio_distribution,
+    )
 
     ratios = []
     for case in held_out_cases(24, first_seed=201):
@@ -183,7 +187,7 @@ def test_hybrid_on_the_held_out_sweep():
 
 @pytest.mark.slow
 def test_hybrid_within_the_two_methods_and_best_at_the_ends():
-    from validation.impastor_lighting import specular_error_vs_alpha
+    from validation.studies.impastor_lighting import specular_error_vs_alpha
 
     result = specular_error_vs_alpha(
         (0.01, 0.03, 0.07, 0.2, 0.5), n_side=4, light_resolution=(64, 32), supersample=6

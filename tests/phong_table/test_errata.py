@@ -4,8 +4,8 @@ import numpy as np
 
 from phong_table.model import SpectralPhong, average_exponent_Wang
 from phong_table.placement import inverse_importance_ratio_Wang, table_importance_Wang
-from reference.lights import PointLight
-from reference.materials import PhongMaterial
+from reference.materials.types import PhongMaterial
+from reference.scene.lights import PointLight
 
 
 def _model(n):

@@ -14,10 +14,10 @@ from phong_table.model import (
     specular_RGB,
     specular_RGB_derivative,
 )
+from reference.colour.spectra import DEFAULT_GRID, GRID_31
 from reference.errors import SpecrefError
-from reference.lights import AmbientLight, PointLight
-from reference.materials import LambertMaterial, PhongMaterial
-from reference.spectra import DEFAULT_GRID, GRID_31
+from reference.materials.types import LambertMaterial, PhongMaterial
+from reference.scene.lights import AmbientLight, PointLight
 
 
 def _colour_RGB(model: SpectralPhong, spectrum: np.ndarray) -> np.ndarray:

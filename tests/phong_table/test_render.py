@@ -5,7 +5,7 @@ import pytest
 from phong_table import SCENES, SpectralPhong, render_sphere
 from phong_table.render import light_geometry, sphere_gbuffer
 from phong_table.scenes import constant_material, highlight_point, spectral_phong_unit_peak
-from reference.spectra import DEFAULT_GRID
+from reference.colour.spectra import DEFAULT_GRID
 
 
 @pytest.mark.parametrize("scene", ["R1", "R3"])

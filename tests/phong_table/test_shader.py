@@ -7,14 +7,14 @@ import pytest
 
 from phong_table import INTERPOLATION_METHODS, PLACEMENT_METHODS
 from phong_table.shader import OPTION_KEYS, shade_phong_point_table
-from reference.camera import Camera
+from reference.colour.spectra import spectrum_from_dataset
 from reference.errors import SpecrefError
-from reference.gbuffer import render_gbuffer
-from reference.geometry import Sphere
-from reference.lights import PointLight
-from reference.materials import PhongMaterial
-from reference.shading import PHONG_POINT_METHODS, ShadingContext, shade_gbuffer
-from reference.spectra import spectrum_from_dataset
+from reference.geometry.camera import Camera
+from reference.geometry.gbuffer import render_gbuffer
+from reference.geometry.shapes import Sphere
+from reference.materials.types import PhongMaterial
+from reference.scene.lights import PointLight
+from reference.scene.shading import PHONG_POINT_METHODS, ShadingContext, shade_gbuffer
 
 
 @pytest.fixture(scope="module")

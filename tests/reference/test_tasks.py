@@ -52,7 +52,7 @@ TABLE1_FIGURES = ("scene", "view", "placement", "interpolation", "entries", "seg
 
 def test_phong_table1_on_a_cluster_equals_serial(client):
     # issue 18: Table 1's scenes × views are tasks; the errors do not depend on where they ran
-    from validation.phong_table1 import run_table1
+    from validation.studies.phong_table1 import run_table1
 
     def figures(result):
         return [tuple(row[k] for k in TABLE1_FIGURES) for row in result["rows"]]
@@ -68,7 +68,7 @@ def test_impastor_table1_on_a_cluster_equals_serial(client):
     # issue 18: Ferwerda's Table 1 runs one task per light; the same table as serially
     import numpy as np
 
-    from validation.impastor import table1
+    from validation.studies.impastor import table1
 
     serial = table1(lights=("D65", "A"), scheduler="serial")
     distributed = table1(lights=("D65", "A"), scheduler=client.scheduler.address)

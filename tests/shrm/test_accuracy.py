@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from reference.envmap import latlong_pixel_directions
 from reference.errors import SpecrefError
+from reference.geometry.envmap import latlong_pixel_directions
 from shrm.accuracy import (
     accuracy_order,
     bright_texels,

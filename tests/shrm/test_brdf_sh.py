@@ -1,8 +1,8 @@
 import numpy as np
 import pytest
 
-from reference.brdf import BRDF_METHODS, brdf_lambert
 from reference.errors import SpecrefError
+from reference.materials.brdf import BRDF_METHODS, brdf_lambert
 from shrm.brdf_sh import (
     VIEW_FIT_RIDGE,
     brdf_sh_coefficients,

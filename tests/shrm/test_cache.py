@@ -336,7 +336,7 @@ def read_only_cache(tmp_path):
 
 
 def _full_disk(folder, monkeypatch):
-    """ENOSPC at the writer's temporary file, as tests/validation/test_cli_outputs.py does."""
+    """ENOSPC at the writer's temporary file, as tests/validation/cli/test_cli_outputs.py does."""
     import errno
     import tempfile
 

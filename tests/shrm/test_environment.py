@@ -5,22 +5,22 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from reference.camera import Camera
+from reference.colour.spectra import GRID_31, GRID_41
 from reference.errors import SpecrefError
-from reference.gbuffer import render_gbuffer
-from reference.geometry import Sphere
-from reference.images import read_hdr
-from reference.lights import EnvironmentLight
-from reference.materials import LambertMaterial, PhongMaterial
-from reference.shading import SHADERS, ShadingContext, Surface, shade_gbuffer
-from reference.spectra import GRID_31, GRID_41
+from reference.geometry.camera import Camera
+from reference.geometry.gbuffer import render_gbuffer
+from reference.geometry.shapes import Sphere
+from reference.images.formats import read_hdr
+from reference.materials.types import LambertMaterial, PhongMaterial
+from reference.scene.lights import EnvironmentLight
+from reference.scene.shading import SHADERS, ShadingContext, Surface, shade_gbuffer
 from shrm.environment import (
     environment_spectral_radiance,
     phong_environment_Lambda,
     shade_lambert_environment,
     shade_phong_environment,
 )
-from validation.oracles import phong_Lambda_mp
+from validation.studies.oracles import phong_Lambda_mp
 
 
 def _up_surface(n=1):
@@ -42,12 +42,13 @@ def test_environment_spectral_radiance_interpolates_spectral_maps():
 
 
 def test_environment_spectral_radiance_of_rgb_white_is_d65_shaped():
-    # Source: colour-science's D65 (reference.spectra dataset), normalized to Y = 1 on the grid:
+    # Source: colour-science's D65 (reference.colour.spectra dataset), normalized to Y = 1 on the
+    # grid:
     # an RGB white texel v becomes v · D65(λ)/Y(D65) (Mallett 2019 basis, flat to 1e-5).
-    from reference.spectra import resample_spectrum, spectrum_from_dataset
+    from reference.colour.spectra import resample_spectrum, spectrum_from_dataset
 
     D = resample_spectrum(spectrum_from_dataset("illuminant", "D65"), GRID_31, "constant")
-    from reference.colorimetry import band_weights
+    from reference.colour.colorimetry import band_weights
 
     D = D / (D @ band_weights(GRID_31, None)[:, 1])
     got = environment_spectral_radiance(EnvironmentLight(np.full((2, 4, 3), 2.0)), GRID_31)
@@ -56,8 +57,8 @@ def test_environment_spectral_radiance_of_rgb_white_is_d65_shaped():
 
 @pytest.mark.parametrize("n", [1.0, 8.0, 100.0])
 def test_phong_environment_Lambda_matches_mpmath(n):
-    # Source: mpmath, 50 dps (validation/oracles.py: phong_Lambda_mp), times the 2/(n+1) of the
-    # un-normalized lobe max(t, 0)^n / π.
+    # Source: mpmath, 50 dps (validation/studies/oracles.py: phong_Lambda_mp), times the 2/(n+1) of
+    # the un-normalized lobe max(t, 0)^n / π.
     order = 6
     Lam = phong_environment_Lambda([n, n], order)
     assert Lam.shape == (2, order + 1)
@@ -107,8 +108,8 @@ def test_bruteforce_under_a_uniform_sky_converges():
     assert errors[1] < 1e-3
 
 
-def test_environment_shaders_frequency_vs_bruteforce(shared_data):
-    image = read_hdr(shared_data / "environments" / "studio_small_03_1k.hdr")[::8, ::8].copy()
+def test_environment_shaders_frequency_vs_bruteforce(package_data):
+    image = read_hdr(package_data / "environments" / "studio_small_03_1k.hdr")[::8, ::8].copy()
     env = EnvironmentLight(image, name="studio")
     g = render_gbuffer([Sphere()], Camera(eye=(0, 0, 5)), 12, 12)
     k = np.linspace(0.2, 0.8, 41)

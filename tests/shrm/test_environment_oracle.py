@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 import shrm  # noqa: F401  (registers the environment shaders)
-from reference.images import write_exr
-from reference.materials import MATERIAL_TYPES
-from reference.render import render_scene
-from reference.scene import load_scene
-from reference.shading import SHADERS
+from reference.images.formats import write_exr
+from reference.materials.types import MATERIAL_TYPES
+from reference.scene.loader import load_scene
+from reference.scene.render import render_scene
+from reference.scene.shading import SHADERS
 from shrm.environment import cached_spectral_radiance
 from shrm.shrm_oracles import env_quadrature
 
@@ -37,7 +37,7 @@ def _env_types():
 
 
 #: Material types whose environment shader has no brute-force path, and why (refused in one line).
-NO_ORACLE = {"polymer": "E60: the hybrid's physical counterpart is shrm.polymer_oracle"}
+NO_ORACLE = {"polymer": "E60: the hybrid's physical counterpart is shrm.polymer.oracle"}
 
 
 def test_every_material_type_with_an_environment_shader_is_covered():
@@ -79,7 +79,7 @@ file = "env.exr"
 
 def _direct_sum(scene, normal, view):
     """Σ over map pixels of f L cos w, with the material's own reflectance model (XYZ)."""
-    from reference.brdf import BRDF_METHODS
+    from reference.materials.brdf import BRDF_METHODS
 
     ctx = scene.shading_context()
     light, m = scene.lights[0], scene.materials[0]
@@ -131,7 +131,7 @@ def test_isotropic_brdf_metadata_and_upsampling(tmp_path):
 
 
 def _table_scene(tmp_path):
-    from reference.brdf_table import tabulate_registered_brdf, write_brdf_table
+    from reference.materials.table import tabulate_registered_brdf, write_brdf_table
 
     write_brdf_table(tmp_path / "ggx.brdf", tabulate_registered_brdf("ggx", 5.0, 15.0))
     MATERIALS["table"] = 'brdf = "table"' + "\n" + 'file = "ggx.brdf"'

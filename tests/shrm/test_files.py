@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from reference.colour.spectra import DEFAULT_GRID, GRID_41
+from reference.colour.upsampling import RGB_to_spectra_Mallett2019
 from reference.errors import SpecrefError
-from reference.images import read_exr, spectral_channel_names, write_exr
-from reference.spectra import DEFAULT_GRID, GRID_41
-from reference.upsampling import RGB_to_spectra_Mallett2019
+from reference.images.formats import read_exr, spectral_channel_names, write_exr
 from shrm.files import prefilter_file, project_file, read_environment
 
 SPECTRAL_NAMES = spectral_channel_names(GRID_41.wavelengths_nm)
@@ -22,7 +22,8 @@ def test_read_environment_keeps_or_converts_bands(tmp_path, rng):
     np.testing.assert_allclose(image, rgb, rtol=1e-6)  # OpenEXR stores float32
     same, _ = read_environment(tmp_path / "rgb.exr", "rgb")
     np.testing.assert_array_equal(same, image)
-    # Source: colour.recovery's Mallett 2019 basis (tests/reference/test_upsampling.py checks it).
+    # Source: colour.recovery's Mallett 2019 basis (tests/reference/colour/test_upsampling.py checks
+    # it).
     spectral, names = read_environment(tmp_path / "rgb.exr", "spectral")
     assert spectral.shape == (4, 8, DEFAULT_GRID.n_bands)
     assert names == SPECTRAL_NAMES

@@ -9,7 +9,7 @@ from shrm.lobes import (
     parse_kernel,
     phong_Lambda_gaussian,
 )
-from validation.oracles import lambert_Lambda_mp, phong_Lambda_mp
+from validation.studies.oracles import lambert_Lambda_mp, phong_Lambda_mp
 
 
 def test_lambert_Lambda_closed_form_and_mpmath():

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from reference.brdf import BRDF_METHODS, brdf_lambert
+from reference.materials.brdf import BRDF_METHODS, brdf_lambert
 from shrm.montecarlo import environment_mc, environment_sampling_probabilities
 from shrm.shrm_oracles import env_quadrature
 from shrm.split import angular_sum

@@ -1,24 +1,24 @@
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from reference.data import data_path
 from reference.errors import SpecrefError
-from reference.images import read_png
-from reference.scene import load_scene, loads_scene
+from reference.images.formats import read_png
+from reference.scene.loader import load_scene, loads_scene
 from shrm.orbit import render_orbit, scene_state, turn_camera
 from shrm.session import HERBERT_STAGES, RenderSession
 from validation.cli import main
 
 ALL = [s.name for s in HERBERT_STAGES]
-EXAMPLE = Path(__file__).resolve().parents[2] / "docs" / "examples" / "shrm-orbit.toml"
+EXAMPLE = data_path("examples/shrm-orbit.toml")
 LATER = ["extract", "gbuffer", "shade"]
 
 
 def test_turn_camera_is_a_rotation_about_the_target():
-    from reference.camera import Camera
+    from reference.geometry.camera import Camera
 
     c = Camera(eye=(1.0, 2.0, 4.0), target=(1.0, 0.0, 0.0))
     # A quarter turn about y through the target: (0, 2, 4) relative becomes (4, 2, 0)
@@ -110,7 +110,7 @@ BAD_SCENES = {
 
 @pytest.mark.parametrize("case", BAD_SCENES, ids=list(BAD_SCENES))
 def test_bad_scenes_give_one_line_and_exit_2(case, tmp_path, capsys):
-    from reference.images import write_exr
+    from reference.images.formats import write_exr
 
     write_exr(tmp_path / "sky.exr", np.ones((8, 16, 3), dtype=np.float32))
     material, light, message = BAD_SCENES[case]
@@ -152,7 +152,7 @@ def test_cli_orbit_without_traceback():
 
 
 def test_loads_scene_reads_spectral_parameters(tmp_path):
-    from reference.images import write_exr
+    from reference.images.formats import write_exr
 
     write_exr(tmp_path / "sky.exr", np.ones((8, 16, 3), dtype=np.float32))
     text = SCENE.format(material='brdf = "lafortune"\nn = 12', light=ENV)
@@ -164,7 +164,7 @@ def test_loads_scene_reads_spectral_parameters(tmp_path):
 
 
 def _square_map(tmp_path):
-    from reference.images import write_exr
+    from reference.images.formats import write_exr
 
     path = tmp_path / "square.exr"
     write_exr(path, np.ones((16, 16, 3), dtype=np.float32))
@@ -242,7 +242,7 @@ def test_prepare_runs_a_stage_ahead_and_counts_it_in_the_next_frame():
 def test_bad_brdf_parameters_are_refused_when_the_scene_loads():
     # before: the BRDF refused alpha < 0 only when shading, in a message without file or key
     from reference.errors import SpecrefError
-    from reference.scene import loads_scene
+    from reference.scene.loader import loads_scene
 
     text = """[camera]
 eye = [0.0, 0.0, 6.0]

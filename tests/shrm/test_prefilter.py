@@ -1,9 +1,9 @@
 import numpy as np
 import pytest
 
-from reference.cubemap import cubemap_texel_directions
 from reference.errors import SpecrefError
-from reference.images import read_hdr
+from reference.geometry.cubemap import cubemap_texel_directions
+from reference.images.formats import read_hdr
 from shrm.lobes import kernel_table, parse_kernel
 from shrm.prefilter import (
     BRUTEFORCE_METHODS,
@@ -19,10 +19,10 @@ from shrm.transform import project_latlong
 @pytest.mark.parametrize(
     ("kernel", "bound"), [("phong:32", 1e-11), ("phong:256", 2e-9), ("lambert", 5e-4)]
 )
-def test_frequency_matches_bruteforce_at_L100(kernel, bound, shared_data):
+def test_frequency_matches_bruteforce_at_L100(kernel, bound, package_data):
     # Same Fejér-1 weights: the two differ only by the kernel's truncation at L = 100 (addition
     # theorem). Bounds are the targets, on venice_sunset (downsampled 4×, one channel).
-    image = read_hdr(shared_data / "environments" / "venice_sunset_1k.hdr")[::4, ::4, :1].copy()
+    image = read_hdr(package_data / "environments" / "venice_sunset_1k.hdr")[::4, ::4, :1].copy()
     d = cubemap_texel_directions(8)
     coeffs = prefilter_coefficients(project_latlong(image, 100), parse_kernel(kernel).Lambda(100))
     frequency = sh_evaluate(coeffs, d, backend="numba")

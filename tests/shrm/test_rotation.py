@@ -12,7 +12,7 @@ def test_rotation_matches_projection_of_rotated_map_L100(rng):
     L, H = 100, 202
     c = rng.normal(size=(1, (L + 1) ** 2)) / (L + 1)
     R = rotation_matrix([0.3, -0.5, 0.8], 2.2)
-    from reference.envmap import latlong_pixel_directions
+    from reference.geometry.envmap import latlong_pixel_directions
 
     d = latlong_pixel_directions(H, 2 * H)
     rotated = project_latlong(sh_evaluate(c, d @ R, backend="ducc0"), L, backend="ducc0")

@@ -23,7 +23,7 @@ from shrm.transform import (
     SH_KERNELS,
 )
 
-DATA = Path(__file__).resolve().parents[1] / "data" / "sh_basis.json"
+DATA = Path(__file__).resolve().parents[2] / "validation" / "data" / "sh_basis.json"
 
 
 def _points():

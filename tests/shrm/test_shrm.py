@@ -1,12 +1,12 @@
 import numpy as np
 import pytest
 
-from reference.brdf import BRDF_METHODS
-from reference.brdf_isotropic import brdf_lafortune
-from reference.camera import Camera
-from reference.cubemap import cubemap_texel_directions
-from reference.gbuffer import render_gbuffer
-from reference.geometry import Sphere
+from reference.geometry.camera import Camera
+from reference.geometry.cubemap import cubemap_texel_directions
+from reference.geometry.gbuffer import render_gbuffer
+from reference.geometry.shapes import Sphere
+from reference.materials.brdf import BRDF_METHODS
+from reference.materials.isotropic import brdf_lafortune
 from shrm.brdf_sh import brdf_sh_coefficients
 from shrm.rotation import rotation_matrix, sh_rotation_blocks
 from shrm.sh import sh_evaluate
@@ -118,8 +118,9 @@ def test_render_through_the_gbuffer_converges_to_the_closed_form(rng):
     truth[g.mask] = _poly_closed_form(coeffs, g.normal[g.mask], view)
     peak = truth[g.mask].max()
     # The SHRM's texels are exact; what is left is the seamless bilinear lookup of
-    # reference.cubemap, second order inside a face and first order at face edges, where a tap
-    # across the edge snaps to the neighbouring face's nearest texel (observed rates 0.98, 1.04).
+    # reference.geometry.cubemap, second order inside a face and first order at face edges, where a
+    # tap across the edge snaps to the neighbouring face's nearest texel (observed rates 0.98,
+    # 1.04).
     rho = brdf_sh_coefficients(brdf_lafortune, POLY, 6, 2, "normal")
     errors = [
         np.abs(render_shrm(g, shrm_create(coeffs, rho, "normal", size=S), view) - truth)[

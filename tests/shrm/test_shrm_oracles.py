@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from reference.brdf import brdf_lambert
 from reference.errors import SpecrefError
+from reference.materials.brdf import brdf_lambert
 from shrm.sh import sh_evaluate
 from shrm.shrm_oracles import env_quadrature, reflected_bruteforce
 

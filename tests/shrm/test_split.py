@@ -1,14 +1,13 @@
 """Tests of shrm.split (SH + angular split, Herbert §9) and of the scene path that uses it."""
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
-from reference.brdf import BRDF_METHODS
-from reference.camera import downsample_box
-from reference.images import read_image
-from reference.spectra import SpectralGrid
+from reference.colour.spectra import SpectralGrid
+from reference.data import data_path
+from reference.geometry.camera import downsample_box
+from reference.images.formats import read_image
+from reference.materials.brdf import BRDF_METHODS
 from shrm.orbit import brdf_params_on_grid
 from shrm.shrm_oracles import env_quadrature, reflected_bruteforce
 from shrm.split import (
@@ -21,7 +20,7 @@ from shrm.split import (
     split_shade,
 )
 
-ENVIRONMENTS = Path(__file__).resolve().parents[3] / "shared" / "data" / "environments"
+ENVIRONMENTS = data_path("environments")
 GRID = SpectralGrid(410.0, 710.0, 50.0)
 
 
@@ -34,11 +33,10 @@ def _sphere_points(R):
 
 
 def _spectral_env(name, rows):
-    from reference.lights import EnvironmentLight
+    from reference.scene.lights import EnvironmentLight
     from shrm.environment import environment_spectral_radiance
 
     path = ENVIRONMENTS / name
-    assert path.is_file(), f"{path} missing: set up ../shared/data (SPECREF_SHARED_DATA)"
     image = read_image(path)
     f = image.shape[0] // rows
     image = downsample_box(image[: f * rows, : 2 * f * rows], f)
@@ -46,7 +44,7 @@ def _spectral_env(name, rows):
 
 
 def _y_weights():
-    from reference.shading import ShadingContext
+    from reference.scene.shading import ShadingContext
 
     return ShadingContext(GRID).weights(None)[:, 1]
 

@@ -38,7 +38,7 @@ def test_rows_missing_or_twice_are_refused(rng):
 
 
 def test_progress_bar_counts_every_row(tmp_path, capsys, rng):
-    from reference.zarr_images import write_zarr_image
+    from reference.images.zarr_store import write_zarr_image
 
     image = rng.random((24, 48, 2)).astype(np.float32)
     path = write_zarr_image(tmp_path / "m.zarr", image, ["R", "G"], rows_per_chunk=5)

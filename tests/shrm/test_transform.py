@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from reference.errors import SpecrefError
-from reference.images import read_hdr
+from reference.images.formats import read_hdr
 from shrm.sh import sh_evaluate
 from shrm.transform import SH_BACKENDS, project_function, project_latlong, synthesize_latlong
 
@@ -43,10 +43,10 @@ def test_solid_angle_weights_leave_round_trip_error(rng):
     assert 1e-5 < err < 1e-2
 
 
-def test_ducc0_agrees_with_numpy_on_real_map(shared_data):
+def test_ducc0_agrees_with_numpy_on_real_map(package_data):
     # The fast path against its oracle on venice_sunset_1k.hdr (512×1024, RGB), L = 100: ≤ 1e-13
     # relative to the largest coefficient.
-    image = read_hdr(shared_data / "environments" / "venice_sunset_1k.hdr")
+    image = read_hdr(package_data / "environments" / "venice_sunset_1k.hdr")
     a = project_latlong(image, 100, backend="numpy")
     b = project_latlong(image, 100, backend="ducc0")
     assert np.abs(a - b).max() / np.abs(a).max() <= 1e-13
@@ -93,7 +93,7 @@ def test_transform_shapes(backend, rng):
 def test_synthesis_agrees_with_direct_evaluation(rng):
     # Source: the basis evaluated directly at the pixel centres (shrm.sh.sh_evaluate, itself
     # checked against mpmath in test_sh.py): synthesis is the same sum by rings and rFFT.
-    from reference.envmap import latlong_pixel_directions
+    from reference.geometry.envmap import latlong_pixel_directions
 
     c = rng.normal(size=(2, 49))
     expected = sh_evaluate(c, latlong_pixel_directions(10, 20))

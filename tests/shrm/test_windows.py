@@ -2,15 +2,15 @@ import numpy as np
 import pytest
 
 from reference.errors import SpecrefError
-from reference.images import read_hdr
+from reference.images.formats import read_hdr
 from shrm.transform import project_latlong, synthesize_latlong
 from shrm.windows import apply_window, parse_window, ringing_statistics, window_gaussian
 
 
-def test_windows_and_ringing(shared_data):
+def test_windows_and_ringing(package_data):
     # The default Gaussian window (σ = π/L) leaves no negative pixel on venice_sunset at L = 100;
     # the plain truncation rings below zero.
-    image = read_hdr(shared_data / "environments" / "venice_sunset_1k.hdr")
+    image = read_hdr(package_data / "environments" / "venice_sunset_1k.hdr")
     c = project_latlong(image, 100, backend="ducc0")
     none = ringing_statistics(synthesize_latlong(c, 512, backend="ducc0"))
     gauss = ringing_statistics(

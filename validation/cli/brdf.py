@@ -6,7 +6,7 @@ from validation.cli.parser import Parser, registry_option
 
 
 def _cmd_brdf_tabulate(args) -> int:
-    from reference.brdf_table import tabulate_registered_brdf, write_brdf_table
+    from reference.materials.table import tabulate_registered_brdf, write_brdf_table
 
     table = tabulate_registered_brdf(args.model, args.theta_step, args.phi_step)
     write_brdf_table(args.out, table, {"source": f"specref brdf tabulate {args.model}"})
@@ -15,7 +15,7 @@ def _cmd_brdf_tabulate(args) -> int:
 
 
 def _cmd_brdf_check(args) -> int:
-    from reference.brdf_table import read_brdf_table
+    from reference.materials.table import read_brdf_table
 
     t = read_brdf_table(args.file)
     print(
@@ -28,8 +28,8 @@ def _cmd_brdf_check(args) -> int:
 
 def add_parser(sub) -> None:
     """Add ``specref brdf`` and its options to the subcommand parsers ``sub``."""
-    from reference.brdf import BRDF_METHODS
-    from reference.brdf_table import tabulable_brdf_names
+    from reference.materials.brdf import BRDF_METHODS
+    from reference.materials.table import tabulable_brdf_names
 
     p = sub.add_parser("brdf", help="tabulate isotropic BRDFs and check BRDF table files")
     brdf = p.add_subparsers(dest="brdf_command", required=True, parser_class=Parser)

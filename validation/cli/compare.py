@@ -6,7 +6,7 @@ from __future__ import annotations
 def _cmd_compare(args) -> int:
     import json
 
-    from reference.compare import compare_files, summary_line
+    from reference.scene.compare import compare_files, summary_line
 
     summary = compare_files(args.a, args.b, args.mask, args.json, args.diff)
     print(json.dumps(summary, indent=2) if args.json == "-" else summary_line(summary))

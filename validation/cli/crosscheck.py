@@ -6,10 +6,9 @@ import sys
 
 
 def _cmd_crosscheck(args) -> int:
-    from validation.crosscheck import (
+    from validation.studies.crosscheck import (
         FULL,
         QUICK,
-        SHARED_DATA,
         crosscheck_summary,
         run_crosscheck,
     )
@@ -18,13 +17,13 @@ def _cmd_crosscheck(args) -> int:
         from pathlib import Path
 
         from reference.errors import require
-        from reference.images import check_output_folder
+        from reference.files import check_output_folder
 
         json_path = Path(args.json)
         require(not json_path.is_dir(), f"--json: {json_path} is a folder; give a file name")
         check_output_folder(json_path.parent)
     settings = QUICK if args.quick else FULL
-    data = args.data or SHARED_DATA
+    data = args.data
     result = run_crosscheck(
         data, settings, progress=lambda name: print(name, file=sys.stderr), only=args.case
     )
@@ -60,8 +59,8 @@ def add_parser(sub) -> None:
     p.add_argument(
         "--data",
         metavar="FOLDER",
-        help="shared data (environments/, spectra/); default $SPECREF_SHARED_DATA or "
-        "../shared/data",
+        help="a folder laid out as the shipped data (environments/, spectra/); default the data "
+        "shipped with specref",
     )
     p.add_argument("--case", metavar="TEXT", help="run only the cases whose name contains TEXT")
     p.add_argument("--json", metavar="OUT.json", help="also write the per-case summary as JSON")

@@ -6,9 +6,9 @@ from validation.cli.parser import Parser, registry_option
 
 
 def _cmd_display_calibrate(args) -> int:
-    from reference.calibration import calibrate_display
-    from reference.calibration_files import write_calibration
-    from reference.display_spectral import load_spectral_display, spectral_display
+    from reference.display.calibration import calibrate_display
+    from reference.display.calibration_files import write_calibration
+    from reference.display.spectral import load_spectral_display, spectral_display
 
     display = load_spectral_display(args.display) if args.display else spectral_display()
     calibration = calibrate_display(
@@ -39,7 +39,7 @@ def _cmd_display_calibrate(args) -> int:
         f"ColorChecker ΔE00 mean {chart['mean']:.2f}, max {chart['max']:.2f}"
     )
     if args.profile:
-        from reference.icc import build_icc_profile, check_icc_profile
+        from reference.display.icc import build_icc_profile, check_icc_profile
 
         icc = build_icc_profile(summary["files"][".ti3"])
         check = check_icc_profile(icc, summary["files"][".ti3"])
@@ -53,8 +53,8 @@ def _cmd_display_calibrate(args) -> int:
 
 def add_parser(sub) -> None:
     """Add ``specref display`` and its options to the subcommand parsers ``sub``."""
-    from reference.calibration import CALIBRATION_CURVES, WHITES
-    from reference.instruments import INSTRUMENTS
+    from reference.display.calibration import CALIBRATION_CURVES, WHITES
+    from reference.display.instruments import INSTRUMENTS
 
     p = sub.add_parser("display", help="display calibration (Herbert et al. §6)")
     dsub = p.add_subparsers(dest="display_command", required=True, parser_class=Parser)

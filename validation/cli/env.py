@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-from validation.cli.parser import Parser, registry_option
+from validation.cli.parser import Parser, input_file, registry_option
 
 
 def _cmd_env_fit(args) -> int:
-    from validation.spectral_env import fit_file
+    from validation.studies.spectral_env import fit_file
 
     report = fit_file(
         args.out,
@@ -28,10 +28,10 @@ def _cmd_env_fit(args) -> int:
 
 
 def _cmd_env_spectralize(args) -> int:
-    from reference.spectra import DEFAULT_GRID
-    from reference.spectral_images import spectralize_file
-    from reference.spectral_regression import load_regression
-    from reference.upsampling import DEFAULT_REGRESSION_MODEL
+    from reference.colour.spectra import DEFAULT_GRID
+    from reference.colour.spectral_regression import load_regression
+    from reference.colour.upsampling import DEFAULT_REGRESSION_MODEL
+    from reference.images.spectral import spectralize_file
 
     path = DEFAULT_REGRESSION_MODEL if args.model == "default" else args.model
     model = load_regression(path, DEFAULT_GRID.wavelengths_nm)
@@ -44,7 +44,7 @@ def _cmd_env_spectralize(args) -> int:
 
 
 def _cmd_env_convert(args) -> int:
-    from reference.zarr_images import convert_to_zarr
+    from reference.images.spectral import convert_to_zarr
 
     info = convert_to_zarr(args.input, args.out, args.rows, args.compression)
     print(
@@ -57,8 +57,12 @@ def _cmd_env_convert(args) -> int:
 
 def add_parser(sub) -> None:
     """Add ``specref env fit|spectralize|convert`` to the subcommand parsers ``sub``."""
-    from reference.spectral_regression import DEFAULT_LOSS, REGRESSION_FEATURES, REGRESSION_LOSSES
-    from reference.spectral_target import CAMERAS, TARGET_AUGMENTATIONS
+    from reference.colour.spectral_regression import (
+        DEFAULT_LOSS,
+        REGRESSION_FEATURES,
+        REGRESSION_LOSSES,
+    )
+    from reference.colour.spectral_target import CAMERAS, TARGET_AUGMENTATIONS
 
     p = sub.add_parser("env", help="spectral environments: camera-target regression (Herbert §4)")
     env = p.add_subparsers(dest="env_command", required=True, parser_class=Parser)
@@ -100,12 +104,12 @@ def add_parser(sub) -> None:
     s.add_argument("--rows", type=int, default=None, help="rows per block (default: 2^17 pixels)")
     s.add_argument("-o", "--out", required=True, help="output .exr, .tif or .zarr")
     s.set_defaults(func=_cmd_env_spectralize)
-    from reference.zarr_images import ZARR_COMPRESSIONS
+    from reference.images.zarr_store import ZARR_COMPRESSIONS
 
     c = env.add_parser(
         "convert", help="convert a panorama (.exr, .hdr, .tif) to a chunked Zarr store"
     )
-    c.add_argument("input", help="lat-long panorama: .exr, .hdr or spectral .tif")
+    c.add_argument("input", type=input_file, help="lat-long panorama: .exr, .hdr or spectral .tif")
     c.add_argument("out", metavar="OUT.zarr", help="the Zarr store to write (docs/scale-out.md)")
     c.add_argument(
         "--rows",

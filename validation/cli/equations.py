@@ -7,8 +7,8 @@ from pathlib import Path
 
 
 def _cmd_equations(args) -> int:
-    from reference.images import write_text_atomic
-    from validation.equations import (
+    from reference.files import write_text_atomic
+    from validation.report.equations import (
         REGENERATE,
         collect_citations,
         equation_problems,

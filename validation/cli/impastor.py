@@ -9,14 +9,14 @@ from validation.cli.parser import Parser, registry_option
 def _cmd_impastor_table1(args) -> int:
     import json
 
-    from validation.impastor_cli import format_table1, table1_for_cli
+    from validation.studies.impastor_commands import format_table1, table1_for_cli
 
     result = table1_for_cli(
         args.design, args.channels, args.white_luminance, args.display, args.scheduler
     )
     print(format_table1(result))
     if args.json:
-        from reference.images import write_text_atomic
+        from reference.files import write_text_atomic
 
         write_text_atomic(args.json, json.dumps(result, indent=1) + "\n")
         print(f"wrote {args.json}")
@@ -35,7 +35,7 @@ def _vector(text: str, option: str) -> tuple:
 
 
 def _cmd_impastor_render(args) -> int:
-    from validation.impastor_cli import render_for_cli
+    from validation.studies.impastor_commands import render_for_cli
 
     observer = _vector(args.observer, "--observer")
     lamp = _vector(args.light_position, "--light-position")

@@ -16,6 +16,29 @@ class Parser(argparse.ArgumentParser):
         self.exit(2, f"specref: error: {message} (see specref {self.prog.split()[-1]} --help)\n")
 
 
+def input_file(value: str) -> str:
+    """An input file argument: ``data:<name>`` names a file shipped with specref, else the path.
+
+    For argparse's ``type=``; an unknown ``data:`` name is a one-line usage error (exit code 2).
+
+    Examples
+    --------
+    >>> input_file("data:environments/venice_sunset_1k.hdr").endswith("venice_sunset_1k.hdr")
+    True
+    >>> input_file("my/scene.toml")
+    'my/scene.toml'
+    """
+    from reference.data import DATA_SCHEME, data_path
+    from reference.errors import SpecrefError
+
+    if not value.startswith(DATA_SCHEME):
+        return value
+    try:
+        return str(data_path(value))
+    except SpecrefError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
+
+
 def write_json(path, result) -> None:
     """Write ``result`` (NumPy values converted) as JSON to ``path``, atomically, and say so.
 
@@ -30,7 +53,7 @@ def write_json(path, result) -> None:
     wrote .../r.json
     {'rms': 0.5}
     """
-    from reference.images import write_text_atomic
+    from reference.files import write_text_atomic
     from validation.report import to_jsonable
 
     write_text_atomic(path, json.dumps(to_jsonable(result), indent=1))

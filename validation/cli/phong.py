@@ -10,10 +10,11 @@ from validation.cli.parser import registry_option, write_json
 
 def _cmd_phong(args) -> int:
     from reference.errors import SpecrefError
-    from validation import phong, phong_table1
+    from validation.studies import phong, phong_table1
 
     if args.action == "edit":
-        from validation import editor_app, editor_browser
+        from phong_table.editor import app as editor_app
+        from phong_table.editor import browser as editor_browser
 
         path = args.file if args.file is not None else args.material
         if args.screenshot:
@@ -62,9 +63,9 @@ def _write_images(args) -> None:
     """``table1 --images DIR``: Figs. 2-7 of Wang et al. as ``DIR/images/phong-*.png``."""
     from pathlib import Path
 
-    from reference.images import check_output_folder
-    from validation.phong_figures import paper_figures
+    from reference.files import check_output_folder
     from validation.report import ReportContext
+    from validation.studies.phong_figures import paper_figures
 
     folder = check_output_folder(args.images)
     ctx = ReportContext(Path(folder), section="phong")

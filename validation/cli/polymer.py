@@ -15,9 +15,9 @@ def _numbers(text: str, name: str) -> list[float]:
 
 
 def _cmd_polymer_characterize(args) -> int:
-    from reference.spectra import GRIDS
-    from shrm.characterization import characterize_model, write_characterization
-    from shrm.kubelka_munk import polymer_constituents
+    from reference.colour.spectra import GRIDS
+    from shrm.polymer.characterization import characterize_model, write_characterization
+    from shrm.polymer.kubelka_munk import polymer_constituents
 
     constituents = polymer_constituents(GRIDS[args.grid], args.constituents)
     ch = characterize_model(
@@ -36,8 +36,8 @@ def _cmd_polymer_characterize(args) -> int:
 
 def add_parser(sub) -> None:
     """Add ``specref polymer`` and its options to the subcommand parsers ``sub``."""
-    from reference.spectra import GRIDS
-    from shrm.characterization import DEFAULT_THICKNESS_MM, DEFAULT_TIO2_PCT
+    from reference.colour.spectra import GRIDS
+    from shrm.polymer.characterization import DEFAULT_THICKNESS_MM, DEFAULT_TIO2_PCT
 
     p = sub.add_parser("polymer", help="polymer characterization files (Herbert et al. §3.1)")
     polymer = p.add_subparsers(dest="polymer_command", required=True, parser_class=Parser)

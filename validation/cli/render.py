@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from reference.envmap import TEXEL_PLACEMENTS
-from validation.cli.parser import registry_option
+from reference.geometry.envmap import TEXEL_PLACEMENTS
+from validation.cli.parser import input_file, registry_option
 
 
 def _cmd_render(args) -> int:
@@ -11,7 +11,7 @@ def _cmd_render(args) -> int:
 
     import phong_table  # noqa: F401  (registers its shaders, if any)
     import shrm  # noqa: F401  (registers the environment-light shaders, if any)
-    from reference.render import render_scene_file
+    from reference.scene.render import render_scene_file
 
     result = render_scene_file(
         args.scene,
@@ -45,15 +45,22 @@ def _cmd_render(args) -> int:
 
 def add_parser(sub) -> None:
     """Add ``specref render`` and its options to the subcommand parsers ``sub``."""
-    from reference.render_metadata import DEFAULT_ACCURACY, RENDER_OUTPUTS
+    from reference.scene.metadata import DEFAULT_ACCURACY, RENDER_OUTPUTS
 
     p = sub.add_parser(
         "render",
         help="render a scene file to a display-encoded PNG (and optionally a linear EXR)",
         description="Render a TOML scene (docs/scene-format.md). Relative paths in the scene are "
-        "relative to its folder. Outputs and metadata: docs/render-outputs.md.",
+        "relative to its folder; data:<path> names a file shipped with specref "
+        "(data:examples/<name>.toml, data:environments/...). Outputs and metadata: "
+        "docs/render-outputs.md.",
     )
-    p.add_argument("scene", metavar="SCENE.toml", help="the scene file")
+    p.add_argument(
+        "scene",
+        metavar="SCENE.toml",
+        type=input_file,
+        help="the scene file, or data:examples/<name>.toml",
+    )
     p.add_argument(
         "-o", "--output", required=True, metavar="OUT.png", help="display-encoded 8-bit PNG"
     )

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from validation.cli.parser import Parser, registry_option
+from validation.cli.parser import Parser, input_file, registry_option
 
 
 def _cmd_sh_project(args) -> int:
@@ -34,7 +34,7 @@ def add_parser(sub) -> None:
     p = sub.add_parser("sh", help="spherical harmonics: project and prefilter environment maps")
     sh = p.add_subparsers(dest="sh_command", required=True, parser_class=Parser)
     q = sh.add_parser("project", help="SH coefficients of a lat-long map (.npz)")
-    q.add_argument("env", help="lat-long map, .hdr or .exr (RGB or spectral)")
+    q.add_argument("env", type=input_file, help="lat-long map, .hdr or .exr (RGB or spectral)")
     q.add_argument("--order", type=int, required=True, help="SH order L")
     registry_option(q, "--window", WINDOWS, "window against ringing")
     q.add_argument("--bands", choices=("spectral", "rgb"), default=None, help="convert first")
@@ -42,7 +42,7 @@ def add_parser(sub) -> None:
     q.add_argument("-o", "--out", required=True, help="output .npz")
     q.set_defaults(func=_cmd_sh_project)
     r = sh.add_parser("prefilter", help="frequency-space prefiltered cube or lat-long map (.exr)")
-    r.add_argument("env", help="lat-long map, .hdr or .exr")
+    r.add_argument("env", type=input_file, help="lat-long map, .hdr or .exr")
     registry_option(r, "--kernel", PREFILTER_KERNELS, "prefilter kernel", required=True)
     r.add_argument("--out", required=True, help="output .exr")
     r.add_argument("--tol", type=float, default=1e-2, help="adaptive-order tolerance")

@@ -7,12 +7,12 @@ from pathlib import Path
 import numpy as np
 
 from reference.errors import SpecrefError, require, require_positive_int
-from validation.cli.parser import Parser, registry_option
+from validation.cli.parser import Parser, input_file, registry_option
 
 
 def _check_arguments(args) -> None:
     """The arguments that need no data, before any work (issue 17 §5)."""
-    from reference.images import check_output_folder
+    from reference.files import check_output_folder
     from shrm.brdf_sh import P_RANGE
 
     require_positive_int(args.frames, "orbit --frames", 100000)
@@ -43,7 +43,7 @@ def _cmd_shrm_orbit(args) -> int:
     quick = {"env_height": 16, "size": 8, "resolution": 48, "F_max": 12, "P_max": 6}
     orders = {k: v for k, v in (("tol", args.tol), ("F", args.F), ("P", args.P)) if v is not None}
     if args.scene is not None:
-        from reference.scene import load_scene
+        from reference.scene.loader import load_scene
 
         for flag, value in (("--brdf", args.brdf), ("--env", args.env), ("--quick", args.quick)):
             if value:
@@ -70,13 +70,19 @@ def _cmd_shrm_orbit(args) -> int:
 
 def add_parser(sub) -> None:
     """Add ``specref shrm`` and its options to the subcommand parsers ``sub``."""
-    from reference.brdf import BRDF_METHODS
+    from reference.materials.brdf import BRDF_METHODS
     from shrm.orbit import analytic_isotropic_brdf_names
 
     p = sub.add_parser("shrm", help="SH reflection maps (Herbert et al. §5.5-5.6)")
     shrm = p.add_subparsers(dest="shrm_command", required=True, parser_class=Parser)
     o = shrm.add_parser("orbit", help="render a camera orbit; PNG frames and per-stage timings")
-    o.add_argument("scene", nargs="?", metavar="SCENE.toml", help="scene file (default: built-in)")
+    o.add_argument(
+        "scene",
+        nargs="?",
+        type=input_file,
+        metavar="SCENE.toml",
+        help="scene file (default: built-in)",
+    )
     o.add_argument("--frames", type=int, default=8, help="frames of a full turn (default 8)")
     o.add_argument("-o", "--out", required=True, help="output folder")
     analytic = analytic_isotropic_brdf_names()
@@ -87,7 +93,9 @@ def add_parser(sub) -> None:
         "isotropic BRDF of the built-in sphere (default effect_pigment)",
         where=lambda key, _: key in analytic,
     )
-    o.add_argument("--env", help="lat-long environment (.hdr/.exr); default venice_sunset_1k")
+    o.add_argument(
+        "--env", type=input_file, help="lat-long environment (.hdr/.exr); default venice_sunset_1k"
+    )
     o.add_argument("--quick", action="store_true", help="small maps and images")
     o.add_argument("--tol", type=float, help="order tolerance (default 0.05, an L2 tail)")
     o.add_argument("--F", type=int, help="lighting order (default: from --tol)")

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 
 def _cmd_sweep(args) -> int:
-    from validation.sweep import run_sweep, sweep_csv
+    from validation.studies.sweep import run_sweep, sweep_csv
 
     rows = run_sweep(args.file, scheduler=args.scheduler)
     text = sweep_csv(rows, args.out)
@@ -18,7 +18,7 @@ def _cmd_sweep(args) -> int:
 def add_parser(sub) -> None:
     """Add ``specref sweep`` and its options to the subcommand parsers ``sub``."""
     from reference.tasks import add_scheduler_option
-    from validation.sweep import SWEEP_KINDS
+    from validation.studies.sweep import SWEEP_KINDS
 
     p = sub.add_parser(
         "sweep",

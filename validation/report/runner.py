@@ -10,7 +10,7 @@ writes, each atomically:
   so a reviewer can look without a browser;
 - optionally a Markdown rendering (``docs/results.md`` is generated this way, never typed).
 
-A new section is a module in ``validation/sections/`` that defines ``SECTION`` (a
+A new section is a module in ``validation/report/sections/`` that defines ``SECTION`` (a
 :class:`~validation.report.types.ReportSection`) and one entry in a part of :data:`PARTS`.
 """
 
@@ -27,18 +27,11 @@ import time
 from pathlib import Path
 
 from reference.errors import require
-from reference.images import read_json, write_text_atomic
+from reference.files import read_json, write_text_atomic
 from reference.registry import Registry
 from reference.tasks import LOCAL, SERIAL, dask_client, scheduler_address
 from validation.report.render import render_html, render_markdown
-from validation.report.types import (
-    ReportContext,
-    ReportPart,
-    ReportSection,
-    SectionResult,
-    to_jsonable,
-)
-from validation.sections import (
+from validation.report.sections import (
     crosscheck,
     display,
     examples,
@@ -54,6 +47,13 @@ from validation.sections import (
     shrm_fullres,
     spectral,
     spectral_env,
+)
+from validation.report.types import (
+    ReportContext,
+    ReportPart,
+    ReportSection,
+    SectionResult,
+    to_jsonable,
 )
 
 __all__ = ["PARTS", "REPORT_SECTIONS", "SECTIONS", "run_report"]

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from reference.images import write_png
+from reference.images.formats import write_png
 
 __all__ = [
     "Check",
@@ -329,7 +329,7 @@ class ReportContext:
         import matplotlib.pyplot as plt
         from PIL import Image as PILImage
 
-        from reference.images import write_bytes_atomic
+        from reference.files import write_bytes_atomic
 
         rel = f"images/{self.section}-{name}.png"
         buffer = io.BytesIO()

@@ -1,0 +1,257 @@
+"""Atomic file writes: every output of specref goes to a temporary file that is renamed into place.
+
+The data go to a temporary file in the destination folder, which is flushed, synced and renamed over
+the destination, so an interrupted run never leaves a half-written file. The file system's refusals
+(a folder where a file should be, no permission, a full disk) become one-line
+:class:`~reference.errors.SpecrefError` messages that name the file (:func:`output_error`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import os
+import tempfile
+from pathlib import Path
+
+from reference.errors import SpecrefError, require
+
+__all__ = [
+    "WRITE_ERRORS",
+    "atomic_path",
+    "atomic_write",
+    "check_output_folder",
+    "output_error",
+    "read_json",
+    "write_bytes_atomic",
+    "write_text_atomic",
+]
+
+# The process umask, read once at import: mkstemp creates files 0600, and a finished output should
+# get the permissions an ordinary open() would give it.
+_UMASK = os.umask(0o022)
+os.umask(_UMASK)
+
+
+def _new_file_permissions(tmp) -> None:
+    """Give a temporary file the permissions of a newly created ordinary file (0666 & ~umask)."""
+    os.chmod(tmp, 0o666 & ~_UMASK)
+
+
+#: Errors of the file system that mean "this output cannot be written here", by errno, with what the
+#: one-line message says about them.
+WRITE_ERRORS = {
+    errno.EISDIR: "is a folder; give a file name",
+    errno.ENOTDIR: "a part of the path is a file, not a folder",
+    errno.EEXIST: "a part of the path is a file, not a folder",
+    errno.EACCES: "permission denied",
+    errno.EPERM: "permission denied",
+    errno.EROFS: "read-only file system",
+    errno.ENOSPC: "no space left on the device",
+    errno.EDQUOT: "disk quota exceeded",
+    errno.EFBIG: "file too large for the file system",
+}
+
+
+def output_error(path, error: OSError) -> SpecrefError | None:
+    """The one-line :class:`SpecrefError` for an OSError met while writing ``path``, if it is one.
+
+    Every writer (:func:`atomic_write`, :func:`write_exr`) turns the file system's refusals (a
+    folder where a file should be, a file where a folder should be, no permission, a full disk)
+    into this message, so no command shows a traceback for them.
+
+    Returns
+    -------
+    SpecrefError or None
+        None when ``error`` is not a refusal to write (the caller re-raises it).
+
+    Examples
+    --------
+    >>> import errno
+    >>> output_error("out/a.exr", OSError(errno.ENOSPC, "No space left on device"))
+    SpecrefError('out/a.exr: cannot write (no space left on the device)')
+    >>> output_error("a.exr", OSError(errno.EIO, "I/O error")) is None
+    True
+    """
+    reason = WRITE_ERRORS.get(getattr(error, "errno", None))
+    if reason is None:
+        return None
+    return SpecrefError(f"{path}: cannot write ({reason})")
+
+
+@contextlib.contextmanager
+def _write_errors(path):
+    """Turn the file system's refusals to write ``path`` into one-line SpecrefErrors."""
+    try:
+        yield
+    except OSError as error:
+        translated = output_error(path, error)
+        if translated is None:
+            raise
+        raise translated from None
+
+
+@contextlib.contextmanager
+def atomic_write(path, mode: str = "wb"):
+    """Open a temporary file beside ``path``; on success, sync it and rename it to ``path``.
+
+    On an exception the temporary file is removed and ``path`` is untouched. When the file system
+    refuses the write (see :func:`output_error`) the error is a one-line :class:`SpecrefError`.
+
+    Parameters
+    ----------
+    path : str or Path
+        Destination; its folder is created if missing.
+    mode : str
+        ``"wb"`` or ``"w"``.
+
+    Yields
+    ------
+    file object
+        The temporary file, opened in ``mode``.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     p = os.path.join(d, "out.txt")
+    ...     with atomic_write(p, "w") as f:
+    ...         _ = f.write("done")
+    ...     open(p).read()
+    'done'
+    """
+    path = Path(path)
+    with _write_errors(path):
+        require(not path.is_dir(), f"{path}: cannot write ({WRITE_ERRORS[errno.EISDIR]})")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        try:
+            _new_file_permissions(tmp)
+            with os.fdopen(fd, mode) as handle:
+                yield handle
+                handle.flush()
+                os.fsync(handle.fileno())
+            os.replace(tmp, path)
+        except BaseException:
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(tmp)
+            raise
+
+
+@contextlib.contextmanager
+def atomic_path(path, suffix: str = ""):
+    """Yield a temporary file name beside ``path``; on success, sync it and rename it to ``path``.
+
+    For writers that take a file name rather than a file object (OpenEXR, tifffile). As in
+    :func:`atomic_write`, an exception removes the temporary file and leaves ``path`` untouched,
+    and the file system's refusals become one-line :class:`SpecrefError` (:func:`output_error`).
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     with atomic_path(os.path.join(d, "a.bin")) as tmp:
+    ...         _ = open(tmp, "wb").write(b"xy")
+    ...     sorted(os.listdir(d))
+    ['a.bin']
+    """
+    path = Path(path)
+    with _write_errors(path):
+        require(not path.is_dir(), f"{path}: cannot write ({WRITE_ERRORS[errno.EISDIR]})")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
+        os.close(fd)
+        tmp = Path(name)
+        try:
+            yield tmp
+            with open(tmp, "rb+") as handle:
+                os.fsync(handle.fileno())
+            _new_file_permissions(tmp)
+            os.replace(tmp, path)
+        except BaseException:
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(tmp)
+            raise
+
+
+def read_json(path, kind: str = "JSON"):
+    """Read a JSON file; a missing or malformed one is a one-line :class:`SpecrefError`.
+
+    Parameters
+    ----------
+    path : str or Path
+    kind : str
+        What the file should be, for the message (``"JSON display file"``).
+
+    Examples
+    --------
+    >>> read_json("/nonexistent.json", "JSON display file")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: /nonexistent.json: file not found
+    """
+    import json
+
+    path = Path(path)
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise SpecrefError(f"{path}: file not found") from None
+    except (OSError, ValueError) as error:
+        raise SpecrefError(f"{path}: not a {kind} ({error})") from None
+
+
+def check_output_folder(folder) -> Path:
+    """Create ``folder`` if needed and prove that a file can be written in it; return it.
+
+    Commands that write many files into a folder call this before any work, so an unwritable
+    folder (a file of that name, a read-only file system, a full disk) is refused in one line
+    before the first frame rather than after it.
+
+    Raises
+    ------
+    SpecrefError
+        One line naming the folder and the reason (:func:`output_error`).
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     check_output_folder(os.path.join(d, "frames")).is_dir()
+    True
+    """
+    folder = Path(folder)
+    with _write_errors(folder):
+        require(not folder.is_file(), f"{folder}: cannot write ({WRITE_ERRORS[errno.ENOTDIR]})")
+        folder.mkdir(parents=True, exist_ok=True)
+    probe = write_bytes_atomic(folder / ".specref-write-probe", b"specref")
+    probe.unlink()
+    return folder
+
+
+def write_bytes_atomic(path, data: bytes) -> Path:
+    """Write ``data`` to ``path`` atomically and return the path.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     write_bytes_atomic(os.path.join(d, "a.bin"), b"xy").stat().st_size
+    2
+    """
+    with atomic_write(path, "wb") as handle:
+        handle.write(data)
+    return Path(path)
+
+
+def write_text_atomic(path, text: str) -> Path:
+    """Write ``text`` (UTF-8) to ``path`` atomically and return the path.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     write_text_atomic(os.path.join(d, "a.txt"), "é").read_text(encoding="utf-8")
+    'é'
+    """
+    return write_bytes_atomic(path, text.encode("utf-8"))

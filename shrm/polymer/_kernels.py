@@ -1,0 +1,137 @@
+"""numba twins of the polymer family: the oracle's rough specular sum, the shading of the hybrid.
+
+Twins of ``shrm.polymer.oracle.rough_specular_samples`` and of
+``shrm.polymer.material.polymer_shade_parts``. Each kernel keeps the names and equation comments of
+its NumPy reference, never validates, never prints, and writes into an output array that the public
+entry point allocated. The equality tests live in ``tests/shrm/polymer``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+__all__ = ["polymer_shade_parts_kernel", "rough_specular_samples_kernel"]
+
+
+@numba.njit(cache=False)
+def _fresnel_dielectric(cos_i, n):
+    """Exact unpolarized Fresnel reflectance from air (``reference.materials.fresnel``)."""
+    cos_i = min(max(cos_i, 0.0), 1.0)
+    # Snell's law: cos θ_t = sqrt(1 - (1 - cos² θ_i) / n²)
+    cos_t = math.sqrt(1.0 - (1.0 - cos_i * cos_i) / (n * n))
+    # Born & Wolf §1.5.2
+    r_s = (cos_i - n * cos_t) / (cos_i + n * cos_t)
+    r_p = (n * cos_i - cos_t) / (n * cos_i + cos_t)
+    return 0.5 * (r_s * r_s + r_p * r_p)
+
+
+@numba.njit(cache=False)
+def _latlong_bilinear_add(image, dx, dy, dz, weight, x_out):
+    """x_out[b] = weight × bilinear look-up of the lat-long map (``latlong_lookup_bilinear``)."""
+    H, W = image.shape[0], image.shape[1]
+    u = math.atan2(dx, -dz) / (2.0 * math.pi)
+    if u < 0.0:
+        u += 1.0
+    if u >= 1.0:
+        u = 0.0
+    v = math.acos(min(max(dy, -1.0), 1.0)) / math.pi
+    x = u * W - 0.5
+    y = min(max(v * H - 0.5, 0.0), H - 1.0)
+    x0 = math.floor(x)
+    y0 = min(math.floor(y), H - 1)
+    fx, fy = x - x0, y - y0
+    x1, y1 = (x0 + 1) % W, min(y0 + 1, H - 1)
+    x0 = x0 % W
+    for b in range(image.shape[2]):
+        top = image[y0, x0, b] * (1 - fx) + image[y0, x1, b] * fx
+        bottom = image[y1, x0, b] * (1 - fx) + image[y1, x1, b] * fx
+        x_out[b] = weight * (top * (1 - fy) + bottom * fy)
+
+
+@numba.njit(cache=False)
+def rough_specular_samples_kernel(N, V, radiance, alpha, n, u, total, total_sq):
+    """Twin of ``shrm.polymer.oracle.rough_specular_samples``: sums of F(o·h) G_1(i) L(i)."""
+    nb = radiance.shape[2]
+    x = np.empty(nb)
+    for p in range(N.shape[0]):
+        nx, ny, nz = N[p, 0], N[p, 1], N[p, 2]
+        # Duff et al. 2017: the tangent frame (T, B, N)
+        sign = math.copysign(1.0, nz)
+        a = -1.0 / (sign + nz)
+        b = nx * ny * a
+        tx, ty, tz = 1.0 + sign * nx * nx * a, sign * b, -sign * nx
+        bx, by, bz = b, sign + ny * ny * a, -ny
+        ox = V[p, 0] * tx + V[p, 1] * ty + V[p, 2] * tz
+        oy = V[p, 0] * bx + V[p, 1] * by + V[p, 2] * bz
+        oz = max(V[p, 0] * nx + V[p, 1] * ny + V[p, 2] * nz, 1e-6)
+        norm = math.sqrt(ox * ox + oy * oy + oz * oz)
+        ox, oy, oz = ox / norm, oy / norm, oz / norm
+        # Heitz 2018, listing 1: the view in the stretched configuration
+        vx, vy, vz = alpha * ox, alpha * oy, oz
+        norm = math.sqrt(vx * vx + vy * vy + vz * vz)
+        vx, vy, vz = vx / norm, vy / norm, vz / norm
+        lensq = vx * vx + vy * vy
+        if lensq > 0:
+            inv = 1.0 / math.sqrt(lensq)
+            t1x, t1y, t1z = -vy * inv, vx * inv, 0.0
+        else:
+            t1x, t1y, t1z = 1.0, 0.0, 0.0
+        t2x, t2y, t2z = vy * t1z - vz * t1y, vz * t1x - vx * t1z, vx * t1y - vy * t1x
+        s = 0.5 * (1.0 + vz)
+        for m in range(u.shape[1]):
+            r = math.sqrt(u[p, m, 0])
+            phi = 2.0 * math.pi * u[p, m, 1]
+            q1 = r * math.cos(phi)
+            q2 = (1.0 - s) * math.sqrt(1.0 - q1 * q1) + s * r * math.sin(phi)
+            q3 = math.sqrt(max(0.0, 1.0 - q1 * q1 - q2 * q2))
+            hx = alpha * (q1 * t1x + q2 * t2x + q3 * vx)
+            hy = alpha * (q1 * t1y + q2 * t2y + q3 * vy)
+            hz = max(0.0, q1 * t1z + q2 * t2z + q3 * vz)
+            norm = math.sqrt(hx * hx + hy * hy + hz * hz)
+            hx, hy, hz = hx / norm, hy / norm, hz / norm
+            # i = 2 (o·h) h − o; weight F(o·h) G_1(i) (Eq. (34), Walter et al. 2007)
+            oh = ox * hx + oy * hy + oz * hz
+            ix, iy, iz = 2.0 * oh * hx - ox, 2.0 * oh * hy - oy, 2.0 * oh * hz - oz
+            if iz > 0.0:
+                c2 = max(iz * iz, 1e-300)
+                G = 2.0 / (1.0 + math.sqrt(1.0 + alpha * alpha * (1.0 - c2) / c2))
+            else:
+                G = 0.0
+            weight = _fresnel_dielectric(oh, n) * G
+            dx = ix * tx + iy * bx + iz * nx
+            dy = ix * ty + iy * by + iz * ny
+            dz = ix * tz + iy * bz + iz * nz
+            _latlong_bilinear_add(radiance, dx, dy, dz, weight, x)
+            for band in range(nb):
+                total[p, band] += x[band]
+                total_sq[p, band] += x[band] * x[band]
+
+
+@numba.njit(cache=False)
+def polymer_shade_parts_kernel(E_d, S, B, L, E_effect, D_Tint, Col_B, Col_L, gloss, Mod, out):
+    """Twin of ``shrm.polymer.material.polymer_shade_parts``: Eq. (1), Herbert et al., one pass.
+
+    ``D_Tint = D_polymer Tint_polymer``, ``Col_B = Col_trans (1 − u)``, ``Col_L = Col_trans u``
+    (n_bands,); ``Mod`` (1,) or (N,); ``L`` and ``E_effect`` are read only where their weight is
+    nonzero (an empty array: never). The NumPy reference makes a pass over the pixels per term;
+    here each pixel's bands are read once and written once (the frame is memory-bound).
+    """
+    N, n_bands = E_d.shape
+    use_L = L.shape[0] == N
+    use_effect = E_effect.shape[0] == N
+    for p in range(N):
+        m = Mod[0] if Mod.size == 1 else Mod[p]
+        for b in range(n_bands):
+            # Eq. (2), Herbert et al.: E_d D_polymer Tint_polymer (1 − Mod_effect), then Eq. (1),
+            # Herbert et al.: + gloss S + Col_trans ((1 − u) B + u L)
+            I = E_d[p, b] * (D_Tint[b] * (1.0 - m)) + S[p, b] * gloss + B[p, b] * Col_B[b]
+            if use_L:
+                I += L[p, b] * Col_L[b]
+            # Eq. (3), Herbert et al.: + E_effect Mod_effect
+            if use_effect:
+                I += E_effect[p, b] * m
+            out[p, b] = I
+    return out

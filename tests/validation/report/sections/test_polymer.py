@@ -1,0 +1,35 @@
+import pytest
+
+from shrm.polymer.hybrid import MIRROR_FACTORS
+from validation.report.runner import REPORT_SECTIONS, SECTIONS, run_report
+
+
+def test_polymer_section_follows_the_shrm_sections():
+    # the polymer model shades from SHRMs: it comes right after them (the SHRM section and its
+    # full-resolution measurements)
+    names = [s.name for s in SECTIONS]
+    assert names.index("shrm-fullres") == names.index("shrm") + 1
+    assert names.index("polymer") == names.index("shrm-fullres") + 1
+    assert REPORT_SECTIONS.lookup("polymer").title == "Herbert hybrid model"
+
+
+@pytest.mark.slow
+def test_report_polymer_section_quick(tmp_path):
+    results = run_report(tmp_path, quick=True, only=["polymer"], progress=False)
+    section = results["sections"]["polymer"]
+    # Fig. 2: three thicknesses (0.03", 0.06", 0.120"), 11 loads, over black and in transmission
+    assert sorted(section["fig2"]) == ["0.762", "1.524", "3.048"]
+    assert all(len(c["L_transmission"]) == 11 for c in section["fig2"].values())
+    checks = [c for c in results["checks"] if c["section"] == "polymer"]
+    assert len(checks) == 15
+    assert all(c["passed"] for c in checks), [c for c in checks if not c["passed"]]
+    names = ("fig2", "chips", "terms-fresnel", "terms-cosine", "terms-none", "oracle-images")
+    for name in (*names, "oracle-sweeps", "oracle-speed"):
+        assert (tmp_path / "images" / f"polymer-{name}.png").is_file()
+    # Erratum E34: the printed model returns more than a passive surface can at grazing views
+    assert all(v["grazing"] > 1.0 for v in section["uniform_sky"].values())
+    # The hybrid against the layered oracle: every sweep, every M_s, and the speed chart's points
+    oracle = section["oracle"]
+    assert sorted(oracle["sweeps"]) == ["gloss", "thickness_mm", "tio2_pct"]
+    assert sorted(oracle["speed"]["hybrid"]) == sorted(MIRROR_FACTORS.names())
+    assert len(oracle["failures"]) == 3 * len(MIRROR_FACTORS.names())

@@ -1,0 +1,189 @@
+import json
+
+import numpy as np
+import pytest
+
+from reference.errors import SpecrefError
+from validation.report import (
+    Check,
+    ReportContext,
+    ReportSection,
+    SectionData,
+    Table,
+    Text,
+    to_jsonable,
+)
+from validation.report.runner import REPORT_SECTIONS, SECTIONS, run_report
+
+
+def test_report_spectral_section_quick(tmp_path):
+    md = tmp_path / "results.md"
+    results = run_report(
+        tmp_path / "r", quick=True, only=["spectral-core"], markdown=md, progress=False
+    )
+    stored = json.loads((tmp_path / "r" / "results.json").read_text())
+    assert stored == json.loads(json.dumps(results))
+    section = stored["sections"]["spectral-core"]
+    # The published figures are the ones the tests check
+    # (tests/reference/colour/test_colorimetry.py).
+    assert section["380-780/10 FL2 astm_e308"]["mean"] < 0.06
+    assert section["380-780/10 FL2 point"]["mean"] > 3.0
+    html = (tmp_path / "r" / "index.html").read_text()
+    assert "<h2>Spectral core</h2>" in html
+    assert "ColorChecker accuracy" in html
+    image = tmp_path / "r" / "images" / "spectral-core-fl2-patches.png"
+    assert image.stat().st_size > 1000
+    text = md.read_text()
+    assert text.startswith("# specref results")
+    assert "| grid | light | weights |" in text
+
+
+def test_report_refuses_unknown_section_and_bad_bench(tmp_path):
+    with pytest.raises(SpecrefError, match="unknown report section 'spectra'"):
+        run_report(tmp_path, only=["spectra"], progress=False)
+    with pytest.raises(SpecrefError, match=r"missing\.json: file not found"):
+        run_report(tmp_path, only=["spectral-core"], bench_json=tmp_path / "missing.json")
+    bad = tmp_path / "bad.json"
+    bad.write_text("{not json")
+    with pytest.raises(SpecrefError, match="not a pytest-benchmark JSON file"):
+        run_report(tmp_path, only=["spectral-core"], bench_json=bad, progress=False)
+
+
+def test_registered_section_renders_blocks(tmp_path):
+    def compute(ctx):
+        assert ctx.quick
+        return SectionData({"value": np.float64(2.5), "arr": np.arange(2)})
+
+    def present(ctx, data):
+        rows = [["a", 1.23456, float("nan")]]
+        return [
+            Text("hello `code`"),
+            Table(["x", "y", "z"], rows, "T"),
+            ctx.image("img", np.ones((2, 2, 3))),
+        ]
+
+    def checks(data):
+        return [Check("a", "<= 1", 0.5, True), Check("b", "<= 1", 2.0, False)]
+
+    section = ReportSection("test-only", "Test only", compute, present, checks)
+    results = run_report(
+        tmp_path, quick=True, only=["test-only"], progress=False, sections=[section]
+    )
+    section = results["sections"]["test-only"]
+    assert section["value"] == 2.5
+    assert section["arr"] == [0, 1]
+    html = (tmp_path / "index.html").read_text()
+    assert "<code>code</code>" in html
+    assert "<td>1.235</td>" in html
+    assert "<td>—</td>" in html
+    assert (tmp_path / "images" / "test-only-img.png").is_file()
+    assert "1 of 2 targets hold; 1 do not" in html
+    assert [c["passed"] for c in results["checks"]] == [True, False]
+    # The failing target is shown open in its section, the rest folded; all targets at the end.
+    section_html = html[html.index("id='test-only'") : html.index("id='targets'")]
+    assert section_html.index("Targets that do not hold") < section_html.index("<details>")
+    assert html.index("id='summary'") < html.index("id='test-only'") < html.index("id='targets'")
+    # A 2×2 render is shown enlarged without smoothing, its true size in the caption.
+    assert "width='256' height='256' class='pixelated'" in html
+    assert "true size 2×2 px, shown ×128" in html
+    # Provenance: commit, cores and run times, in the page and in results.json.
+    meta = results["meta"]
+    assert {"commit", "cores", "total_seconds", "section_seconds"} <= set(meta)
+    assert set(meta["section_seconds"]) == {"test-only"}
+    assert f"cores: {meta['cores']}" in html
+
+
+def test_bench_groups_filters_by_prefix():
+    ctx = ReportContext(out_dir=".", bench={"benchmarks": [{"group": "raster-a"}, {"group": "sh"}]})
+    assert list(ctx.bench_groups("raster")) == ["raster-a"]
+    assert ReportContext(out_dir=".").bench_groups("x") == {}
+
+
+def test_to_jsonable():
+    value = {"a": (np.int32(1), np.bool_(True)), 2: [np.inf, np.float32(0.5)]}
+    assert to_jsonable(value) == {"a": [1, True], "2": [None, 0.5]}
+
+
+def test_sections_compute_present_check(tmp_path):
+    calls = []
+
+    def compute(ctx):
+        calls.append("compute")
+        return SectionData({"x": np.float64(0.5)}, {"image": np.zeros((2, 2, 3))})
+
+    def present(ctx, data):
+        calls.append("present")
+        assert "image" in data.arrays
+        return [Text(f"x = {data.results['x']}"), ctx.image("img", data.arrays["image"])]
+
+    def checks(data):
+        calls.append("checks")
+        return [Check("x", "<= 1", data.results["x"], data.results["x"] <= 1)]
+
+    section = ReportSection("three-steps", "Three steps", compute, present, checks)
+    results = run_report(tmp_path, quick=True, progress=False, sections=[section])
+    assert calls == ["compute", "present", "checks"]
+    # The presenter's arrays stay out of results.json; the results go in.
+    stored = json.loads((tmp_path / "results.json").read_text())["sections"]["three-steps"]
+    assert stored["x"] == 0.5
+    assert "image" not in stored
+    assert results["checks"][0]["passed"] is True
+
+
+def test_section_registry_is_the_tuple_of_sections():
+    assert REPORT_SECTIONS.names() == [s.name for s in SECTIONS]
+    assert len(set(REPORT_SECTIONS.names())) == len(SECTIONS)
+
+
+def test_summary_shows_headlines_and_hero(tmp_path):
+    from validation.report import Headline
+
+    def present(ctx, data):
+        return [ctx.image("small", np.zeros((4, 8, 3))), ctx.image("hero", np.ones((300, 400, 3)))]
+
+    section = ReportSection(
+        "with-headlines",
+        "With headlines",
+        lambda ctx: SectionData({"speed": 12.8}),
+        present,
+        lambda data: [Check("speed", ">= 10", data.results["speed"], True)],
+        headlines=lambda data: [
+            Headline(f"table {data.results['speed']:.1f}× faster than exact", "paper: ~10×")
+        ],
+        hero="hero",
+    )
+    md = tmp_path / "results.md"
+    run_report(tmp_path / "r", quick=True, progress=False, sections=[section], markdown=md)
+    html = (tmp_path / "r" / "index.html").read_text()
+    summary = html[html.index("id='summary'") : html.index("<nav>")]
+    assert "table 12.8× faster than exact" in summary
+    assert "(paper: ~10×)" in summary
+    assert "images/with-headlines-hero.png" in summary
+    assert "images/with-headlines-small.png" not in summary
+    assert "1 of 1 targets hold" in summary
+    text = md.read_text()
+    assert text.index("## Summary") < text.index("## With headlines") < text.index("## All targets")
+    assert "- table 12.8× faster than exact (paper: ~10×)" in text
+
+
+def test_default_headlines_are_the_first_checks():
+    section = ReportSection(
+        "d",
+        "D",
+        lambda ctx: SectionData({}),
+        lambda ctx, data: [],
+        lambda data: [Check(f"c{i}", "<= 1", 0.5, True) for i in range(3)],
+    )
+    result = section.run(ReportContext(out_dir="."))
+    assert [h.text for h in result.headlines] == ["c0: 0.5", "c1: 0.5"]
+    assert [h.anchor for h in result.headlines] == ["<= 1", "<= 1"]
+
+
+def test_comparison_layout(tmp_path):
+    ctx = ReportContext(out_dir=tmp_path, section="cmp")
+    rng = np.random.default_rng(7)
+    reference = rng.random((16, 16, 3))
+    image = ctx.comparison("a", reference, reference * 1.1, ("brute force", "SHRM"), "caption")
+    assert (tmp_path / image.path).is_file()
+    assert image.width > 3 * 200
+    assert image.height > 150

@@ -1,0 +1,59 @@
+"""The report in a real browser (issue: the report for its readers).
+
+Needs Debian's ``chromium`` and ``chromium-driver`` (``apt install chromium chromium-driver``;
+``.ci/run`` installs them); skipped with that hint where they are missing.
+"""
+
+import shutil
+
+import pytest
+
+from reference.browser import INSTALL_HINT, find_chromium
+from validation.report.browser import check_report_page
+from validation.report.runner import PARTS, SECTIONS, run_report
+
+pytestmark = pytest.mark.skipif(
+    find_chromium() is None or shutil.which("chromedriver") is None, reason=INSTALL_HINT
+)
+
+
+@pytest.fixture(scope="module")
+def quick_report(tmp_path_factory):
+    out = tmp_path_factory.mktemp("report")
+    results = run_report(out, quick=True, progress=False, screenshot=True)
+    return out, results
+
+
+def test_quick_report_reads_in_a_browser(quick_report):
+    out, _results = quick_report
+    page = check_report_page(out / "index.html", width=1280)
+    # Every picture loads, at least 256 CSS pixels wide.
+    assert page["images"], "the report shows no images"
+    broken = [i["src"] for i in page["images"] if not i["complete"] or i["natural"] <= 0]
+    assert broken == []
+    narrow = [(i["src"], i["shown"]) for i in page["images"] if i["shown"] < 256]
+    assert narrow == []
+    # Nothing overflows the page horizontally at 1280 px.
+    assert page["scroll_width"] <= page["client_width"]
+    # The summary is the first content, and every in-page link resolves.
+    assert page["first_content"] == "summary"
+    assert page["broken_links"] == []
+    assert page["links"] >= 2 * len(SECTIONS)
+    # Each part of the summary states figures and links to its sections.
+    html = (out / "index.html").read_text()
+    summary = html[html.index("id='summary'") : html.index("<nav>")]
+    for part in PARTS:
+        block = summary[summary.index(f"id='summary-{part.name}'") :]
+        block = block[: block.index("</div></div>")]
+        assert block.count("<li>") >= 1 + len(part.sections), part.name
+
+
+def test_first_screen_screenshot_is_written(quick_report):
+    from PIL import Image
+
+    out, results = quick_report
+    assert results["meta"]["screenshot"] == "written"
+    with Image.open(out / "first-screen.png") as shot:
+        assert shot.size == (1280, 900)
+        # Not a blank page: the first screen has text and pictures (many distinct colours).
+        assert len(shot.convert("RGB").getcolors(maxcolors=1 << 20) or []) > 50

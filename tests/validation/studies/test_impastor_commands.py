@@ -1,0 +1,198 @@
+"""Tests of validation.studies.impastor_commands and `specref impastor`: inputs, table, render."""
+
+from __future__ import annotations
+
+import json
+import re
+
+import numpy as np
+import pytest
+
+from reference.errors import SpecrefError
+from reference.images.formats import read_png
+from validation.cli import main
+from validation.studies.impastor_commands import format_table1, render_for_cli, table1_for_cli
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"n_channels": 2}, "^--channels: channel count must be >= 3, got 2$"),
+        ({"design": "gauss"}, "^unknown multispectral design 'gauss'; allowed: "),
+        ({"display_file": "/no/such.json"}, "^/no/such.json: file not found"),
+    ],
+)
+def test_table1_for_cli_bad_input(kwargs, match):
+    args = {"design": "optimized", "n_channels": 6, "white_luminance": 200.0}
+    args.update(kwargs)
+    with pytest.raises(SpecrefError, match=match):
+        table1_for_cli(**args)
+
+
+@pytest.mark.parametrize(
+    ("args", "match"),
+    [
+        (("D65", 16, "nearest"), "^unknown lighting method 'nearest'; allowed: fis, hybrid"),
+        (("D65", 0, "median_cut"), r"^--size: must be an integer in \[1, 4096\], got 0$"),
+        (("D65", 5000, "median_cut"), r"^--size: must be an integer in \[1, 4096\], got 5000$"),
+        (("D66", 16, "median_cut"), "unknown illuminant 'D66'"),
+    ],
+)
+def test_render_for_cli_bad_input(args, match, tmp_path):
+    with pytest.raises(SpecrefError, match=match):
+        render_for_cli(*args, tmp_path / "p.png")
+    assert not (tmp_path / "p.png").exists()
+
+
+def test_format_table1_round_trips_the_figures():
+    # Property: every figure of the result appears in its row, to the printed two decimals, and
+    # the out-of-gamut lines name the patches; a light without screen output prints "—".
+    rows = [
+        {
+            "label": "D65 (24)",
+            "simulation": {"mean": 0.123, "std": 0.05, "p90": 0.2, "max": 0.456},
+            "screen": {"mean": 1.5, "std": 0.25, "p90": 2.0, "max": 3.125},
+        },
+        {
+            "label": "A (24)",
+            "simulation": {"mean": 0.3, "std": 0.1, "p90": 0.4, "max": 0.9},
+            "screen": {},
+        },
+    ]
+    result = {
+        "design": "optimized",
+        "n_channels": 6,
+        "rows": rows,
+        "lights": {"D65": {"out_of_gamut": []}, "A": {"out_of_gamut": ["cyan", "blue"]}},
+    }
+    lines = format_table1(result).splitlines()
+    assert len(lines) == 3 + len(rows) + len(result["lights"])
+    assert "6-channel optimized design" in lines[0]
+    for row, line in zip(rows, lines[3:5], strict=True):
+        assert line.startswith(row["label"])
+        numbers = [float(x) for x in re.findall(r"\d+\.\d\d", line[len(row["label"]) :])]
+        expected = [row["simulation"][k] for k in ("mean", "std", "p90", "max")]
+        expected += [row["screen"][k] for k in ("mean", "std", "p90", "max") if row["screen"]]
+        np.testing.assert_allclose(numbers, expected, atol=0.005)
+    assert lines[4].rstrip().endswith("—")
+    assert lines[5] == "out of gamut under D65: 0 (none)"
+    assert lines[6] == "out of gamut under A: 2 (cyan, blue)"
+
+
+def test_cli_table1_writes_json(tmp_path, capsys):
+    out = tmp_path / "t1.json"
+    assert main(["impastor", "table1", "--json", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "Table 1" in text
+    assert "out of gamut under A" in text
+    doc = json.loads(out.read_text())
+    labels = [r["label"] for r in doc["rows"]]
+    assert {"D65 (24)", "D50 (24)", "A (24)"} <= set(labels)
+    assert doc["n_channels"] == 6
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["impastor", "table1", "--channels", "2"], "channel count must be >= 3"),
+        (["impastor", "table1", "--design", "gauss"], "unknown multispectral design"),
+        (["impastor", "table1", "--display", "/no/such.json"], "file not found"),
+        (["impastor", "render", "--method", "nearest"], "unknown lighting method"),
+        (["impastor", "render", "--light", "D66"], "unknown illuminant 'D66'"),
+    ],
+)
+def test_cli_bad_input_exits_2(argv, message, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert message in err
+    assert "Traceback" not in err
+
+
+def test_cli_render(tmp_path, capsys, monkeypatch):
+    out = tmp_path / "p.png"
+    assert (
+        main(["impastor", "render", "--size", "24", "--method", "median_cut", "--out", str(out)])
+        == 0
+    )
+    assert read_png(out).shape[:2] == (24, 24)
+
+
+def _tilted_booth():
+    # The screen tilted 15° (its mirror of an on-axis view turns 30° up) and the booth light 3.5°
+    # off that mirror direction: inside the specular lobe (§3.4.3, Ferwerda: 1.1 % at the
+    # mirror angle, negligible beyond 10°).
+    from reference.display.pipeline import ScreenGeometry
+
+    geometry = ScreenGeometry(tilt=np.radians(15.0))
+    flare = {"screen_lux": 1000.0, "position": (0.0, 0.5, 1.0), "luminance": 2000.0}
+    return geometry, (0.0, 0.0, 0.6), flare
+
+
+def test_specular_flare_is_subtracted():
+    # Issue 16 (g): with the specular flare subtracted, what the observer sees (emission at their
+    # angle plus the diffuse and the specular flare) is the intended painting; compensating the
+    # diffuse flare alone (what the CLI did before) leaves the specular flare on the screen.
+    from reference.display.model import screen_flare_XYZ, virtual_display
+    from reference.display.pipeline import _off_mirror_deg
+    from validation.studies.impastor_commands import painting_on_display
+
+    geometry, eye, flare = _tilted_booth()
+    white = virtual_display().white_XYZ / virtual_display().white_XYZ[1]
+    XYZ = np.random.default_rng(16).uniform(20.0, 60.0, (12, 16, 1)) * white  # grays, cd/m²
+    both = painting_on_display(XYZ, geometry, eye, flare)
+    assert both["in_gamut"].all()
+    assert np.abs(both["seen_XYZ"][..., 1] / XYZ[..., 1] - 1).max() < 5e-3
+    diffuse_only = painting_on_display(XYZ, geometry, eye, {**flare, "luminance": 0.0})
+    mirror = _off_mirror_deg(geometry, eye, flare["position"], 12, 16)
+    specular = screen_flare_XYZ(virtual_display(), np.zeros(3), flare["luminance"] * white, mirror)
+    seen = diffuse_only["seen_XYZ"] + specular  # the light is there all the same
+    assert specular[..., 1].max() > 5.0  # cd/m²: a visible veil
+    assert np.abs(seen[..., 1] / XYZ[..., 1] - 1).max() > 0.1
+    assert (both["counts"] <= diffuse_only["counts"]).all()
+
+
+def test_write_counts_reports_both_flares(tmp_path):
+    from validation.studies.impastor_commands import _write_counts
+
+    geometry, eye, flare = _tilted_booth()
+    XYZ = np.full((8, 8, 3), 40.0)
+    line = _write_counts(XYZ, tmp_path / "c.png", geometry, eye, flare)
+    assert re.search(r"diffuse 0\.64 cd/m², specular up to \d+\.\d\d cd/m²", line)
+    assert read_png(tmp_path / "c.png").shape[:2] == (8, 8)
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "message"),
+    [
+        ("--light-position", "0,0,-1", "--light-position: (0, 0, -1) m must be x,y,z in front"),
+        ("--light-position", "0,1", "--light-position: must be x,y,z in metres, got '0,1'"),
+        ("--light-luminance", "-5", "--light-luminance: must be >= 0 cd/m², got -5.0"),
+    ],
+)
+def test_render_light_bad_input(tmp_path, capsys, option, value, message):
+    argv = ["impastor", "render", "--size", "8", "--out", str(tmp_path / "p.png")]
+    argv += ["--counts", str(tmp_path / "c.png"), option, value]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1
+    assert message in err[0]
+    assert not (tmp_path / "p.png").exists()
+
+
+def test_render_light_options_reach_the_counts(tmp_path, capsys, monkeypatch):
+    # --light-position and --light-luminance change the counts written, through the real CLI
+    # (the painting replaced by a uniform gray, so the test does not render).
+    import impastor.painting
+
+    gray = {"XYZ": np.full((6, 6, 3), 40.0), "sRGB": np.full((6, 6, 3), 0.5), "seconds": {}}
+    monkeypatch.setattr(impastor.painting, "render_painting", lambda *a, **k: gray)
+    counts = {}
+    for luminance in ("0", "2000"):
+        out = tmp_path / f"c{luminance}.png"
+        argv = ["impastor", "render", "--size", "6", "--out", str(tmp_path / "p.png")]
+        argv += ["--counts", str(out), "--tilt", "15", "--light-position", "0,0.5,1.0"]
+        assert main([*argv, "--light-luminance", luminance]) == 0
+        assert "specular up to" in capsys.readouterr().out
+        counts[luminance] = read_png(out)
+    assert (counts["2000"] <= counts["0"]).all()
+    assert (counts["2000"] < counts["0"]).any()

@@ -1,0 +1,244 @@
+"""Report section "Environment SH order from an accuracy": error against order, and renders.
+
+The figures (issue 17 §1; ``shrm.accuracy``, ``validation.studies.env_accuracy``):
+
+- error against order: the relative error of Y of the SH-only frequency path against the
+  brute-force angular oracle (mean and max over lit directions of a Fibonacci set), per order, for
+  every shipped environment and the synthetic worst cases (a single bright texel, a sun disc), for
+  the Lambert and a Phong kernel, with the order the default rule picks (bright texels lit exactly
+  plus SH for the residual) and its measured error;
+- the default render of a Lambertian sphere (ρ = 0.5, the path of ``specref render``) against
+  ``specref render --oracle``, before (order from the kernel's tail alone, tolerance 1e-2) and
+  after issue 17, with the order and exact texels each used.
+
+compute → :func:`sh_order_study`; present → :func:`present`; checks → :func:`checks`.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+
+from reference.data import environment_maps
+from reference.images.formats import read_image, write_exr
+from reference.scene.loader import loads_scene
+from reference.scene.metadata import DEFAULT_ACCURACY, MAX_FACTOR
+from validation.report import Check, ReportContext, ReportSection, SectionData, Table, Text
+from validation.studies.env_accuracy import (
+    SRGB_Y,
+    error_by_order,
+    fibonacci_directions,
+    render_against_oracle,
+    sphere_scene_toml,
+    worst_case_maps,
+)
+
+__all__ = ["SETTINGS", "sh_order_study"]
+
+#: The kernels of the chart: irradiance and a Phong lobe.
+KERNELS = ("lambert", "phong:32")
+#: Orders of the error-against-order chart.
+ORDERS = (2, 4, 8, 14, 24, 32, 48, 64, 96, 128, 192, 256, 384, 511)
+#: The old default: order from the kernel's L2 tail alone (``shrm.lobes.DEFAULT_TOL``).
+OLD_OPTIONS = {"environment_tol": 1e-2}
+
+#: Sizes per mode. ``tiny`` is for tests: worst cases only, small maps.
+SETTINGS = {
+    "full": {"shipped": True, "worst_height": 512, "directions": 1500, "render_size": 24},
+    "quick": {"shipped": True, "worst_height": 256, "directions": 400, "render_size": 10},
+    "tiny": {"shipped": False, "worst_height": 32, "directions": 60, "render_size": 6},
+}
+
+
+def _cases(folder: Path, s: dict) -> dict[str, Path]:
+    """Environment files by name: the shipped maps and the worst cases (written to ``folder``)."""
+    cases = {}
+    if s["shipped"]:
+        for path in environment_maps():
+            if path.suffix.lower() in (".hdr", ".exr"):
+                cases[path.name] = path
+    for name, image in worst_case_maps(s["worst_height"]).items():
+        cases[name] = write_exr(folder / f"{name.replace(' ', '-')}.exr", image)
+    return cases
+
+
+def sh_order_study(ctx: ReportContext, settings: dict | None = None) -> SectionData:
+    """Error against order per map and kernel, and default renders against the oracle.
+
+    Parameters
+    ----------
+    ctx : ReportContext
+        ``ctx.quick`` picks the sizes.
+    settings : dict, optional
+        One of :data:`SETTINGS`.
+
+    Returns
+    -------
+    SectionData
+        ``results``: ``by_order`` (case → kernel → orders, mean, max, chosen) and ``renders``
+        (case → old / new → mean, max, orders).
+
+    Examples
+    --------
+    >>> data = sh_order_study(ReportContext(Path(".")), SETTINGS["tiny"])
+    >>> sorted(data.results["by_order"]), [c.passed for c in checks(data)]
+    (['single texel', 'sun disc'], [True, True, True, True, True, True, True, True])
+    """
+    s = settings or SETTINGS["quick" if ctx.quick else "full"]
+    data = SectionData()
+    directions = fibonacci_directions(s["directions"])
+    by_order, renders = {}, {}
+    with tempfile.TemporaryDirectory() as folder:
+        for name, path in _cases(Path(folder), s).items():
+            Y = read_image(path)[..., :3] @ SRGB_Y
+            by_order[name] = {}
+            for kernel in KERNELS:
+                alone = error_by_order(Y, kernel, ORDERS, directions, split=False)
+                chosen = error_by_order(Y, kernel, (), directions)["chosen"]
+                by_order[name][kernel] = {**alone, "chosen": chosen}
+            scene = loads_scene(sphere_scene_toml(path, size=s["render_size"]))
+            renders[name] = {
+                label: _render_summary(render_against_oracle(scene, options))
+                for label, options in (("old", OLD_OPTIONS), ("new", None))
+            }
+    data.results["by_order"] = by_order
+    data.results["renders"] = renders
+    return data
+
+
+def _render_summary(found: dict) -> dict:
+    (choice,) = found["records"]["environment"].values()
+    return {
+        "mean": found["mean"],
+        "max": found["max"],
+        "order": choice["order"],
+        "exact_texels": choice.get("exact_texels", 0),
+    }
+
+
+def present(ctx: ReportContext, data: SectionData) -> list:
+    """The chart and tables of the section (module docstring); draws from ``data`` only."""
+    renders = data.results["renders"]
+    return [
+        Text(
+            "specref render picks the SH order of environment lighting from a tolerance users "
+            f"read per pixel (--accuracy, default {DEFAULT_ACCURACY:g}): mean relative error of Y "
+            f"over pixels brighter than 1 % of the peak at most the tolerance, max at most "
+            f"{MAX_FACTOR:g}×. Texels carrying ≥ 0.1 % of the power and ≥ 100× the median are lit "
+            "exactly; SH carries the rest at the order the estimate (shrm.accuracy) needs."
+        ),
+        _order_chart(ctx, data.results["by_order"]),
+        Table(
+            ["map", "kernel", "order", "exact texels", "estimated max", "measured mean", "max"],
+            [
+                [
+                    name,
+                    k,
+                    c["order"],
+                    c["exact_texels"],
+                    c["estimate_max"],
+                    c["measured_mean"],
+                    c["measured_max"],
+                ]
+                for name, per in data.results["by_order"].items()
+                for k, c in ((k, v["chosen"]) for k, v in per.items())
+            ],
+            "The default rule per map: order, exact texels and the error of Y at held-out "
+            "directions against brute force",
+            "{:.3g}",
+        ),
+        Table(
+            [
+                "map",
+                "old order",
+                "old mean",
+                "old max",
+                "new order",
+                "exact texels",
+                "new mean",
+                "new max",
+            ],
+            [
+                [
+                    name,
+                    r["old"]["order"],
+                    r["old"]["mean"],
+                    r["old"]["max"],
+                    r["new"]["order"],
+                    r["new"]["exact_texels"],
+                    r["new"]["mean"],
+                    r["new"]["max"],
+                ]
+                for name, r in renders.items()
+            ],
+            "Lambertian sphere (ρ = 0.5), default render against --oracle, relative error of Y "
+            "over lit pixels: before issue 17 (kernel tail 1e-2) and now",
+            "{:.3g}",
+        ),
+    ]
+
+
+def _order_chart(ctx, by_order):
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, len(KERNELS), figsize=(10, 3.6), sharey=True)
+    for ax, kernel in zip(axes, KERNELS, strict=True):
+        for i, (name, per) in enumerate(by_order.items()):
+            curve, colour = per[kernel], f"C{i}"
+            ax.loglog(curve["orders"], curve["max"], color=colour, label=name)
+            ax.loglog(curve["orders"], curve["mean"], color=colour, ls=":", lw=1)
+            chosen = curve["chosen"]
+            ax.plot(max(chosen["order"], 1), chosen["measured_max"], "o", color=colour)
+        ax.axhline(MAX_FACTOR * DEFAULT_ACCURACY, color="k", ls="--", lw=1)
+        ax.axhline(DEFAULT_ACCURACY, color="k", ls=":", lw=1)
+        ax.set_xlabel("order L")
+        ax.set_title(kernel, fontsize=9)
+    axes[0].set_ylabel("relative error of Y (max —, mean ···)")
+    axes[0].legend(fontsize=7)
+    return ctx.figure(
+        "error-vs-order",
+        fig,
+        "Error against order, SH alone; dots: the default rule's order with bright texels lit "
+        "exactly (its max error); dashed: the promised max, dotted: the promised mean",
+    )
+
+
+def checks(data: SectionData) -> list[Check]:
+    """The default render meets the promised bound on every map (issue 17 §1)."""
+    found = []
+    for name, r in data.results["renders"].items():
+        new = r["new"]
+        found.append(
+            Check(
+                f"{name}: default render vs oracle, mean",
+                f"<= {DEFAULT_ACCURACY:g}",
+                new["mean"],
+                new["mean"] <= DEFAULT_ACCURACY,
+            )
+        )
+        found.append(
+            Check(
+                f"{name}: default render vs oracle, max",
+                f"<= {MAX_FACTOR * DEFAULT_ACCURACY:g}",
+                new["max"],
+                new["max"] <= MAX_FACTOR * DEFAULT_ACCURACY,
+            )
+        )
+    for name, per in data.results["by_order"].items():
+        for kernel, curve in per.items():
+            c = curve["chosen"]
+            ok = c["measured_max"] <= MAX_FACTOR * DEFAULT_ACCURACY
+            found.append(
+                Check(
+                    f"{name}, {kernel}: chosen order at held-out directions, max",
+                    f"<= {MAX_FACTOR * DEFAULT_ACCURACY:g}",
+                    c["measured_max"],
+                    ok,
+                )
+            )
+    return found
+
+
+SECTION = ReportSection(
+    "sh-order", "Environment SH order from an accuracy", sh_order_study, present, checks
+)

@@ -1,0 +1,198 @@
+"""Library side of ``specref impastor``: checked inputs and formatted tables."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from impastor.multispectral import MIN_CHANNELS, MULTISPECTRAL_DESIGNS
+from reference.errors import require
+
+__all__ = ["format_table1", "render_for_cli", "table1_for_cli"]
+
+
+def table1_for_cli(
+    design: str, n_channels: int, white_luminance: float, display_file=None, scheduler=None
+):
+    """Validate the CLI's arguments and compute :func:`validation.studies.impastor.table1`.
+
+    Examples
+    --------
+    >>> table1_for_cli("optimized", 2, 200.0)
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: --channels: channel count must be >= 3, got 2
+    """
+    from reference.display.model import load_display_measurements, virtual_display
+    from validation.studies.impastor import table1
+
+    MULTISPECTRAL_DESIGNS.lookup(design)
+    require(
+        n_channels >= MIN_CHANNELS,
+        f"--channels: channel count must be >= {MIN_CHANNELS}, got {n_channels}",
+    )
+    display = load_display_measurements(display_file) if display_file else virtual_display()
+    return table1(design, n_channels, white_luminance, display, scheduler=scheduler)
+
+
+def format_table1(result: dict) -> str:
+    """Table 1 as text: six-channel simulation and screen output, ΔE00 statistics per row.
+
+    Examples
+    --------
+    >>> row = {"label": "D65 (24)", "simulation": dict(mean=0.2, std=0.1, p90=0.3, max=0.4),
+    ...        "screen": dict(mean=0.5, std=0.2, p90=0.8, max=1.0)}
+    >>> print(format_table1({"design": "optimized", "n_channels": 6, "rows": [row],
+    ...                      "lights": {"D65": {"out_of_gamut": []}}}).splitlines()[3])
+    D65 (24)    0.20  0.10  0.30  0.40 |  0.50  0.20  0.80  1.00
+    """
+    lines = [
+        f"Table 1 (Ferwerda 2015): CIEDE2000 against the 5 nm spectral truth, "
+        f"{result['n_channels']}-channel {result['design']} design",
+        f"{'':10} {'six-channel simulation':^24} | {'screen output':^24}",
+        f"{'':10} {'mean':>5} {'std':>5} {'90th':>5} {'max':>5} | "
+        f"{'mean':>5} {'std':>5} {'90th':>5} {'max':>5}",
+    ]
+    for row in result["rows"]:
+        sim, scr = row["simulation"], row["screen"]
+        left = f"{sim['mean']:5.2f} {sim['std']:5.2f} {sim['p90']:5.2f} {sim['max']:5.2f}"
+        right = (
+            f"{scr['mean']:5.2f} {scr['std']:5.2f} {scr['p90']:5.2f} {scr['max']:5.2f}"
+            if scr
+            else "  —"
+        )
+        lines.append(f"{row['label']:10} {left} | {right}")
+    for light, info in result["lights"].items():
+        names = ", ".join(info["out_of_gamut"]) or "none"
+        lines.append(f"out of gamut under {light}: {len(info['out_of_gamut'])} ({names})")
+    return "\n".join(lines)
+
+
+#: The booth light's centre in screen coordinates (m): above and behind an observer at 0.6 m.
+DEFAULT_LIGHT_POSITION = (0.0, 1.2, 0.9)
+
+
+def render_for_cli(
+    light: str,
+    size: int,
+    method: str,
+    out,
+    counts_out=None,
+    observer=(0.0, 0.0, 0.6),
+    tilt_deg: float = 0.0,
+    screen_lux: float = 1000.0,
+    light_position=DEFAULT_LIGHT_POSITION,
+    light_luminance: float | None = None,
+) -> str:
+    """Render the demo painting and write it as a PNG; return a one-line summary.
+
+    With ``counts_out``, the painting's XYZ also goes through the display per pixel (Eq. (1),
+    Ferwerda: ``L_factor`` at the observer's angle from each screen point; the screen's diffuse
+    flare under ``screen_lux`` of the booth light and its specular flare, §3.4.3, Ferwerda: the
+    booth light at ``light_position`` (m, screen coordinates) of ``light_luminance`` cd/m²,
+    default the booth ceiling's mean luminance, mirrored by the screen, subtracted;
+    :mod:`reference.display.pipeline`) and the 11-bit counts are written as a 16-bit PNG.
+
+    Examples
+    --------
+    >>> render_for_cli("D65", 16, "nearest", "x.png")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: unknown lighting method 'nearest'; allowed: fis, hybrid,
+    median_cut, variance_min
+    """
+    from impastor.painting import PAINTING_LIGHTING_METHODS, render_painting
+    from reference.colour.spectra import spectrum_from_dataset
+    from reference.errors import require_positive_int
+    from reference.images.formats import write_png
+
+    PAINTING_LIGHTING_METHODS.lookup(method)
+    size = require_positive_int(size, "--size", 4096)
+    spectrum_from_dataset("illuminant", light)
+    if counts_out is not None:
+        from reference.display.pipeline import ScreenGeometry, screen_view_angles
+        from reference.errors import require_finite
+
+        geometry = ScreenGeometry(tilt=np.radians(tilt_deg))
+        screen_view_angles(geometry, observer, 2, 2)  # an observer behind the screen fails first
+        lamp = require_finite(light_position, "--light-position")
+        require(
+            lamp.shape == (3,) and lamp @ geometry.normal > 0,
+            f"--light-position: ({', '.join(f'{c:g}' for c in np.ravel(lamp))}) m must be x,y,z "
+            "in front of the screen (the side it faces), or it is not mirrored by it",
+        )
+        if light_luminance is None:
+            from impastor.painting import _booth_kind, booth_light_image
+
+            light_luminance = float(booth_light_image(_booth_kind(light)).mean())
+        require(
+            np.isfinite(light_luminance) and light_luminance >= 0,
+            f"--light-luminance: must be >= 0 cd/m², got {light_luminance!r}",
+        )
+    result = render_painting(light, size, method)
+    write_png(out, result["sRGB"])
+    seconds = sum(result["seconds"].values())
+    summary = f"wrote {out} ({size}×{size}, {light}, {method}, shading {seconds:.2f} s)"
+    if counts_out is not None:
+        flare = {"screen_lux": screen_lux, "position": lamp, "luminance": light_luminance}
+        summary += "; " + _write_counts(result["XYZ"], counts_out, geometry, observer, flare)
+    return summary
+
+
+def painting_on_display(XYZ, geometry, observer, flare: dict, compensate: bool = True) -> dict:
+    """The painting through the virtual display per pixel, with the booth light's screen flare.
+
+    Eq. (1), Ferwerda, with the diffuse and specular flare of §3.4.3, Ferwerda
+    (:func:`reference.display.pipeline.image_to_display_counts`): ``flare`` holds
+    ``screen_lux`` (illuminance on the screen), ``position`` (the light's centre, m) and
+    ``luminance`` (cd/m²), the light taken at the display white's chromaticity.
+
+    Examples
+    --------
+    >>> from reference.display.pipeline import ScreenGeometry
+    >>> flare = {"screen_lux": 1000.0, "position": (0.0, 1.2, 0.9), "luminance": 2000.0}
+    >>> out = painting_on_display(np.full((2, 2, 3), 80.0), ScreenGeometry(), (0, 0, 0.6), flare)
+    >>> bool(np.allclose(out["seen_XYZ"], 80.0, rtol=5e-3))
+    True
+    """
+    from reference.display.model import virtual_display
+    from reference.display.pipeline import image_to_display_counts
+
+    display = virtual_display()
+    white = display.white_XYZ / display.white_XYZ[1]
+    return image_to_display_counts(
+        XYZ,
+        display,
+        geometry,
+        observer,
+        E_XYZ=flare["screen_lux"] * white,
+        light_position=flare["position"],
+        light_XYZ=flare["luminance"] * white,
+        compensate=compensate,
+    )
+
+
+def _write_counts(XYZ, path, geometry, observer, flare: dict) -> str:
+    """The painting through the virtual display, per pixel; the counts as a 16-bit PNG."""
+    import imagecodecs
+
+    from reference.display.model import screen_flare_XYZ, virtual_display
+    from reference.display.pipeline import _off_mirror_deg
+    from reference.files import write_bytes_atomic
+
+    out = painting_on_display(XYZ, geometry, observer, flare)
+    write_bytes_atomic(path, imagecodecs.png_encode(out["counts"].astype(np.uint16)))
+    lit = XYZ[..., 1] > 1.0
+    error = np.abs(out["seen_XYZ"][..., 1][lit] / XYZ[..., 1][lit] - 1.0)
+    # §3.4.3, Ferwerda: the specular part of the flare subtracted, at its largest on the screen
+    mirror = _off_mirror_deg(geometry, observer, flare["position"], *XYZ.shape[:2])
+    display = virtual_display()
+    diffuse = screen_flare_XYZ(display, [0.0, flare["screen_lux"], 0.0])[1]
+    specular = screen_flare_XYZ(display, np.zeros(3), [0.0, flare["luminance"], 0.0], mirror)
+    return (
+        f"wrote {path} (11-bit counts; θ up to {np.degrees(out['theta'].max()):.1f}°, "
+        f"flare subtracted: diffuse {diffuse:.2f} cd/m², specular up to "
+        f"{specular[..., 1].max():.2f} cd/m²; "
+        f"{int((~out['in_gamut'] & lit).sum())} of {int(lit.sum())} lit pixels out of gamut, "
+        f"seen Y within "
+        f"{100 * np.median(error):.2f} % of intended, median)"
+    )
