@@ -10,100 +10,21 @@
 
 from __future__ import annotations
 
-from reference.materials.brdf import (
-    BRDF_METHODS,
-    albedo_quadrature,
-    brdf_lambert,
-    brdf_ward_duer,
-    brdf_ward_duer_specular,
-    check_ward_duer_params,
-    frame_from_normal,
-    pdf_cosine,
-    pdf_ward_duer,
-    pdf_ward_duer_lobe,
-    sample_cosine,
-    sample_ward_duer,
-    sample_ward_duer_lobe,
-)
-from reference.materials.fresnel import (
-    FRESNEL_LUT_SIZE,
-    FresnelLUT,
-    fresnel_dielectric,
-    fresnel_diffuse,
-    fresnel_lut,
-)
-from reference.materials.isotropic import (
-    brdf_ggx,
-    brdf_lafortune,
-    brdf_ward_isotropic,
-    ggx_distribution,
-    ggx_smith_G1,
-    isotropic_angles,
-    isotropic_directions,
-    register_brdf,
-)
-from reference.materials.table import (
-    MAX_TABLE_ANGLES,
-    BRDFTable,
-    brdf_tabulated,
-    read_brdf_table,
-    tabulable_brdf_names,
-    tabulate_brdf,
-    tabulate_registered_brdf,
-    write_brdf_table,
-)
-from reference.materials.thinfilm import (
-    airy_reflectance,
-    brdf_effect_pigment,
-)
-from reference.materials.types import (
-    MATERIAL_TYPES,
-    LambertMaterial,
-    MaterialType,
-    PhongMaterial,
-    make_material,
-)
+from reference.materials import brdf, fresnel, isotropic, table, thinfilm, types
+from reference.materials.brdf import *  # noqa: F403
+from reference.materials.fresnel import *  # noqa: F403
+from reference.materials.isotropic import *  # noqa: F403
+from reference.materials.table import *  # noqa: F403
+from reference.materials.thinfilm import *  # noqa: F403
+from reference.materials.types import *  # noqa: F403
 
-__all__ = [
-    "BRDF_METHODS",
-    "FRESNEL_LUT_SIZE",
-    "MATERIAL_TYPES",
-    "MAX_TABLE_ANGLES",
-    "BRDFTable",
-    "FresnelLUT",
-    "LambertMaterial",
-    "MaterialType",
-    "PhongMaterial",
-    "airy_reflectance",
-    "albedo_quadrature",
-    "brdf_effect_pigment",
-    "brdf_ggx",
-    "brdf_lafortune",
-    "brdf_lambert",
-    "brdf_tabulated",
-    "brdf_ward_duer",
-    "brdf_ward_duer_specular",
-    "brdf_ward_isotropic",
-    "check_ward_duer_params",
-    "frame_from_normal",
-    "fresnel_dielectric",
-    "fresnel_diffuse",
-    "fresnel_lut",
-    "ggx_distribution",
-    "ggx_smith_G1",
-    "isotropic_angles",
-    "isotropic_directions",
-    "make_material",
-    "pdf_cosine",
-    "pdf_ward_duer",
-    "pdf_ward_duer_lobe",
-    "read_brdf_table",
-    "register_brdf",
-    "sample_cosine",
-    "sample_ward_duer",
-    "sample_ward_duer_lobe",
-    "tabulable_brdf_names",
-    "tabulate_brdf",
-    "tabulate_registered_brdf",
-    "write_brdf_table",
-]
+__all__ = sorted(
+    {
+        *brdf.__all__,
+        *isotropic.__all__,
+        *table.__all__,
+        *thinfilm.__all__,
+        *fresnel.__all__,
+        *types.__all__,
+    }
+)

@@ -11,162 +11,37 @@
 
 from __future__ import annotations
 
-from reference.scene.colorchecker import (
-    COLORCHECKER_LAYOUT,
-    ColorCheckerMaterial,
-    colorchecker_material,
-    colorchecker_patch_centres_uv,
-    colorchecker_patch_index,
-    colorchecker_patch_pixels,
-    shade_colorchecker_ambient,
-    shade_colorchecker_point,
+from reference.scene import (
+    colorchecker,
+    compare,
+    items,
+    lights,
+    loader,
+    metadata,
+    render,
+    shading,
+    values,
 )
-from reference.scene.compare import (
-    STDERR_CHANNELS,
-    XYZ_to_uv_prime,
-    compare_files,
-    compare_images,
-    exr_to_XYZ,
-    pixel_differences,
-    summary_line,
-)
-from reference.scene.items import (
-    LIGHT_TYPES,
-    OBJECT_TYPES,
-    SceneItemType,
-)
-from reference.scene.lights import (
-    AmbientLight,
-    EnvironmentLight,
-    PointLight,
-    attenuation_Wang,
-    point_light_vectors,
-)
-from reference.scene.loader import (
-    MAX_RENDER_SAMPLES,
-    MAX_SUPERSAMPLE,
-    DisplaySettings,
-    RenderSettings,
-    Scene,
-    check_render_size,
-    load_scene,
-    loads_scene,
-    parse_spectral,
-    scene_from_dict,
-)
-from reference.scene.metadata import (
-    DEFAULT_ACCURACY,
-    LIT_FRACTION,
-    MAX_FACTOR,
-    METADATA_SCHEMA,
-    NORMALISATION,
-    RENDER_OUTPUTS,
-    check_accuracy,
-    exr_attributes,
-    output_channels,
-    output_image,
-    read_exr_metadata,
-    render_metadata,
-)
-from reference.scene.render import (
-    SHADING_TILE_SAMPLES,
-    RenderResult,
-    XYZ_to_display,
-    background_XYZ,
-    check_shaders,
-    render_scene,
-    render_scene_file,
-    scene_gbuffer,
-    shade_scene,
-    write_render,
-)
-from reference.scene.shading import (
-    PHONG_POINT_METHODS,
-    SHADERS,
-    ShadingContext,
-    Surface,
-    phong_cosines,
-    phong_spectral_exact,
-    shade_gbuffer,
-    shader_key,
-    spectral_output_weights,
-    surface_of,
-)
-from reference.scene.values import (
-    SPECTRUM_FORMS,
-    SceneReader,
-    SpectrumForm,
-    SpectrumSpec,
-)
+from reference.scene.colorchecker import *  # noqa: F403
+from reference.scene.compare import *  # noqa: F403
+from reference.scene.items import *  # noqa: F403
+from reference.scene.lights import *  # noqa: F403
+from reference.scene.loader import *  # noqa: F403
+from reference.scene.metadata import *  # noqa: F403
+from reference.scene.render import *  # noqa: F403
+from reference.scene.shading import *  # noqa: F403
+from reference.scene.values import *  # noqa: F403
 
-__all__ = [
-    "COLORCHECKER_LAYOUT",
-    "DEFAULT_ACCURACY",
-    "LIGHT_TYPES",
-    "LIT_FRACTION",
-    "MAX_FACTOR",
-    "MAX_RENDER_SAMPLES",
-    "MAX_SUPERSAMPLE",
-    "METADATA_SCHEMA",
-    "NORMALISATION",
-    "OBJECT_TYPES",
-    "PHONG_POINT_METHODS",
-    "RENDER_OUTPUTS",
-    "SHADERS",
-    "SHADING_TILE_SAMPLES",
-    "SPECTRUM_FORMS",
-    "STDERR_CHANNELS",
-    "AmbientLight",
-    "ColorCheckerMaterial",
-    "DisplaySettings",
-    "EnvironmentLight",
-    "PointLight",
-    "RenderResult",
-    "RenderSettings",
-    "Scene",
-    "SceneItemType",
-    "SceneReader",
-    "ShadingContext",
-    "SpectrumForm",
-    "SpectrumSpec",
-    "Surface",
-    "XYZ_to_display",
-    "XYZ_to_uv_prime",
-    "attenuation_Wang",
-    "background_XYZ",
-    "check_accuracy",
-    "check_render_size",
-    "check_shaders",
-    "colorchecker_material",
-    "colorchecker_patch_centres_uv",
-    "colorchecker_patch_index",
-    "colorchecker_patch_pixels",
-    "compare_files",
-    "compare_images",
-    "exr_attributes",
-    "exr_to_XYZ",
-    "load_scene",
-    "loads_scene",
-    "output_channels",
-    "output_image",
-    "parse_spectral",
-    "phong_cosines",
-    "phong_spectral_exact",
-    "pixel_differences",
-    "point_light_vectors",
-    "read_exr_metadata",
-    "render_metadata",
-    "render_scene",
-    "render_scene_file",
-    "scene_from_dict",
-    "scene_gbuffer",
-    "shade_colorchecker_ambient",
-    "shade_colorchecker_point",
-    "shade_gbuffer",
-    "shade_scene",
-    "shader_key",
-    "spectral_output_weights",
-    "summary_line",
-    "surface_of",
-    "write_render",
-]
+__all__ = sorted(
+    {
+        *lights.__all__,
+        *shading.__all__,
+        *values.__all__,
+        *colorchecker.__all__,
+        *items.__all__,
+        *loader.__all__,
+        *metadata.__all__,
+        *render.__all__,
+        *compare.__all__,
+    }
+)
