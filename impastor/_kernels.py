@@ -8,13 +8,14 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
+
+from reference.jit import njit
 
 # --- specular lighting (impastor.specular_lighting) ------------------------------
 
 
-@numba.njit(cache=False)
+@njit
 def _ward_lobe(wi, wo, n, alpha):
     """Eq. (4), Ferwerda, for ρ_s = 1; 0 below the horizon."""
     cos_i = wi[0] * n[0] + wi[1] * n[1] + wi[2] * n[2]
@@ -29,7 +30,7 @@ def _ward_lobe(wi, wo, n, alpha):
     return math.exp(-tan2_h / (alpha * alpha)) / (4.0 * math.pi * alpha * alpha * cos_i * cos_o)
 
 
-@numba.njit(cache=False)
+@njit
 def _lobe_geometry(x0, x1, x2, P_p, N_p, V_p, n_light, alpha, wi):
     """Eq. (2), Ferwerda, weighted by the lobe: f_s (N·I)(−N_light·I) / d² for a light point x."""
     d0, d1, d2 = x0 - P_p[0], x1 - P_p[1], x2 - P_p[2]
@@ -43,7 +44,7 @@ def _lobe_geometry(x0, x1, x2, P_p, N_p, V_p, n_light, alpha, wi):
     return _ward_lobe(wi, V_p, N_p, alpha) * cos_s * cos_l / dist2
 
 
-@numba.njit(cache=False)
+@njit
 def specular_point_lights_kernel(P, N, V, alpha, light_pos, light_L, n_light, pixel_area, vis, out):
     """Twin of ``specular_point_lights``: Σ_n f_s(I_n, V) L_n (N·I_n)(−N_light·I_n) A/P / d_n²."""
     wi = np.empty(3)
@@ -59,7 +60,7 @@ def specular_point_lights_kernel(P, N, V, alpha, light_pos, light_L, n_light, pi
         out[p] = acc
 
 
-@numba.njit(cache=False)
+@njit
 def _mip_fetch(mips, offsets, heights, widths, level, a, b):
     """Bilinear fetch (texel centres, clamp to edge) of one mip level stored flat."""
     H, W = heights[level], widths[level]
@@ -77,7 +78,7 @@ def _mip_fetch(mips, offsets, heights, widths, level, a, b):
     return top * (1.0 - fy) + bottom * fy
 
 
-@numba.njit(cache=False)
+@njit
 def specular_fis_kernel(
     P, N, V, alpha, u, mips, offsets, heights, widths, origin, A, B, l_A, l_B, pixel_area, bias, out
 ):
@@ -152,7 +153,7 @@ def specular_fis_kernel(
         out[p] = acc / K
 
 
-@numba.njit(cache=False)
+@njit
 def specular_brute_force_kernel(
     P, N, V, alpha, image, origin, A, B, l_A, l_B, n_light, supersample, out
 ):
@@ -183,7 +184,7 @@ def specular_brute_force_kernel(
 # --- horizon maps (impastor.horizon) --------------------------------------------
 
 
-@numba.njit(cache=False)
+@njit
 def _sample_periodic(h, y, x):
     """Bilinear height at fractional pixel coordinates (periodic)."""
     H, W = h.shape
@@ -196,7 +197,7 @@ def _sample_periodic(h, y, x):
     return top * (1.0 - fy) + bottom * fy
 
 
-@numba.njit(cache=False)
+@njit
 def _horizon_along(h, pixel_size, j, i, phi, max_steps, step):
     dx, dy = math.cos(phi), math.sin(phi)
     best = 0.0
@@ -209,7 +210,7 @@ def _horizon_along(h, pixel_size, j, i, phi, max_steps, step):
     return math.atan(best)
 
 
-@numba.njit(cache=False)
+@njit
 def horizon_map_kernel(h, pixel_size, n_sectors, max_steps, step, out):
     """Twin of ``horizon_map``: each sector marched along its centre azimuth."""
     H, W = h.shape
@@ -220,7 +221,7 @@ def horizon_map_kernel(h, pixel_size, n_sectors, max_steps, step, out):
                 out[j, i, s] = _horizon_along(h, pixel_size, j, i, phi, max_steps, step)
 
 
-@numba.njit(cache=False)
+@njit
 def ray_march_shadows_kernel(h, pixel_size, phi, beta, max_steps, step, out):
     """Twin of ``ray_march_shadows``: lit where β exceeds the horizon along the exact azimuth."""
     H, W = h.shape

@@ -30,8 +30,9 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
+
+from reference.jit import njit
 
 #: ``exp(x)`` is below the smallest normal double for ``x`` under this; such terms are skipped,
 #: since a subnormal result takes the C library's slow path and the term is below 2.2e-308 anyway.
@@ -53,7 +54,7 @@ LINEAR, PARABOLIC, PARABOLIC_W, MONOTONE = 0, 1, 2, 3
 W_RESOLUTION = 1e-6
 
 
-@numba.njit(cache=False)
+@njit
 def light_geometry_kernel(position, normal, view, light_position, attenuation, out):
     """``cos θ``, ``t`` and ``f_att`` per pixel, into ``out`` (3, N).
 
@@ -84,7 +85,7 @@ def light_geometry_kernel(position, normal, view, light_position, attenuation, o
     return out
 
 
-@numba.njit(cache=False, inline="always")
+@njit(inline="always")
 def _interval(nodes, guide, steps, uniform, t):
     """Index i of the interval ``[t_i, t_{i+1}]`` holding ``t`` (``searchsorted`` − 1, clipped).
 
@@ -112,7 +113,7 @@ def _interval(nodes, guide, steps, uniform, t):
     return lo
 
 
-@numba.njit(cache=False, inline="always")
+@njit(inline="always")
 def _linear(nodes, values, inv_width, i, t):
     """The chord of interval ``i`` at ``t`` (3 channels)."""
     s = (t - nodes[i]) * inv_width[i]
@@ -123,7 +124,7 @@ def _linear(nodes, values, inv_width, i, t):
     )
 
 
-@numba.njit(cache=False)
+@njit
 def _monotone_records(nodes, values, inv_width, cubic):
     """The monotone cubics of a table, one row of 20 per interval (read by the table kernel).
 
@@ -148,7 +149,7 @@ def _monotone_records(nodes, values, inv_width, cubic):
     return records
 
 
-@numba.njit(cache=False)
+@njit
 def _parabolic_records(nodes, values):
     """The t-parabolas of a table (Wang et al., §5), one row of 10 per stencil node ``j``.
 
@@ -166,7 +167,7 @@ def _parabolic_records(nodes, values):
     return records
 
 
-@numba.njit(cache=False, inline="always")
+@njit(inline="always")
 def _write_parabola(records, j, first, x0, x1, x2, values):
     """Write stencil ``j``'s parabola about ``x1``: ``y_j``, ``B``, ``C`` from column ``first``.
 
@@ -184,7 +185,7 @@ def _write_parabola(records, j, first, x0, x1, x2, values):
         records[j, first + 6 + c] = _flush(C)
 
 
-@numba.njit(cache=False)
+@njit
 def _parabolic_w_records(nodes, values, a):
     """The w-parabolas of a table (``interpolate_parabolic_w``): per stencil and per interval.
 
@@ -217,7 +218,7 @@ def _parabolic_w_records(nodes, values, a):
     return stencils, intervals
 
 
-@numba.njit(cache=False, inline="always")
+@njit(inline="always")
 def _parabolic_w_row(stencils, j):
     """Row ``j`` of :func:`_parabolic_w_records`: abscissa, ln top, in w, ``y``, ``B``, ``C``."""
     return (
@@ -230,7 +231,7 @@ def _parabolic_w_row(stencils, j):
     )
 
 
-@numba.njit(cache=False, inline="always")
+@njit(inline="always")
 def _parabolic_row(records, j):
     """Row ``j`` of :func:`_parabolic_records`: ``t_j`` and the 3-tuples ``y_j``, ``B``, ``C``."""
     return (
@@ -241,13 +242,13 @@ def _parabolic_row(records, j):
     )
 
 
-@numba.njit(cache=False, inline="always")
+@njit(inline="always")
 def _flush(x):
     """``x``, or 0 when ``|x|`` is below :data:`TABLE_FLUSH`."""
     return x if abs(x) >= TABLE_FLUSH else 0.0
 
 
-@numba.njit(cache=False, inline="always")
+@njit(inline="always")
 def _monotone_row(records, i):
     """Row ``i`` of :func:`_monotone_records`: ``1/h``, then 3-tuples ``v_i``, c1, c2, c3, min, max.
 
@@ -264,7 +265,7 @@ def _monotone_row(records, i):
     )
 
 
-@numba.njit(cache=False, inline="always")
+@njit(inline="always")
 def _monotone_channel(v, c1, c2, c3, low, high, s):
     """The Hermite cubic of one channel: ``v_i + s (c1 + s (c2 + s c3))``.
 
@@ -274,7 +275,7 @@ def _monotone_channel(v, c1, c2, c3, low, high, s):
     return min(max(v + s * (c1 + s * (c2 + s * c3)), low), high)
 
 
-@numba.njit(cache=False, inline="always")
+@njit(inline="always")
 def _write(out, p, A, D, f_att, cos_theta, r, g, b):
     """Eq. (7), Wang et al.: ambient + f_att (cos θ · diffuse RGB + specular RGB), pixel ``p``.
 
@@ -286,7 +287,7 @@ def _write(out, p, A, D, f_att, cos_theta, r, g, b):
     out[p, 2] = A[2] + f_att * (cos_theta * D[2] + b)
 
 
-@numba.njit(cache=False)
+@njit
 def shade_exact_kernel(cos_theta, t, f_att, diffuse_RGB, C, n, ambient_RGB, out):
     """Exact spectral Phong shading to linear RGB: one ``ln t`` per pixel, one ``exp`` per band.
 
@@ -324,7 +325,7 @@ def shade_exact_kernel(cos_theta, t, f_att, diffuse_RGB, C, n, ambient_RGB, out)
     return out
 
 
-@numba.njit(cache=False, inline="always")
+@njit(inline="always")
 def _shade_monotone_loop(
     cos_theta,
     t,
@@ -377,7 +378,7 @@ def _shade_monotone_loop(
         _write(out, p, A, D, f_att[p], cos_theta[p], r, g, b)
 
 
-@numba.njit(cache=False, inline="always")
+@njit(inline="always")
 def _shade_parabolic_loop(
     cos_theta,
     t,
@@ -439,7 +440,7 @@ def _shade_parabolic_loop(
         _write(out, p, A, D, f_att[p], cos_theta[p], r, g, b)
 
 
-@numba.njit(cache=False, inline="always")
+@njit(inline="always")
 def _shade_parabolic_w_loop(
     cos_theta,
     t,
@@ -505,7 +506,7 @@ def _shade_parabolic_w_loop(
         _write(out, p, A, D, f_att[p], cos_theta[p], r, g, b)
 
 
-@numba.njit(cache=False, inline="always")
+@njit(inline="always")
 def _shade_linear_loop(
     cos_theta,
     t,
@@ -563,7 +564,7 @@ def _shade_linear_loop(
         _write(out, p, A, D, f_att[p], cos_theta[p], r, g, b)
 
 
-@numba.njit(cache=False)
+@njit
 def shade_table_kernel(
     cos_theta,
     t,
@@ -644,7 +645,7 @@ def shade_table_kernel(
     return out
 
 
-@numba.njit(cache=False, inline="always")
+@njit(inline="always")
 def _pchip_end_slope(h0, h1, m0, m1):
     """One-sided three-point end slope, kept shape-preserving (as SciPy's PCHIP)."""
     d = ((2.0 * h0 + h1) * m0 - h0 * m1) / (h0 + h1)
@@ -655,7 +656,7 @@ def _pchip_end_slope(h0, h1, m0, m1):
     return d
 
 
-@numba.njit(cache=False)
+@njit
 def tabulate_kernel(nodes, C, n, cells_per_entry):
     """Values, slopes, inverse widths, Horner cubics, inverse-map index and bisection steps.
 
@@ -737,7 +738,7 @@ def tabulate_kernel(nodes, C, n, cells_per_entry):
     return values, slopes, inv_width, cubic, guide, steps
 
 
-@numba.njit(cache=False)
+@njit
 def table_error_kernel(t_fine, C, n, entries, floor, p, hedge, grading):
     """Nodes that equidistribute the interpolation error of the true ``f_sp``.
 
@@ -849,7 +850,7 @@ def table_error_kernel(t_fine, C, n, entries, floor, p, hedge, grading):
     return nodes
 
 
-@numba.njit(cache=False)
+@njit
 def _fine_weights_kernel(unit, t_lo, t_hi, r_lo, r_hi, cells):
     """The fine grid on ``[t_lo, t_hi]`` and the pixel density at its midpoints.
 
@@ -888,7 +889,7 @@ def _fine_weights_kernel(unit, t_lo, t_hi, r_lo, r_hi, cells):
     return t_fine, p
 
 
-@numba.njit(cache=False)
+@njit
 def _place_seen_error_kernel(
     unit, t_lo, t_hi, entries, r_lo, r_hi, cells, C, n, floor, hedge, grading
 ):
@@ -927,7 +928,7 @@ def _place_seen_error_kernel(
     return out
 
 
-@numba.njit(cache=False)
+@njit
 def _zero_below_kernel(nodes, values):
     """Twin of ``phong_table.table.zero_below``: ``t_z`` with ``z`` two before the first nonzero."""
     first = nodes.size
@@ -939,7 +940,7 @@ def _zero_below_kernel(nodes, values):
     return nodes[z] if z >= 1 else -1.0
 
 
-@numba.njit(cache=False)
+@njit
 def _finite_nonnegative_kernel(values):
     """Every value finite and >= 0 (the check of ``phong_table.placement.check_density``)."""
     for x in values:  # noqa: SIM110 (a loop numba compiles)
@@ -948,7 +949,7 @@ def _finite_nonnegative_kernel(values):
     return True
 
 
-@numba.njit(cache=False)
+@njit
 def _increasing_kernel(nodes):
     """Twin of ``phong_table.table.increasing``: strictly increasing from 0 to 1."""
     if nodes[0] != 0.0 or nodes[nodes.size - 1] != 1.0:

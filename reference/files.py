@@ -21,6 +21,7 @@ __all__ = [
     "atomic_path",
     "atomic_write",
     "check_output_folder",
+    "default_cache_dir",
     "output_error",
     "read_json",
     "write_bytes_atomic",
@@ -255,3 +256,27 @@ def write_text_atomic(path, text: str) -> Path:
     'é'
     """
     return write_bytes_atomic(path, text.encode("utf-8"))
+
+
+def default_cache_dir() -> Path:
+    """The cache folder: ``$SPECREF_CACHE_DIR``, ``$XDG_CACHE_HOME/specref``, ``~/.cache/specref``.
+
+    Returns
+    -------
+    Path
+        The folder (not created here).
+
+    Examples
+    --------
+    >>> import os
+    >>> os.environ["SPECREF_CACHE_DIR"] = "/tmp/specref-doc-cache"
+    >>> str(default_cache_dir())
+    '/tmp/specref-doc-cache'
+    >>> del os.environ["SPECREF_CACHE_DIR"]
+    """
+    explicit = os.environ.get("SPECREF_CACHE_DIR")
+    if explicit:
+        return Path(explicit).expanduser()
+    xdg = os.environ.get("XDG_CACHE_HOME")
+    base = Path(xdg).expanduser() if xdg and Path(xdg).is_absolute() else Path.home() / ".cache"
+    return base / "specref"

@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
+
+from reference.jit import njit
 
 # Rescaling step of the extended-exponent recurrence: values are kept in [2^-SCALE, 2^SCALE].
 SCALE_BITS = 200
@@ -19,7 +20,7 @@ _SMALL = 2.0**-SCALE_BITS
 _INV_SQRT_4PI = 1.0 / math.sqrt(4.0 * math.pi)
 
 
-@numba.njit(cache=False)
+@njit
 def _sectoral_next(p, e, m, sin_theta, scaled):
     """λ_mm from λ_{m-1,m-1}, as (mantissa, binary exponent); the exponent moves only if scaled."""
     # Sectoral recurrence: λ_mm = -sqrt((2m+1)/(2m)) sin θ λ_{m-1,m-1}
@@ -30,7 +31,7 @@ def _sectoral_next(p, e, m, sin_theta, scaled):
     return p, e
 
 
-@numba.njit(cache=False)
+@njit
 def _point_table(L, sgn, u, sin_theta, A, B, scaled, keep, lam):
     """lam[t(l, m)] = λ_lm(x) for one point, m-major, for the orders with ``keep[m]``.
 
@@ -58,7 +59,7 @@ def _point_table(L, sgn, u, sin_theta, A, B, scaled, keep, lam):
         t0 += L + 1 - m
 
 
-@numba.njit(cache=False)
+@njit
 def legendre_table_kernel(L, sgn, u, sin_theta, A, B, scaled, keep, out):
     """Twin of ``shrm.sh.legendre_table``: out[t(l, m), j] = λ_lm(x_j), m-major layout.
 
@@ -77,7 +78,7 @@ def legendre_table_kernel(L, sgn, u, sin_theta, A, B, scaled, keep, out):
             t0 += L + 1 - m
 
 
-@numba.njit(cache=False)
+@njit
 def legendre_analysis_kernel(L, sgn, u, sin_theta, w, A, B, F_cos, F_sin, scaled, out):
     """Twin of ``shrm.transform.legendre_analysis``: c_lm = Σ_j w_j √2 λ_lm(θ_j) F_m(θ_j).
 
@@ -105,7 +106,7 @@ def legendre_analysis_kernel(L, sgn, u, sin_theta, w, A, B, F_cos, F_sin, scaled
             t0 += L + 1 - m
 
 
-@numba.njit(cache=False)
+@njit
 def legendre_synthesis_kernel(L, sgn, u, sin_theta, A, B, coeffs, scaled, G_cos, G_sin):
     """Twin of ``shrm.transform.legendre_synthesis``: ring Fourier amplitudes of Σ c_lm Y_lm.
 
@@ -131,7 +132,7 @@ def legendre_synthesis_kernel(L, sgn, u, sin_theta, A, B, coeffs, scaled, G_cos,
             t0 += L + 1 - m
 
 
-@numba.njit(cache=False)
+@njit
 def sh_evaluate_kernel(L, sgn, u, sin_theta, phi, A, B, coeffs, scaled, out):
     """Twin of ``shrm.sh.sh_evaluate``: out[n, c] = Σ_lm c_lm Y_lm(θ_n, φ_n) at any directions."""
     C = coeffs.shape[1]
@@ -157,7 +158,7 @@ def sh_evaluate_kernel(L, sgn, u, sin_theta, phi, A, B, coeffs, scaled, out):
             t0 += L + 1 - m
 
 
-@numba.njit(cache=False)
+@njit
 def prefilter_bruteforce_table_kernel(normals, directions, weights, radiance, angles, values, out):
     """Twin of ``shrm.prefilter.prefilter_bruteforce`` for tabulated lobes K(γ).
 
@@ -184,7 +185,7 @@ def prefilter_bruteforce_table_kernel(normals, directions, weights, radiance, an
                 out[k, c] += radiance[p, c] * kern
 
 
-@numba.njit(cache=False)
+@njit
 def prefilter_bruteforce_power_kernel(normals, directions, weights, radiance, s, scale, out):
     """Twin of ``shrm.prefilter.prefilter_bruteforce`` for the power lobes K(t) = scale·max(t, 0)^s.
 

@@ -37,7 +37,7 @@ map reuse." specref's scheme:
 - **Size limit.** After each write the least-recently-used entries are deleted until the folder's
   entries fit in ``max_bytes``; a hit refreshes the entry's modification time, which is the LRU
   clock.
-- **Location.** :func:`default_cache_dir`: ``$SPECREF_CACHE_DIR`` if set, else
+- **Location.** :func:`reference.files.default_cache_dir`: ``$SPECREF_CACHE_DIR`` if set, else
   ``$XDG_CACHE_HOME/specref``, else ``~/.cache/specref``; the CLI's ``--cache-dir`` overrides both.
   ``specref cache info`` and ``specref cache clear`` inspect and empty it.
 
@@ -64,7 +64,7 @@ from pathlib import Path
 import numpy as np
 
 from reference.errors import SpecrefError, SpecrefWarning, require
-from reference.files import atomic_write, output_error
+from reference.files import atomic_write, default_cache_dir, output_error
 
 __all__ = [
     "CACHE_MAGIC",
@@ -89,30 +89,6 @@ _HEAD = len(CACHE_MAGIC) + _PREFIX.size
 #: A leftover temporary file older than this (s) belongs to a writer that died; opening a cache,
 #: ``clear`` and eviction remove it (empty or carrying our magic); younger ones are left alone.
 STALE_TEMP_SECONDS = 3600.0
-
-
-def default_cache_dir() -> Path:
-    """The cache folder: ``$SPECREF_CACHE_DIR``, ``$XDG_CACHE_HOME/specref``, ``~/.cache/specref``.
-
-    Returns
-    -------
-    Path
-        The folder (not created here).
-
-    Examples
-    --------
-    >>> import os
-    >>> os.environ["SPECREF_CACHE_DIR"] = "/tmp/specref-doc-cache"
-    >>> str(default_cache_dir())
-    '/tmp/specref-doc-cache'
-    >>> del os.environ["SPECREF_CACHE_DIR"]
-    """
-    explicit = os.environ.get("SPECREF_CACHE_DIR")
-    if explicit:
-        return Path(explicit).expanduser()
-    xdg = os.environ.get("XDG_CACHE_HOME")
-    base = Path(xdg).expanduser() if xdg and Path(xdg).is_absolute() else Path.home() / ".cache"
-    return base / "specref"
 
 
 def _feed(h, value, where: str) -> None:

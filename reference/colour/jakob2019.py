@@ -32,13 +32,13 @@ References
 from __future__ import annotations
 
 import functools
-import os
 import warnings
 from pathlib import Path
 
 import numpy as np
 
 from reference.errors import SpecrefWarning, require
+from reference.files import default_cache_dir
 
 __all__ = [
     "DEFAULT_TABLE_SIZE",
@@ -226,15 +226,6 @@ def generate_table_Jakob2019(size: int = DEFAULT_TABLE_SIZE) -> tuple[np.ndarray
     return scale, np.ascontiguousarray(coefficients)
 
 
-def _cache_folder() -> Path:
-    """Specref's cache folder, as ``shrm.cache.default_cache_dir`` finds it."""
-    explicit = os.environ.get("SPECREF_CACHE_DIR")
-    if explicit:
-        return Path(explicit)
-    xdg = os.environ.get("XDG_CACHE_HOME")
-    return (Path(xdg) if xdg else Path.home() / ".cache") / "specref"
-
-
 def _write_coeff(path: Path, scale: np.ndarray, coefficients: np.ndarray) -> None:
     """The ``.coeff`` file of rgb2spec, Mitsuba 3 and colour-science, written atomically."""
     import struct
@@ -265,7 +256,7 @@ def table_Jakob2019(size: int = DEFAULT_TABLE_SIZE):
     """
     from colour.recovery import LUT3D_Jakob2019
 
-    path = _cache_folder() / f"jakob2019-sRGB-{int(size)}.coeff"
+    path = default_cache_dir() / f"jakob2019-sRGB-{int(size)}.coeff"
     lut = LUT3D_Jakob2019()
     try:
         return lut.read(path)

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import math
 
-import numba
+from reference.jit import njit
 
 
-@numba.njit(cache=False)
+@njit
 def _face_direction(face, s, t):
     """Direction (unnormalized) of face coordinates (s, t) in [-1, 1] (OpenGL layout)."""
     if face == 0:
@@ -23,7 +23,7 @@ def _face_direction(face, s, t):
     return -s, -t, -1.0
 
 
-@numba.njit(cache=False)
+@njit
 def _direction_face(x, y, z):
     """Face and (s, t) of a direction: the major axis picks the face."""
     ax, ay, az = abs(x), abs(y), abs(z)
@@ -40,7 +40,7 @@ def _direction_face(x, y, z):
     return 5, -x / az, -y / az
 
 
-@numba.njit(cache=False)
+@njit
 def _fetch_index(face, i, j, S):
     """Texel (face, j, i), continuing across face edges by re-projecting the tap direction."""
     if 0 <= i < S and 0 <= j < S:
@@ -52,7 +52,7 @@ def _fetch_index(face, i, j, S):
     return f2, j2, i2
 
 
-@numba.njit(cache=False)
+@njit
 def cubemap_lookup_kernel(cube, directions, out):
     """Twin of ``reference.geometry.cubemap.cubemap_lookup_bilinear``: seamless bilinear taps."""
     S = cube.shape[1]
@@ -75,7 +75,7 @@ def cubemap_lookup_kernel(cube, directions, out):
                     out[n, c] += wgt * cube[f2, j2, i2, c]
 
 
-@numba.njit(cache=False)
+@njit
 def gather_bilinear_kernel(image, taps, weights, texel, out):
     """Twin of ``cubemap.gather_bilinear``: out[texel[j]] = Σ_k w[j, k] image[taps[j, k]].
 

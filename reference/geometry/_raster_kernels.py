@@ -11,8 +11,9 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
+
+from reference.jit import njit
 
 __all__ = ["rasterize_triangles_kernel"]
 
@@ -20,7 +21,7 @@ __all__ = ["rasterize_triangles_kernel"]
 DEGENERATE_RELATIVE_AREA = 1e-12
 
 
-@numba.njit(cache=False)
+@njit
 def rasterize_triangles_kernel(x, y, z, width, height, perspective, cull_backfaces):
     """Rasterize screen-space triangles with a z-buffer (numba twin of ``rasterize_triangles``).
 

@@ -10,13 +10,14 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
+
+from reference.jit import njit
 
 __all__ = ["polymer_shade_parts_kernel", "rough_specular_samples_kernel"]
 
 
-@numba.njit(cache=False)
+@njit
 def _fresnel_dielectric(cos_i, n):
     """Exact unpolarized Fresnel reflectance from air (``reference.materials.fresnel``)."""
     cos_i = min(max(cos_i, 0.0), 1.0)
@@ -28,7 +29,7 @@ def _fresnel_dielectric(cos_i, n):
     return 0.5 * (r_s * r_s + r_p * r_p)
 
 
-@numba.njit(cache=False)
+@njit
 def _latlong_bilinear_add(image, dx, dy, dz, weight, x_out):
     """x_out[b] = weight × bilinear look-up of the lat-long map (``latlong_lookup_bilinear``)."""
     H, W = image.shape[0], image.shape[1]
@@ -51,7 +52,7 @@ def _latlong_bilinear_add(image, dx, dy, dz, weight, x_out):
         x_out[b] = weight * (top * (1 - fy) + bottom * fy)
 
 
-@numba.njit(cache=False)
+@njit
 def rough_specular_samples_kernel(N, V, radiance, alpha, n, u, total, total_sq):
     """Twin of ``shrm.polymer.oracle.rough_specular_samples``: sums of F(o·h) G_1(i) L(i)."""
     nb = radiance.shape[2]
@@ -110,7 +111,7 @@ def rough_specular_samples_kernel(N, V, radiance, alpha, n, u, total, total_sq):
                 total_sq[p, band] += x[band] * x[band]
 
 
-@numba.njit(cache=False)
+@njit
 def polymer_shade_parts_kernel(E_d, S, B, L, E_effect, D_Tint, Col_B, Col_L, gloss, Mod, out):
     """Twin of ``shrm.polymer.material.polymer_shade_parts``: Eq. (1), Herbert et al., one pass.
 

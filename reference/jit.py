@@ -1,0 +1,57 @@
+"""The decorator of specref's numba kernels: compiled once per machine, cached on disk.
+
+Every ``_kernels.py`` decorates its kernels with :func:`njit`, which is ``numba.njit(cache=True)``
+(never ``fastmath``). numba writes each compiled kernel to a cache folder and later processes load
+it instead of compiling again: the first import on a machine pays the compile, every other process,
+test worker and Dask worker of that machine does not.
+
+The folder is ``$NUMBA_CACHE_DIR`` when the user sets it (numba's own setting), else ``numba/``
+below specref's cache root (:func:`reference.files.default_cache_dir`, ``$SPECREF_CACHE_DIR`` or
+``~/.cache/specref``), so an installed package never writes into ``site-packages``.
+
+Why the cache is safe (``tests/reference/test_jit.py`` shows each point):
+
+- numba keys a cached kernel by its source file's modification time and size, its signature and the
+  CPU, so an edited kernel file is compiled again and a different machine never loads it;
+- numba writes cache files to a temporary name and renames them into place, so processes that
+  compile the same kernel at once each find a whole file;
+- a kernel calls only kernels of its own file (no ``_kernels.py`` imports another), so the file's
+  stamp covers every function a cached kernel inlined.
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+from pathlib import Path
+
+import numba
+
+from reference.files import default_cache_dir
+
+__all__ = ["kernel_cache_dir", "njit"]
+
+
+def kernel_cache_dir() -> Path:
+    """The folder where numba caches specref's compiled kernels.
+
+    Examples
+    --------
+    >>> import os
+    >>> os.environ["NUMBA_CACHE_DIR"] = "/tmp/numba-doc-cache"
+    >>> str(kernel_cache_dir())
+    '/tmp/numba-doc-cache'
+    >>> del os.environ["NUMBA_CACHE_DIR"]
+    >>> kernel_cache_dir().name
+    'numba'
+    """
+    explicit = os.environ.get("NUMBA_CACHE_DIR")
+    return Path(explicit).expanduser() if explicit else default_cache_dir() / "numba"
+
+
+# numba reads NUMBA_CACHE_DIR once, when it is first imported; setting its config here, before any
+# kernel is decorated, sends the cache to specref's folder unless the user chose one.
+numba.config.CACHE_DIR = str(kernel_cache_dir())
+
+#: ``numba.njit(cache=True)``: the decorator of every kernel (STYLE.md §6: never ``fastmath``).
+njit = functools.partial(numba.njit, cache=True)
