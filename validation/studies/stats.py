@@ -27,6 +27,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -100,11 +101,13 @@ def _gauss_legendre(edges: np.ndarray, order: int, sub: int) -> tuple[np.ndarray
 
 
 def _directions(cos_theta, phi) -> np.ndarray:
+    """Unit directions ``(..., 3)`` at ``(cos θ, φ)`` about +z."""
     sin_theta = np.sqrt(np.maximum(0.0, 1.0 - cos_theta * cos_theta))
     return np.stack([sin_theta * np.cos(phi), sin_theta * np.sin(phi), cos_theta], axis=-1)
 
 
 def _save_diagnostics(out_dir, name, observed, expected) -> list[Path]:
+    """Write ``chi2_<name>.npz`` and a PNG of expected, observed and their difference."""
     import io
 
     import matplotlib.pyplot as plt
@@ -134,6 +137,147 @@ def _save_diagnostics(out_dir, name, observed, expected) -> list[Path]:
     plt.close(fig)
     write_bytes_atomic(png, buffer.getvalue())
     return [npz, png]
+
+
+class _RefusedError(Exception):
+    """A check before the statistics failed; the message says which."""
+
+
+@dataclass(frozen=True)
+class _Grid:
+    """The histogram grid of one test: the domain and the cell edges in cos θ and in φ."""
+
+    domain: str
+    cos_edges: np.ndarray
+    phi_edges: np.ndarray
+
+    @classmethod
+    def on(cls, domain: str, res: int) -> _Grid:
+        """Check ``domain`` and ``res``; ``res − 1`` cells in cos θ and ``2 (res − 1)`` in φ."""
+        require_choice(domain, DOMAINS, "chi2 domain")
+        require(
+            isinstance(res, int) and res >= 3 and res % 2 == 1,
+            f"chi2_test: res: must be an odd integer >= 3 (cos θ cell edges), got {res!r}",
+        )
+        lo, hi = DOMAINS[domain]
+        n_phi = 2 * (res - 1)
+        return cls(domain, np.linspace(lo, hi, res), np.linspace(0.0, 2.0 * np.pi, n_phi + 1))
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """``(n_theta, n_phi)``: the number of cells in cos θ and in φ."""
+        return self.cos_edges.size - 1, self.phi_edges.size - 1
+
+
+class _Counts(NamedTuple):
+    """Observed and expected counts per cell, and the pdf's mass over the domain."""
+
+    observed: np.ndarray
+    expected: np.ndarray
+    mass: float
+
+
+def _histogram(sample, n_samples: int, seed: int, grid: _Grid) -> tuple[np.ndarray, int]:
+    """Draw and bin the samples: ``(observed, n_valid)``; refuses samples outside the domain."""
+    # Samples: directions, then their cell.
+    u = np.random.default_rng(seed).random((n_samples, 2))
+    d = np.asarray(sample(u), dtype=np.float64)
+    if d.shape != (n_samples, 3):
+        raise _RefusedError(f"sample returned shape {d.shape}, expected {(n_samples, 3)}")
+    valid = np.isfinite(d).all(axis=-1) & (np.linalg.norm(d, axis=-1) > 0.5)
+    d = d[valid]
+    cos_theta = np.clip(d[:, 2] / np.linalg.norm(d, axis=-1), -1.0, 1.0)
+    outside = cos_theta < grid.cos_edges[0] - 1e-9
+    if outside.any():
+        worst = float(cos_theta.min())
+        count = int(outside.sum())
+        raise _RefusedError(f"{count} samples outside the {grid.domain} (cos θ = {worst:.3g})")
+    phi = np.mod(np.arctan2(d[:, 1], d[:, 0]), 2.0 * np.pi)
+    observed, _, _ = np.histogram2d(cos_theta, phi, bins=[grid.cos_edges, grid.phi_edges])
+    return observed, int(valid.sum())
+
+
+def _expected_counts(pdf, n_samples: int, grid: _Grid, quad_order: int, quad_sub: int) -> tuple:
+    """The pdf integrated over each cell, as counts: ``(expected, mass)``.
+
+    Refuses a negative or non-finite pdf, and pdf mass above 1 + 1e-3.
+    """
+    n_theta, n_phi = grid.shape
+    # Composite Gauss–Legendre in cos θ and φ, one row of cos θ cells at a time.
+    c_nodes, c_w = _gauss_legendre(grid.cos_edges, quad_order, quad_sub)
+    p_nodes, p_w = _gauss_legendre(grid.phi_edges, quad_order, quad_sub)
+    expected = np.zeros((n_theta, n_phi))
+    for i in range(n_theta):
+        C, P = np.meshgrid(c_nodes[i], p_nodes.ravel(), indexing="ij")
+        values = np.asarray(pdf(_directions(C.ravel(), P.ravel())), dtype=np.float64)
+        values = values.reshape(C.shape)
+        if not np.isfinite(values).all() or (values < 0).any():
+            raise _RefusedError("the pdf is negative or not finite inside the domain")
+        weighted = (c_w[i][:, None] * values).sum(axis=0).reshape(n_phi, -1)
+        expected[i] = (weighted * p_w).sum(axis=1)
+    mass = float(expected.sum())
+    if mass > 1.0 + 1e-3:
+        raise _RefusedError(f"the pdf integrates to {mass:.6f} > 1 + 1e-3 over the {grid.domain}")
+    expected *= n_samples
+    return expected, mass
+
+
+def _pool_cells(counts: _Counts, n_samples: int, n_valid: int) -> tuple[np.ndarray, np.ndarray]:
+    """Pool the cells expecting fewer than 5 samples into one bin: ``(bins_o, bins_e)``."""
+    # The chi-square approximation needs E >= 5.
+    order = np.argsort(counts.expected.ravel())
+    e_flat, o_flat = counts.expected.ravel()[order], counts.observed.ravel()[order]
+    small = e_flat < 5.0
+    bins_e = list(e_flat[~small])
+    bins_o = list(o_flat[~small])
+    pooled_e, pooled_o = float(e_flat[small].sum()), float(o_flat[small].sum())
+    # Samples the pdf does not account for (mass < 1: invalid samples) join the pooled bin.
+    pooled_e += n_samples * (1.0 - counts.mass) if counts.mass < 1.0 else 0.0
+    pooled_o += float(n_samples - n_valid)
+    if pooled_e > 0.0 or pooled_o > 0.0:
+        if pooled_e < 5.0 and bins_e:
+            bins_e[0] += pooled_e
+            bins_o[0] += pooled_o
+        else:
+            bins_e.append(pooled_e)
+            bins_o.append(pooled_o)
+    return np.asarray(bins_o), np.asarray(bins_e)
+
+
+def _pearson(bins_o: np.ndarray, bins_e: np.ndarray) -> tuple[float, int]:
+    """Pearson's statistic and its degrees of freedom; refuses samples where none are expected."""
+    if (bins_e <= 0).any() and (bins_o[bins_e <= 0] > 0).any():
+        raise _RefusedError("samples fell where the pdf integrates to zero")
+    keep = bins_e > 0
+    statistic = float(((bins_o[keep] - bins_e[keep]) ** 2 / bins_e[keep]).sum())
+    return statistic, int(keep.sum()) - 1
+
+
+def _report(name, out_dir, alpha_test: float, counts: _Counts, statistic: float, dof: int):
+    """The p-value against the Šidák-corrected level; diagnostics saved on failure."""
+    from scipy.stats import chi2
+
+    p_value = float(chi2.sf(statistic, dof))
+    passed = p_value >= alpha_test
+    message = (
+        f"chi2 {name}: p = {p_value:.3g} vs Šidák α = {alpha_test:.3g} "
+        f"(χ² = {statistic:.1f}, dof = {dof}, mass = {counts.mass:.5f})"
+    )
+    files = []
+    if not passed and out_dir is not None:
+        files = _save_diagnostics(out_dir, name, counts.observed, counts.expected)
+        message += "; saved " + ", ".join(str(f) for f in files)
+    return Chi2Result(
+        passed,
+        message,
+        p_value,
+        statistic,
+        alpha_test,
+        dof,
+        counts.observed,
+        counts.expected,
+        files,
+    )
 
 
 def chi2_test(
@@ -203,86 +347,15 @@ def chi2_test(
     >>> result.passed, result.dof
     (True, 127)
     """
-    require_choice(domain, DOMAINS, "chi2 domain")
-    require(
-        isinstance(res, int) and res >= 3 and res % 2 == 1,
-        f"chi2_test: res: must be an odd integer >= 3 (cos θ cell edges), got {res!r}",
-    )
+    grid = _Grid.on(domain, res)
     require(n_samples >= 1000, f"chi2_test: n_samples: must be >= 1000, got {n_samples}")
-    lo, hi = DOMAINS[domain]
-    n_theta, n_phi = res - 1, 2 * (res - 1)
-    cos_edges = np.linspace(lo, hi, res)
-    phi_edges = np.linspace(0.0, 2.0 * np.pi, n_phi + 1)
     alpha_test = sidak_alpha(alpha, n_tests)
-    fail = lambda message: Chi2Result(False, f"chi2 {name}: {message}", alpha=alpha_test)  # noqa: E731
-
-    # Samples: directions, then their cell.
-    u = np.random.default_rng(seed).random((n_samples, 2))
-    d = np.asarray(sample(u), dtype=np.float64)
-    if d.shape != (n_samples, 3):
-        return fail(f"sample returned shape {d.shape}, expected {(n_samples, 3)}")
-    valid = np.isfinite(d).all(axis=-1) & (np.linalg.norm(d, axis=-1) > 0.5)
-    d = d[valid]
-    cos_theta = np.clip(d[:, 2] / np.linalg.norm(d, axis=-1), -1.0, 1.0)
-    if (cos_theta < lo - 1e-9).any():
-        worst = float(cos_theta.min())
-        count = int((cos_theta < lo - 1e-9).sum())
-        return fail(f"{count} samples outside the {domain} (cos θ = {worst:.3g})")
-    phi = np.mod(np.arctan2(d[:, 1], d[:, 0]), 2.0 * np.pi)
-    observed, _, _ = np.histogram2d(cos_theta, phi, bins=[cos_edges, phi_edges])
-
-    # Expected: the pdf integrated over each cell (composite Gauss–Legendre in cos θ and φ).
-    c_nodes, c_w = _gauss_legendre(cos_edges, quad_order, quad_sub)
-    p_nodes, p_w = _gauss_legendre(phi_edges, quad_order, quad_sub)
-    expected = np.zeros((n_theta, n_phi))
-    for i in range(n_theta):
-        C, P = np.meshgrid(c_nodes[i], p_nodes.ravel(), indexing="ij")
-        values = np.asarray(pdf(_directions(C.ravel(), P.ravel())), dtype=np.float64)
-        values = values.reshape(C.shape)
-        if not np.isfinite(values).all() or (values < 0).any():
-            return fail("the pdf is negative or not finite inside the domain")
-        weighted = (c_w[i][:, None] * values).sum(axis=0).reshape(n_phi, -1)
-        expected[i] = (weighted * p_w).sum(axis=1)
-    mass = float(expected.sum())
-    if mass > 1.0 + 1e-3:
-        return fail(f"the pdf integrates to {mass:.6f} > 1 + 1e-3 over the {domain}")
-    expected *= n_samples
-
-    # Pool cells expecting fewer than 5 samples (the chi-square approximation needs E >= 5).
-    order = np.argsort(expected.ravel())
-    e_flat, o_flat = expected.ravel()[order], observed.ravel()[order]
-    small = e_flat < 5.0
-    bins_e = list(e_flat[~small])
-    bins_o = list(o_flat[~small])
-    pooled_e, pooled_o = float(e_flat[small].sum()), float(o_flat[small].sum())
-    # Samples the pdf does not account for (mass < 1: invalid samples) join the pooled bin.
-    pooled_e += n_samples * (1.0 - mass) if mass < 1.0 else 0.0
-    pooled_o += float(n_samples - valid.sum())
-    if pooled_e > 0.0 or pooled_o > 0.0:
-        if pooled_e < 5.0 and bins_e:
-            bins_e[0] += pooled_e
-            bins_o[0] += pooled_o
-        else:
-            bins_e.append(pooled_e)
-            bins_o.append(pooled_o)
-    bins_e, bins_o = np.asarray(bins_e), np.asarray(bins_o)
-    if (bins_e <= 0).any() and (bins_o[bins_e <= 0] > 0).any():
-        return fail("samples fell where the pdf integrates to zero")
-    keep = bins_e > 0
-    statistic = float(((bins_o[keep] - bins_e[keep]) ** 2 / bins_e[keep]).sum())
-    dof = int(keep.sum()) - 1
-    from scipy.stats import chi2
-
-    p_value = float(chi2.sf(statistic, dof))
-    passed = p_value >= alpha_test
-    message = (
-        f"chi2 {name}: p = {p_value:.3g} vs Šidák α = {alpha_test:.3g} "
-        f"(χ² = {statistic:.1f}, dof = {dof}, mass = {mass:.5f})"
-    )
-    files = []
-    if not passed and out_dir is not None:
-        files = _save_diagnostics(out_dir, name, observed, expected)
-        message += "; saved " + ", ".join(str(f) for f in files)
-    return Chi2Result(
-        passed, message, p_value, statistic, alpha_test, dof, observed, expected, files
-    )
+    try:
+        # Check and bin the samples, integrate the pdf over each cell, pool the small cells.
+        observed, n_valid = _histogram(sample, n_samples, seed, grid)
+        expected, mass = _expected_counts(pdf, n_samples, grid, quad_order, quad_sub)
+        counts = _Counts(observed, expected, mass)
+        statistic, dof = _pearson(*_pool_cells(counts, n_samples, n_valid))
+    except _RefusedError as refusal:
+        return Chi2Result(False, f"chi2 {name}: {refusal}", alpha=alpha_test)
+    return _report(name, out_dir, alpha_test, counts, statistic, dof)
