@@ -58,9 +58,11 @@ from __future__ import annotations
 import functools
 import itertools
 import json
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -113,8 +115,8 @@ SPECTRAL_WEIGHT_GRID = (1e2, 1e3, 1e4, 1e5)
 CV_PERCENTILE = 95.0
 #: The augmentation's total weight against the target's patches (0: none), by CV (erratum E44).
 AUGMENT_WEIGHT_GRID = (0.0, 1.0, 2.0, 4.0)
-#: The light a spectral panorama is relit under in issue 15's targets; the colorimetric loss
-#: measures ΔE94 under it beside the capture illuminant.
+#: The light a spectral panorama is relit under in the held-out targets (erratum E44); the
+#: colorimetric loss measures ΔE94 under it beside the capture illuminant.
 RELIT_ILLUMINANT = "A"
 #: Model-file format tag and version (3: ``augmentation``; 2: ``loss`` and ``spectral_weight``;
 #: version 1 files, all fitted with the spectral loss, and version 2 files are still read).
@@ -665,6 +667,16 @@ def fit_regression(
     >>> model.predict([[0.2, 0.5, 0.9]]).round(3)
     array([[0.9, 0.5, 0.2]])
     """
+    RGB, spectra, wavelengths = _check_fit_target(RGB, spectra, wavelengths_nm, ridge)
+    X, scale = _unit_rms_features(RGB, kind, degree)
+    _check_loss_options(loss, spectral_weight, augment, augment_weight)
+    target = _Target(kind, degree, X, scale, spectra, wavelengths, illuminant, loss, augment)
+    grid = _search_grid(target, ridge, spectral_weight, augment_weight)
+    return _fitted_model(target, _choose(target, grid), camera, training_set)
+
+
+def _check_fit_target(RGB, spectra, wavelengths_nm, ridge):
+    """The target's RGB, spectra and wavelengths as float64 arrays, checked; a fixed λ checked."""
     RGB, spectra = _check_target(RGB, spectra)
     wavelengths = np.asarray(wavelengths_nm, dtype=np.float64)
     require(
@@ -676,6 +688,11 @@ def fit_regression(
             np.isfinite(ridge) and 0.0 <= ridge <= MAX_RIDGE,
             f"ridge strength must be in [0, {MAX_RIDGE:g}], got {ridge!r}",
         )
+    return RGB, spectra, wavelengths
+
+
+def _unit_rms_features(RGB, kind: str, degree: int) -> tuple[np.ndarray, np.ndarray]:
+    """The target's features ``X / scale``, columns scaled to unit RMS, and ``scale``."""
     X = features_RGB(RGB, kind, degree)
     require(
         RGB.shape[0] >= CV_FOLDS * 2,
@@ -684,7 +701,11 @@ def fit_regression(
     # Feature columns scaled to unit RMS, so that one λ grid suits every degree
     scale = np.sqrt((X**2).mean(axis=0))
     scale = np.where(scale > 0, scale, 1.0)
-    X = X / scale
+    return X / scale, scale
+
+
+def _check_loss_options(loss: str, spectral_weight, augment, augment_weight) -> None:
+    """Check the loss key, β (colorimetric loss only) and a (with an augmentation only)."""
     REGRESSION_LOSSES.lookup(loss)
     if spectral_weight is not None:
         require(
@@ -696,123 +717,190 @@ def fit_regression(
         or (augment is not None and np.isfinite(augment_weight) and augment_weight >= 0),
         f"augmentation weight (with an augmentation only) must be >= 0, got {augment_weight!r}",
     )
-    if augment is None:
-        weights_grid = (0.0,)
+
+
+@dataclass(frozen=True, eq=False)
+class _Target:
+    """A target as the fit sees it: unit-RMS features, spectra, the loss and the augmentation."""
+
+    kind: str
+    degree: int
+    X: np.ndarray  # (n, k): the features over ``scale``
+    scale: np.ndarray  # (k,)
+    spectra: np.ndarray  # (n, b)
+    wavelengths: np.ndarray  # (b,)
+    illuminant: str
+    loss: str
+    augment: Callable | None
+    # the colorimetric loss's Jacobians (n, 3·lights, b) and the lights' band weights
+    G: np.ndarray | None = field(init=False, default=None)
+    lights: list | None = field(init=False, default=None)
+
+    def __post_init__(self):
+        if self.colorimetric:
+            G, lights = _loss_jacobians(self.spectra, self.wavelengths, self.illuminant)
+            object.__setattr__(self, "G", G)
+            object.__setattr__(self, "lights", lights)
+
+    @property
+    def colorimetric(self) -> bool:
+        """Whether the loss is the colorimetric one (module docstring)."""
+        return self.loss == "colorimetric"
+
+
+class _Grid(NamedTuple):
+    """What cross-validation chooses from: λ, β (colorimetric loss; else None) and a."""
+
+    ridges: tuple
+    betas: tuple | None
+    augment_weights: tuple
+
+    @property
+    def points(self):
+        """The λ of each point (spectral loss), or its (λ, β) (colorimetric loss)."""
+        if self.betas is None:
+            return self.ridges
+        return [(r, w) for r in self.ridges for w in self.betas]
+
+
+class _Choice(NamedTuple):
+    """The chosen λ, β (None for the spectral loss) and a, with the cross-validation's record."""
+
+    ridge: float
+    spectral_weight: float | None
+    augment_weight: float
+    cv: dict | None
+
+
+def _search_grid(target: _Target, ridge, spectral_weight, augment_weight) -> _Grid:
+    """The grid of λ, β and a to cross-validate; a value given is a grid of one."""
+    if target.augment is None:
+        weights = (0.0,)
     else:
-        weights_grid = AUGMENT_WEIGHT_GRID if augment_weight is None else (float(augment_weight),)
-    colorimetric = loss == "colorimetric"
-    if colorimetric:
-        G, lights = _loss_jacobians(spectra, wavelengths, illuminant)
-        ridges = COLORIMETRIC_RIDGE_GRID if ridge is None else (float(ridge),)
-        betas = SPECTRAL_WEIGHT_GRID if spectral_weight is None else (float(spectral_weight),)
-        grid = [(r, w) for r in ridges for w in betas]
-    else:
-        grid = RIDGE_GRID if ridge is None else (float(ridge),)
+        weights = AUGMENT_WEIGHT_GRID if augment_weight is None else (float(augment_weight),)
+    if not target.colorimetric:
+        return _Grid(RIDGE_GRID if ridge is None else (float(ridge),), None, weights)
+    ridges = COLORIMETRIC_RIDGE_GRID if ridge is None else (float(ridge),)
+    betas = SPECTRAL_WEIGHT_GRID if spectral_weight is None else (float(spectral_weight),)
+    return _Grid(ridges, betas, weights)
 
-    def extra_rows(train, held):
-        """Features and spectra of the augmentation made from ``train`` (and its loss terms)."""
-        if augment is None or max(weights_grid) == 0:
-            return None
-        RGB_e, S_e = augment(train, held)
-        RGB_e, S_e = _check_target(RGB_e, S_e)
-        X_e = features_RGB(RGB_e, kind, degree) / scale
-        if not colorimetric:
-            return X_e, S_e, None
-        G_e = _loss_jacobians(S_e, wavelengths, illuminant)[0]
-        return X_e, S_e, _colorimetric_terms(X_e, S_e, G_e)
 
-    def solutions(train, extra, a, grid=grid):
-        """The solutions over ``grid`` on the patches ``train`` plus the extra ones at weight a."""
-        if not (a > 0 and extra is not None and len(extra[0])):
-            if colorimetric:
-                return _colorimetric_solutions(X[train], spectra[train], G[train], grid)
-            return _ridge_solutions(X[train], spectra[train], grid)
-        # E44: the n_e extra patches weigh a·n_t in total against the n_t patches' n_t, the
-        # weights scaled to a mean of 1 over the N = n_t + n_e rows
-        n_t, n_e = len(train), len(extra[0])
-        N = n_t + n_e
-        w_t = N / (n_t * (1.0 + a))
-        w_e = a * n_t / n_e * w_t
-        if colorimetric:
-            own = _colorimetric_terms(X[train], spectra[train], G[train])
-            terms = [w_t * t + w_e * e for t, e in zip(own, extra[2], strict=True)]
-            return _colorimetric_solve(terms, N, spectra.shape[1], grid)
-        root = np.sqrt(np.concatenate([np.full(n_t, w_t), np.full(n_e, w_e)]))[:, None]
-        Xw = np.concatenate([X[train], extra[0]]) * root
-        return _ridge_solutions(Xw, np.concatenate([spectra[train], extra[1]]) * root, grid)
+def _augmentation_rows(target: _Target, train, held):
+    """Features and spectra of the augmentation made from ``train`` (and its loss terms)."""
+    RGB_e, S_e = target.augment(train, held)
+    RGB_e, S_e = _check_target(RGB_e, S_e)
+    X_e = features_RGB(RGB_e, target.kind, target.degree) / target.scale
+    if not target.colorimetric:
+        return X_e, S_e, None
+    G_e = _loss_jacobians(S_e, target.wavelengths, target.illuminant)[0]
+    return X_e, S_e, _colorimetric_terms(X_e, S_e, G_e)
 
+
+def _solutions(target: _Target, train, extra, a, grid):
+    """The solutions over ``grid`` on the patches ``train`` plus the extra ones at weight a."""
+    X, spectra, G = target.X, target.spectra, target.G
+    if not (a > 0 and extra is not None and len(extra[0])):
+        if target.colorimetric:
+            return _colorimetric_solutions(X[train], spectra[train], G[train], grid)
+        return _ridge_solutions(X[train], spectra[train], grid)
+    # E44: the n_e extra patches weigh a·n_t in total against the n_t patches' n_t, the
+    # weights scaled to a mean of 1 over the N = n_t + n_e rows
+    n_t, n_e = len(train), len(extra[0])
+    N = n_t + n_e
+    w_t = N / (n_t * (1.0 + a))
+    w_e = a * n_t / n_e * w_t
+    if target.colorimetric:
+        own = _colorimetric_terms(X[train], spectra[train], G[train])
+        terms = [w_t * t + w_e * e for t, e in zip(own, extra[2], strict=True)]
+        return _colorimetric_solve(terms, N, spectra.shape[1], grid)
+    root = np.sqrt(np.concatenate([np.full(n_t, w_t), np.full(n_e, w_e)]))[:, None]
+    Xw = np.concatenate([X[train], extra[0]]) * root
+    return _ridge_solutions(Xw, np.concatenate([spectra[train], extra[1]]) * root, grid)
+
+
+def _cv_scores(target: _Target, grid: _Grid) -> np.ndarray:
+    """Held-out scores, shape (augmentation weights, points): ΔE94 percentile or spectral RMS."""
+    X, spectra = target.X, target.spectra
+    points, weights = grid.points, grid.augment_weights
     folds = np.array_split(np.random.default_rng(CV_SEED).permutation(len(X)), CV_FOLDS)
-    cv = None
-    if len(grid) * len(weights_grid) > 1:
-        # k-fold cross-validation over augmentation weight × grid; the folds' held-out patches
-        # are the target's own, the augmentation is made from the other folds' (E44)
-        errors = [[[] for _ in grid] for _ in weights_grid]
-        sq = np.zeros((len(weights_grid), len(grid)))
-        for held in folds:
-            train = np.setdiff1d(np.arange(len(X)), held)
-            extra = extra_rows(train, held)
-            for i, a in enumerate(weights_grid):
-                for j, W in enumerate(solutions(train, extra, a)):
-                    P = X[held] @ W
-                    if colorimetric:
-                        # the CV_PERCENTILE-th percentile of held-out ΔE94, both lights
-                        errors[i][j].extend(_delta_E94(spectra[held], P, Wl) for Wl in lights)
-                    else:
-                        sq[i, j] += ((P - spectra[held]) ** 2).sum()
-        if colorimetric:
-            scores = np.array(
-                [[np.percentile(np.concatenate(e), CV_PERCENTILE) for e in row] for row in errors]
-            )
-        else:
-            scores = np.sqrt(sq / spectra.size)  # held-out spectral RMS
-        i, j = np.unravel_index(int(np.argmin(scores)), scores.shape)
-        cv = {"folds": CV_FOLDS, "seed": CV_SEED}
-        if colorimetric:
-            ridge, spectral_weight = grid[j]
-            cv |= {
-                "criterion": f"percentile {CV_PERCENTILE:g} of ΔE94 under "
-                + " and ".join(dict.fromkeys((illuminant, RELIT_ILLUMINANT))),
-                "ridge_grid": list(ridges),
-                "spectral_weight_grid": list(betas),
-                "scores": scores[i].reshape(len(ridges), len(betas)).tolist(),
-            }
-        else:
-            ridge = float(grid[j])
-            cv |= {"grid": list(grid), "rms": scores[i].tolist()}
-        if augment is not None:
-            cv |= {
-                "augment_weight_grid": list(weights_grid),
-                "augment_scores": scores.min(axis=1).tolist(),
-            }
-        a = weights_grid[i]
+    # k-fold cross-validation over augmentation weight × grid; the folds' held-out patches
+    # are the target's own, the augmentation is made from the other folds' (E44)
+    errors = [[[] for _ in points] for _ in weights]
+    sq = np.zeros((len(weights), len(points)))
+    for held in folds:
+        train = np.setdiff1d(np.arange(len(X)), held)
+        augmented = target.augment is not None and max(weights) > 0
+        extra = _augmentation_rows(target, train, held) if augmented else None
+        for i, a in enumerate(weights):
+            for j, W in enumerate(_solutions(target, train, extra, a, points)):
+                P = X[held] @ W
+                if target.colorimetric:
+                    # the CV_PERCENTILE-th percentile of held-out ΔE94, both lights
+                    errors[i][j].extend(_delta_E94(spectra[held], P, Wl) for Wl in target.lights)
+                else:
+                    sq[i, j] += ((P - spectra[held]) ** 2).sum()
+    if target.colorimetric:
+        return np.array(
+            [[np.percentile(np.concatenate(e), CV_PERCENTILE) for e in row] for row in errors]
+        )
+    return np.sqrt(sq / spectra.size)  # held-out spectral RMS
+
+
+def _choose(target: _Target, grid: _Grid) -> _Choice:
+    """λ, β and a: the grid's point of least held-out score, or its only point."""
+    points, weights = grid.points, grid.augment_weights
+    if len(points) * len(weights) == 1:
+        if target.colorimetric:
+            return _Choice(*points[0], weights[0], None)
+        return _Choice(float(points[0]), None, weights[0], None)
+    scores = _cv_scores(target, grid)
+    i, j = np.unravel_index(int(np.argmin(scores)), scores.shape)
+    cv = {"folds": CV_FOLDS, "seed": CV_SEED}
+    if target.colorimetric:
+        ridge, spectral_weight = points[j]
+        cv |= {
+            "criterion": f"percentile {CV_PERCENTILE:g} of ΔE94 under "
+            + " and ".join(dict.fromkeys((target.illuminant, RELIT_ILLUMINANT))),
+            "ridge_grid": list(grid.ridges),
+            "spectral_weight_grid": list(grid.betas),
+            "scores": scores[i].reshape(len(grid.ridges), len(grid.betas)).tolist(),
+        }
     else:
-        a = weights_grid[0]
-        if colorimetric:
-            ridge, spectral_weight = grid[0]
-        else:
-            ridge = float(grid[0])
-    everything = np.arange(len(X))
-    extra = extra_rows(everything, None) if a > 0 else None
-    chosen = [(float(ridge), float(spectral_weight))] if colorimetric else [float(ridge)]
-    (W,) = solutions(everything, extra, a, chosen)
+        ridge, spectral_weight = float(points[j]), None
+        cv |= {"grid": list(points), "rms": scores[i].tolist()}
+    if target.augment is not None:
+        cv |= {
+            "augment_weight_grid": list(weights),
+            "augment_scores": scores.min(axis=1).tolist(),
+        }
+    return _Choice(ridge, spectral_weight, weights[i], cv)
+
+
+def _fitted_model(target: _Target, choice: _Choice, camera, training_set) -> SpectralRegression:
+    """The fit on every patch at the chosen λ, β and a, as a model in RGB's own scale."""
+    ridge, spectral_weight, a, cv = choice
+    everything = np.arange(len(target.X))
+    extra = _augmentation_rows(target, everything, None) if a > 0 else None
+    chosen = [(float(ridge), float(spectral_weight))] if target.colorimetric else [float(ridge)]
+    (W,) = _solutions(target, everything, extra, a, chosen)
     augmentation = None
-    if augment is not None:
+    if target.augment is not None:
         augmentation = {
-            "method": getattr(augment, "name", "custom"),
+            "method": getattr(target.augment, "name", "custom"),
             "weight": float(a),
             "patches": 0 if extra is None else len(extra[0]),
         }
     return SpectralRegression(
-        kind,
-        int(degree),
-        W / scale[:, None],
-        wavelengths,
+        target.kind,
+        int(target.degree),
+        W / target.scale[:, None],
+        target.wavelengths,
         float(ridge),
-        illuminant,
+        target.illuminant,
         camera,
         training_set,
         cv,
-        loss,
+        target.loss,
         None if spectral_weight is None else float(spectral_weight),
         augmentation,
     )
