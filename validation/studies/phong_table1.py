@@ -5,8 +5,8 @@ Rows (:func:`run_table1`, :func:`run_material`) hold the figures of :mod:`valida
 and frame times on the same cached G-buffer) under the keys of the ``specref phong`` JSON:
 ``scene``, ``view``, ``placement``, ``interpolation``, ``entries``, ``segments``, ``rms_display``,
 ``rms_linear``, ``rms``, ``overshoot``, ``build_s``, ``shade_s``, ``exact_shade_s``, ``frame_s``,
-``exact_frame_s``, ``speedup`` and ``frame_speedup``. :func:`table1_targets` checks the issue's
-targets on them.
+``exact_frame_s``, ``speedup`` and ``frame_speedup``. :func:`table1_targets` checks the Table 1
+targets on them (``docs/phong-tables.md``, "Report checks").
 """
 
 from __future__ import annotations
@@ -129,7 +129,104 @@ def _table1_variants(entries: int):
 
 
 def _ratio(a: float, b: float) -> float:
+    """``a / b``, or infinity when ``b`` is not positive."""
     return float(a / b) if b > 0 else float("inf")
+
+
+def _check(target: str, value, limit, passed) -> dict:
+    """One check of :func:`table1_targets`; ``passed`` None is reported, not gated."""
+    passed = None if passed is None else bool(passed)
+    return {"target": target, "value": value, "limit": limit, "pass": passed}
+
+
+def _row_checks(table_rows: list[dict]) -> list[dict]:
+    """The error placement's RMS at 200 entries and its shading speed-up, worst Table 1 row."""
+    checks = []
+    for interpolation, limit in (("monotone", 1e-3), ("parabolic", 1e-3), ("linear", 1e-2)):
+        errs = [
+            r["rms"]
+            for r in table_rows
+            if r["placement"] == "error" and r["interpolation"] == interpolation
+        ]
+        if errs:
+            target = f"error/{interpolation} RMS at 200 entries, worst row"
+            checks.append(_check(target, max(errs), limit, max(errs) <= limit))
+    speed = [
+        r["speedup"]
+        for r in table_rows
+        if r["placement"] == "error" and r["interpolation"] == "monotone"
+    ]
+    if speed:
+        target = "error/monotone shading speed-up (build included), worst row"
+        checks.append(_check(target, min(speed), 10.0, min(speed) >= 10.0))
+    return checks
+
+
+def _ladder_checks(states: dict, tick) -> tuple[list[dict], list[dict]]:
+    """The ``--tolerance 0.05`` picks of each view, and the rows of every table over the ladder.
+
+    Returns the pick checks and the records (rows with ``scene`` and ``view``) for the never-worse
+    and overshoot checks.
+    """
+    checks, records = [], []
+    for (scene, view), state in states.items():
+        for interpolation in ("monotone", "parabolic"):
+            pick = tolerance_search(state, 0.05, interpolation)
+            tick()
+            checks.append(
+                _check(
+                    f"--tolerance 0.05 pick, {scene} {view} {interpolation}",
+                    pick["entries"],
+                    64,
+                    pick["entries"] is not None and pick["entries"] <= 64 and pick["verified"],
+                )
+            )
+        # the error placement against the others, same interpolation, every m of the ladder
+        for m in ENTRY_LADDER:
+            for interpolation in never_worse_interpolations():
+                for variant in table_variants():
+                    segments = variant.segments(m)
+                    row = table_error_row(state, variant.placement, interpolation, m, segments)
+                    records.append({"scene": scene, "view": view, **row})
+            tick()
+    return checks, records
+
+
+def _failure_mode_checks(resolution: int) -> list[dict]:
+    """The paper's failure modes in the far view: n ≡ 2000 overshoot, bimodal 5/500 RMS ratios."""
+    n2000 = view_state(SCENES.lookup("n2000").build(), "far", resolution)
+    row = table_error_row(n2000, "importance", "parabolic", 200, 200)
+    checks = [
+        _check(
+            "n = 2000, importance p = m, t-parabola overshoot at m = 200 (peaks)",
+            row["overshoot"],
+            1.0,
+            row["overshoot"] >= 1.0,
+        )
+    ]
+    bimodal = view_state(SCENES.lookup("bimodal").build(), "far", resolution)
+    for interpolation in ("parabolic", "monotone"):
+        imp = [
+            table_error_row(bimodal, "importance", interpolation, m, m)["rms"] for m in (200, 800)
+        ]
+        err = [table_error_row(bimodal, "error", interpolation, m)["rms"] for m in (200, 800)]
+        # the paper's failure mode is its parabola; the monotone figures are reported (INFO)
+        gate = interpolation == "parabolic"
+        checks += [
+            _check(
+                f"bimodal 5/500, importance p = m, RMS(800)/RMS(200), {interpolation}",
+                _ratio(imp[1], imp[0]),
+                0.5,
+                imp[1] >= 0.5 * imp[0] if gate else None,
+            ),
+            _check(
+                f"bimodal 5/500, error placement RMS(200)/RMS(800), {interpolation}",
+                _ratio(err[0], err[1]),
+                30.0,
+                err[0] >= 30.0 * err[1] if gate else None,
+            ),
+        ]
+    return checks
 
 
 def table1_targets(
@@ -139,7 +236,7 @@ def table1_targets(
     progress=None,
     failure_modes: bool = True,
 ) -> list[dict]:
-    """Check the issue's targets; each check is ``{"target", "value", "limit", "pass"}``.
+    """Check the Table 1 targets; each check is ``{"target", "value", "limit", "pass"}``.
 
     The checks: the error placement's RMS at 200 entries (monotone and parabolic ≤ 1e-3, linear
     ≤ 1e-2) and its shading speed-up (≥ 10×) on every Table 1 row; ``--tolerance 0.05`` picks
@@ -159,108 +256,27 @@ def table1_targets(
     [True, True, True]
     """
     states = states or {}
-    checks = []
-
-    def add(target, value, limit, passed):
-        # passed None: reported, not gated
-        passed = None if passed is None else bool(passed)
-        checks.append({"target": target, "value": value, "limit": limit, "pass": passed})
-
-    def tick():
-        if progress is not None:
-            progress()
-
+    tick = progress if progress is not None else lambda: None
     table_rows = [r for r in rows or [] if r["placement"] != "exact"]
-    for interpolation, limit in (("monotone", 1e-3), ("parabolic", 1e-3), ("linear", 1e-2)):
-        errs = [
-            r["rms"]
-            for r in table_rows
-            if r["placement"] == "error" and r["interpolation"] == interpolation
-        ]
-        if errs:
-            add(
-                f"error/{interpolation} RMS at 200 entries, worst row",
-                max(errs),
-                limit,
-                max(errs) <= limit,
-            )
-    speed = [
-        r["speedup"]
-        for r in table_rows
-        if r["placement"] == "error" and r["interpolation"] == "monotone"
-    ]
-    if speed:
-        add(
-            "error/monotone shading speed-up (build included), worst row",
-            min(speed),
-            10.0,
-            min(speed) >= 10.0,
-        )
-    shoot = [r["overshoot"] for r in table_rows if r["interpolation"] == "monotone"]
-    # never worse, tolerance picks, monotone overshoot over the ladder
-    overshoot_max = max(shoot, default=0.0)
-    records = []
-    for (scene, view), state in states.items():
-        for interpolation in ("monotone", "parabolic"):
-            pick = tolerance_search(state, 0.05, interpolation)
-            tick()
-            add(
-                f"--tolerance 0.05 pick, {scene} {view} {interpolation}",
-                pick["entries"],
-                64,
-                pick["entries"] is not None and pick["entries"] <= 64 and pick["verified"],
-            )
-        # the error placement against the others, same interpolation, every m of the ladder
-        for m in ENTRY_LADDER:
-            for interpolation in never_worse_interpolations():
-                for variant in table_variants():
-                    segments = variant.segments(m)
-                    row = table_error_row(state, variant.placement, interpolation, m, segments)
-                    records.append({"scene": scene, "view": view, **row})
-                    if interpolation == "monotone":
-                        overshoot_max = max(overshoot_max, row["overshoot"])
-            tick()
-    worst_margin, worst_where = _never_worse(records)
+    checks = _row_checks(table_rows)
+    # the tolerance picks and the ladder of every Table 1 view
+    pick_checks, records = _ladder_checks(states, tick)
+    checks += pick_checks
     if states:
-        add(
-            f"error minus best other RMS, worst case ({worst_where})",
-            worst_margin,
-            TIE_8BIT,
-            worst_margin <= TIE_8BIT,
-        )
-    add("monotone overshoot, largest", overshoot_max, 0.0, overshoot_max == 0.0)
-    if not failure_modes:
-        return checks
-    # failure modes, far view
-    n2000 = view_state(SCENES.lookup("n2000").build(), "far", resolution)
-    row = table_error_row(n2000, "importance", "parabolic", 200, 200)
-    add(
-        "n = 2000, importance p = m, t-parabola overshoot at m = 200 (peaks)",
-        row["overshoot"],
-        1.0,
-        row["overshoot"] >= 1.0,
+        worst_margin, worst_where = _never_worse(records)
+        target = f"error minus best other RMS, worst case ({worst_where})"
+        checks.append(_check(target, worst_margin, TIE_8BIT, worst_margin <= TIE_8BIT))
+    # monotone overshoot over the Table 1 rows, then the ladder
+    overshoot_max = max(
+        (r["overshoot"] for r in table_rows if r["interpolation"] == "monotone"), default=0.0
     )
-    bimodal = view_state(SCENES.lookup("bimodal").build(), "far", resolution)
-    for interpolation in ("parabolic", "monotone"):
-        imp = [
-            table_error_row(bimodal, "importance", interpolation, m, m)["rms"] for m in (200, 800)
-        ]
-        err = [table_error_row(bimodal, "error", interpolation, m)["rms"] for m in (200, 800)]
-        # the paper's failure mode is its parabola; the monotone figures are reported (INFO)
-        gate = interpolation == "parabolic"
-        add(
-            f"bimodal 5/500, importance p = m, RMS(800)/RMS(200), {interpolation}",
-            _ratio(imp[1], imp[0]),
-            0.5,
-            imp[1] >= 0.5 * imp[0] if gate else None,
-        )
-        add(
-            f"bimodal 5/500, error placement RMS(200)/RMS(800), {interpolation}",
-            _ratio(err[0], err[1]),
-            30.0,
-            err[0] >= 30.0 * err[1] if gate else None,
-        )
-    tick()
+    for r in records:
+        if r["interpolation"] == "monotone":
+            overshoot_max = max(overshoot_max, r["overshoot"])
+    checks.append(_check("monotone overshoot, largest", overshoot_max, 0.0, overshoot_max == 0.0))
+    if failure_modes:
+        checks += _failure_mode_checks(resolution)
+        tick()
     return checks
 
 
@@ -295,7 +311,7 @@ def _never_worse(records):
 
 
 def target_checks(records, picks, failure, speed, speed_source, scope="") -> list[Check]:
-    """The issue's targets as report checks, from the section's measured figures.
+    """The Table 1 targets as report checks, from the section's measured figures.
 
     Parameters
     ----------
@@ -450,7 +466,7 @@ def run_table1(
     progress: bool = False,
     scheduler: str | None = None,
 ) -> dict:
-    """Table 1 of Wang et al., reproduced and extended, with the issue's target checks.
+    """Table 1 of Wang et al., reproduced and extended, with the checks of :func:`table1_targets`.
 
     Rows: for each scene and view (default: ``validation.studies.phong.table1_scenes`` and every
     view of ``phong_table.scenes.VIEWS``), the exact render (the baseline), then each table variant
