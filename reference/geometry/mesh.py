@@ -22,7 +22,7 @@ References
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -279,10 +279,33 @@ def mesh_from_obj(
     array([[0, 1, 2],
            [0, 2, 3]])
     """
+    name, text = _read_obj_text(path)
+    obj = _ObjContents(current=material)
+    for where, parts in _obj_statements(text, name):
+        keyword = parts[0]
+        if keyword == "usemtl" and groups is not None:
+            obj.current = _obj_group(" ".join(parts[1:]), groups, where)
+        elif keyword in OBJ_IGNORED:
+            continue
+        elif keyword not in _OBJ_READ:
+            raise SpecrefError(
+                f"{where}: unknown statement {keyword!r}; allowed: "
+                f"{', '.join(_OBJ_READ + OBJ_IGNORED)}"
+            )
+        elif keyword == "f":
+            obj.add_face(parts, where)
+        else:
+            obj.add_element(parts, where)
+    require(len(obj.corners) > 0, f"{name}: no faces ('f' statements) found")
+    return obj.mesh(name, material, cull_backfaces, grouped=groups is not None)
+
+
+def _read_obj_text(path) -> tuple[str, str]:
+    """The file's name and text, or a one-line error naming the file."""
     path = Path(path)
     name = str(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        return name, path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise SpecrefError(f"{name}: file not found") from None
     except IsADirectoryError:
@@ -292,105 +315,111 @@ def mesh_from_obj(
     except OSError as error:
         raise SpecrefError(f"{name}: cannot read ({error.strerror})") from None
 
-    positions: list[list[float]] = []
-    texcoords: list[list[float]] = []
-    normals: list[list[float]] = []
-    corners: list[tuple[int, int, int]] = []  # (v, vt, vn), -1 where absent
-    face_materials: list[int] = []  # per triangle, when groups are read
-    current = material
-    has_vt: bool | None = None
-    has_vn: bool | None = None
+
+def _obj_statements(text: str, name: str):
+    """Each statement of an OBJ text as ``(where, words)``, comments and blank lines skipped."""
     lines = text.replace("\\\n", " ").splitlines()
     for number, raw in enumerate(lines, start=1):
         line = raw.split("#", 1)[0].strip()
-        if not line:
-            continue
-        parts = line.split()
+        if line:
+            yield f"{name}: line {number}", line.split()
+
+
+def _obj_group(group: str, groups, where: str) -> int:
+    """The material index of a ``usemtl`` group, or an error naming it and the groups allowed."""
+    if group not in groups:
+        raise SpecrefError(
+            f"{where}: usemtl group {group!r} has no scene material; allowed: "
+            f"{', '.join(sorted(groups)) or 'none defined'}"
+        )
+    return int(groups[group])
+
+
+@dataclass(eq=False)
+class _ObjContents:
+    """What an OBJ file's statements have defined so far: elements, triangle corners, groups."""
+
+    positions: list[list[float]] = field(default_factory=list)
+    texcoords: list[list[float]] = field(default_factory=list)
+    normals: list[list[float]] = field(default_factory=list)
+    corners: list[tuple[int, int, int]] = field(default_factory=list)  # (v, vt, vn), -1: absent
+    face_materials: list[int] = field(default_factory=list)  # per triangle, when groups are read
+    current: int | None = 0  # the material of the faces that follow
+    has_vt: bool | None = None
+    has_vn: bool | None = None
+
+    def add_element(self, parts: list[str], where: str) -> None:
+        """A ``v``, ``vn`` or ``vt`` statement (``vt``'s v flipped to ``1 − v_obj``)."""
         keyword = parts[0]
-        where = f"{name}: line {number}"
-        if keyword == "usemtl" and groups is not None:
-            group = " ".join(parts[1:])
-            if group not in groups:
-                raise SpecrefError(
-                    f"{where}: usemtl group {group!r} has no scene material; allowed: "
-                    f"{', '.join(sorted(groups)) or 'none defined'}"
-                )
-            current = int(groups[group])
-            continue
-        if keyword in OBJ_IGNORED:
-            continue
-        if keyword not in _OBJ_READ:
-            raise SpecrefError(
-                f"{where}: unknown statement {keyword!r}; allowed: "
-                f"{', '.join(_OBJ_READ + OBJ_IGNORED)}"
-            )
         if keyword in ("v", "vn"):
             values = _obj_numbers(parts, where, 3, 7 if keyword == "v" else 3)[:3]
+            elements = self.positions if keyword == "v" else self.normals
             require(
                 all(np.isfinite(values)),
-                f"{where}: {keyword} {len(positions if keyword == 'v' else normals) + 1}: "
-                f"must be finite, got {values}",
+                f"{where}: {keyword} {len(elements) + 1}: must be finite, got {values}",
             )
-            (positions if keyword == "v" else normals).append(values)
-        elif keyword == "vt":
+            elements.append(values)
+        else:
             values = _obj_numbers(parts, where, 1, 3)
             require(all(np.isfinite(values)), f"{where}: vt: must be finite, got {values}")
             u, v_obj = values[0], values[1] if len(values) > 1 else 0.0
-            texcoords.append([u, 1.0 - v_obj])
-        else:
-            require(
-                len(parts) >= 4, f"{where}: face needs at least 3 corners, got {len(parts) - 1}"
-            )
-            face = []
-            for token in parts[1:]:
-                fields = token.split("/")
-                require(
-                    len(fields) <= 3 and fields[0] != "",
-                    f"{where}: face corner {token!r}: expected v, v/vt, v//vn or v/vt/vn",
-                )
-                fields += [""] * (3 - len(fields))
-                v = _obj_index(fields[0], len(positions), "vertex", where)
-                vt = _obj_index(fields[1], len(texcoords), "texture", where) if fields[1] else -1
-                vn = _obj_index(fields[2], len(normals), "normal", where) if fields[2] else -1
-                for kind, present, seen in (("vt", vt >= 0, has_vt), ("vn", vn >= 0, has_vn)):
-                    require(
-                        seen is None or seen == present,
-                        f"{where}: face corner {token!r} "
-                        + ("names" if present else "lacks")
-                        + f" a {kind} index but earlier corners "
-                        + ("do not" if present else "do")
-                        + "; mixed faces are not supported",
-                    )
-                has_vt, has_vn = vt >= 0, vn >= 0
-                face.append((v, vt, vn))
-            # Fan triangulation from the first corner: (0, k, k + 1).
-            require(
-                current is not None,
-                f"{where}: face before any usemtl, and no material for ungrouped faces",
-            )
-            for k in range(1, len(face) - 1):
-                corners.extend((face[0], face[k], face[k + 1]))
-                face_materials.append(current)
-    require(len(corners) > 0, f"{name}: no faces ('f' statements) found")
+            self.texcoords.append([u, 1.0 - v_obj])
 
-    # One mesh vertex per distinct (v, vt, vn) corner.
-    table = np.asarray(corners, dtype=np.int64)
-    unique, inverse = np.unique(table, axis=0, return_inverse=True)
-    faces = inverse.reshape(-1, 3)
-    vertices = np.asarray(positions, dtype=np.float64)[unique[:, 0]]
-    uvs = np.asarray(texcoords, dtype=np.float64)[unique[:, 1]] if has_vt else None
-    vn = np.asarray(normals, dtype=np.float64)[unique[:, 2]] if has_vn else None
-    per_face = None if groups is None else np.asarray(face_materials, dtype=np.int32)
-    return TriangleMesh(
-        vertices,
-        faces,
-        vn,
-        uvs,
-        material or 0,
-        cull_backfaces,
-        source=name,
-        face_materials=per_face,
-    )
+    def add_face(self, parts: list[str], where: str) -> None:
+        """An ``f`` statement, fan-triangulated, its triangles given the current material."""
+        require(len(parts) >= 4, f"{where}: face needs at least 3 corners, got {len(parts) - 1}")
+        face = [self._corner(token, where) for token in parts[1:]]
+        # Fan triangulation from the first corner: (0, k, k + 1).
+        require(
+            self.current is not None,
+            f"{where}: face before any usemtl, and no material for ungrouped faces",
+        )
+        for k in range(1, len(face) - 1):
+            self.corners.extend((face[0], face[k], face[k + 1]))
+            self.face_materials.append(self.current)
+
+    def _corner(self, token: str, where: str) -> tuple[int, int, int]:
+        """A face corner ``v[/vt][/vn]`` as 0-based ``(v, vt, vn)``, -1 where absent."""
+        fields = token.split("/")
+        require(
+            len(fields) <= 3 and fields[0] != "",
+            f"{where}: face corner {token!r}: expected v, v/vt, v//vn or v/vt/vn",
+        )
+        fields += [""] * (3 - len(fields))
+        v = _obj_index(fields[0], len(self.positions), "vertex", where)
+        vt = _obj_index(fields[1], len(self.texcoords), "texture", where) if fields[1] else -1
+        vn = _obj_index(fields[2], len(self.normals), "normal", where) if fields[2] else -1
+        for kind, present, seen in (("vt", vt >= 0, self.has_vt), ("vn", vn >= 0, self.has_vn)):
+            require(
+                seen is None or seen == present,
+                f"{where}: face corner {token!r} "
+                + ("names" if present else "lacks")
+                + f" a {kind} index but earlier corners "
+                + ("do not" if present else "do")
+                + "; mixed faces are not supported",
+            )
+        self.has_vt, self.has_vn = vt >= 0, vn >= 0
+        return v, vt, vn
+
+    def mesh(self, name: str, material, cull_backfaces: bool, grouped: bool) -> TriangleMesh:
+        """The mesh: one vertex per distinct ``(v, vt, vn)`` corner."""
+        table = np.asarray(self.corners, dtype=np.int64)
+        unique, inverse = np.unique(table, axis=0, return_inverse=True)
+        faces = inverse.reshape(-1, 3)
+        vertices = np.asarray(self.positions, dtype=np.float64)[unique[:, 0]]
+        uvs = np.asarray(self.texcoords, dtype=np.float64)[unique[:, 1]] if self.has_vt else None
+        vn = np.asarray(self.normals, dtype=np.float64)[unique[:, 2]] if self.has_vn else None
+        per_face = np.asarray(self.face_materials, dtype=np.int32) if grouped else None
+        return TriangleMesh(
+            vertices,
+            faces,
+            vn,
+            uvs,
+            material or 0,
+            cull_backfaces,
+            source=name,
+            face_materials=per_face,
+        )
 
 
 def mesh_to_obj(mesh: TriangleMesh, path) -> Path:
@@ -495,6 +524,20 @@ def uv_sphere_mesh(
         f"uv_sphere_mesh: radius: must be > 0, got {radius}",
     )
     c = np.asarray(center, dtype=np.float64)
+    d, uv = _sphere_directions_uvs(n_theta, n_phi)
+    faces = _sphere_faces(n_theta, n_phi)
+    return TriangleMesh(
+        c + radius * d.reshape(-1, 3),
+        faces,
+        normals=d.reshape(-1, 3),
+        uvs=uv.reshape(-1, 2),
+        material=material,
+        source="uv_sphere_mesh",
+    )
+
+
+def _sphere_directions_uvs(n_theta: int, n_phi: int) -> tuple[np.ndarray, np.ndarray]:
+    """Unit directions ``(n_theta + 1, n_phi + 1, 3)`` and uvs of the sphere's vertex grid."""
     j = np.arange(n_theta + 1)[:, None]
     i = np.arange(n_phi + 1)[None, :]
     theta = np.pi * j / n_theta
@@ -512,20 +555,17 @@ def uv_sphere_mesh(
     u[0] = (i[0] + 0.5) / n_phi
     u[-1] = (i[0] - 0.5) / n_phi
     uv = np.stack([u, np.broadcast_to(j / n_theta, u.shape)], axis=-1)
+    return d, uv
+
+
+def _sphere_faces(n_theta: int, n_phi: int) -> np.ndarray:
+    """The sphere's triangles over its vertex grid, outward-facing; none degenerate at the poles."""
     index = np.arange((n_theta + 1) * (n_phi + 1)).reshape(n_theta + 1, n_phi + 1)
     a, b = index[:-1, :-1], index[:-1, 1:]  # row j: columns i, i + 1
     c_, d_ = index[1:, :-1], index[1:, 1:]  # row j + 1
     upper = np.stack([a, b, d_], axis=-1)[1:]  # (j, i), (j, i+1), (j+1, i+1); none at the +y pole
     lower = np.stack([a, d_, c_], axis=-1)[:-1]  # (j, i), (j+1, i+1), (j+1, i); none at the −y pole
-    faces = np.concatenate([upper.reshape(-1, 3), lower.reshape(-1, 3)])
-    return TriangleMesh(
-        c + radius * d.reshape(-1, 3),
-        faces,
-        normals=d.reshape(-1, 3),
-        uvs=uv.reshape(-1, 2),
-        material=material,
-        source="uv_sphere_mesh",
-    )
+    return np.concatenate([upper.reshape(-1, 3), lower.reshape(-1, 3)])
 
 
 def grid_mesh(plane: Plane, n_u: int = 1, n_v: int = 1) -> TriangleMesh:
