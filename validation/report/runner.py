@@ -211,10 +211,32 @@ def run_report(
     >>> round(results["sections"]["spectral-core"]["380-780/10 FL2 point"]["mean"], 1)
     4.0
     """
-    import matplotlib
-
     out_dir = Path(out_dir)
-    sections = list(SECTIONS if sections is None else sections)
+    sections = _chosen_sections(list(SECTIONS if sections is None else sections), only)
+    bench = _read_bench(bench_json)
+    address = scheduler_address(scheduler, default=SERIAL)
+    meta = _meta(quick, bench_json, address)
+    # Run the sections, timed.
+    started = time.perf_counter()
+    done = _run_sections(sections, out_dir, quick, bench, progress and not _quiet(), address)
+    meta["total_seconds"] = round(time.perf_counter() - started, 1)
+    meta["section_seconds"] = {s.name: round(r.seconds, 1) for s, r in done}
+    # Write the page, the figures and, on request, the Markdown and the first screen.
+    results = _results(meta, done)
+    parts = _parts(done, sections)
+    write_text_atomic(out_dir / "index.html", render_html("specref report", meta, done, parts))
+    _write_results(out_dir, results)
+    if markdown is not None:
+        text = render_markdown("specref results", meta, done, markdown_image_prefix, parts)
+        write_text_atomic(markdown, text)
+    if screenshot:
+        results["meta"]["screenshot"] = _first_screen(out_dir)
+        _write_results(out_dir, results)
+    return results
+
+
+def _chosen_sections(sections: list, only: list[str] | None) -> list:
+    """The sections named in ``only`` (all when it is empty); an unknown key is refused."""
     if only:
         known = Registry("report section")
         for section in sections:
@@ -222,11 +244,21 @@ def run_report(
         for name in only:
             known.lookup(name)
         sections = [s for s in sections if s.name in only]
-    bench = None
-    if bench_json is not None:
-        bench = read_json(bench_json, "pytest-benchmark JSON file")
-        require(isinstance(bench, dict), f"{bench_json}: not a pytest-benchmark JSON file")
-    meta = {
+    return sections
+
+
+def _read_bench(bench_json) -> dict | None:
+    """The pytest-benchmark JSON of ``make bench``, or None when no file is given."""
+    if bench_json is None:
+        return None
+    bench = read_json(bench_json, "pytest-benchmark JSON file")
+    require(isinstance(bench, dict), f"{bench_json}: not a pytest-benchmark JSON file")
+    return bench
+
+
+def _meta(quick: bool, bench_json, address: str | None) -> dict:
+    """The run's description: commit, date, mode, machine, benchmark file and scheduler."""
+    return {
         "commit": _commit(),
         "date": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M UTC"),
         "mode": "quick" if quick else "full",
@@ -234,52 +266,59 @@ def run_report(
         "python": platform.python_version(),
         "machine": platform.machine(),
         "benchmarks": str(bench_json) if bench_json else "none (run make bench)",
+        "scheduler": "serial" if address == SERIAL else (address or "local cluster"),
     }
-    address = scheduler_address(scheduler, default=SERIAL)
-    meta["scheduler"] = "serial" if address == SERIAL else (address or "local cluster")
-    started = time.perf_counter()
-    with matplotlib.rc_context(CHART_STYLE), contextlib.ExitStack() as stack:
-        client = None if address == SERIAL else stack.enter_context(dask_client(address or LOCAL))
-        show = progress and not _quiet()
-        done = _run_sections(sections, out_dir, quick, bench, show, client)
-    meta["total_seconds"] = round(time.perf_counter() - started, 1)
-    meta["section_seconds"] = {s.name: round(r.seconds, 1) for s, r in done}
+
+
+def _results(meta: dict, done: list) -> dict:
+    """The content of ``results.json``: ``meta``, every section's checks and figures."""
     results: dict = {"meta": meta, "checks": [], "sections": {}}
     for section, result in done:
         results["sections"][section.name] = to_jsonable(result.results)
         for c in result.checks:
             results["checks"].append(to_jsonable({"section": section.name, **c.__dict__}))
-    parts = [p.only(s.name for s, _ in done) for p in PARTS]
-    parts = [p for p in parts if p.sections] or [ReportPart("all", "", "", tuple(sections))]
-    title = "specref report"
-    write_text_atomic(out_dir / "index.html", render_html(title, meta, done, parts))
-    write_text_atomic(out_dir / "results.json", json.dumps(results, indent=1, sort_keys=False))
-    if markdown is not None:
-        text = render_markdown("specref results", meta, done, markdown_image_prefix, parts)
-        write_text_atomic(markdown, text)
-    if screenshot:
-        from validation.report.browser import screenshot_first_screen
-
-        shot = screenshot_first_screen(out_dir / "index.html", out_dir / "first-screen.png")
-        results["meta"]["screenshot"] = shot
-        write_text_atomic(out_dir / "results.json", json.dumps(results, indent=1, sort_keys=False))
     return results
 
 
-def _run_sections(sections, out_dir, quick, bench, progress, client=None) -> list:
-    """Run each section under its own progress bar; returns ``[(section, result), ...]``."""
+def _parts(done: list, sections: list) -> list[ReportPart]:
+    """The parts with the sections that ran; one untitled part when they belong to none."""
+    parts = [p.only(s.name for s, _ in done) for p in PARTS]
+    return [p for p in parts if p.sections] or [ReportPart("all", "", "", tuple(sections))]
+
+
+def _first_screen(out_dir: Path) -> str:
+    """Write ``first-screen.png`` of ``index.html``; returns the outcome for ``results.json``."""
+    from validation.report.browser import screenshot_first_screen
+
+    return screenshot_first_screen(out_dir / "index.html", out_dir / "first-screen.png")
+
+
+def _write_results(out_dir: Path, results: dict) -> None:
+    """Write ``results.json`` atomically."""
+    write_text_atomic(out_dir / "results.json", json.dumps(results, indent=1, sort_keys=False))
+
+
+def _run_sections(sections, out_dir, quick, bench, progress, address) -> list:
+    """Run each section under its own progress bar; returns ``[(section, result), ...]``.
+
+    The sections draw in :data:`CHART_STYLE` and run their tasks on one Dask client at
+    ``address`` (a local cluster for None), or serially for ``reference.tasks.SERIAL``.
+    """
+    import matplotlib
     from tqdm import tqdm
 
     done: list[tuple[ReportSection, SectionResult]] = []
     width = max((len(s.title) for s in sections), default=0)
-    for i, section in enumerate(sections, 1):
-        desc = f"[{i}/{len(sections)}] {section.title:<{width}}"
-        with tqdm(total=1, desc=desc, file=sys.stderr, disable=not progress, leave=True) as bar:
-            ctx = ReportContext(out_dir, quick, bench, section.name, client)
-            start = time.perf_counter()
-            result = section.run(ctx)
-            result.seconds = time.perf_counter() - start
-            result.results.setdefault("section_seconds", result.seconds)
-            bar.update(1)
-        done.append((section, result))
+    with matplotlib.rc_context(CHART_STYLE), contextlib.ExitStack() as stack:
+        client = None if address == SERIAL else stack.enter_context(dask_client(address or LOCAL))
+        for i, section in enumerate(sections, 1):
+            desc = f"[{i}/{len(sections)}] {section.title:<{width}}"
+            with tqdm(total=1, desc=desc, file=sys.stderr, disable=not progress, leave=True) as bar:
+                ctx = ReportContext(out_dir, quick, bench, section.name, client)
+                start = time.perf_counter()
+                result = section.run(ctx)
+                result.seconds = time.perf_counter() - start
+                result.results.setdefault("section_seconds", result.seconds)
+                bar.update(1)
+            done.append((section, result))
     return done
