@@ -6,7 +6,7 @@ depends on the kernel's tail *and* on the environment: by Parseval its mean squa
 is ``Σ_{l>L} Λ_l² C_l / 4π`` with ``C_l = Σ_m L_lm²`` the map's power in degree l, and a map whose
 energy sits in a few bright texels keeps its power to high degrees. The kernel's tail alone
 (:func:`shrm.lobes.adaptive_order`) ignores that and picks order 14 for the irradiance under
-``studio_small_03_1k.hdr``, 29 % off at some pixels (issue 17).
+``studio_small_03_1k.hdr``, 29 % off at some pixels (erratum E75).
 
 :func:`accuracy_order` measures the truncation error itself, in frequency space, on the luminance
 Y of the map: it projects Y to the map's band limit ``L_max = min(W/2 − 1, 511)``, scales by Λ_l,

@@ -52,6 +52,9 @@ References
 
 from __future__ import annotations
 
+import functools
+from typing import NamedTuple
+
 import numpy as np
 
 from reference.errors import require, require_choice
@@ -370,7 +373,29 @@ def brdf_sh_coefficients(
     view_fit = default_view_fit(frame, view_fit)
     require(isinstance(F, int) and F >= 0, f"SHRM: F: must be an integer >= 0, got {F!r}")
     require(isinstance(P, int) and P >= 0, f"SHRM: P: must be an integer >= 0, got {P!r}")
-    M = min(F, P)
+    nodes = _projection_nodes(F, P, quadrature, n_phi, view_fit, view_power)
+    rho_tilde = functools.partial(
+        transfer_function, brdf, params, frame=frame, view_power=view_power
+    )
+    rho, b = _project_transfer(rho_tilde, nodes, F, P, fit=view_fit == "hemisphere")
+    if view_fit == "sphere":
+        return rho
+    return _fit_hemisphere(rho, b, view_power, quadrature, ridge)
+
+
+class _Nodes(NamedTuple):
+    """The quadrature of R&H 2002's triple integral: θ_i, θ_o and Δφ with their weights."""
+
+    theta_i: np.ndarray  # lighting polar angles
+    w_i: np.ndarray  # weights of dcos θ_i
+    theta_o: np.ndarray  # view polar angles
+    w_o: np.ndarray  # weights of dcos θ_o
+    w_fit: np.ndarray  # the hemisphere fit's weights, w(x) dcos θ_o
+    phi: np.ndarray  # Δφ, trapezoid nodes
+
+
+def _projection_nodes(F, P, quadrature, n_phi, view_fit, view_power) -> _Nodes:
+    """θ_i panels clustered at the pole plus ``max(8, F/2)`` uniform ones; θ_o; Δφ uniform."""
     near = 0.01 * 2.0 ** np.arange(8)
     theta_i, w_i = _panels_gauss(
         np.clip(np.concatenate([np.linspace(0, np.pi, max(8, F // 2) + 1), near]), 0, np.pi),
@@ -380,6 +405,18 @@ def brdf_sh_coefficients(
     # The panels are in θ; dcos θ = sin θ dθ
     w_i = w_i * np.sin(theta_i)
     phi = 2.0 * np.pi * np.arange(n_phi) / n_phi
+    return _Nodes(theta_i, w_i, theta_o, w_o, w_fit, phi)
+
+
+def _project_transfer(rho_tilde, nodes: _Nodes, F: int, P: int, fit: bool):
+    """R&H 2002's isotropic BRDF coefficients by quadrature, view by view.
+
+    Returns ``rho`` (C, F+1, P+1, M+1) and, with ``fit``, the same moments weighted by the
+    hemisphere fit's weights (``b`` of its normal equations; otherwise zeros).
+    """
+    theta_i, w_i, theta_o, w_o, w_fit, phi = nodes
+    n_phi = phi.size
+    M = min(F, P)
     lam_i, lam_o = _lambda_blocks(F, theta_i), _lambda_blocks(P, theta_o)
     cos_m_phi = np.cos(np.arange(M + 1)[:, None] * phi[None, :]) * (2.0 * np.pi / n_phi)
     s_i, s_o = np.sin(theta_i), np.sin(theta_o)
@@ -396,7 +433,7 @@ def brdf_sh_coefficients(
             axis=-1,
         )
         wo_b = np.broadcast_to(wo_a, wi_dir.shape)
-        values = transfer_function(brdf, params, wi_dir, wo_b, frame, view_power)
+        values = rho_tilde(wi_dir, wo_b)
         if rho is None:
             rho = np.zeros((values.shape[-1], F + 1, P + 1, M + 1))
             b = np.zeros_like(rho)
@@ -406,19 +443,24 @@ def brdf_sh_coefficients(
             # 2π ∫ λ_lm(θ_i) λ_pm(θ_o) · moment
             part = 2.0 * np.pi * (lam_i[m] @ moments[m]).T[:, :, None] * lam_o[m][None, None, :, a]
             rho[:, m:, m:, m] += part * w_o[a]  # (C, F+1-m, P+1-m)
-            if view_fit == "hemisphere":
+            if fit:
                 b[:, m:, m:, m] += part * w_fit[a]
-    if view_fit == "hemisphere":
-        mu = VIEW_FIT_RIDGE if ridge is None else float(ridge)
-        for m in range(M + 1):
-            # The sphere projection of the even continuation: the moments over the seen views
-            # twice for p − m even, none for p − m odd (λ_pm(−x) = (−1)^{p−m} λ_pm(x))
-            prior = rho[:, :, m:, m] * (1.0 + (-1.0) ** np.arange(P + 1 - m))
-            # The normal equations (G_m + μ I) ρ = b + μ ρ_sphere (module docstring)
-            rhs = b[:, :, m:, m] + mu * prior
-            G = hemisphere_gram(P, m, view_power, quadrature, mu)
-            sol = np.linalg.solve(G, rhs.reshape(-1, P + 1 - m).T).T
-            rho[:, :, m:, m] = sol.reshape(rhs.shape)
+    return rho, b
+
+
+def _fit_hemisphere(rho, b, view_power: float, quadrature: int, ridge: float | None):
+    """The hemisphere view fit: ``(G_m + μ I) ρ = b + μ ρ_sphere`` for every m (in place)."""
+    P, M = rho.shape[2] - 1, rho.shape[3] - 1
+    mu = VIEW_FIT_RIDGE if ridge is None else float(ridge)
+    for m in range(M + 1):
+        # The sphere projection of the even continuation: the moments over the seen views
+        # twice for p − m even, none for p − m odd (λ_pm(−x) = (−1)^{p−m} λ_pm(x))
+        prior = rho[:, :, m:, m] * (1.0 + (-1.0) ** np.arange(P + 1 - m))
+        # The normal equations (G_m + μ I) ρ = b + μ ρ_sphere (module docstring)
+        rhs = b[:, :, m:, m] + mu * prior
+        G = hemisphere_gram(P, m, view_power, quadrature, mu)
+        sol = np.linalg.solve(G, rhs.reshape(-1, P + 1 - m).T).T
+        rho[:, :, m:, m] = sol.reshape(rhs.shape)
     return rho
 
 

@@ -1,7 +1,7 @@
 """An importance-sampled Monte Carlo estimator of environment reflection, for comparison.
 
 Not Herbert et al.'s method: the speed–accuracy study of the report (section "SHRMs on
-full-resolution maps", issue 21) sets the SHRM and the SH + angular split beside the estimator a
+full-resolution maps") sets the SHRM and the SH + angular split beside the estimator a
 path tracer would use at the same time per frame. :func:`environment_mc` estimates exactly the
 sum that the brute-force oracle :func:`shrm.split.angular_sum` computes over every texel of a
 map: ``S = Σ_k f(ω_k, v, n) max(n·ω_k, 0) L_k w_k``. It draws M texels per point with

@@ -310,6 +310,26 @@ def orbit_camera(frame: int, frames: int, radius: float = 5.0, elevation_deg: fl
     )
 
 
+def _demo_environment(environment_path, env_height: int, n_bands: int) -> np.ndarray:
+    """The map box-filtered to ``env_height`` rows, its luminance on every band (equal energy)."""
+    from pathlib import Path
+
+    from reference.data import data_path
+    from reference.geometry.camera import downsample_box
+    from reference.images.formats import read_image
+
+    default = data_path("environments/venice_sunset_1k.hdr")
+    path = Path(environment_path) if environment_path else default
+    require(path.is_file(), f"{path}: environment file not found (--env)")
+    image = read_image(path)
+    H, W = image.shape[:2]
+    require(W == 2 * H, f"{path}: a lat-long map must be 2:1 (width = 2 × height), got {W}×{H}")
+    factor = max(1, image.shape[0] // env_height)
+    image = downsample_box(image[: factor * env_height, : factor * 2 * env_height], factor)
+    luminance = image @ np.array([0.2126, 0.7152, 0.0722])
+    return np.repeat(luminance[..., None], n_bands, axis=-1)
+
+
 def demo_state(
     environment_path=None,
     env_height: int = 64,
@@ -354,28 +374,12 @@ def demo_state(
     >>> state["environment"].shape, sorted(state["dynamic"])
     ((16, 32, 16), ['k_d', 'k_e', 'k_s'])
     """
-    from pathlib import Path
-
-    from reference.colour.spectra import SpectralGrid, spectrum_from_dataset
-    from reference.data import data_path
-    from reference.geometry.camera import downsample_box
+    from reference.colour.spectra import SpectralGrid, resample_spectrum, spectrum_from_dataset
     from reference.geometry.shapes import Sphere
-    from reference.images.formats import read_image
 
     grid = grid or SpectralGrid(400.0, 700.0, 20.0)
-    default = data_path("environments/venice_sunset_1k.hdr")
-    path = Path(environment_path) if environment_path else default
-    require(path.is_file(), f"{path}: environment file not found (--env)")
-    image = read_image(path)
-    H, W = image.shape[:2]
-    require(W == 2 * H, f"{path}: a lat-long map must be 2:1 (width = 2 × height), got {W}×{H}")
-    factor = max(1, image.shape[0] // env_height)
-    image = downsample_box(image[: factor * env_height, : factor * 2 * env_height], factor)
-    luminance = image @ np.array([0.2126, 0.7152, 0.0722])
-    environment = np.repeat(luminance[..., None], grid.n_bands, axis=-1)
+    environment = _demo_environment(environment_path, env_height, grid.n_bands)
     illuminant = spectrum_from_dataset("illuminant", "D65")
-    from reference.colour.spectra import resample_spectrum
-
     D65 = np.asarray(resample_spectrum(illuminant, grid), dtype=np.float64)
     params = brdf_params_on_grid(brdf, grid)
     return {

@@ -207,9 +207,8 @@ def shrm_create(
     """Create a SHRM in frequency space from lighting and BRDF coefficients.
 
     R&H 2002, the SHRM coefficients: ``B^loc_pq(n) = Σ_l ρ_{lp|q|} [D(R_nᵀ) L]_lq``, rotated to
-    world axes,
-    evaluated on a Fejér-1 grid (an FFT over φ per row), projected onto SH of degree F + P and
-    synthesized at the cube-map texels (module docstring).
+    world axes, evaluated on a Fejér-1 grid (an FFT over φ per row), projected onto SH of degree
+    F + P and synthesized at the cube-map texels (module docstring).
 
     Parameters
     ----------
@@ -258,11 +257,36 @@ def shrm_create(
     W = 2 * H
     theta = latlong_ring_angles(H)
     phi = 2.0 * np.pi * (np.arange(W) + 0.5) / W
+    # B_pq(n) on a Fejér-1 grid of 2(F+P)+2 rows: each texel's frame, then world axes
+    A_cos, A_sin = _local_row_terms(L, rho, theta)
+    B_world = _rotate_to_world(A_cos, A_sin, theta, phi)  # (H, W, C, (P+1)²)
+    # B_pq(n) is band-limited to F + P: project exactly (Fejér-1), synthesize at the texels
+    from reference.geometry.cubemap import cubemap_texel_directions
+
+    grid = B_world.reshape(H, W, C * P1 * P1)
+    coeffs_n = project_latlong(grid, K, backend=backend, where="SHRM")
+    texels = cubemap_texel_directions(size)
+    values = sh_evaluate(coeffs_n, texels, backend=backend)
+    coeffs = values.reshape(6, size, size, C, P1 * P1)
+    irradiance = None
+    if lambert is not None:
+        lambert = np.broadcast_to(np.asarray(lambert, dtype=np.float64), (C,)).copy()
+        irradiance = _irradiance_cube(env_coeffs, texels, backend)
+    return SHRM(coeffs, frame, F, P, float(view_power), lambert, irradiance)
+
+
+def _local_row_terms(L, rho, theta) -> tuple[np.ndarray, np.ndarray]:
+    """The texels' local ``B^loc_pq`` per grid row θ_j, as cosine and sine Fourier terms in φ.
+
+    Both terms have shape (H, C, P+1, 2P+1, F+1): row, channel, p, q + P, m'.
+    """
+    C, F1, P1, _ = rho.shape
+    H = theta.size
     # D(R_nᵀ) L = D(Qᵀ) Y(θ) D(Q) Y(φ) L. The part per row, M_j = D(Qᵀ) Y(θ_j) D(Q), meets
     # Y(φ) L = Σ_m' cos(m'φ) L^c_m' + sin(m'φ) L^s_m' (polar_rotate): per row two sets of Fourier
     # terms are contracted with ρ, and the φ dependence is a sum over m' for every column.
-    blocks = _quarter_turn_blocks(F)
-    qmax = P
+    blocks = _quarter_turn_blocks(F1 - 1)
+    qmax = P1 - 1
     A_cos = np.zeros((H, C, P1, 2 * qmax + 1, F1))
     A_sin = np.zeros((H, C, P1, 2 * qmax + 1, F1))
     for l in range(F1):
@@ -295,6 +319,13 @@ def shrm_create(
         r = rho[:, l][:, :, np.abs(qs)]  # (C, P+1, nq)
         A_cos[:, :, :, qs + qmax, : l + 1] += r[None, ..., None] * u[:, :, None]
         A_sin[:, :, :, qs + qmax, : l + 1] += r[None, ..., None] * v[:, :, None]
+    return A_cos, A_sin
+
+
+def _rotate_to_world(A_cos, A_sin, theta, phi) -> np.ndarray:
+    """``B_pq(n) = [D(R_n) B^loc(n)]_pq`` in world axes on the Fejér-1 grid, (H, W, C, (P+1)²)."""
+    F1 = A_cos.shape[-1]
+    P = qmax = A_cos.shape[2] - 1
     cos_phi = np.cos(np.arange(F1)[None, :] * phi[:, None])  # (W, F+1)
     sin_phi = np.sin(np.arange(F1)[None, :] * phi[:, None])
     # The view coefficients (p, q) in specref's layout: A (H, C, F+1, (P+1)²)
@@ -309,26 +340,7 @@ def shrm_create(
     # Σ_m' cos(m'φ_k) A_cos + sin(m'φ_k) A_sin, then Y(−φ_k) per column k
     B_world = np.moveaxis(A[0] @ cos_phi.T + A[1] @ sin_phi.T, -1, 1)  # (H, W, C, (P+1)²)
     B_world = _polar_rotate_each(B_world, -phi[None, :, None, None], P)
-    # B_pq(n) is band-limited to F + P: project exactly (Fejér-1), synthesize at the texels
-    from reference.geometry.cubemap import cubemap_texel_directions
-
-    grid = B_world.reshape(H, W, C * P1 * P1)
-    coeffs_n = project_latlong(grid, K, backend=backend, where="SHRM")
-    texels = cubemap_texel_directions(size)
-    values = sh_evaluate(coeffs_n, texels, backend=backend)
-    irradiance = None
-    if lambert is not None:
-        lambert = np.broadcast_to(np.asarray(lambert, dtype=np.float64), (C,)).copy()
-        irradiance = _irradiance_cube(env_coeffs, texels, backend)
-    return SHRM(
-        values.reshape(6, size, size, C, P1 * P1),
-        frame,
-        F,
-        P,
-        float(view_power),
-        lambert,
-        irradiance,
-    )
+    return B_world
 
 
 def _irradiance_cube(env_coeffs, texels, backend) -> np.ndarray:

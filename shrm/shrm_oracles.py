@@ -20,11 +20,13 @@ References
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from reference.errors import require_choice
 from shrm.brdf_sh import FRAMES, VIEW_FIT_RIDGE, default_view_fit
-from shrm.sh import fejer1_weights, sh_basis
+from shrm.sh import fejer1_weights, order_of, sh_basis
 from shrm.shrm import SHRM
 from shrm.transform import project_latlong
 
@@ -194,28 +196,37 @@ def shrm_texels_angular(
     if view_fit == "hemisphere":
         Y = sh_basis(P, views)
         w_v = np.repeat(fejer1_weights(Hv), 2 * Hv) * (2.0 * np.pi / (2 * Hv))
+    reflected = functools.partial(
+        reflected_bruteforce, brdf, params, frame, env=env, view_power=view_power
+    )
     for t, n in enumerate(texels):
         if view_fit == "sphere":
-            B = reflected_bruteforce(
-                brdf, params, frame, np.broadcast_to(n, views.shape), views, env, view_power
-            )
+            B = reflected(np.broadcast_to(n, views.shape), views)
             # B_pq(n) = ∫ B(n, v) Y_pq(v) dv on the Fejér-1 grid of views
             out[t] = project_latlong(B.reshape(Hv, 2 * Hv, C), P, where="SHRM oracle")
-            continue
-        # The hemisphere fit (shrm.brdf_sh): weighted least squares over the seen views, plus
-        # μ |B − B_sphere|², B_sphere the projection of the even continuation (views mirrored)
-        x = views @ n
-        seen = x > 0.0
-        v = views[seen]
-        B = reflected_bruteforce(
-            brdf, params, frame, np.broadcast_to(n, v.shape), v, env, view_power
-        )
-        mirrored = sh_basis(P, v - 2.0 * x[seen, None] * n)
-        prior = ((Y[seen] + mirrored).T * w_v[seen]) @ B
-        w = w_v[seen] * x[seen] ** (-2.0 * view_power)
-        G = (Y[seen].T * w) @ Y[seen] + VIEW_FIT_RIDGE * np.eye(Y.shape[1])
-        out[t] = np.linalg.solve(G, (Y[seen].T * w) @ B + VIEW_FIT_RIDGE * prior).T
+        else:
+            out[t] = _texel_hemisphere_fit(reflected, n, views, Y, w_v, view_power)
     return out
+
+
+def _texel_hemisphere_fit(reflected, n, views, Y, w_v, view_power: float) -> np.ndarray:
+    """One texel's ``B_pq`` (C, (P+1)²) by the hemisphere fit of :mod:`shrm.brdf_sh`.
+
+    ``reflected(index, views)`` is :func:`reflected_bruteforce` with the BRDF and environment
+    bound; ``Y`` and ``w_v`` are ``Y_pq`` and the weights of the Fejér-1 grid of ``views``.
+    """
+    P = order_of(Y.shape[1])
+    # The hemisphere fit (shrm.brdf_sh): weighted least squares over the seen views, plus
+    # μ |B − B_sphere|², B_sphere the projection of the even continuation (views mirrored)
+    x = views @ n
+    seen = x > 0.0
+    v = views[seen]
+    B = reflected(np.broadcast_to(n, v.shape), v)
+    mirrored = sh_basis(P, v - 2.0 * x[seen, None] * n)
+    prior = ((Y[seen] + mirrored).T * w_v[seen]) @ B
+    w = w_v[seen] * x[seen] ** (-2.0 * view_power)
+    G = (Y[seen].T * w) @ Y[seen] + VIEW_FIT_RIDGE * np.eye(Y.shape[1])
+    return np.linalg.solve(G, (Y[seen].T * w) @ B + VIEW_FIT_RIDGE * prior).T
 
 
 def shrm_create_angular(
