@@ -305,6 +305,40 @@ def read_characterization(path) -> Characterization:
     reference.errors.SpecrefError: ...bad.csv: spectra do not match the grid: ... has no over_white
     """
     path = Path(path)
+    meta, (header_line, header), rows = _read_rows(path)
+    require(
+        [h.strip() for h in header[:3]] == ["thickness_mm", "tio2_pct", "measurement"]
+        and len(header) > 3,
+        f"{path}:{header_line}: header must be thickness_mm,tio2_pct,measurement,<wavelengths nm>",
+    )
+    wavelengths = np.array([_float(h, f"{path}:{header_line}: wavelength") for h in header[3:]])
+    require(
+        bool(np.all(np.diff(wavelengths) > 0)),
+        f"{path}:{header_line}: wavelengths must increase, got {header[3:]}",
+    )
+    spectra, order = _read_spectra(path, header, rows)
+    thickness, loads = _grid_axes(path, spectra, order)
+    arrays = {
+        name: np.array([[spectra[d, c, name] for c in loads] for d in thickness])
+        for name in MEASUREMENTS
+    }
+    for key, default in (("index", 1.54), ("backing_white", 0.9)):
+        meta[key] = _float(str(meta.get(key, default)), f"{path}: # {key}")
+    require(meta["index"] > 1, f"{path}: # index: must be > 1, got {meta['index']:g}")
+    meta.setdefault("material", path.stem)
+    return Characterization(
+        wavelengths,
+        np.array(thickness),
+        np.array(loads),
+        arrays["over_black"],
+        arrays["over_white"],
+        arrays["transmittance"],
+        meta,
+    )
+
+
+def _read_rows(path: Path) -> tuple[dict, tuple, list]:
+    """The file's ``# key: value`` lines before the header, its header and its rows, numbered."""
     require(path.is_file(), f"{path}: no such characterization file")
     try:
         lines = path.read_text().splitlines()
@@ -326,17 +360,11 @@ def read_characterization(path) -> Characterization:
             (n for n, _ in body), csv.reader(line for _, line in body), strict=True
         )
     ]
-    (header_line, header), rows = rows[0], rows[1:]
-    require(
-        [h.strip() for h in header[:3]] == ["thickness_mm", "tio2_pct", "measurement"]
-        and len(header) > 3,
-        f"{path}:{header_line}: header must be thickness_mm,tio2_pct,measurement,<wavelengths nm>",
-    )
-    wavelengths = np.array([_float(h, f"{path}:{header_line}: wavelength") for h in header[3:]])
-    require(
-        bool(np.all(np.diff(wavelengths) > 0)),
-        f"{path}:{header_line}: wavelengths must increase, got {header[3:]}",
-    )
+    return meta, rows[0], rows[1:]
+
+
+def _read_spectra(path: Path, header: list, rows: list) -> tuple[dict, list]:
+    """Each row's spectrum by ``(thickness, TiO2, measurement)``, and the chips in file order."""
     spectra: dict[tuple[float, float, str], np.ndarray] = {}
     order: list[tuple[float, float]] = []
     for number, row in rows:
@@ -365,6 +393,11 @@ def read_characterization(path) -> Characterization:
         spectra[d, c, name] = values
         if not order or order[-1] != (d, c):
             order.append((d, c))
+    return spectra, order
+
+
+def _grid_axes(path: Path, spectra: dict, order: list) -> tuple[list, list]:
+    """The thickness and TiO2 axes of the chips, checked to form a complete, monotonic grid."""
     require(order, f"{path}: no spectra after the header")
     thickness = list(dict.fromkeys(d for d, _ in order))
     loads = [c for d, c in order if d == thickness[0]]
@@ -387,20 +420,4 @@ def read_characterization(path) -> Characterization:
                 f"{path}: spectra do not match the grid: thickness {d:g}, TiO2 {c:g} has no {name}",
             )
     require(thickness[0] > 0, f"{path}: thickness_mm must be > 0, got {thickness[0]:g}")
-    arrays = {
-        name: np.array([[spectra[d, c, name] for c in loads] for d in thickness])
-        for name in MEASUREMENTS
-    }
-    for key, default in (("index", 1.54), ("backing_white", 0.9)):
-        meta[key] = _float(str(meta.get(key, default)), f"{path}: # {key}")
-    require(meta["index"] > 1, f"{path}: # index: must be > 1, got {meta['index']:g}")
-    meta.setdefault("material", path.stem)
-    return Characterization(
-        wavelengths,
-        np.array(thickness),
-        np.array(loads),
-        arrays["over_black"],
-        arrays["over_white"],
-        arrays["transmittance"],
-        meta,
-    )
+    return thickness, loads

@@ -324,6 +324,25 @@ def polymer_look(
     )
 
 
+def _terms_inputs(normal, view, look: PolymerLook, maps: PolymerMaps, Mod_effect):
+    """The inputs of :func:`polymer_terms`, checked: N and V (N, 3), ``Mod_effect`` as (N, 1)."""
+    N = np.asarray(normal, dtype=np.float64)
+    V = np.asarray(view, dtype=np.float64)
+    require(
+        N.ndim == 2 and N.shape == V.shape and N.shape[1] == 3,
+        f"polymer_terms: normal and view must be (N, 3), got {N.shape} and {V.shape}",
+    )
+    nb = look.D_polymer.size
+    require(
+        maps.radiance.shape[-1] == nb,
+        f"polymer_terms: maps have {maps.radiance.shape[-1]} bands, the look {nb}",
+    )
+    Mod = np.asarray(require_finite(Mod_effect, "polymer: Mod_effect"), dtype=np.float64)
+    require(bool(np.all((Mod >= 0) & (Mod <= 1))), "polymer: Mod_effect: must be in [0, 1]")
+    Mod = np.broadcast_to(Mod, N.shape[:1])[:, None]
+    return N, V, Mod
+
+
 def polymer_terms(
     normal, view, look: PolymerLook, maps: PolymerMaps, Mod_effect=0.0, E_effect=None
 ) -> dict[str, np.ndarray]:
@@ -365,20 +384,7 @@ def polymer_terms(
     >>> bool(np.allclose(terms["I_result"], expected, atol=1e-3))
     True
     """
-    N = np.asarray(normal, dtype=np.float64)
-    V = np.asarray(view, dtype=np.float64)
-    require(
-        N.ndim == 2 and N.shape == V.shape and N.shape[1] == 3,
-        f"polymer_terms: normal and view must be (N, 3), got {N.shape} and {V.shape}",
-    )
-    nb = look.D_polymer.size
-    require(
-        maps.radiance.shape[-1] == nb,
-        f"polymer_terms: maps have {maps.radiance.shape[-1]} bands, the look {nb}",
-    )
-    Mod = np.asarray(require_finite(Mod_effect, "polymer: Mod_effect"), dtype=np.float64)
-    require(bool(np.all((Mod >= 0) & (Mod <= 1))), "polymer: Mod_effect: must be in [0, 1]")
-    Mod = np.broadcast_to(Mod, N.shape[:1])[:, None]
+    N, V, Mod = _terms_inputs(normal, view, look, maps, Mod_effect)
     cos_theta = np.clip(np.einsum("ij,ij->i", N, V), 0.0, 1.0)
     # Eq. (1), Herbert et al.: F_r from the cos θ LUT, per pixel
     F_r = look.fresnel.lookup(cos_theta)

@@ -490,7 +490,11 @@ def km_invert(
         bool(np.all((R_0 >= 0) & (T2 > 0) & (R_0 + np.sqrt(np.clip(T2, 0, None)) <= 1 + 1e-12))),
         "km_invert: the reflectances are not those of a slab with these surfaces and backings",
     )
-    T = np.sqrt(T2)
+    return _km_K_S(R_0, np.sqrt(T2), d)
+
+
+def _km_K_S(R_0, T, d):
+    """K and S of a body of thickness d, mm, from its reflectance R_0 and transmittance T."""
     # Kubelka (1948): a − 1 = ((1 − R_0)² − T²) / (2 R_0), b, S and K
     scattering = R_0 > 1e-14
     R_0s = np.where(scattering, R_0, 1.0)

@@ -47,6 +47,7 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import NamedTuple
 
 import numpy as np
 
@@ -513,8 +514,19 @@ def _irradiance_in(N, radiance, coupling: Coupling, side: float, chunk: int = 51
     return out
 
 
-def _specular(N, V, radiance, n, alpha, tol, samples, max_samples, seed, backend, scale):
+class _Rounds(NamedTuple):
+    """The Monte Carlo rounds of the specular lobe (:func:`polymer_oracle`'s keywords)."""
+
+    tol: float
+    samples: int
+    max_samples: int
+    seed: int
+    backend: str
+
+
+def _specular(N, V, radiance, n, alpha, scale, rounds: _Rounds):
     """The interface term, in rounds of doubling sample counts until ``tol`` or ``max_samples``."""
+    tol, samples, max_samples, seed, backend = rounds
     P, nb = N.shape[0], radiance.shape[-1]
     if alpha <= 0.0:
         cos_o = np.clip(np.einsum("ij,ij->i", N, V), 0.0, 1.0)
@@ -657,18 +669,7 @@ def polymer_oracle(
     body, transmission = oracle_diffuse(normal, view, radiance, K, S, d, n, gloss)
     N, V, radiance = _inputs(normal, view, radiance)
     scale = (body + transmission).mean(axis=1)
-    spec, se, M, rel = _specular(
-        N,
-        V,
-        radiance,
-        float(n),
-        gloss_alpha(gloss),
-        tol,
-        samples,
-        max_samples,
-        seed,
-        backend,
-        scale,
-    )
+    rounds = _Rounds(tol, samples, max_samples, seed, backend)
+    spec, se, M, rel = _specular(N, V, radiance, float(n), gloss_alpha(gloss), scale, rounds)
     result = spec + body + transmission
     return OracleResult(spec, body, transmission, result, se, M, rel, time.perf_counter() - t0)
