@@ -16,6 +16,46 @@ The importance proxy ignores ``k_s``, the light and the spread of ``n(λ)``, and
 ``[0, S_1]`` has ``ir = 1/p`` of the weight whatever ``m`` is: with ``p = m`` and a bimodal ``n(λ)``
 that interval never shrinks, so the table stops converging (see ``docs/phong-tables.md``).
 
+**The error placement** (:func:`table_error`, ours). Its Notes derive the density: ``ρ ∝
+|f^(k)|^{1/k}`` equidistributes the largest error of an interpolation of order ``k``.
+
+**One density for three channels.** One node set serves the three channels and every
+interpolation: the density is the larger of the normalised ``max_c |f_c''|^{1/2}`` and
+``max_c |f_c'''|^{1/3}`` (``c`` over R, G, B; each channel's error is in the same display units),
+which costs each interpolation at most half its own optimal nodes. A floor keeps intervals bounded
+where the derivative vanishes (zero crossings of ``f^(k)``, ``n(λ) ≤ 1``):
+``ρ = ρ_error/∫ρ_error + floor``.
+
+**The seen range.** A view sees only part of [0, 1]: the scenes' near view, zoomed on the
+highlight, sees ``t`` from about 0.78 to 1, and nodes below that are wasted on its pixels.
+Given the frame's range ``[t_lo, t_hi]``, the density is equidistributed there
+(:func:`fine_grid` mapped onto it) and each open side gets a margin interval and one more to
+0 or 1 (:func:`place_seen`). The table is then exact only on the frame it was built for; in
+Wang et al.'s use (editing spectra on a fixed view) that is the frame. The paper's placements
+(``uniform``, ``importance``) do not read the range.
+
+**The pixels' RMS.** The figure that matters is the RMS error over the frame's pixels, not the
+largest error over ``t``: with ``p(t)`` the pixels' density in ``t`` (``t_density``,
+:func:`pixel_density`), the mean square error is ``∫ p (c_k h^k f^(k))² dt = c_k² ∫ p
+|f^(k)|² ρ^(−2k) dt``, which under ``∫ρ = m`` is smallest (a Lagrange multiplier) for ``ρ ∝
+(p |f^(k)|²)^{1/(2k+1)}``. Pixels bunch where the view sees the highlight (the near view has
+most of its pixels at ``t > 0.9``), where the max-norm density alone puts too few nodes. The
+density is then the largest of the four normalised densities (``k = 2, 3``, pixel-weighted, and
+max-norm at the weight :data:`ERROR_HEDGE`): the pixel-weighted ones lead, and the max-norm ones
+take over only where they ask for more than twice as many nodes, which guards against a
+histogram of few pixels (a small frame). ``tests/validation/studies/test_phong.py`` checks the
+result against uniform and importance tables on measured materials.
+
+**Grading for the parabola** (Erratum E85). The parabola of the interval around node ``j``
+goes through ``t_{j-1}, t_j, t_{j+1}``; its error is ``|f^(3)| |(t - t_{j-1})(t - t_j)(t -
+t_{j+1})|/6``, about ``h_{j-1} h_j^2`` rather than ``h^3`` where the two widths differ. Where
+a narrow lobe (``n = 10^4`` in one band) meets the floor's wide intervals the widths jump by
+~10^3 in one node and the parabola swings far below 0. For such interpolations the width
+``w = M/(m ρ)`` is capped by a sweep each way at ``w(s) + g |t - s|`` (``g`` =
+:data:`ERROR_GRADING`), so neighbouring widths differ by at most ``1/(1 - g)``. Linear
+and monotone interpolation keep the ungraded nodes (grading cost the monotone table up to
+3x at ``m = 200`` on such a lobe).
+
 References
 ----------
 - C.-M. Wang, J.-R. Chern, J. Lee, "An Efficient Spectral Rendering Technique for Phong Illumination
@@ -409,46 +449,11 @@ def table_error(
     why the placement converges where the uniform table (error ∝ ``n^k``) and the importance table
     (whose first interval does not shrink) do not.
 
-    One node set serves the three channels and every interpolation: the density is the larger of
-    the normalised ``max_c |f_c''|^{1/2}`` and ``max_c |f_c'''|^{1/3}`` (``c`` over R, G, B; each
-    channel's error is in the same display units), which costs each interpolation at most half its
-    own optimal nodes. A floor keeps
-    intervals bounded where the derivative vanishes (zero crossings of ``f^(k)``, ``n(λ) ≤ 1``):
-    ``ρ = ρ_error/∫ρ_error + floor``.
-
-    **The seen range.** A view sees only part of [0, 1]: the scenes' near view, zoomed on the
-    highlight, sees ``t`` from about 0.78 to 1, and nodes below that are wasted on its pixels.
-    Given the frame's range ``[t_lo, t_hi]``, the density is equidistributed there
-    (:func:`fine_grid` mapped onto it) and each open side gets a margin interval and one more to
-    0 or 1 (:func:`place_seen`). The table is then exact only on the frame it was built for; in
-    Wang et al.'s use (editing spectra on a fixed view) that is the frame. The paper's placements
-    (``uniform``, ``importance``) do not read the range.
-
-    **The pixels' RMS.** The figure that matters is the RMS error over the frame's pixels, not the
-    largest error over ``t``: with ``p(t)`` the pixels' density in ``t`` (``t_density``,
-    :func:`pixel_density`), the mean square error is ``∫ p (c_k h^k f^(k))² dt = c_k² ∫ p
-    |f^(k)|² ρ^(−2k) dt``, which under ``∫ρ = m`` is smallest (a Lagrange multiplier) for ``ρ ∝
-    (p |f^(k)|²)^{1/(2k+1)}``. Pixels bunch where the view sees the highlight (the near view has
-    most of its pixels at ``t > 0.9``), where the max-norm density alone puts too few nodes. The
-    density is then the largest of the four normalised densities (``k = 2, 3``, pixel-weighted, and
-    max-norm at the weight :data:`ERROR_HEDGE`): the pixel-weighted ones lead, and the max-norm ones
-    take over only where they ask for more than twice as many nodes, which guards against a
-    histogram of few pixels (a small frame). ``tests/validation/studies/test_phong.py`` checks the
-    result against uniform and importance tables on measured materials.
-
-    **Grading for the parabola** (Erratum E85). The parabola of the interval around node ``j``
-    goes through ``t_{j-1}, t_j, t_{j+1}``; its error is ``|f^(3)| |(t - t_{j-1})(t - t_j)(t -
-    t_{j+1})|/6``, about ``h_{j-1} h_j^2`` rather than ``h^3`` where the two widths differ. Where
-    a narrow lobe (``n = 10^4`` in one band) meets the floor's wide intervals the widths jump by
-    ~10^3 in one node and the parabola swings far below 0. For such interpolations the width
-    ``w = M/(m ρ)`` is capped by a sweep each way at ``w(s) + g |t - s|`` (``g`` =
-    :data:`ERROR_GRADING`), so neighbouring widths differ by at most ``1/(1 - g)``. Linear
-    and monotone interpolation keep the ungraded nodes (grading cost the monotone table up to
-    3x at ``m = 200`` on such a lobe).
-
-    The derivatives are evaluated at the midpoints of the fine grid, the density integrated there,
-    and the cumulative density inverted at ``q/m`` by linear interpolation. The compiled twin is
-    ``phong_table._kernels.table_error_kernel``.
+    Each derivative's density is normalised, the largest taken and the floor added (module
+    docstring: the channels, the floor, the seen range, the pixels' RMS, the grading for the
+    parabola). The derivatives are evaluated at the midpoints of the fine grid, the density
+    integrated there, and its cumulative inverted at ``q/m`` by linear interpolation; the
+    compiled twin is ``phong_table._kernels.table_error_kernel``.
 
     Examples
     --------
@@ -511,7 +516,7 @@ def _error_nodes(model: SpectralPhong, m: int, floor: float, t_fine, p, grading:
     for k in (2, 3):
         f_k = np.abs(model.specular_derivative(t_mid, k)).max(axis=-1)
         # the largest error c_k h^k |f^(k)| is equidistributed by |f^(k)|^(1/k); the pixels'
-        # mean square error Σ p (c_k h^k f^(k))² by (p |f^(k)|²)^(1/(2k+1)) (Notes)
+        # mean square error Σ p (c_k h^k f^(k))² by (p |f^(k)|²)^(1/(2k+1)) (module docstring)
         densities = [(f_k ** (1.0 / k), ERROR_HEDGE if p.size else 1.0)]
         if p.size:
             densities.append(((p * f_k * f_k) ** (1.0 / (2 * k + 1)), 1.0))

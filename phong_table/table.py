@@ -320,6 +320,21 @@ def build_table(
     ...
     reference.errors.SpecrefError: importance table: segments: must divide entries = 10, got 3
     """
+    method, m, p = _checked_placement(material, placement, entries, segments)
+    frame = _frame_keywords(method, m, t_range, t_density, interpolation)
+    place = method.extra.get("compiled", method.reference) if compiled else method.reference
+    nodes = np.ascontiguousarray(place(material, m, p, **frame), dtype=np.float64)
+    # the compiled build runs no NumPy array operation between its kernels (phong_table._kernels)
+    require(
+        _kernels._increasing_kernel(nodes) if compiled else increasing(nodes),
+        f"{placement} table: nodes are not strictly increasing from 0 to 1 (m = {m}); use fewer "
+        "entries",
+    )
+    return _tabulated(material, nodes, compiled, placement, p)
+
+
+def _checked_placement(material, placement: str, entries, segments):
+    """The placement's registry entry and ``(m, p)``, checked with the material and segments."""
     method = PLACEMENT_METHODS.lookup(placement)
     require(
         isinstance(material, SpectralPhong),
@@ -331,20 +346,22 @@ def build_table(
         f"{segments!r}",
     )
     m, p = check_entries(entries, segments, f"{placement} table")
-    place = method.extra.get("compiled", method.reference) if compiled else method.reference
+    return method, m, p
+
+
+def _frame_keywords(method, m: int, t_range, t_density, interpolation) -> dict:
+    """The frame as the placement reads it: the range and pixel density of t, the interpolation."""
     seen = {}
     if method.extra.get("t_range") and t_range is not None:
         seen = {"t_range": t_range, "t_density": t_density}
     if method.extra.get("interpolation") and interpolation is not None:
         check_interpolation(interpolation, m)
         seen["interpolation"] = interpolation
-    nodes = np.ascontiguousarray(place(material, m, p, **seen), dtype=np.float64)
-    # the compiled build runs no NumPy array operation between its kernels (phong_table._kernels)
-    require(
-        _kernels._increasing_kernel(nodes) if compiled else increasing(nodes),
-        f"{placement} table: nodes are not strictly increasing from 0 to 1 (m = {m}); use fewer "
-        "entries",
-    )
+    return seen
+
+
+def _tabulated(material, nodes, compiled: bool, placement: str, p: int) -> SpecularTable:
+    """Eq. (11), Wang et al. at the nodes, and what every lookup needs (NumPy or numba twins)."""
     make = _kernels.tabulate_kernel if compiled else tabulate
     # Eq. (11), Wang et al. at the nodes, one power per distinct exponent (the same sum)
     C, n = material.specular_weights_distinct, material.n_distinct
