@@ -25,7 +25,10 @@ References
 
 from __future__ import annotations
 
+import functools
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
@@ -360,14 +363,43 @@ def calibrate_display(
     make_instrument = INSTRUMENTS.lookup(instrument).reference
     xy = white_xy(white)
     calibration_points(points, 0.5)  # checks the count first
-    meter = make_instrument()
-    rng = np.random.default_rng(seed)
-
-    def measure(drives):
-        return meter.measure(display, drives, rng)
-
+    # the instrument reading the display: drives (..., 3) -> XYZ (..., 3)
+    measure = functools.partial(make_instrument().measure, display, rng=np.random.default_rng(seed))
     # Erratum E53: the loop's heuristics (characterisation, placement, tolerances) are ours
     model = _characterize(display, measure)
+    XYZ_w1, Y_white = _brightest_white(model, xy, white)
+    loop = _Loop(model, measure, XYZ_w1, tolerance_uv, tolerance_Y, max_iterations)
+    # the white first: one channel stays at full drive
+    done = {1.0: loop.run_point(Y_white * XYZ_w1, model.XYZ_to_rho(Y_white * XYZ_w1), True)}
+    Y_white, Y_black = float(done[1.0].XYZ[1]), float(model.black_XYZ[1])
+    aim = _Aim(Y_white, Y_black / Y_white, CALIBRATION_CURVES.lookup(curve).reference)
+    loop.add_points(done, aim, points, refine_rounds)
+    return Calibration(
+        lut=loop.lut(done, aim),
+        white_xy=xy,
+        white=str(white),
+        curve=curve,
+        Y_white=Y_white,
+        Y_black=Y_black,
+        points=_points_record(done),
+        instrument=instrument,
+        display=getattr(display, "name", ""),
+    )
+
+
+def _points_record(done: dict) -> dict:
+    """``Calibration.points``: the points' gray levels, drives, XYZ and iterations, by level."""
+    rows = [done[g] for g in sorted(done)]
+    return {
+        "G": np.array(sorted(done)),
+        "drives": np.array([r.drives for r in rows]),
+        "XYZ": np.array([r.XYZ for r in rows]),
+        "iterations": np.array([r.iteration for r in rows]),
+    }
+
+
+def _brightest_white(model: _Characterization, xy, white: str) -> tuple[np.ndarray, float]:
+    """The target white's XYZ at Y = 1, and the largest Y the display gives that chromaticity."""
     # the target white's direction, Y = 1
     XYZ_w1 = np.array([xy[0] / xy[1], 1.0, (1.0 - xy.sum()) / xy[1]])
     direction = np.linalg.solve(model.P, XYZ_w1)
@@ -375,84 +407,113 @@ def calibrate_display(
         raise SpecrefError(_gamut_message(xy, model.P, white))
     # the brightest white of that chromaticity: ρ = P⁻¹(Y XYZ_w1 − XYZ_K) <= 1
     offset = np.linalg.solve(model.P, model.black_XYZ)
-    Y_white = float(np.min((1.0 + offset) / direction))
-    Y_black = float(model.black_XYZ[1])
+    return XYZ_w1, float(np.min((1.0 + offset) / direction))
 
-    def run_point(target_XYZ, rho, is_white):
+
+class _Point(NamedTuple):
+    """A control point's best reading: drives, XYZ, linear drives ρ, which reading (1 = first)."""
+
+    drives: np.ndarray
+    XYZ: np.ndarray
+    rho: np.ndarray
+    iteration: int
+
+
+class _Aim(NamedTuple):
+    """The calibrated white's luminance (cd/m²), the black relative to it, and the tone curve."""
+
+    Y_white: float
+    black_relative: float
+    curve: Callable  # a CALIBRATION_CURVES reference: curve(G, black_relative)
+
+    def Y(self, G):
+        """Target luminance (cd/m²) at gray levels ``G``."""
+        return self.Y_white * self.curve(G, self.black_relative)
+
+
+@dataclass(frozen=True)
+class _Loop:
+    """The calibration loop: the display's model, the instrument, the target white, tolerances."""
+
+    model: _Characterization
+    measure: Callable  # drives (..., 3) -> XYZ (..., 3), cd/m²
+    XYZ_w1: np.ndarray  # the target white, Y = 1
+    tolerance_uv: float
+    tolerance_Y: float
+    max_iterations: int
+
+    def run_point(self, target_XYZ, rho, is_white) -> _Point:
+        """Measure and correct one point until it holds; the best reading (module docstring, 3.)."""
         best = None
-        for iteration in range(1, max_iterations + 1):
-            drives = model.rho_to_drives(rho)
-            XYZ = measure(drives)
+        for iteration in range(1, self.max_iterations + 1):
+            drives = self.model.rho_to_drives(rho)
+            XYZ = self.measure(drives)
             duv = float(np.linalg.norm(XYZ_to_uv(XYZ) - XYZ_to_uv(target_XYZ)))
             dY = abs(XYZ[1] / target_XYZ[1] - 1.0)
-            score = duv / tolerance_uv + (0.0 if is_white else dY / tolerance_Y)
+            score = duv / self.tolerance_uv + (0.0 if is_white else dY / self.tolerance_Y)
             if best is None or score < best[0]:
                 best = (score, drives, XYZ, rho, iteration)
-            if duv <= tolerance_uv and (is_white or dY <= tolerance_Y):
+            if duv <= self.tolerance_uv and (is_white or dY <= self.tolerance_Y):
                 break
             if is_white:  # the white's luminance is whatever full drive gives
-                target_XYZ = XYZ[1] * XYZ_w1
-            rho = _correct(model.P, rho, target_XYZ - XYZ)
+                target_XYZ = XYZ[1] * self.XYZ_w1
+            rho = _correct(self.model.P, rho, target_XYZ - XYZ)
             if is_white:  # the brightest white: one channel at full drive
                 rho = rho / rho.max()
-        return best[1:]
+        return _Point(*best[1:])
 
-    # the white first: one channel stays at full drive
-    rho_white = model.XYZ_to_rho(Y_white * XYZ_w1)
-    drives_w, XYZ_w, rho_w, iterations_w = run_point(Y_white * XYZ_w1, rho_white, True)
-    Y_white = float(XYZ_w[1])
-    black_relative = Y_black / Y_white
-    target = CALIBRATION_CURVES.lookup(curve).reference
-    G_low = _level_at(target, 0.008, black_relative)
-    G = calibration_points(points, G_low)
-    done = {1.0: (drives_w, XYZ_w, rho_w, iterations_w)}
+    def add_point(self, done: dict, aim: _Aim, G_k) -> None:
+        """Run the point at gray level ``G_k`` and record it in ``done``."""
+        target_XYZ = aim.Y_white * float(aim.curve(G_k, aim.black_relative)) * self.XYZ_w1
+        done[float(G_k)] = self.run_point(target_XYZ, self.model.XYZ_to_rho(target_XYZ), False)
 
-    def add_point(G_k):
-        target_XYZ = Y_white * float(target(G_k, black_relative)) * XYZ_w1
-        done[float(G_k)] = run_point(target_XYZ, model.XYZ_to_rho(target_XYZ), False)
+    def add_points(self, done: dict, aim: _Aim, points: int, refine_rounds: int) -> None:
+        """The control points from the white down, then those the refinement rounds add."""
+        G_low = _level_at(aim.curve, 0.008, aim.black_relative)
+        for G_k in calibration_points(points, G_low)[-2::-1]:
+            self.add_point(done, aim, G_k)
+        # "the ability to add more points where required" (§6): check the middle of each interval
+        # and add a point where the table misses by more than three tolerances
+        for _ in range(refine_rounds):
+            G = np.array(sorted(done))
+            lut = self.lut(done, aim)
+            middles = 0.5 * (G[1:] + G[:-1])
+            room = 64 - len(G)
+            if room <= 0:
+                break
+            XYZ = self.measure(_interp_lut(lut, middles))
+            target_XYZ = aim.Y(middles)[:, None] * self.XYZ_w1
+            miss_uv = np.linalg.norm(XYZ_to_uv(XYZ) - XYZ_to_uv(target_XYZ), axis=-1)
+            miss_Y = np.abs(XYZ[:, 1] / target_XYZ[:, 1] - 1.0)
+            worst = np.maximum(miss_uv / self.tolerance_uv, miss_Y / self.tolerance_Y)
+            add = middles[worst > 3.0]
+            if add.size == 0:
+                break
+            for G_k in add[np.argsort(-worst[worst > 3.0])][:room]:
+                self.add_point(done, aim, G_k)
 
-    for G_k in G[-2::-1]:
-        add_point(G_k)
-    # "the ability to add more points where required" (§6): check the middle of each interval
-    # and add a point where the table misses by more than three tolerances
-    for _ in range(refine_rounds):
+    def lut(self, done: dict, aim: _Aim) -> np.ndarray:
+        """The tables between the points: the model's answer plus the interpolated corrections."""
+        from scipy.interpolate import PchipInterpolator
+
+        model = self.model
         G = np.array(sorted(done))
-        rho_points = np.array([done[g][2] for g in G])
-        lut = _fill_lut(G, rho_points, model, target, Y_white, black_relative, XYZ_w1)
-        middles = 0.5 * (G[1:] + G[:-1])
-        room = 64 - len(G)
-        if room <= 0:
-            break
-        XYZ = measure(_interp_lut(lut, middles))
-        target_XYZ = (Y_white * target(middles, black_relative))[:, None] * XYZ_w1
-        miss_uv = np.linalg.norm(XYZ_to_uv(XYZ) - XYZ_to_uv(target_XYZ), axis=-1)
-        miss_Y = np.abs(XYZ[:, 1] / target_XYZ[:, 1] - 1.0)
-        worst = np.maximum(miss_uv / tolerance_uv, miss_Y / tolerance_Y)
-        add = middles[worst > 3.0]
-        if add.size == 0:
-            break
-        for G_k in add[np.argsort(-worst[worst > 3.0])][:room]:
-            add_point(G_k)
-    G = np.array(sorted(done))
-    rows = [done[g] for g in G]
-    rho_points = np.array([r[2] for r in rows])
-    lut = _fill_lut(G, rho_points, model, target, Y_white, black_relative, XYZ_w1)
-    return Calibration(
-        lut=lut,
-        white_xy=xy,
-        white=str(white),
-        curve=curve,
-        Y_white=Y_white,
-        Y_black=Y_black,
-        points={
-            "G": G,
-            "drives": np.array([r[0] for r in rows]),
-            "XYZ": np.array([r[1] for r in rows]),
-            "iterations": np.array([r[3] for r in rows]),
-        },
-        instrument=instrument,
-        display=getattr(display, "name", ""),
-    )
+        rho_points = np.array([done[g].rho for g in G])
+        levels = np.linspace(0.0, 1.0, LUT_SIZE)
+        Y = aim.Y(levels)
+        rho_model = model.XYZ_to_rho(Y[:, None] * self.XYZ_w1)
+        rho_model_points = model.XYZ_to_rho(aim.Y(G)[:, None] * self.XYZ_w1)
+        corrections = PchipInterpolator(G, rho_points - rho_model_points, extrapolate=True)
+        rho = rho_model + corrections(np.clip(levels, G[0], 1.0))
+        # below the lowest point the black is left alone: its ratio, scaled to the luminance
+        below = levels < G[0]
+        Y_low = aim.Y(G[0]) - model.black_XYZ[1]
+        scale = np.clip((Y[below] - model.black_XYZ[1]) / Y_low, 0.0, 1.0)
+        rho[below] = scale[:, None] * rho_points[0]
+        rho[0] = 0.0
+        drives = model.rho_to_drives(rho).T
+        # a table must not decrease (noise can make neighbouring corrections cross)
+        return np.maximum.accumulate(drives, axis=1)
 
 
 def _correct(P, rho, dXYZ) -> np.ndarray:
@@ -486,27 +547,6 @@ def _level_at(target, fraction, black_relative) -> float:
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if target(mid, black_relative) < fraction else (lo, mid)
     return max(hi, 1.0 / (LUT_SIZE - 1))
-
-
-def _fill_lut(G, rho_points, model, target, Y_white, black_relative, XYZ_w1) -> np.ndarray:
-    """The tables between the points: the model's answer plus the interpolated corrections."""
-    from scipy.interpolate import PchipInterpolator
-
-    levels = np.linspace(0.0, 1.0, LUT_SIZE)
-    Y = Y_white * target(levels, black_relative)
-    rho_model = model.XYZ_to_rho(Y[:, None] * XYZ_w1)
-    rho_model_points = model.XYZ_to_rho((Y_white * target(G, black_relative))[:, None] * XYZ_w1)
-    corrections = PchipInterpolator(G, rho_points - rho_model_points, extrapolate=True)
-    rho = rho_model + corrections(np.clip(levels, G[0], 1.0))
-    # below the lowest point the black is left alone: its ratio, scaled to the luminance
-    below = levels < G[0]
-    Y_low = Y_white * target(G[0], black_relative) - model.black_XYZ[1]
-    scale = np.clip((Y[below] - model.black_XYZ[1]) / Y_low, 0.0, 1.0)
-    rho[below] = scale[:, None] * rho_points[0]
-    rho[0] = 0.0
-    drives = model.rho_to_drives(rho).T
-    # a table must not decrease (noise can make neighbouring corrections cross)
-    return np.maximum.accumulate(drives, axis=1)
 
 
 def verify_calibration(
