@@ -402,12 +402,33 @@ def read_brdf_table(path) -> BRDFTable:
     reference.errors.SpecrefError: .../b.txt:3: BRDF at 550 nm: must be >= 0, got -1
     """
     path = Path(path)
+    name, header, wavelengths, rows = _parse_brdf_table(_read_brdf_text(path), path)
+    require(header is not None, f"{path}: no header line 'theta_i theta_s phi_s <wavelengths nm>'")
+    require(rows, f"{path}: no data rows after the header (line {header})")
+    axes = _brdf_table_axes(rows, path)
+    values = np.empty((axes[0].size, axes[1].size, axes[2].size, wavelengths.size))
+    for (theta_i, theta_s, phi_s), spectrum in rows.items():
+        i = np.searchsorted(axes[0], theta_i)
+        o = np.searchsorted(axes[1], theta_s)
+        p = np.searchsorted(axes[2], phi_s)
+        values[i, o, p] = spectrum
+    # φ_s from the specular side becomes Δφ = 180° − φ_s, increasing.
+    phi_d = 180.0 - axes[2][::-1]
+    return BRDFTable(axes[0], axes[1], phi_d, wavelengths, values[:, :, ::-1], name=name)
+
+
+def _read_brdf_text(path: Path) -> str:
+    """The file's text, or a one-line error naming it."""
     try:
-        text = path.read_text(encoding="utf-8")
+        return path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise SpecrefError(f"{path}: file not found") from None
     except (OSError, UnicodeDecodeError) as error:
         raise SpecrefError(f"{path}: unreadable BRDF table ({error})") from None
+
+
+def _parse_brdf_table(text: str, path: Path):
+    """The table's name, header line number, wavelengths, and rows ``{(θ_i, θ_s, φ_s): values}``."""
     header, wavelengths, rows, where = None, None, {}, {}
     name = path.stem
     for number, raw in enumerate(text.splitlines(), 1):
@@ -421,58 +442,68 @@ def read_brdf_table(path) -> BRDFTable:
             continue
         fields = line.replace(",", " ").split()
         if header is None:
-            require(
-                [f.lower() for f in fields[:3]] == ["theta_i", "theta_s", "phi_s"],
-                f"{path}:{number}: header: must start with 'theta_i theta_s phi_s', got "
-                f"{' '.join(fields[:3])!r}",
-            )
-            try:
-                wavelengths = np.array([float(f) for f in fields[3:]])
-            except ValueError:
-                raise SpecrefError(
-                    f"{path}:{number}: header: wavelength columns must be numbers (nm), got "
-                    f"{' '.join(fields[3:])!r}"
-                ) from None
-            require(
-                wavelengths.size >= 1 and bool((wavelengths > 0).all()),
-                f"{path}:{number}: header: needs at least one positive wavelength column (nm)",
-            )
-            header = number
+            wavelengths, header = _brdf_table_header(fields, f"{path}:{number}"), number
             continue
-        require(
-            len(fields) == 3 + wavelengths.size,
-            f"{path}:{number}: expected {3 + wavelengths.size} columns "
-            f"(theta_i theta_s phi_s and {wavelengths.size} BRDF values), got {len(fields)}",
-        )
-        try:
-            numbers = [float(f) for f in fields]
-        except ValueError:
-            raise SpecrefError(f"{path}:{number}: not a number in {line!r:.80}") from None
-        theta_i, theta_s, phi_s = numbers[:3]
-        for label, value, high in (
-            ("theta_i", theta_i, 90.0),
-            ("theta_s", theta_s, 90.0),
-            ("phi_s", phi_s, 180.0),
-        ):
-            require(
-                np.isfinite(value) and 0.0 <= value <= high,
-                f"{path}:{number}: {label}: must be in [0, {high:g}] degrees, got {value:g}",
-            )
-        for lam, value in zip(wavelengths, numbers[3:], strict=True):
-            require(
-                np.isfinite(value),
-                f"{path}:{number}: BRDF at {lam:g} nm: must be finite, got {value}",
-            )
-            require(value >= 0, f"{path}:{number}: BRDF at {lam:g} nm: must be >= 0, got {value:g}")
-        geometry = (theta_i, theta_s, phi_s)
+        numbers = _brdf_table_row(fields, line, wavelengths, f"{path}:{number}")
+        geometry = tuple(numbers[:3])
         if geometry in rows:
+            theta_i, theta_s, phi_s = geometry
             raise SpecrefError(
                 f"{path}:{number}: duplicated angles theta_i={theta_i:g} theta_s={theta_s:g} "
                 f"phi_s={phi_s:g} (first at line {where[geometry]})"
             )
         rows[geometry], where[geometry] = numbers[3:], number
-    require(header is not None, f"{path}: no header line 'theta_i theta_s phi_s <wavelengths nm>'")
-    require(rows, f"{path}: no data rows after the header (line {header})")
+    return name, header, wavelengths, rows
+
+
+def _brdf_table_header(fields: list[str], at: str) -> np.ndarray:
+    """The wavelengths (nm) of a header ``theta_i theta_s phi_s <wavelengths>``, checked."""
+    require(
+        [f.lower() for f in fields[:3]] == ["theta_i", "theta_s", "phi_s"],
+        f"{at}: header: must start with 'theta_i theta_s phi_s', got {' '.join(fields[:3])!r}",
+    )
+    try:
+        wavelengths = np.array([float(f) for f in fields[3:]])
+    except ValueError:
+        raise SpecrefError(
+            f"{at}: header: wavelength columns must be numbers (nm), got {' '.join(fields[3:])!r}"
+        ) from None
+    require(
+        wavelengths.size >= 1 and bool((wavelengths > 0).all()),
+        f"{at}: header: needs at least one positive wavelength column (nm)",
+    )
+    return wavelengths
+
+
+def _brdf_table_row(fields: list[str], line: str, wavelengths, at: str) -> list[float]:
+    """A data row's numbers ``theta_i, theta_s, phi_s, BRDF...``, checked: angles and values."""
+    require(
+        len(fields) == 3 + wavelengths.size,
+        f"{at}: expected {3 + wavelengths.size} columns "
+        f"(theta_i theta_s phi_s and {wavelengths.size} BRDF values), got {len(fields)}",
+    )
+    try:
+        numbers = [float(f) for f in fields]
+    except ValueError:
+        raise SpecrefError(f"{at}: not a number in {line!r:.80}") from None
+    theta_i, theta_s, phi_s = numbers[:3]
+    for label, value, high in (
+        ("theta_i", theta_i, 90.0),
+        ("theta_s", theta_s, 90.0),
+        ("phi_s", phi_s, 180.0),
+    ):
+        require(
+            np.isfinite(value) and 0.0 <= value <= high,
+            f"{at}: {label}: must be in [0, {high:g}] degrees, got {value:g}",
+        )
+    for lam, value in zip(wavelengths, numbers[3:], strict=True):
+        require(np.isfinite(value), f"{at}: BRDF at {lam:g} nm: must be finite, got {value}")
+        require(value >= 0, f"{at}: BRDF at {lam:g} nm: must be >= 0, got {value:g}")
+    return numbers
+
+
+def _brdf_table_axes(rows: dict, path: Path) -> list[np.ndarray]:
+    """The grid's θ_i, θ_s and φ_s nodes; an error names a geometry the rows miss."""
     axes = [np.unique([g[k] for g in rows]) for k in range(3)]
     expected = axes[0].size * axes[1].size * axes[2].size
     if len(rows) != expected:
@@ -485,15 +516,7 @@ def read_brdf_table(path) -> BRDFTable:
                     f"{axes[0].size} theta_i, {axes[1].size} theta_s and {axes[2].size} phi_s "
                     f"values"
                 )
-    values = np.empty((axes[0].size, axes[1].size, axes[2].size, wavelengths.size))
-    for (theta_i, theta_s, phi_s), spectrum in rows.items():
-        i = np.searchsorted(axes[0], theta_i)
-        o = np.searchsorted(axes[1], theta_s)
-        p = np.searchsorted(axes[2], phi_s)
-        values[i, o, p] = spectrum
-    # φ_s from the specular side becomes Δφ = 180° − φ_s, increasing.
-    phi_d = 180.0 - axes[2][::-1]
-    return BRDFTable(axes[0], axes[1], phi_d, wavelengths, values[:, :, ::-1], name=name)
+    return axes
 
 
 def _table_example(rng):
