@@ -20,6 +20,7 @@ import hashlib
 import time
 from collections import OrderedDict
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -79,7 +80,7 @@ PAINT_SPECTRA = (
 )
 #: Horizon-map sectors of the renderer: 36 (twelve three-channel images, twice the paper's 18 in
 #: six), the fewest that keep horizon-map shadows within 2 % of ray-marched ones at every light
-#: elevation from 10° to 75° for relief up to four times the painting's (issue 22, erratum E95).
+#: elevation from 10° to 75° for relief up to four times the painting's (erratum E95).
 HORIZON_SECTORS = 36
 #: The booth: the viewer's eye and the ceiling light (§3.2, Fig. 7), metres, y up.
 EYE = (0.0, 0.45, 0.6)
@@ -328,37 +329,13 @@ def render_painting(
     plane = booth_plane_light(_booth_kind(light), *light_resolution)
     lights = point_lights_from_plane(plane, lighting.extra["sampling"], n_lights)
     S6 = light_to_channels(spectrum_from_dataset("illuminant", light), d)
-    g = _painting_gbuffer(size, painting["width_m"])
-    mask = g.mask
-    P, V = g.position[mask], g.view[mask]
-    # Texel of each visible pixel (uv: u along +x columns, v along +z rows).
-    n_tex = painting["height"].shape[0]
-    col = np.clip((g.uv[mask][:, 0] * n_tex).astype(int), 0, n_tex - 1)
-    row = np.clip((g.uv[mask][:, 1] * n_tex).astype(int), 0, n_tex - 1)
-    T, B, N_geo = np.array([1.0, 0, 0]), np.array([0, 0, 1.0]), np.array([0, 1.0, 0])
-    normals_tangent = normal_map_from_height(painting["height"], painting["pixel_size"])
-    N = tangent_to_world(normals_tangent[row, col], T, B, N_geo)
+    px = _canvas_pixels(painting, size)
+    P, V, N = px.P, px.V, px.N
     seconds = {}
     start = time.perf_counter()
-    visibility = None
-    if shadows:
-        # Once per height field, not per frame (§3.5.3, Ferwerda: a precomputed map).
-        hmap = cached_horizon_map(
-            painting["height"], painting["pixel_size"], HORIZON_SECTORS, 32, backend
-        )
-        to_light = lights.position[None] - P[:, None]
-        phi, beta = light_azimuth_elevation(to_light, T, B, N_geo)
-        visibility = horizon_lookup(hmap[row, col][:, None, :], phi, beta).astype(float)
+    visibility = _horizon_visibility(painting, px, lights, backend) if shadows else None
     seconds["shadows"] = time.perf_counter() - start
-    # Six-channel materials: ρ_d from the measured spectra, ρ_s and α from the maps.
-    names = list(PAINT_SPECTRA)
-    R6 = spectra_to_channels(np.stack([spectra[n] for n in names]), d)
-    canvas = spectra_to_channels(spectra.get("office-paper", np.full(81, 0.85)), d)
-    table = np.concatenate([R6, canvas[None]])
-    material = painting["material"][row, col]
-    rho_d = table[np.where(material < 0, len(names), material)]
-    rho_s = painting["rho_s"][row, col][:, None]
-    alpha = painting["alpha"][row, col]
+    rho_d, rho_s, alpha = _canvas_materials(painting, spectra, d, px)
     start = time.perf_counter()
     # Eq. (2), Ferwerda: illuminance from the point lights (luminance image: one channel)
     E = illuminance_point_lights(P, N, lights, visibility)
@@ -369,12 +346,67 @@ def render_painting(
     I_s = lighting.reference(P, N, V, alpha, plane, lights, n_samples, visibility, backend)
     L_specular = rho_s * S6 * I_s
     seconds["specular"] = time.perf_counter() - start
-    XYZ = np.zeros((*g.shape, 3))
-    XYZ[mask] = channels_to_XYZ(L_diffuse + L_specular, d)
+    XYZ = np.zeros((*px.gbuffer.shape, 3))
+    XYZ[px.gbuffer.mask] = channels_to_XYZ(L_diffuse + L_specular, d)
     # Display: linear sRGB with the white diffuser under the booth light at 1/1.2 of white.
     white_Y = float(np.median(E)) / np.pi
     rgb = XYZ_to_display_RGB(XYZ / (1.2 * white_Y))
     return {"XYZ": XYZ, "sRGB": linear_to_display(rgb, "srgb"), "seconds": seconds}
+
+
+class _CanvasPixels(NamedTuple):
+    """The canvas's visible pixels: G-buffer, points, views, texels and normal-mapped normals."""
+
+    gbuffer: object
+    P: np.ndarray
+    V: np.ndarray
+    row: np.ndarray
+    col: np.ndarray
+    N: np.ndarray
+
+
+def _canvas_pixels(painting: dict, size: int) -> _CanvasPixels:
+    """The canvas seen from :data:`EYE` at ``size²`` pixels, normals from the height map."""
+    g = _painting_gbuffer(size, painting["width_m"])
+    mask = g.mask
+    P, V = g.position[mask], g.view[mask]
+    # Texel of each visible pixel (uv: u along +x columns, v along +z rows).
+    n_tex = painting["height"].shape[0]
+    col = np.clip((g.uv[mask][:, 0] * n_tex).astype(int), 0, n_tex - 1)
+    row = np.clip((g.uv[mask][:, 1] * n_tex).astype(int), 0, n_tex - 1)
+    T, B, N_geo = _canvas_frame()
+    normals_tangent = normal_map_from_height(painting["height"], painting["pixel_size"])
+    N = tangent_to_world(normals_tangent[row, col], T, B, N_geo)
+    return _CanvasPixels(g, P, V, row, col, N)
+
+
+def _canvas_frame() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The canvas's tangent frame T, B, N in world axes: u along +x, v along +z, up +y."""
+    return np.array([1.0, 0, 0]), np.array([0, 0, 1.0]), np.array([0, 1.0, 0])
+
+
+def _horizon_visibility(painting: dict, px: _CanvasPixels, lights, backend: str) -> np.ndarray:
+    """Each pixel's visibility (0 or 1) of each point light, by its texel's horizon (§3.5.3)."""
+    # Once per height field, not per frame (§3.5.3, Ferwerda: a precomputed map).
+    hmap = cached_horizon_map(
+        painting["height"], painting["pixel_size"], HORIZON_SECTORS, 32, backend
+    )
+    to_light = lights.position[None] - px.P[:, None]
+    phi, beta = light_azimuth_elevation(to_light, *_canvas_frame())
+    return horizon_lookup(hmap[px.row, px.col][:, None, :], phi, beta).astype(float)
+
+
+def _canvas_materials(painting: dict, spectra: dict, d, px: _CanvasPixels):
+    """Six-channel materials per pixel: ρ_d from the measured spectra, ρ_s and α from the maps."""
+    names = list(PAINT_SPECTRA)
+    R6 = spectra_to_channels(np.stack([spectra[n] for n in names]), d)
+    canvas = spectra_to_channels(spectra.get("office-paper", np.full(81, 0.85)), d)
+    table = np.concatenate([R6, canvas[None]])
+    material = painting["material"][px.row, px.col]
+    rho_d = table[np.where(material < 0, len(names), material)]
+    rho_s = painting["rho_s"][px.row, px.col][:, None]
+    alpha = painting["alpha"][px.row, px.col]
+    return rho_d, rho_s, alpha
 
 
 def painting_samples(n_side: int, painting: dict):

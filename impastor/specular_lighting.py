@@ -36,6 +36,8 @@ References
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from impastor._kernels import (
@@ -290,54 +292,72 @@ def specular_fis(
     P, N, V, a, shape = _flat(points, normals, views, alpha)
     # Cranley & Patterson 1976: a rotated set keeps the stratification, moves every sample
     u = np.mod(hammersley(n_samples) + np.asarray(shift, dtype=np.float64), 1.0)
-    K = u.shape[0]
     out = np.zeros((P.shape[0], light.image.shape[-1]))
-    A, B = np.asarray(light.A), np.asarray(light.B)
+    channel = _fis_channel_kernel if backend == "numba" else _fis_channel
     for c, image in enumerate(_channels(light.image)):
-        levels = mip_pyramid(image)
-        if backend == "numba":
-            flat = np.concatenate([level.ravel() for level in levels])
-            sizes = np.array([level.size for level in levels])
-            offsets = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
-            heights = np.array([level.shape[0] for level in levels], dtype=np.int64)
-            widths = np.array([level.shape[1] for level in levels], dtype=np.int64)
-            column = np.zeros(P.shape[0])
-            specular_fis_kernel(
-                P, N, V, a, u, flat, offsets, heights, widths, np.asarray(light.origin), A, B,
-                light.l_A, light.l_B, light.pixel_area, float(bias), column,
-            )  # fmt: skip
-            out[:, c] = column
-            continue
-        t, b = frame_from_normal(N)
-        acc = np.zeros(P.shape[0])
-        for k in range(K):
-            # Ward 1992 half-vector sample, reflected about the view: ω_i = 2(V·h)h − V
-            tan2_h = -(a**2) * np.log1p(-min(u[k, 0], 1.0 - 1e-16))
-            cos_h = 1.0 / np.sqrt(1.0 + tan2_h)
-            sin_h = np.sqrt(np.maximum(0.0, 1.0 - cos_h**2))
-            phi = 2.0 * np.pi * u[k, 1]
-            h = (sin_h * np.cos(phi))[:, None] * t + (sin_h * np.sin(phi))[:, None] * b
-            h += cos_h[:, None] * N
-            v_h = np.einsum("pi,pi->p", V, h)
-            wi = 2.0 * v_h[:, None] * h - V
-            cos_i = np.einsum("pi,pi->p", wi, N)
-            pdf = pdf_ward_duer_lobe(V, wi, N, a)
-            # The light lookup (light_plane_uv): where ω_i meets the light, in unit pixel coords
-            a_uv, b_uv, d = light_plane_uv(light, P, wi)
-            hit = (cos_i > 0) & (v_h > 0) & np.isfinite(d)
-            hit &= (a_uv >= 0) & (a_uv < 1) & (b_uv >= 0) & (b_uv < 1)
-            cos_l = -(wi @ light.n_light)
-            safe_d = np.where(hit, d, 1.0)
-            safe_pdf = np.where(hit, pdf, 1.0)
-            # Colbert et al. 2010: Ω_s = 1/(K p), Ω_p = (A/P) cos θ_l / d², level ½ log2(Ω_s/Ω_p)
-            omega_s = 1.0 / (K * safe_pdf)
-            omega_p = light.pixel_area * np.where(hit, cos_l, 1.0) / safe_d**2
-            level = np.maximum(0.5 * np.log2(omega_s / omega_p) + bias, 0.0)
-            L = mip_lookup(levels, np.where(hit, a_uv, 0.5), np.where(hit, b_uv, 0.5), level)
-            f = brdf_ward_duer_specular(wi, V, N, a)
-            acc += np.where(hit, f * L * cos_i / safe_pdf, 0.0)
-        out[:, c] = acc / K
+        out[:, c] = channel(_Pixels(P, N, V, a), u, mip_pyramid(image), light, bias)
     return out.reshape((*shape, -1))
+
+
+class _Pixels(NamedTuple):
+    """Flattened shading points, normals, views and roughness (:func:`_flat`)."""
+
+    P: np.ndarray
+    N: np.ndarray
+    V: np.ndarray
+    a: np.ndarray
+
+
+def _fis_channel(px: _Pixels, u, levels, light: PlaneLight, bias: float) -> np.ndarray:
+    """One channel of :func:`specular_fis` in NumPy: K lobe samples, each a filtered lookup."""
+    P, N, V, a = px
+    K = u.shape[0]
+    t, b = frame_from_normal(N)
+    acc = np.zeros(P.shape[0])
+    for k in range(K):
+        # Ward 1992 half-vector sample, reflected about the view: ω_i = 2(V·h)h − V
+        tan2_h = -(a**2) * np.log1p(-min(u[k, 0], 1.0 - 1e-16))
+        cos_h = 1.0 / np.sqrt(1.0 + tan2_h)
+        sin_h = np.sqrt(np.maximum(0.0, 1.0 - cos_h**2))
+        phi = 2.0 * np.pi * u[k, 1]
+        h = (sin_h * np.cos(phi))[:, None] * t + (sin_h * np.sin(phi))[:, None] * b
+        h += cos_h[:, None] * N
+        v_h = np.einsum("pi,pi->p", V, h)
+        wi = 2.0 * v_h[:, None] * h - V
+        cos_i = np.einsum("pi,pi->p", wi, N)
+        pdf = pdf_ward_duer_lobe(V, wi, N, a)
+        # The light lookup (light_plane_uv): where ω_i meets the light, in unit pixel coords
+        a_uv, b_uv, d = light_plane_uv(light, P, wi)
+        hit = (cos_i > 0) & (v_h > 0) & np.isfinite(d)
+        hit &= (a_uv >= 0) & (a_uv < 1) & (b_uv >= 0) & (b_uv < 1)
+        cos_l = -(wi @ light.n_light)
+        safe_d = np.where(hit, d, 1.0)
+        safe_pdf = np.where(hit, pdf, 1.0)
+        # Colbert et al. 2010: Ω_s = 1/(K p), Ω_p = (A/P) cos θ_l / d², level ½ log2(Ω_s/Ω_p)
+        omega_s = 1.0 / (K * safe_pdf)
+        omega_p = light.pixel_area * np.where(hit, cos_l, 1.0) / safe_d**2
+        level = np.maximum(0.5 * np.log2(omega_s / omega_p) + bias, 0.0)
+        L = mip_lookup(levels, np.where(hit, a_uv, 0.5), np.where(hit, b_uv, 0.5), level)
+        f = brdf_ward_duer_specular(wi, V, N, a)
+        acc += np.where(hit, f * L * cos_i / safe_pdf, 0.0)
+    return acc / K
+
+
+def _fis_channel_kernel(px: _Pixels, u, levels, light: PlaneLight, bias: float) -> np.ndarray:
+    """One channel of :func:`specular_fis` by its numba twin, the mip pyramid in one array."""
+    P, N, V, a = px
+    A, B = np.asarray(light.A), np.asarray(light.B)
+    flat = np.concatenate([level.ravel() for level in levels])
+    sizes = np.array([level.size for level in levels])
+    offsets = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
+    heights = np.array([level.shape[0] for level in levels], dtype=np.int64)
+    widths = np.array([level.shape[1] for level in levels], dtype=np.int64)
+    column = np.zeros(P.shape[0])
+    specular_fis_kernel(
+        P, N, V, a, u, flat, offsets, heights, widths, np.asarray(light.origin), A, B,
+        light.l_A, light.l_B, light.pixel_area, float(bias), column,
+    )  # fmt: skip
+    return column
 
 
 # --- multiple importance sampling (the hybrid's arbiter) ------------------------------------------
@@ -400,19 +420,47 @@ def specular_mis(
     power = L_texel.mean(axis=-1)
     total = power.sum()
     require(total > 0, "specular_mis: the light has no power")
-    n_P = P.shape[0]
-    Vm, Nm, Pm, am = V[:, None], N[:, None], P[:, None], a[:, None]
+    mis = _MIS(light, P[:, None], V[:, None], N[:, None], a[:, None], power, total)
+    g_light, texel = _mis_light_samples(mis, rng, M)
+    g_lobe, lobe_texel = _mis_lobe_samples(mis, rng, M)
+    estimate = np.einsum("pm,pmc->pc", g_light, L_texel[texel])
+    estimate += np.einsum("pm,pmc->pc", g_lobe, L_texel[lobe_texel])
+    # The standard error of the channel mean: the two techniques' sample variances, over M
+    variance = g_light * power[texel]
+    variance = variance.var(axis=1, ddof=1) + (g_lobe * power[lobe_texel]).var(axis=1, ddof=1)
+    return (estimate / M).reshape((*shape, -1)), np.sqrt(variance / M).reshape(shape)
 
-    def weighted(wi, d, texel, valid):
-        # Balance heuristic: f L cos θ_s / (p_light + p_lobe), both per unit solid angle
-        cos_l = -(wi @ light.n_light)
-        cos_s = np.einsum("pmi,pmi->pm", wi, np.broadcast_to(Nm, wi.shape))
-        p_light = power[texel] / (total * light.pixel_area) * d**2 / np.maximum(cos_l, 1e-300)
-        p_lobe = pdf_ward_duer_lobe(Vm, wi, Nm, am)
-        f = brdf_ward_duer_specular(wi, Vm, Nm, am)
-        ok = valid & (cos_l > 0) & (cos_s > 0) & (p_light + p_lobe > 0)
-        return np.where(ok, f * cos_s / np.where(ok, p_light + p_lobe, 1.0), 0.0)
 
+class _MIS(NamedTuple):
+    """What both techniques of :func:`specular_mis` share: the light, the pixels, the power."""
+
+    light: PlaneLight
+    Pm: np.ndarray  # (n_P, 1, 3): one axis for the samples
+    Vm: np.ndarray
+    Nm: np.ndarray
+    am: np.ndarray  # (n_P, 1)
+    power: np.ndarray  # (H·W,): each light pixel's channel mean
+    total: float
+
+
+def _balance_weights(mis: _MIS, wi, d, texel, valid) -> np.ndarray:
+    """``f cos θ_s / (p_light + p_lobe)`` per sample, 0 where the sample is not valid."""
+    light, Vm, Nm, am = mis.light, mis.Vm, mis.Nm, mis.am
+    # Balance heuristic: f L cos θ_s / (p_light + p_lobe), both per unit solid angle
+    cos_l = -(wi @ light.n_light)
+    cos_s = np.einsum("pmi,pmi->pm", wi, np.broadcast_to(Nm, wi.shape))
+    p_light = mis.power[texel] / (mis.total * light.pixel_area) * d**2 / np.maximum(cos_l, 1e-300)
+    p_lobe = pdf_ward_duer_lobe(Vm, wi, Nm, am)
+    f = brdf_ward_duer_specular(wi, Vm, Nm, am)
+    ok = valid & (cos_l > 0) & (cos_s > 0) & (p_light + p_lobe > 0)
+    return np.where(ok, f * cos_s / np.where(ok, p_light + p_lobe, 1.0), 0.0)
+
+
+def _mis_light_samples(mis: _MIS, rng, M: int) -> tuple[np.ndarray, np.ndarray]:
+    """Technique 1 of :func:`specular_mis`: its weights and light pixels, (n_P, M) each."""
+    light, Pm, power, total = mis.light, mis.Pm, mis.power, mis.total
+    n_P = Pm.shape[0]
+    H, W = light.shape
     # Technique 1: a light pixel in proportion to its power, a point uniform inside it
     u = rng.random((n_P, M, 3))
     cdf = np.cumsum(power) / total
@@ -420,7 +468,14 @@ def specular_mis(
     x = light.pixel_positions(texel // W + u[..., 1], texel % W + u[..., 2])
     d = np.linalg.norm(x - Pm, axis=-1)
     wi = (x - Pm) / d[..., None]
-    g_light = weighted(wi, d, texel, np.ones(d.shape, dtype=bool))
+    return _balance_weights(mis, wi, d, texel, np.ones(d.shape, dtype=bool)), texel
+
+
+def _mis_lobe_samples(mis: _MIS, rng, M: int) -> tuple[np.ndarray, np.ndarray]:
+    """Technique 2 of :func:`specular_mis`: its weights and the light pixels met, (n_P, M) each."""
+    light, Pm, Vm, Nm, am = mis.light, mis.Pm, mis.Vm, mis.Nm, mis.am
+    n_P = Pm.shape[0]
+    H, W = light.shape
     # Technique 2: Ward's lobe, the light pixel it meets (light_plane_uv: Eq. (8), Ferwerda)
     u = rng.random((n_P, M, 2))
     wi = sample_ward_duer_lobe(*(np.broadcast_to(x, (n_P, M, 3)) for x in (Vm, Nm)), am, u)
@@ -428,14 +483,8 @@ def specular_mis(
     hit = np.isfinite(d) & (a_uv >= 0) & (a_uv < 1) & (b_uv >= 0) & (b_uv < 1)
     col = np.clip(np.floor(np.where(hit, a_uv, 0.0) * W), 0, W - 1).astype(np.int64)
     row = np.clip(np.floor(np.where(hit, b_uv, 0.0) * H), 0, H - 1).astype(np.int64)
-    g_lobe = weighted(wi, np.where(hit, d, 1.0), row * W + col, hit)
-    lobe_texel = row * W + col
-    estimate = np.einsum("pm,pmc->pc", g_light, L_texel[texel])
-    estimate += np.einsum("pm,pmc->pc", g_lobe, L_texel[lobe_texel])
-    # The standard error of the channel mean: the two techniques' sample variances, over M
-    variance = g_light * power[texel]
-    variance = variance.var(axis=1, ddof=1) + (g_lobe * power[lobe_texel]).var(axis=1, ddof=1)
-    return (estimate / M).reshape((*shape, -1)), np.sqrt(variance / M).reshape(shape)
+    g_lobe = _balance_weights(mis, wi, np.where(hit, d, 1.0), row * W + col, hit)
+    return g_lobe, row * W + col
 
 
 # --- brute force ---------------------------------------------------------------------------------
