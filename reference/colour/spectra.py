@@ -403,14 +403,13 @@ def spectrum_from_csv(
 
     Two layouts are recognised:
 
-    - **long**: one sample per line, wavelength (nm) in the first column and values in the others; a
-    header
-      line is optional. ``column`` picks the value column by header name or 1-based index (default:
-      the second column).
+    - **long**: one sample per line, wavelength (nm) in the first column and values in the others;
+      a header line is optional. ``column`` picks the value column by header name or 1-based index
+      (default: the second column).
     - **wide**: a header row whose cells name wavelengths (``400``, ``400nm``, ``R400 nm``),
-    followed by data
-      rows; ``row`` picks the data row (0-based, default the first). Preamble lines before the
-      header are skipped, as in the Nix Spectro exports in ``data:spectra``, shipped with specref.
+      followed by data rows; ``row`` picks the data row (0-based, default the first). Preamble
+      lines before the header are skipped, as in the Nix Spectro exports in ``data:spectra``,
+      shipped with specref.
 
     The delimiter (``;``, ``,``, tab or spaces) is sniffed; a first line ``sep=;`` is honoured.
 
@@ -448,7 +447,20 @@ def spectrum_from_csv(
     path = Path(path)
     label = name or str(path)
     rows, line_numbers = _read_rows(path)
-    # Wide layout: the first row with at least three increasing wavelength-like cells (200-2500 nm).
+    wide = _wide_header(rows)
+    if wide is not None:
+        header_row, wl_cols = wide
+        wavelengths, values = _wide_samples(rows[header_row + 1 :], wl_cols, row, label)
+    else:
+        wavelengths, values = _long_samples(rows, line_numbers, column, label)
+    return make_spectrum(wavelengths, np.asarray(values) * scale, label)
+
+
+def _wide_header(rows: list[list[str]]) -> tuple[int, list[tuple[float, int]]] | None:
+    """The wide layout's header: the first row with >= 3 increasing wavelength cells (200-2500 nm).
+
+    Returns its index and its ``(wavelength, column)`` cells, or None for the long layout.
+    """
     for r, cells in enumerate(rows):
         wl_cols = [
             (float(m.group(1)), i)
@@ -457,22 +469,27 @@ def spectrum_from_csv(
         ]
         increasing = all(a[0] < b[0] for a, b in itertools.pairwise(wl_cols))
         if len(wl_cols) >= 3 and increasing:
-            data_rows = rows[r + 1 :]
-            require(
-                0 <= row < len(data_rows),
-                f"{label}: row: must be in [0, {len(data_rows) - 1}], got {row}",
-            )
-            data = data_rows[row]
-            values = []
-            for wl, i in wl_cols:
-                value = _as_float(data[i]) if i < len(data) else None
-                require(
-                    value is not None, f"{label}: row {row}: no number under the {wl:g} nm column"
-                )
-                values.append(value)
-            wavelengths = [wl for wl, _ in wl_cols]
-            return make_spectrum(wavelengths, np.asarray(values) * scale, label)
-    # Long layout.
+            return r, wl_cols
+    return None
+
+
+def _wide_samples(data_rows, wl_cols, row: int, label: str) -> tuple[list[float], list[float]]:
+    """Wavelengths and values of data row ``row`` under the wide header's wavelength columns."""
+    require(
+        0 <= row < len(data_rows),
+        f"{label}: row: must be in [0, {len(data_rows) - 1}], got {row}",
+    )
+    data = data_rows[row]
+    values = []
+    for wl, i in wl_cols:
+        value = _as_float(data[i]) if i < len(data) else None
+        require(value is not None, f"{label}: row {row}: no number under the {wl:g} nm column")
+        values.append(value)
+    return [wl for wl, _ in wl_cols], values
+
+
+def _long_samples(rows, line_numbers, column, label: str) -> tuple[list[float], list[float]]:
+    """Wavelengths (first column) and values (``column``) of the long layout, one per line."""
     header = None
     if rows and _as_float(rows[0][0]) is None:
         header, rows, line_numbers = rows[0], rows[1:], line_numbers[1:]
@@ -502,7 +519,7 @@ def spectrum_from_csv(
         f"{label}: needs at least 2 samples (a wavelength and a value per line, or a header row "
         f"of wavelengths), got {len(wavelengths)}",
     )
-    return make_spectrum(wavelengths, np.asarray(values) * scale, label)
+    return wavelengths, values
 
 
 # --- resampling ----------------------------------------------------------------------
@@ -573,6 +590,17 @@ def resample_spectrum(
     inside = (target >= wl[0] - tol) & (target <= wl[-1] + tol)
     out = np.empty_like(target)
     # Inside the measured range: interpolate.
+    out[inside] = _interpolate(spectrum, target[inside], interpolation)
+    # Outside it: the extrapolation the caller chose.
+    if extrapolation != "error":  # "error" has refused a spectrum that does not cover the grid
+        below, above = target < wl[0] - tol, target > wl[-1] + tol
+        out[below], out[above] = _extrapolate(spectrum, target[below], target[above], extrapolation)
+    return out
+
+
+def _interpolate(spectrum: Spectrum, x: np.ndarray, interpolation: str) -> np.ndarray:
+    """Values at wavelengths ``x`` inside the measured range, ``"linear"`` or ``"sprague"``."""
+    wl, v = spectrum.wavelengths_nm, spectrum.values
     if interpolation == "sprague":
         # Sprague's fifth-order scheme needs six uniformly spaced samples (CIE 167): refuse rather
         # than fall back to linear without saying so.
@@ -584,18 +612,21 @@ def resample_spectrum(
         )
         from colour.algebra import SpragueInterpolator
 
-        out[inside] = SpragueInterpolator(wl, v)(np.clip(target[inside], wl[0], wl[-1]))
-    else:
-        out[inside] = np.interp(target[inside], wl, v)
-    # Outside it: the extrapolation the caller chose.
-    below, above = target < wl[0] - tol, target > wl[-1] + tol
+        return SpragueInterpolator(wl, v)(np.clip(x, wl[0], wl[-1]))
+    return np.interp(x, wl, v)
+
+
+def _extrapolate(spectrum: Spectrum, below, above, extrapolation: str):
+    """Values at wavelengths ``below`` and ``above`` the measured range (CIE 015 §7.2.2)."""
+    wl, v = spectrum.wavelengths_nm, spectrum.values
     if extrapolation == "constant":
-        out[below], out[above] = v[0], v[-1]
-    elif extrapolation == "zero":
-        out[below], out[above] = 0.0, 0.0
-    elif extrapolation == "linear":
-        slope_lo = (v[1] - v[0]) / (wl[1] - wl[0])
-        slope_hi = (v[-1] - v[-2]) / (wl[-1] - wl[-2])
-        out[below] = np.maximum(v[0] + slope_lo * (target[below] - wl[0]), 0.0)
-        out[above] = np.maximum(v[-1] + slope_hi * (target[above] - wl[-1]), 0.0)
-    return out
+        return v[0], v[-1]
+    if extrapolation == "zero":
+        return 0.0, 0.0
+    # "linear": the end segments extended, clipped at 0
+    slope_lo = (v[1] - v[0]) / (wl[1] - wl[0])
+    slope_hi = (v[-1] - v[-2]) / (wl[-1] - wl[-2])
+    return (
+        np.maximum(v[0] + slope_lo * (below - wl[0]), 0.0),
+        np.maximum(v[-1] + slope_hi * (above - wl[-1]), 0.0),
+    )
