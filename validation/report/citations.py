@@ -8,9 +8,11 @@ A citation follows the fixed format of STYLE.md §5, ``Eq. (N), Author`` (``Eq. 
 lines left out), other string constants and comments (consecutive comment lines joined) in every
 package, and from the registries' ``cites``. A docstring or comment belongs to its enclosing
 function or class (a nested function's, or a dunder method's, to the enclosing one); a registry
-entry's to its ``reference`` (or ``cls``) and its ``kernel``. :func:`read_tests` and
-:func:`naming_tests` find the tests that name a function. ``validation.report.equations`` builds the
-index from them.
+entry's to its ``reference`` (or ``cls``) and its ``kernel``. :func:`called_names` reads, with the
+same owners, the names each function or class calls, and :func:`registry_twins` pairs each NumPy
+reference with its numba kernel (STYLE.md §6); the index reads from them which function computes
+an equation and which ones call it. :func:`read_tests` and :func:`naming_tests` find the tests that
+name a function. ``validation.report.equations`` builds the index from them.
 """
 
 from __future__ import annotations
@@ -33,11 +35,15 @@ __all__ = [
     "PACKAGES",
     "ROOT",
     "Citation",
+    "called_names",
     "collect_citations",
+    "is_kernel",
+    "kernel_reference",
     "naming_tests",
     "parse_citations",
     "read_tests",
     "registry_entries",
+    "registry_twins",
     "resolve",
 ]
 
@@ -111,6 +117,7 @@ class _Owners(ast.NodeVisitor):
 
     def __init__(self, docstrings: set[int]):
         self.docstrings, self.stack, self.spans, self.texts = docstrings, [], [], []
+        self.calls: list[tuple[str, str]] = []  # (owner, name called)
 
     def _scope(self, node):
         kind = "class" if isinstance(node, ast.ClassDef) else "function"
@@ -124,11 +131,22 @@ class _Owners(ast.NodeVisitor):
         doc = ast.get_docstring(node)
         if doc:
             self.texts.append((node.body[0].lineno, owner, "docstring", doc))
+        decorators = {id(d) for d in node.decorator_list}
+        for decorator in node.decorator_list:  # run in the enclosing scope
+            self.visit(decorator)
         self.stack.append((owner, kind))
-        self.generic_visit(node)
+        for child in ast.iter_child_nodes(node):
+            if id(child) not in decorators:
+                self.visit(child)
         self.stack.pop()
 
     visit_FunctionDef = visit_AsyncFunctionDef = visit_ClassDef = _scope
+
+    def visit_Call(self, node):
+        name = getattr(node.func, "id", None) or getattr(node.func, "attr", None)
+        if name:
+            self.calls.append((self.stack[-1][0] if self.stack else "", name))
+        self.generic_visit(node)
 
     def visit_Constant(self, node):
         if isinstance(node.value, str) and "Eq" in node.value and id(node) not in self.docstrings:
@@ -156,14 +174,20 @@ def _comment_blocks(source: str) -> list[tuple[int, str]]:
     return blocks
 
 
-def _file_citations(path: Path, root: Path) -> list[Citation]:
-    """The citations in one source file: docstrings, other string constants and comments."""
+def _read(path: Path, root: Path):
+    """``(source, tree, module, owners)`` of one source file, its owners visited."""
     source = path.read_text(encoding="utf-8")
     tree = ast.parse(source)
-    relative = path.relative_to(root).as_posix()
-    module = relative[:-3].replace("/", ".").removesuffix(".__init__")
+    module = path.relative_to(root).as_posix()[:-3].replace("/", ".").removesuffix(".__init__")
     owners = _Owners({id(n.body[0].value) for n in ast.walk(tree) if _has_docstring(n)})
     owners.visit(tree)
+    return source, tree, module, owners
+
+
+def _file_citations(path: Path, root: Path) -> list[Citation]:
+    """The citations in one source file: docstrings, other string constants and comments."""
+    source, tree, module, owners = _read(path, root)
+    relative = path.relative_to(root).as_posix()
     texts = [(t[0], t[1], t[2], _without_doctests(t[3])) for t in owners.texts]
     module_doc = ast.get_docstring(tree)
     if module_doc:
@@ -176,6 +200,35 @@ def _file_citations(path: Path, root: Path) -> list[Citation]:
         for author, number, grouped in parse_citations(text):
             found.append(Citation(relative, line, name, kind, author, number, grouped))
     return found
+
+
+def _sources(root: Path, packages):
+    for package in packages:
+        for path in sorted((root / package).rglob("*.py")):
+            if path.relative_to(root).as_posix() not in SKIP:
+                yield path
+
+
+def called_names(root: Path | None = None, packages=PACKAGES) -> dict[str, frozenset[str]]:
+    """``owner -> {names}``: the names that each function or class of ``packages`` calls.
+
+    A call ``f(...)`` gives ``f`` and ``x.f(...)`` gives ``f``; a call belongs to its owner as a
+    citation does (a nested function's or a dunder method's to the enclosing one), so
+    ``owner`` is a :attr:`Citation.owner`.
+
+    Examples
+    --------
+    >>> calls = called_names(packages=("phong_table",))
+    >>> "inverse_importance_ratio_Wang" in calls["phong_table.placement.table_importance_Wang"]
+    True
+    """
+    root = ROOT if root is None else Path(root)
+    calls: dict[str, set[str]] = defaultdict(set)
+    for path in _sources(root, packages):
+        module, owners = _read(path, root)[2:]
+        for owner, name in owners.calls:
+            calls[f"{module}.{owner}" if owner else module].add(name)
+    return {owner: frozenset(names) for owner, names in calls.items()}
 
 
 def _has_docstring(node) -> bool:
@@ -220,10 +273,10 @@ def _registry_homes(root: Path, packages) -> dict[str, set[str]]:
 
 
 @functools.lru_cache(maxsize=4)
-def _registry_citations(root: Path, packages) -> tuple[list[Citation], dict[str, set[str]]]:
-    """Citations in registry entries' ``cites``, and ``function -> {registry names}``."""
+def _registry_citations(root: Path, packages):
+    """Citations in registry entries' ``cites``, ``function -> {registry names}``, twins."""
     homes = _registry_homes(root, packages)
-    seen, found, registered = set(), [], defaultdict(set)
+    seen, found, registered, twins = set(), [], defaultdict(set), defaultdict(set)
     modules = list(_modules(packages))  # all imported first: importing one can register in another
     for module in modules:
         for var, registry in vars(module).items():
@@ -238,13 +291,60 @@ def _registry_citations(root: Path, packages) -> tuple[list[Citation], dict[str,
                 names = [n for n in map(_qualified, targets) if n]
                 for name in names:
                     registered[name].add(f"{var}[{key!r}]")
+                reference, kernel = (
+                    _qualified(getattr(entry, a, None)) for a in ("reference", "kernel")
+                )
+                if reference and kernel and reference != kernel:
+                    twins[reference].add(kernel)
+                    twins[kernel].add(reference)
                 path = module.__name__.replace(".", "/") + ".py"
                 for author, number, grouped in parse_citations(getattr(entry, "cites", "") or ""):
                     for name in names or [where]:
                         found.append(
                             Citation(path, 0, name, "registry", author, number, grouped, where)
                         )
-    return found, registered
+    return found, registered, twins
+
+
+def is_kernel(name: str) -> bool:
+    """Whether ``name`` is in a ``_*kernels`` module: numba code, a NumPy reference's twin.
+
+    Examples
+    --------
+    >>> is_kernel("phong_table._kernels.tabulate_kernel"), is_kernel("phong_table.table.tabulate")
+    (True, False)
+    """
+    return any(p.startswith("_") and p.endswith("kernels") for p in name.split(".")[:-1])
+
+
+def kernel_reference(kernel: str, names, twins: dict[str, set[str]]) -> str:
+    """A kernel's NumPy reference (STYLE.md §6), or ``""``.
+
+    The reference of the kernel's registry entry (one of ``names`` first), else the function of
+    ``names`` in the same package that ``f_kernel`` is named after: ``f``.
+
+    Examples
+    --------
+    >>> kernel_reference("phong_table._kernels.tabulate_kernel", ["phong_table.table.tabulate"], {})
+    'phong_table.table.tabulate'
+    """
+    registered = sorted(twins.get(kernel, ()), key=lambda t: (t not in names, t))
+    if registered:
+        return registered[0]
+    short = kernel.rsplit(".", 1)[-1]
+    if not short.endswith("_kernel"):
+        return ""
+    package = kernel.split(".")[0]
+    return next(
+        (
+            name
+            for name in sorted(names)
+            if name.rsplit(".", 1)[-1] == short.removesuffix("_kernel")
+            and name.split(".")[0] == package
+            and not is_kernel(name)
+        ),
+        "",
+    )
 
 
 def collect_citations(root: Path | None = None, packages=PACKAGES) -> list[Citation]:
@@ -271,10 +371,8 @@ def collect_citations(root: Path | None = None, packages=PACKAGES) -> list[Citat
     """
     root = ROOT if root is None else Path(root)
     found = []
-    for package in packages:
-        for path in sorted((root / package).rglob("*.py")):
-            if path.relative_to(root).as_posix() not in SKIP:
-                found += _file_citations(path, root)
+    for path in _sources(root, packages):
+        found += _file_citations(path, root)
     found += _registry_citations(root, packages)[0]
     return sorted(set(found), key=lambda c: (c.path, c.line, c.owner, c.number))
 
@@ -288,6 +386,17 @@ def registry_entries(root: Path | None = None, packages=PACKAGES) -> dict[str, s
     ["PLACEMENT_METHODS['importance']"]
     """
     return _registry_citations(ROOT if root is None else Path(root), tuple(packages))[1]
+
+
+def registry_twins(root: Path | None = None, packages=PACKAGES) -> dict[str, set[str]]:
+    """``function -> {twins}``: the kernel of a registry entry's reference, and the reverse.
+
+    Examples
+    --------
+    >>> sorted(registry_twins()["phong_table.placement.table_error"])
+    ['phong_table._kernels.table_error_kernel']
+    """
+    return _registry_citations(ROOT if root is None else Path(root), tuple(packages))[2]
 
 
 # --- tests naming a function ------------------------------------------------------------------

@@ -8,6 +8,13 @@ section and a one-line description); everything else is found in the code:
 - **Citations** (``Eq. (N), Wang et al.``, ``Eq. (N), Herbert et al.``, ``Eq. (N), Ferwerda``; lists
   and ranges expanded) in docstrings, comments and registry entries of every package
   (:func:`validation.report.citations.collect_citations`), each belonging to a function or class.
+- **Which function computes the equation** (:data:`COMPUTES`): a function or class computes
+  ``Eq. (N)`` when a comment in its body names it (STYLE.md §5: a comment names the equation its
+  lines compute) and it calls no other function (a numba kernel aside) whose body comment names
+  it; the others citing it (in a docstring, a registry's ``cites``, or a comment over a call of
+  the computing function) use it. A numba kernel (a function of a ``_*kernels`` module) whose
+  NumPy twin (the reference of its registry entry, or ``f`` for ``f_kernel``) also computes the
+  equation is shown as that twin's.
 - **Tests** that name each function, or are parametrized over its registry
   (:func:`validation.report.citations.naming_tests`).
 - **Errata**: the entries of ``docs/errata.md`` whose bold title cites the equation (an equation
@@ -24,6 +31,7 @@ grep for ``Eq. (N), Author`` would miss it), and an indexed function that cannot
 from __future__ import annotations
 
 import re
+import textwrap
 from collections import defaultdict
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,15 +40,20 @@ from reference.errors import require
 from validation.report.citations import (
     ROOT,
     Citation,
+    called_names,
     collect_citations,
+    is_kernel,
+    kernel_reference,
     naming_tests,
     parse_citations,
     read_tests,
     registry_entries,
+    registry_twins,
     resolve,
 )
 
 __all__ = [
+    "COMPUTES",
     "PAPERS",
     "REGENERATE",
     "Equation",
@@ -56,6 +69,13 @@ __all__ = [
 _EXTERNAL = re.compile(r" \d{4}$")
 #: The one command that regenerates ``docs/equations.md``.
 REGENERATE = "make equations"
+#: The rule that tells the function computing an equation from those using it (in the page).
+COMPUTES = (
+    "A function computes Eq. (N) when a comment in its body names the equation (STYLE.md §5: "
+    "a comment names the equation its lines compute) and it calls no other function (a numba "
+    "kernel aside) whose body comment names it; a docstring, a registry entry's `cites`, or a "
+    "comment over a call of the computing function marks a use."
+)
 
 
 @dataclass(frozen=True)
@@ -219,13 +239,22 @@ PAPERS = (
 
 @dataclass(frozen=True)
 class IndexedFunction:
-    """A function (or class) citing an equation, its registry entries and the tests naming it."""
+    """A function (or class) citing an equation, its registry entries and the tests naming it.
+
+    ``computes`` follows :data:`COMPUTES`; ``calls`` names the functions whose body comment names
+    the equation and that this one calls; ``kernel`` marks a numba kernel, ``twin`` its NumPy
+    reference (or a reference's kernel) among the functions citing the equation.
+    """
 
     name: str
     registered: tuple[str, ...] = ()
     grouped_only: bool = False
     tests: tuple[str, ...] = ()
     doctest: bool = False
+    computes: bool = False
+    calls: tuple[str, ...] = ()
+    kernel: bool = False
+    twin: str = ""
 
 
 @dataclass(frozen=True)
@@ -239,6 +268,23 @@ class EquationRow:
     note: str
     functions: tuple[IndexedFunction, ...] = ()
     errata: tuple[str, ...] = ()
+
+    @property
+    def computed_by(self) -> tuple[IndexedFunction, ...]:
+        """The functions computing the equation, NumPy first; a kernel only if its twin does not."""
+        computing = {f.name for f in self.functions if f.computes}
+        shown = [f for f in self.functions if f.computes and not (f.kernel and f.twin in computing)]
+        return tuple(sorted(shown, key=lambda f: (f.kernel, f.name)))
+
+    @property
+    def used_by(self) -> tuple[IndexedFunction, ...]:
+        """The functions citing the equation without computing it."""
+        return tuple(f for f in self.functions if not f.computes)
+
+    def kernel_twin(self, function: IndexedFunction) -> IndexedFunction | None:
+        """The numba kernel computing the equation beside the NumPy ``function``, if any."""
+        twins = [f for f in self.functions if f.kernel and f.computes and f.twin == function.name]
+        return twins[0] if twins and not function.kernel else None
 
 
 def _errata(root: Path) -> dict[tuple[str, str], set[str]]:
@@ -271,7 +317,42 @@ def _is_function(c: Citation) -> bool:
     return c.kind != "string" and "[" not in c.owner and c.owner != module
 
 
-def equation_index(root: Path | None = None, citations=None) -> list[EquationRow]:
+def _short(name: str) -> str:
+    return name.rsplit(".", 1)[-1]
+
+
+def _row_functions(cited, commented, calls, registered, twins, tests):
+    """The :class:`IndexedFunction` of each function citing one equation.
+
+    ``cited`` maps each function citing it to whether it does so only in ranges or lists;
+    ``commented`` holds those whose body comment names it (see :data:`COMPUTES`).
+    """
+    kernels = {n: kernel_reference(n, cited, twins) for n in cited if is_kernel(n)}
+    functions = []
+    for name, grouped_only in sorted(cited.items()):
+        called = tuple(
+            other
+            for other in sorted(commented)
+            if other != name and not is_kernel(other) and _short(other) in calls.get(name, ())
+        )
+        twin = kernels.get(name) or next((k for k, t in sorted(kernels.items()) if t == name), "")
+        functions.append(
+            IndexedFunction(
+                name,
+                tuple(sorted(registered.get(name, ()))),
+                grouped_only,
+                naming_tests(name, registered.get(name, set()), tests),
+                ">>>" in (getattr(resolve(name), "__doc__", None) or ""),
+                computes=name in commented and not called,
+                calls=called if name in commented else (),
+                kernel=name in kernels,
+                twin=twin,
+            )
+        )
+    return tuple(functions)
+
+
+def equation_index(root: Path | None = None, citations=None, calls=None) -> list[EquationRow]:
     """One row per numbered equation of each paper, in :data:`PAPERS` order.
 
     Parameters
@@ -280,12 +361,16 @@ def equation_index(root: Path | None = None, citations=None) -> list[EquationRow
         The repository root (default: the one this module is in).
     citations : list of Citation, optional
         Default :func:`collect_citations` (tests pass their own).
+    calls : dict, optional
+        ``function -> {names it calls}``, default
+        :func:`~validation.report.citations.called_names` (tests pass their own).
 
     Returns
     -------
     list of EquationRow
-        The functions (and classes) citing the equation, each with its registry entries and the
-        tests that name it, and the errata whose title cites the equation.
+        The functions (and classes) citing the equation, each with its registry entries, the
+        tests that name it and whether it computes the equation (:data:`COMPUTES`), and the errata
+        whose title cites the equation.
 
     Examples
     --------
@@ -293,33 +378,33 @@ def equation_index(root: Path | None = None, citations=None) -> list[EquationRow
     >>> [f.name for f in rows["Wang et al.", 15].functions]
     ['phong_table.placement.inverse_importance_ratio_Wang',
      'phong_table.placement.table_importance_Wang']
+    >>> [f.name for f in rows["Wang et al.", 15].computed_by]
+    ['phong_table.placement.inverse_importance_ratio_Wang']
     >>> "shrm.polymer.hybrid.polymer_terms" in [f.name for f in rows["Herbert et al.", 3].functions]
     True
     """
     root = ROOT if root is None else Path(root)
     require((root / "tests").is_dir(), f"equation index: no tests/ folder in {root}")
     citations = collect_citations(root) if citations is None else citations
-    registered = registry_entries(root)
+    calls = called_names(root) if calls is None else calls
+    registered, twins = registry_entries(root), registry_twins(root)
     tests, errata = read_tests(root), _errata(root)
     # (author, number) -> {owner: cited only in ranges or lists}
     owners: dict[tuple[str, str], dict[str, bool]] = defaultdict(dict)
+    # (author, number) -> {owners with a body comment naming it}
+    commented: dict[tuple[str, str], set[str]] = defaultdict(set)
     for c in citations:
         if c.author and _is_function(c):
             seen = owners[(c.author, c.number)]
             seen[c.owner] = seen.get(c.owner, True) and c.grouped
+            if c.kind == "comment":
+                commented[(c.author, c.number)].add(c.owner)
     rows = []
     for paper in PAPERS:
         for eq in paper.equations:
             key = (paper.author, str(eq.number))
-            functions = tuple(
-                IndexedFunction(
-                    name,
-                    tuple(sorted(registered.get(name, ()))),
-                    grouped_only,
-                    naming_tests(name, registered.get(name, set()), tests),
-                    ">>>" in (getattr(resolve(name), "__doc__", None) or ""),
-                )
-                for name, grouped_only in sorted(owners.get(key, {}).items())
+            functions = _row_functions(
+                owners.get(key, {}), commented.get(key, set()), calls, registered, twins, tests
             )
             found = tuple(sorted(errata.get(key, ()), key=lambda e: int(e[1:])))
             rows.append(
@@ -400,29 +485,58 @@ def _numbers(numbers: list[str]) -> str:
 # --- Markdown ----------------------------------------------------------------------------------
 
 
-def _cell(function: IndexedFunction) -> str:
-    """One function of a row: name, registry entries, the first test naming it."""
-    text = f"`{function.name}`"
-    if function.registered:
-        text += " (" + ", ".join(f"`{r}`" for r in function.registered) + ")"
-    if function.grouped_only:
-        text += ", only in a range or list"
-    if function.tests:
-        more = len(function.tests) - 1
-        text += f"; tested by `{function.tests[0]}`" + (f" and {more} more" if more else "")
-    else:
-        text += "; no test names it" + (" (its doctest runs)" if function.doctest else "")
+def _tested(function: IndexedFunction, shown: int = 2) -> str:
+    """The first ``shown`` tests naming a function, and how many more."""
+    if not function.tests:
+        return "no test names it" + (" (its doctest runs)" if function.doctest else "")
+    first = ", ".join(f"`{t}`" for t in function.tests[:shown])
+    more = len(function.tests) - shown
+    return f"tested by {first}" + (f" and {more} more" if more > 0 else "")
+
+
+def _computing(row: EquationRow, function: IndexedFunction) -> str:
+    """One function computing the equation: name, registry entries, tests, its kernel twin."""
+    notes = [f"`{r}`" for r in function.registered]
+    if function.kernel:
+        notes.append("numba kernel" + (f", twin of `{function.twin}`" if function.twin else ""))
+    text = f"`{function.name}`" + (f" ({', '.join(notes)})" if notes else "")
+    text += f"; {_tested(function)}"
+    twin = row.kernel_twin(function)
+    if twin:
+        text += f"; numba twin `{twin.name}`, {_tested(twin, 1)}"
     return text
+
+
+def _using(function: IndexedFunction) -> str:
+    """One function using the equation, compactly: name, registry entries, calls, tests."""
+    notes = [", ".join(f"`{r}`" for r in function.registered)] if function.registered else []
+    if function.calls:
+        notes.append("calls " + ", ".join(f"`{_short(c)}`" for c in function.calls))
+    if function.grouped_only:
+        notes.append("only in a range or list")
+    n = len(function.tests)
+    if n:
+        notes.append(f"{n} test{'s' * (n != 1)}")
+    else:
+        notes.append("no test names it" + ("; its doctest runs" if function.doctest else ""))
+    return f"`{function.name}` ({'; '.join(notes)})"
 
 
 def _row_markdown(row: EquationRow) -> list[str]:
     lines = [f"### Eq. ({row.number}), {row.author}", "", f"{row.section}. {row.what}.", ""]
     if row.note:
         lines += [f"*{row.note[0].upper()}{row.note[1:]}.*", ""]
-    if row.functions:
-        lines += [f"- {_cell(f)}" for f in row.functions]
+    if row.computed_by:
+        lines += ["- **Computed by**:", *[f"  - {_computing(row, f)}" for f in row.computed_by]]
     else:
-        lines += ["- No function cites it."]
+        lines += ["- **Computed by**: none found (no comment in a function body names it)."]
+    used = row.used_by
+    if used:
+        lines += [f"- **Used by** ({len(used)}): " + ", ".join(_using(f) for f in used) + "."]
+    elif not row.functions:
+        lines += ["- **Used by**: none (no function cites it)."]
+    else:
+        lines += ["- **Used by**: none."]
     if row.errata:
         lines += [f"- Errata: {', '.join(row.errata)} (docs/errata.md)."]
     return [*lines, ""]
@@ -443,8 +557,10 @@ def _external(citations) -> list[str]:
     return lines
 
 
-def render_equation_index(root: Path | None = None, citations=None) -> str:
+def render_equation_index(root: Path | None = None, citations=None, calls=None) -> str:
     """``docs/equations.md``: the summary table, then each paper's equations, then the others.
+
+    ``citations`` and ``calls`` are passed to :func:`equation_index`.
 
     Examples
     --------
@@ -454,7 +570,7 @@ def render_equation_index(root: Path | None = None, citations=None) -> str:
     """
     root = ROOT if root is None else Path(root)
     citations = collect_citations(root) if citations is None else citations
-    rows = equation_index(root, citations)
+    rows = equation_index(root, citations, calls)
     lines = [
         "# Equation index",
         "",
@@ -464,16 +580,26 @@ def render_equation_index(root: Path | None = None, citations=None) -> str:
         "code cites an equation that a paper does not have or cites one without an author, and",
         "when a function named here does not exist.",
         "For each numbered equation of each paper: the functions and classes whose docstring,",
-        "comments or registry entry cite it (`Eq. (N), Author`), the first test that names each",
-        "one, and the errata whose title cites the equation.",
+        "comments or registry entry cite it (`Eq. (N), Author`), split into those that compute",
+        "it and those that use it, the tests that name each one, and the errata whose title cites",
+        "the equation.",
         "",
-        "| paper | Eq. | § | functions | errata | note |",
-        "|---|---|---|---|---|---|",
+        *textwrap.wrap(
+            f"**Computes or uses.** {COMPUTES} A numba kernel whose NumPy twin (the reference of "
+            "its registry entry, or `f` for `f_kernel`) also computes the equation is shown as "
+            "that twin's. Where no comment in a function body names an equation, its row says "
+            "so (**none**): a finding about the code, not an error of the index.",
+            92,
+        ),
+        "",
+        "| paper | Eq. | § | computed by | used by | errata | note |",
+        "|---|---|---|---|---|---|---|",
     ]
     for row in rows:
+        computed = ", ".join(f"`{_short(f.name)}`" for f in row.computed_by) or "**none**"
         lines.append(
-            f"| {row.author} | ({row.number}) | {row.section} | {len(row.functions) or 'none'} | "
-            f"{', '.join(row.errata)} | {row.note} |"
+            f"| {row.author} | ({row.number}) | {row.section} | {computed} | "
+            f"{len(row.used_by)} | {', '.join(row.errata)} | {row.note} |"
         )
     for paper in PAPERS:
         lines += ["", f"## {paper.author}: {paper.title}", "", f"Numbering: {paper.numbering}", ""]

@@ -3,11 +3,15 @@
 import pytest
 
 from validation.report.citations import (
+    called_names,
     collect_citations,
+    is_kernel,
+    kernel_reference,
     naming_tests,
     parse_citations,
     read_tests,
     registry_entries,
+    registry_twins,
     resolve,
 )
 
@@ -77,6 +81,59 @@ def test_collect_reads_docstrings_comments_strings_and_owners(tmp_path, monkeypa
         ("5", "fake_cited_code.A.m", "comment", 15),  # consecutive comment lines are one text
         ("6", "fake_cited_code.A.m", "string", 19),
     ]
+
+
+def test_called_names_belong_to_the_owners_of_citations(tmp_path, monkeypatch):
+    package = tmp_path / "fake_calling_code"
+    package.mkdir()
+    (package / "__init__.py").write_text(
+        "import functools\n\n\n"
+        "@functools.lru_cache(maxsize=2)\n"  # a decorator runs in the enclosing scope
+        "def f(x):\n"
+        "    def inner():\n"
+        "        return g(x)\n\n"  # a nested function's calls are the outer function's
+        "    return inner() + x.h()\n\n\n"
+        "class A:\n"
+        "    def __init__(self):\n"
+        "        self.v = f(1)\n\n"  # a dunder method's calls are its class's
+        "    def m(self):\n"
+        "        return k()\n\n\n"
+        "TOP = sorted([2, 1])\n"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    calls = called_names(tmp_path, ("fake_calling_code",))
+    assert calls == {
+        "fake_calling_code": {"lru_cache", "sorted"},
+        "fake_calling_code.f": {"inner", "g", "h"},
+        "fake_calling_code.A": {"f"},
+        "fake_calling_code.A.m": {"k"},
+    }
+    # the owners are those of the citations read from the same file
+    (package / "__init__.py").write_text(
+        (package / "__init__.py")
+        .read_text()
+        .replace("return k()", "return k()  # Eq. (4), Ferwerda")
+    )
+    found = collect_citations(tmp_path, ("fake_calling_code",))
+    assert [c.owner for c in found] == ["fake_calling_code.A.m"]
+
+
+def test_kernels_and_their_references():
+    assert is_kernel("phong_table._kernels.tabulate_kernel")
+    assert is_kernel("reference.geometry._raster_kernels.rasterize_triangles_kernel")
+    assert not is_kernel("phong_table.table.tabulate")
+    assert not is_kernel("shrm.kernels_of_lobes")  # only a private ``_*kernels`` module
+    twins = registry_twins()
+    # Source: phong_table/placement.py, PLACEMENT_METHODS: Method("error", table_error,
+    # table_error_kernel, ...); Method("uniform", table_uniform, None, ...) has no kernel
+    assert twins["phong_table.placement.table_error"] == {"phong_table._kernels.table_error_kernel"}
+    assert twins["phong_table._kernels.table_error_kernel"] == {"phong_table.placement.table_error"}
+    assert "phong_table.placement.table_uniform" not in twins
+    # without a registry entry, f_kernel is the twin of f in the same package
+    names = ["phong_table.table.tabulate", "shrm.tabulate", "phong_table._kernels.tabulate"]
+    assert kernel_reference("phong_table._kernels.tabulate_kernel", names, {}) == names[0]
+    assert kernel_reference("phong_table._kernels._helper", names, {}) == ""
+    assert kernel_reference("impastor._kernels.tabulate_kernel", names, {}) == ""
 
 
 def test_registry_entries_name_reference_and_kernel():

@@ -7,7 +7,9 @@ from pathlib import Path
 import pytest
 
 from validation.cli import main
+from validation.report.citations import called_names
 from validation.report.equations import (
+    COMPUTES,
     PAPERS,
     REGENERATE,
     ROOT,
@@ -97,6 +99,140 @@ def test_rows_name_functions_tests_and_errata(rows):
         f for f in rows["Wang et al.", 16].functions if f.name.endswith("table_importance_Wang")
     )
     assert importance.registered == ("PLACEMENT_METHODS['importance']",)
+
+
+def _section(text: str, heading: str) -> str:
+    """The section of a rendered index under ``heading``, up to the next heading."""
+    return text.split(f"### {heading}\n", 1)[1].split("\n#", 1)[0]
+
+
+def test_a_body_comment_marks_the_computing_function(tmp_path, monkeypatch):
+    package = tmp_path / "fake_computing_code"
+    package.mkdir()
+    (package / "__init__.py").write_text(
+        "def average(n):\n"
+        '    """The average exponent an of the proxy, Eq. (13), Wang et al."""\n'
+        "    return sum(n) / len(n)\n\n\n"
+        "def mean_exponent(n):\n"
+        '    """The average exponent (no citation here)."""\n'
+        "    # Eq. (13), Wang et al.: an = (1/N) sum of n\n"
+        "    return sum(n) / len(n)\n\n\n"
+        "def table(n):\n"
+        "    # Eq. (13), Wang et al.: an, for the placement\n"
+        "    return mean_exponent(n) + 1\n\n\n"
+        "def closed_form(t, an):\n"
+        '    """Eq. (15), Wang et al., used but computed nowhere."""\n'
+        "    return t ** (1 / (an + 1))\n"
+    )
+    (package / "_kernels.py").write_text(
+        "def mean_exponent_kernel(n, out):\n"
+        "    acc = 0.0\n"
+        "    for x in n:\n"
+        "        acc += x  # Eq. (13), Wang et al.\n"
+        "    out[0] = acc / len(n)\n\n\n"
+        "def _ratio(t, an):\n"
+        "    return t ** (an + 1)  # Eq. (14), Wang et al.\n"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    found = collect_citations(tmp_path, ("fake_computing_code",))
+    calls = called_names(tmp_path, ("fake_computing_code",))
+    rows = {(r.author, r.number): r for r in equation_index(citations=found, calls=calls)}
+
+    # the body comment computes, the docstring mention and the comment over a call use
+    row = rows["Wang et al.", 13]
+    assert [f.name for f in row.computed_by] == ["fake_computing_code.mean_exponent"]
+    twin = row.kernel_twin(row.computed_by[0])
+    assert twin.name == "fake_computing_code._kernels.mean_exponent_kernel"
+    assert twin.kernel
+    assert [(f.name, f.calls) for f in row.used_by] == [
+        ("fake_computing_code.average", ()),
+        ("fake_computing_code.table", ("fake_computing_code.mean_exponent",)),
+    ]
+    # a kernel without a NumPy twin that computes is a computing function of its own
+    (ratio,) = rows["Wang et al.", 14].computed_by
+    assert (ratio.name, ratio.kernel, ratio.twin) == (
+        "fake_computing_code._kernels._ratio",
+        True,
+        "",
+    )
+    # cited only in a docstring: no function computes it, and that is not a problem
+    assert rows["Wang et al.", 15].computed_by == ()
+    assert [f.name for f in rows["Wang et al.", 15].used_by] == ["fake_computing_code.closed_form"]
+    assert equation_problems(found, list(rows.values())) == []
+
+    # The page: "computed by" first, with the twin beside its reference; then "used by"
+    text = render_equation_index(citations=found, calls=calls)
+    section = _section(text, "Eq. (13), Wang et al.")
+    computed, used = section.index("**Computed by**"), section.index("**Used by**")
+    assert computed < used
+    assert "  - `fake_computing_code.mean_exponent`; no test names it; numba twin " in section
+    assert "`fake_computing_code._kernels.mean_exponent_kernel`" in section[computed:used]
+    assert "`fake_computing_code.average`" in section[used:]
+    assert "`fake_computing_code.table` (calls `mean_exponent`; no test names it)" in section
+    assert "`fake_computing_code._kernels._ratio` (numba kernel)" in _section(
+        text, "Eq. (14), Wang et al."
+    )
+    assert "- **Computed by**: none found (no comment in a function body names it)." in _section(
+        text, "Eq. (15), Wang et al."
+    )
+    # the summary table names the computing function, or none
+    assert "| Wang et al. | (13) | §3.2 | `mean_exponent` | 2 | " in text
+    assert "| Wang et al. | (15) | §3.2 | **none** | 1 | " in text
+    assert COMPUTES.split(";")[0] in " ".join(text.split())
+
+
+def test_computing_functions_found_in_the_source(rows):
+    # Source: phong_table/model.py, average_exponent_Wang's body comment "Eq. (13), Wang et
+    # al. (Erratum E1): an = (1/N) Σ_λ n(λ)"; the placement's functions cite it in docstrings
+    row = rows["Wang et al.", 13]
+    assert [f.name for f in row.computed_by] == ["phong_table.model.average_exponent_Wang"]
+    used = {f.name for f in row.used_by}
+    assert {
+        "phong_table.placement.table_importance_Wang",
+        "phong_table.placement.table_error",
+    } <= used
+    # Source: impastor/point_lights.py, illuminance_point_lights's body comments "Eq. (2),
+    # Ferwerda: ..."; median_cut places the lights (docstring and registry cites);
+    # impastor/painting.py, render_painting comments "Eq. (2), Ferwerda" over a call of it
+    row = rows["Ferwerda", 2]
+    names = [f.name for f in row.computed_by]
+    assert "impastor.point_lights.illuminance_point_lights" in names
+    used = {f.name: f for f in row.used_by}
+    assert "impastor.point_lights.median_cut" in used
+    assert used["impastor.painting.render_painting"].calls == (
+        "impastor.point_lights.illuminance_point_lights",
+    )
+    # Source: phong_table/placement.py, table_importance_Wang's "Eq. (15), Wang et al." comment
+    # is over a call of inverse_importance_ratio_Wang, whose body computes t = w^(1/(an+1))
+    row = rows["Wang et al.", 15]
+    assert [f.name for f in row.computed_by] == [
+        "phong_table.placement.inverse_importance_ratio_Wang"
+    ]
+    # Source: shrm/polymer/material.py and shrm/polymer/_kernels.py, both with the "Eq. (3),
+    # Herbert et al.: + E_effect Mod_effect" comment, and POLYMER_KERNELS pairs them
+    row = rows["Herbert et al.", 3]
+    shade_parts = next(f for f in row.computed_by if f.name.endswith(".polymer_shade_parts"))
+    kernel = row.kernel_twin(shade_parts)
+    assert kernel.name == "shrm.polymer._kernels.polymer_shade_parts_kernel"
+    assert kernel not in row.computed_by
+    assert kernel not in row.used_by
+    # Wang et al. (3) is cited nowhere: the row says that nothing computes it
+    assert rows["Wang et al.", 3].computed_by == rows["Wang et al.", 3].functions == ()
+
+
+def test_computes_follows_the_rule_on_the_whole_tree(citations, rows):
+    commented = {(c.author, c.number, c.owner) for c in citations if c.kind == "comment"}
+    for (author, number), row in rows.items():
+        names = {f.name for f in row.functions}
+        for f in row.functions:
+            key = (author, str(number), f.name)
+            # computes <=> a body comment names it and it calls no function that computes it
+            assert f.computes == (key in commented and not f.calls), (key, f.calls)
+            assert all((author, str(number), c) in commented and c in names for c in f.calls)
+        # every function is shown once: computing, as a computing kernel's twin, or using
+        twins = [row.kernel_twin(f) for f in row.computed_by]
+        shown = [*row.computed_by, *(t for t in twins if t), *row.used_by]
+        assert sorted(f.name for f in shown) == sorted(names), (author, number)
 
 
 def test_ranges_and_lists_are_expanded_and_flagged(tmp_path, monkeypatch):
