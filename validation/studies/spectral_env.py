@@ -9,6 +9,8 @@ diffuser under that illuminant as the Lab white.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from reference.colour.colorimetry import XYZ_to_Lab, band_weights, white_XYZ
@@ -299,6 +301,69 @@ def _format(figures: dict, light: str) -> str:
     )
 
 
+class _FitSettings(NamedTuple):
+    """The regression's settings, as ``specref env fit`` takes them."""
+
+    kind: str
+    degree: int
+    ridge: float | None
+    illuminant: str
+    loss: str
+    spectral_weight: float | None
+
+
+def _fit_target_file(target, spectra, augmentation: str | None, fit: _FitSettings):
+    """Fit on a target file, never augmented (erratum E44): the model and in-sample figures."""
+    from reference.colour.spectral_target import read_target
+
+    require(
+        augmentation in (None, "none"),
+        f"{target}: --augment {augmentation}: a target file cannot be augmented (the "
+        "products' camera RGB needs the camera's sensitivities); allowed with --target: none",
+    )
+    RGB, truth = read_target(target, spectra)
+    model = fit_regression(
+        RGB,
+        truth,
+        GRID_41.wavelengths_nm,
+        fit.kind,
+        fit.degree,
+        fit.ridge,
+        fit.illuminant,
+        "",
+        str(target),
+        fit.loss,
+        fit.spectral_weight,
+    )
+    return model, _stats(truth, model.predict(RGB), fit.illuminant)
+
+
+def _fit_lines(out, fit: _FitSettings, model, in_sample: dict, held_out: dict | None) -> list[str]:
+    """The lines ``specref env fit`` prints: the model written, then its figures."""
+    weight = (
+        "" if model.spectral_weight is None else f", spectral weight {model.spectral_weight:.3g}"
+    )
+    extra = model.augmentation
+    if extra:
+        weight += f", {extra['method']} at weight {extra['weight']:g} ({extra['patches']} patches)"
+    lines = [
+        f"wrote {out}: {fit.kind} degree {fit.degree}, {model.loss} loss, "
+        f"ridge {model.ridge:.3g}{weight}, {model.training_set}",
+        f"in-sample: {_format(in_sample, fit.illuminant)}",
+    ]
+    if model.cv and "rms" in model.cv:
+        best = min(model.cv["rms"])
+        lines.append(f"cross-validated ({model.cv['folds']} folds) spectral RMS {best:.4f}")
+    elif model.cv:
+        best = min(min(row) for row in model.cv["scores"])
+        lines.append(
+            f"cross-validated ({model.cv['folds']} folds) {model.cv['criterion']}: {best:.2f}"
+        )
+    for name, figures in (held_out or {}).items():
+        lines.append(f"held out, {name}: {_format(figures, fit.illuminant)}")
+    return lines
+
+
 def fit_file(
     out,
     target=None,
@@ -336,33 +401,15 @@ def fit_file(
     reference.errors.SpecrefError: polynomial degree must be an integer in 1…5, got 9
     """
     from reference.colour.spectral_regression import save_regression
-    from reference.colour.spectral_target import read_target
 
-    held_out = None
+    fit = _FitSettings(kind, degree, ridge, illuminant, loss, spectral_weight)
     if augmentation is not None:
         TARGET_AUGMENTATIONS.lookup(augmentation)
     if target is not None:
-        require(
-            augmentation in (None, "none"),
-            f"{target}: --augment {augmentation}: a target file cannot be augmented (the "
-            "products' camera RGB needs the camera's sensitivities); allowed with --target: none",
-        )
-        RGB, truth = read_target(target, spectra)
-        model = fit_regression(
-            RGB,
-            truth,
-            GRID_41.wavelengths_nm,
-            kind,
-            degree,
-            ridge,
-            illuminant,
-            "",
-            str(target),
-            loss,
-            spectral_weight,
-        )
-        in_sample = _stats(truth, model.predict(RGB), illuminant)
+        model, in_sample = _fit_target_file(target, spectra, augmentation, fit)
+        held_out = None
     else:
+        # The synthetic target of the camera, measured on the held-out sets too.
         model, in_sample = fit_target(
             kind,
             degree,
@@ -376,25 +423,5 @@ def fit_file(
         )
         held_out = held_out_figures(model.predict, camera, noise, HELD_OUT_SETS, illuminant)
     save_regression(model, out)
-    weight = (
-        "" if model.spectral_weight is None else f", spectral weight {model.spectral_weight:.3g}"
-    )
-    extra = model.augmentation
-    if extra:
-        weight += f", {extra['method']} at weight {extra['weight']:g} ({extra['patches']} patches)"
-    lines = [
-        f"wrote {out}: {kind} degree {degree}, {model.loss} loss, ridge {model.ridge:.3g}{weight}, "
-        f"{model.training_set}",
-        f"in-sample: {_format(in_sample, illuminant)}",
-    ]
-    if model.cv and "rms" in model.cv:
-        best = min(model.cv["rms"])
-        lines.append(f"cross-validated ({model.cv['folds']} folds) spectral RMS {best:.4f}")
-    elif model.cv:
-        best = min(min(row) for row in model.cv["scores"])
-        lines.append(
-            f"cross-validated ({model.cv['folds']} folds) {model.cv['criterion']}: {best:.2f}"
-        )
-    for name, figures in (held_out or {}).items():
-        lines.append(f"held out, {name}: {_format(figures, illuminant)}")
+    lines = _fit_lines(out, fit, model, in_sample, held_out)
     return {"model": model, "in_sample": in_sample, "held_out": held_out, "lines": lines}
