@@ -75,7 +75,7 @@ __all__ = [
     "view_state",
 ]
 
-#: Entry counts of the sweeps (the issue's m ∈ {25, ..., 800}).
+#: Entry counts of the sweeps: m from 25 to 800, doubling.
 ENTRY_LADDER = (25, 50, 100, 200, 400, 800)
 #: Entries of Table 1 (the paper's 200).
 TABLE1_ENTRIES = 200
@@ -346,6 +346,45 @@ def time_row(state: ViewState, row: dict, exact_shade_s: float, shared_s: float,
     return row
 
 
+def _segments(placement: str, entries: int) -> int | None:
+    """The segments of a table: ``p = m`` for a placement that takes segments, else None."""
+    return entries if PLACEMENT_METHODS.lookup(placement).extra["segments"] else None
+
+
+def _rms_by_entries(state: ViewState, placement: str, interpolation: str):
+    """``rms(m)``: the rendered RMS of the placement's table of ``m`` entries, each m once."""
+    cache: dict[int, float] = {}
+
+    def rms(m: int) -> float:
+        if m not in cache:
+            segments = _segments(placement, m)
+            cache[m] = table_error_row(state, placement, interpolation, m, segments)["rms"]
+        return cache[m]
+
+    return rms
+
+
+def _fewest_entries(rms, tolerance: float, max_entries: int, least: int = 4) -> dict:
+    """The fewest entries meeting ``rms(m) <= tolerance``: ``{"entries", "rms"}``.
+
+    Doubles ``m`` from ``least`` until it passes, then bisects between the last failing and the
+    first passing count; ``entries`` is None when no ``m <= max_entries`` passes.
+    """
+    m = least
+    while m <= max_entries and rms(m) > tolerance:
+        m *= 2
+    if m > max_entries:
+        return {"entries": None, "rms": rms(m // 2)}
+    low, high = m // 2, m
+    while high - low > 1 and low >= least:
+        mid = (low + high) // 2
+        if rms(mid) <= tolerance:
+            high = mid
+        else:
+            low = mid
+    return {"entries": high, "rms": rms(high)}
+
+
 def tolerance_search(
     state: ViewState,
     tolerance: float,
@@ -392,39 +431,21 @@ def tolerance_search(
         isinstance(tolerance, int | float) and np.isfinite(tolerance) and tolerance > 0,
         f"--tolerance: must be a number > 0, got {tolerance!r}",
     )
-    least = 4
-    candidates = {}
-    for placement in placements:
-        cache: dict[int, float] = {}
-
-        def rms(m, placement=placement, cache=cache):
-            if m not in cache:
-                segments = m if PLACEMENT_METHODS.lookup(placement).extra["segments"] else None
-                cache[m] = table_error_row(state, placement, interpolation, m, segments)["rms"]
-            return cache[m]
-
-        m = least
-        while m <= max_entries and rms(m) > tolerance:
-            m *= 2
-        if m > max_entries:
-            candidates[placement] = {"entries": None, "rms": rms(m // 2)}
-            continue
-        low, high = m // 2, m
-        while high - low > 1 and low >= least:
-            mid = (low + high) // 2
-            if rms(mid) <= tolerance:
-                high = mid
-            else:
-                low = mid
-        candidates[placement] = {"entries": high, "rms": rms(high)}
-    reached = [(c["entries"], p) for p, c in candidates.items() if c["entries"] is not None]
+    candidates = {
+        placement: _fewest_entries(
+            _rms_by_entries(state, placement, interpolation), tolerance, max_entries
+        )
+        for placement in placements
+    }
     result = {"tolerance": float(tolerance), "interpolation": interpolation}
     result["candidates"] = candidates
+    reached = [(c["entries"], p) for p, c in candidates.items() if c["entries"] is not None]
     if not reached:
         result.update(placement=None, entries=None, rms=None, verified_rms=None, verified=False)
         return result
+    # The pick: the fewest entries (ties in the order of placements), rendered once more
     entries, placement = min(reached, key=lambda pair: (pair[0], placements.index(pair[1])))
-    segments = entries if PLACEMENT_METHODS.lookup(placement).extra["segments"] else None
+    segments = _segments(placement, entries)
     verified = table_error_row(state, placement, interpolation, entries, segments)["rms"]
     result.update(
         placement=placement,
@@ -467,8 +488,8 @@ def rising_material(n_top: float, power: float = 1.0, n_bottom: float = 10.0) ->
     """Flat ``k_d = 0.2``, ``k_s = 0.5`` under D65; ``n`` rises steadily to ``n_top``.
 
     ``n(λ) = n_bottom + (n_top − n_bottom) x^power`` with ``x`` from 0 at the grid's first band
-    to 1 at its last: every band has its own exponent (41 distinct powers), the class on which
-    issue 17 measured the table's speed-up (the benchmarks' ``rising`` sweep).
+    to 1 at its last: every band has its own exponent (41 distinct powers), the class on which the
+    benchmarks' ``rising`` sweep measures the table's speed-up.
 
     Examples
     --------
