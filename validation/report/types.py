@@ -79,7 +79,7 @@ class Headline:
         The figure as a sentence fragment, computed from the run, e.g.
         ``"Phong table 12.8× faster than exact at RMS 9e-05"``.
     anchor : str
-        What it is measured against: the paper's figure or the issue's target, e.g.
+        What it is measured against: the paper's figure or a target of ours, e.g.
         ``"paper: ~10×"``.
     """
 
@@ -96,7 +96,7 @@ class Check:
     name : str
         What is checked, e.g. ``"FL2 mean ΔE00, 41 bands"``.
     target : str
-        The target as text, e.g. ``"<= 0.06"`` (from the issue or the paper).
+        The target as text, e.g. ``"<= 0.06"`` (the paper's figure or a target of ours).
     measured : float or str
         The measured value.
     passed : bool

@@ -1,4 +1,4 @@
-"""Studies of the environment SH order chosen from an accuracy (issue 17 §1; ``shrm.accuracy``).
+"""Studies of the environment SH order chosen from an accuracy (erratum E75; ``shrm.accuracy``).
 
 - :func:`worst_case_maps`: synthetic maps where truncation hurts most, a single bright texel and a
   small sun disc over a dim sky;

@@ -1,4 +1,4 @@
-"""The per-pixel hybrid on cases it was not designed on (§3.5.2, Ferwerda; issue 22, erratum E17).
+"""The per-pixel hybrid on cases it was not designed on (§3.5.2, Ferwerda; erratum E17).
 
 The hybrid of median-cut point lights and FIS (``impastor.specular_hybrid``) must never be much
 worse than the better of the two. This module builds the cases that claim is measured on and
