@@ -54,7 +54,7 @@ def specular_point_lights_kernel(P, N, V, alpha, light_pos, light_L, n_light, pi
             if vis[p, k] == 0.0:
                 continue
             x = light_pos[k]
-            # Eq. (2), Ferwerda, with the lobe of Eq. (4), Ferwerda, as the weight
+            # Eq. (2), Ferwerda: each light's contribution, weighted by the lobe (_lobe_geometry)
             g = _lobe_geometry(x[0], x[1], x[2], P[p], N[p], V[p], n_light, alpha[p], wi)
             acc += g * light_L[k] * vis[p, k] * pixel_area
         out[p] = acc
@@ -129,10 +129,10 @@ def specular_fis_kernel(
             ) / denom
             if d <= 0.0:
                 continue
-            # Eq. (6), Ferwerda, then Eq. (7), Ferwerda: the hit point relative to o_TL
-            r0 = d * wi[0] + P[p, 0] - origin[0]
-            r1 = d * wi[1] + P[p, 1] - origin[1]
-            r2 = d * wi[2] + P[p, 2] - origin[2]
+            # Eq. (6), Ferwerda: the hit point on the light plane
+            q0, q1, q2 = d * wi[0] + P[p, 0], d * wi[1] + P[p, 1], d * wi[2] + P[p, 2]
+            # Eq. (7), Ferwerda: the hit point relative to the plane's corner o_TL
+            r0, r1, r2 = q0 - origin[0], q1 - origin[1], q2 - origin[2]
             # Eq. (8), Ferwerda: pinv of [l_A A, l_B B] (orthogonal columns)
             a = (r0 * A[0] + r1 * A[1] + r2 * A[2]) / l_A
             b = (r0 * B[0] + r1 * B[1] + r2 * B[2]) / l_B

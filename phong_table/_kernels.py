@@ -796,7 +796,7 @@ def table_error_kernel(t_fine, C, n, entries, floor, p, hedge, grading):
         if weighted:
             rho2p[q] = (p[q] * f2 * f2) ** (1.0 / 5.0)
             rho3p[q] = (p[q] * f3 * f3) ** (1.0 / 7.0)
-    # normalise each density, take the largest, add the floor, integrate (Notes of table_error)
+    # normalise each density, take the largest, add the floor, integrate (see phong_table.placement)
     mass2, mass3, mass2p, mass3p = 0.0, 0.0, 0.0, 0.0
     for q in range(F - 1):
         h = t_fine[q + 1] - t_fine[q]

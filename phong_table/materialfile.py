@@ -72,7 +72,7 @@ def load_material_file(path) -> SpectralPhong:
         reader.fail("material", "missing: the file needs a [material] table")
     material = reader.table(data["material"], "material", _MATERIAL_KEYS, ("k_d", "k_s", "n"))
     name = reader.string(material.get("name", data.get("name", path.stem)), "name")
-    # Eq. (2), Wang et al.: k_d(λ), k_s(λ), n(λ) (and k_a(λ) of Eq. (1), Wang et al.), each >= 0
+    # the material's spectra k_d(λ), k_s(λ), n(λ) and k_a(λ), each >= 0
     params = {
         key: reader.spectrum_on_grid(material[key], f"material.{key}")
         for key in ("k_d", "k_s", "n", "k_a")

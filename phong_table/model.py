@@ -104,7 +104,7 @@ def specular_RGB_weights(k_s, spectra_to_RGB, intensity: float = 1.0) -> np.ndar
     array([[1., 1., 1.],
            [2., 2., 2.]])
     """
-    # Eq. (11), Wang et al.: k · I_p(λ) k_s(λ) times the row of Eq. (9), Wang et al. for λ
+    # Eq. (11), Wang et al.: k · I_p(λ) k_s(λ) times λ's row of the spectra-to-RGB matrix
     return np.ascontiguousarray(
         intensity * np.asarray(k_s, dtype=np.float64)[:, None] * spectra_to_RGB
     )

@@ -6,7 +6,8 @@
 - :mod:`~shrm.polymer.tint` — the spot-colour library of ``Tint_polymer`` (Eq. (2), Herbert et al.).
 - :mod:`~shrm.polymer.hybrid` — Eqs. (1)–(5), Herbert et al., as spectral terms.
 - :mod:`~shrm.polymer.material` — the ``polymer`` scene material and its environment shader.
-- :mod:`~shrm.polymer.oracle` — the layered physical model behind Eq. (1), by brute force.
+- :mod:`~shrm.polymer.oracle` — the layered physical model behind Eq. (1), Herbert et al., by brute
+  force.
 """
 
 from __future__ import annotations

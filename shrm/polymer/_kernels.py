@@ -126,9 +126,10 @@ def polymer_shade_parts_kernel(E_d, S, B, L, E_effect, D_Tint, Col_B, Col_L, glo
     for p in range(N):
         m = Mod[0] if Mod.size == 1 else Mod[p]
         for b in range(n_bands):
-            # Eq. (2), Herbert et al.: E_d D_polymer Tint_polymer (1 − Mod_effect), then Eq. (1),
-            # Herbert et al.: + gloss S + Col_trans ((1 − u) B + u L)
-            I = E_d[p, b] * (D_Tint[b] * (1.0 - m)) + S[p, b] * gloss + B[p, b] * Col_B[b]
+            # Eq. (2), Herbert et al.: I_d = E_d D_polymer Tint_polymer (1 − Mod_effect)
+            I_d = E_d[p, b] * (D_Tint[b] * (1.0 - m))
+            # Eq. (1), Herbert et al.: I_d + gloss S + Col_trans ((1 − u) B + u L)
+            I = I_d + S[p, b] * gloss + B[p, b] * Col_B[b]
             if use_L:
                 I += L[p, b] * Col_L[b]
             # Eq. (3), Herbert et al.: + E_effect Mod_effect
