@@ -423,40 +423,56 @@ def render_scene(
         scene = scene.with_render(width, height, supersample)
     r = scene.render
     check_shaders(scene)
-    if gbuffer is None:
-        gbuffer = scene_gbuffer(scene)
-    else:
-        expected = (r.height * r.supersample, r.width * r.supersample)
-        require(
-            gbuffer.shape == expected,
-            f"render_scene: the G-buffer has shape {gbuffer.shape} but the render needs "
-            f"{expected} (height × width × supersample)",
-        )
+    gbuffer = _render_gbuffer(scene, gbuffer)
     t_gbuffer = time.perf_counter()
     records: dict = {}
-    spectral_image = None
-    if spectral:
-        samples = shade_scene(scene, gbuffer, options, "spectral", records)
-        W_E = band_weights(scene.grid, None, scene.weights_method, scene.observer)
-        XYZ = samples @ W_E
-        if scene.render.background != "environment":
-            XYZ[~gbuffer.mask] = background_XYZ(scene, np.zeros((1, 3)))[0]
-        spectral_image = downsample_box(samples, r.supersample)
-        XYZ = downsample_box(XYZ, r.supersample)
-    else:
-        XYZ = downsample_box(shade_scene(scene, gbuffer, options, records=records), r.supersample)
+    XYZ, spectral_image = _shade_and_resolve(scene, gbuffer, options, spectral, records)
     t_shading = time.perf_counter()
     RGB_linear, encoded = XYZ_to_display(scene, XYZ)
     t_display = time.perf_counter()
-    timings = {
+    timings = _stage_timings(start, t_gbuffer, t_shading, t_display)
+    return RenderResult(
+        XYZ, RGB_linear, encoded, gbuffer, r.supersample, timings, scene, spectral_image, records
+    )
+
+
+def _render_gbuffer(scene: Scene, gbuffer: GBuffer | None) -> GBuffer:
+    """Stage 1: the scene's supersampled G-buffer, or the one given once its shape is checked."""
+    if gbuffer is None:
+        return scene_gbuffer(scene)
+    r = scene.render
+    expected = (r.height * r.supersample, r.width * r.supersample)
+    require(
+        gbuffer.shape == expected,
+        f"render_scene: the G-buffer has shape {gbuffer.shape} but the render needs "
+        f"{expected} (height × width × supersample)",
+    )
+    return gbuffer
+
+
+def _shade_and_resolve(scene: Scene, gbuffer: GBuffer, options, spectral: bool, records: dict):
+    """Stages 2 and 3: XYZ (and the spectral radiance when asked) box-filtered to the image size."""
+    r = scene.render
+    if not spectral:
+        XYZ = shade_scene(scene, gbuffer, options, records=records)
+        return downsample_box(XYZ, r.supersample), None
+    samples = shade_scene(scene, gbuffer, options, "spectral", records)
+    W_E = band_weights(scene.grid, None, scene.weights_method, scene.observer)
+    XYZ = samples @ W_E
+    if r.background != "environment":
+        XYZ[~gbuffer.mask] = background_XYZ(scene, np.zeros((1, 3)))[0]
+    spectral_image = downsample_box(samples, r.supersample)
+    return downsample_box(XYZ, r.supersample), spectral_image
+
+
+def _stage_timings(start: float, t_gbuffer: float, t_shading: float, t_display: float) -> dict:
+    """``RenderResult.timings``: seconds per stage from the clock readings between them."""
+    return {
         "gbuffer": t_gbuffer - start,
         "shading": t_shading - t_gbuffer,
         "display": t_display - t_shading,
         "total": t_display - start,
     }
-    return RenderResult(
-        XYZ, RGB_linear, encoded, gbuffer, r.supersample, timings, scene, spectral_image, records
-    )
 
 
 def _check_output(path, suffix: str, flag: str) -> Path:
@@ -596,15 +612,9 @@ def render_scene_file(
     >>> render_scene_file(folder / "s.toml", folder / "s.png").encoded.shape
     (4, 6, 3)
     """
-    from reference.scene.metadata import RENDER_OUTPUTS, check_accuracy, render_metadata
+    from reference.scene.metadata import check_accuracy, render_metadata
 
-    if png is not None:
-        _check_output(png, ".png", "-o")
-    if exr is not None:
-        _check_output(exr, ".exr", "--exr")
-    if json is not None and str(json) != "-":
-        _check_output(json, ".json", "--json")
-    RENDER_OUTPUTS.lookup(exr_output)
+    _check_outputs(png, exr, json, exr_output)
     options = {"environment": "bruteforce"} if oracle else {}
     if accuracy is not None:
         options["environment_accuracy"] = check_accuracy(accuracy)
@@ -619,3 +629,16 @@ def render_scene_file(
     if json is not None and str(json) != "-":
         write_text_atomic(json, dumps(metadata, indent=2) + "\n")
     return dataclasses.replace(result, metadata=metadata)
+
+
+def _check_outputs(png, exr, json, exr_output: str) -> None:
+    """Check the output names and the EXR's contents before anything is rendered."""
+    from reference.scene.metadata import RENDER_OUTPUTS
+
+    if png is not None:
+        _check_output(png, ".png", "-o")
+    if exr is not None:
+        _check_output(exr, ".exr", "--exr")
+    if json is not None and str(json) != "-":
+        _check_output(json, ".json", "--json")
+    RENDER_OUTPUTS.lookup(exr_output)
