@@ -282,13 +282,7 @@ def write_zarr_blocks(
     channels = list(channels)
     n = len(channels)
     check_chunk_fits(rows_per_chunk, width, n, str(path))
-    wavelengths = channel_wavelengths_nm(channels)
-    attributes = {
-        "specref": "spectral-panorama",
-        "channels": channels,
-        "wavelengths_nm": None if wavelengths is None else [float(w) for w in wavelengths],
-        "rows_per_chunk": rows_per_chunk,
-    }
+    attributes = _store_attributes(channels, rows_per_chunk)
     with _atomic_folder(path) as tmp:
         array = zarr.create_array(
             store=str(tmp),
@@ -299,30 +293,47 @@ def write_zarr_blocks(
             attributes=attributes,
             zarr_format=3,
         )
-        row = 0
-        pending = np.empty((0, width, n), dtype=np.float32)
-        for block in blocks:
-            block = np.asarray(block, dtype=np.float32)
-            require(
-                block.ndim == 3 and block.shape[1:] == (width, n),
-                f"{path}: a row block of shape {block.shape}; expected (rows, {width}, {n})",
-            )
-            pending = np.concatenate([pending, block]) if len(pending) else block
-            # write whole chunks as they fill, so no chunk is written twice
-            full = (len(pending) // rows_per_chunk) * rows_per_chunk
-            if full:
-                require(row + full <= height, f"{path}: more than {height} rows given")
-                array[row : row + full] = pending[:full]
-                row += full
-                pending = pending[full:]
-            if len(pending) and np.may_share_memory(pending, block):
-                pending = pending.copy()  # the rest waits; the caller may reuse its block's buffer
-        if len(pending):
-            require(row + len(pending) <= height, f"{path}: more than {height} rows given")
-            array[row : row + len(pending)] = pending
-            row += len(pending)
-        require(row == height, f"{path}: {row} rows given for a {height}-row image")
+        _write_row_blocks(array, blocks, rows_per_chunk, path)
     return path
+
+
+def _store_attributes(channels: list[str], rows_per_chunk: int) -> dict:
+    """A store's attributes (module docstring): its kind, channels, grid and chunk height."""
+    wavelengths = channel_wavelengths_nm(channels)
+    return {
+        "specref": "spectral-panorama",
+        "channels": channels,
+        "wavelengths_nm": None if wavelengths is None else [float(w) for w in wavelengths],
+        "rows_per_chunk": rows_per_chunk,
+    }
+
+
+def _write_row_blocks(array, blocks: Iterable[np.ndarray], rows_per_chunk: int, path) -> None:
+    """Write consecutive row blocks into ``array`` as whole chunks; check they cover its rows."""
+    height, width, n = array.shape
+    row = 0
+    pending = np.empty((0, width, n), dtype=np.float32)
+    for block in blocks:
+        block = np.asarray(block, dtype=np.float32)
+        require(
+            block.ndim == 3 and block.shape[1:] == (width, n),
+            f"{path}: a row block of shape {block.shape}; expected (rows, {width}, {n})",
+        )
+        pending = np.concatenate([pending, block]) if len(pending) else block
+        # write whole chunks as they fill, so no chunk is written twice
+        full = (len(pending) // rows_per_chunk) * rows_per_chunk
+        if full:
+            require(row + full <= height, f"{path}: more than {height} rows given")
+            array[row : row + full] = pending[:full]
+            row += full
+            pending = pending[full:]
+        if len(pending) and np.may_share_memory(pending, block):
+            pending = pending.copy()  # the rest waits; the caller may reuse its block's buffer
+    if len(pending):
+        require(row + len(pending) <= height, f"{path}: more than {height} rows given")
+        array[row : row + len(pending)] = pending
+        row += len(pending)
+    require(row == height, f"{path}: {row} rows given for a {height}-row image")
 
 
 def write_zarr_image(path, image, channels, **kwargs) -> Path:
