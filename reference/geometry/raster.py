@@ -319,25 +319,8 @@ def triangle_setup(
     require(np.isfinite(near) and near > 0, f"raster.near: must be > 0, got {near}")
     V, F = mesh.vertices, mesh.faces
     x_v, y_v, z_v = camera.project(V, width, height)
-    front = z_v[F] >= near  # (F, 3): which corners are in front of the near plane
-    n_front = front.sum(axis=1)
-    k = np.arange(3)
-
-    # Each triangle after clipping is three corner pairs (p, q) of its face: p == q is the vertex
-    # itself, p != q the point where the edge from corner p (in front) to q (behind) meets z = near.
-    # Rotating the corners keeps the winding.
-    f = np.flatnonzero(n_front == 3)
-    pieces = [(f, np.broadcast_to(k, (f.size, 3)), np.broadcast_to(k, (f.size, 3)))]
-    f = np.flatnonzero(n_front == 1)  # c0 in front: the triangle (c0, c0→c1, c0→c2)
-    c = (np.argmax(front[f], axis=1)[:, None] + k) % 3
-    pieces.append((f, c[:, [0, 0, 0]], c[:, [0, 1, 2]]))
-    f = np.flatnonzero(n_front == 2)  # c2 behind: the quad (c0, c1, c1→c2, c0→c2), two triangles
-    c = (np.argmin(front[f], axis=1)[:, None] + k + 1) % 3
-    pieces.append((f, c[:, [0, 1, 1]], c[:, [0, 1, 2]]))
-    pieces.append((f, c[:, [0, 1, 0]], c[:, [0, 2, 2]]))
-    face, p, q = (np.concatenate([piece[i] for piece in pieces]) for i in range(3))
-    order = np.argsort(face, kind="stable")
-    face, p, q = face[order], p[order], q[order]
+    # Near-plane clipping: the triangles left, as corner pairs of their faces (front: z >= near)
+    face, p, q = _clipped_corners(z_v[F] >= near)
     a = np.take_along_axis(F[face], p, axis=1)  # vertex ids
     b = np.take_along_axis(F[face], q, axis=1)
 
@@ -365,6 +348,30 @@ def triangle_setup(
         bary=bary,
         perspective=camera.projection == "perspective",
     )
+
+
+def _clipped_corners(front: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The triangles left by near-plane clipping, as faces and corner pairs, sorted by face.
+
+    Each triangle after clipping is three corner pairs ``(p, q)`` of its face: ``p == q`` is the
+    vertex itself, ``p != q`` the point where the edge from corner p (in front) to q (behind)
+    meets ``z = near``. Rotating the corners keeps the winding. ``front`` is ``(F, 3)``: which
+    corners are in front; the result is ``face`` ``(T,)`` and ``p``, ``q`` ``(T, 3)``.
+    """
+    n_front = front.sum(axis=1)
+    k = np.arange(3)
+    f = np.flatnonzero(n_front == 3)
+    pieces = [(f, np.broadcast_to(k, (f.size, 3)), np.broadcast_to(k, (f.size, 3)))]
+    f = np.flatnonzero(n_front == 1)  # c0 in front: the triangle (c0, c0→c1, c0→c2)
+    c = (np.argmax(front[f], axis=1)[:, None] + k) % 3
+    pieces.append((f, c[:, [0, 0, 0]], c[:, [0, 1, 2]]))
+    f = np.flatnonzero(n_front == 2)  # c2 behind: the quad (c0, c1, c1→c2, c0→c2), two triangles
+    c = (np.argmin(front[f], axis=1)[:, None] + k + 1) % 3
+    pieces.append((f, c[:, [0, 1, 1]], c[:, [0, 1, 2]]))
+    pieces.append((f, c[:, [0, 1, 0]], c[:, [0, 2, 2]]))
+    face, p, q = (np.concatenate([piece[i] for piece in pieces]) for i in range(3))
+    order = np.argsort(face, kind="stable")
+    return face[order], p[order], q[order]
 
 
 def gbuffer_from_raster(
@@ -421,35 +428,13 @@ def gbuffer_from_raster(
     # Barycentrics in the original face: the clipped triangle's, mapped through its vertices'.
     w = np.einsum("nk,nkc->nc", bary.reshape(-1, 3)[pixel], setup.bary[tri])
     corners = mesh.faces[setup.face[tri]]  # (N, 3) vertex ids
-
-    def interpolate(values):
-        return np.einsum("nk,nkc->nc", w, values[corners])
-
-    def face_normal(rows):
-        a, b, c = (mesh.vertices[corners[rows, k]] for k in range(3))
-        n = np.cross(b - a, c - a)
-        return n / np.linalg.norm(n, axis=1, keepdims=True)  # non-zero: the face has area
-
-    position = interpolate(mesh.vertices)
-    if mesh.normals is None:
-        normal = face_normal(slice(None))
-    else:
-        normal = interpolate(mesh.normals)
-        # Renormalise; where opposite vertex normals cancel, fall back to the face normal.
-        length = np.linalg.norm(normal, axis=1, keepdims=True)
-        vanish = length[:, 0] <= 1e-12 * np.linalg.norm(mesh.normals[corners], axis=2).max(axis=1)
-        length[vanish] = 1.0
-        normal /= length
-        normal[vanish] = face_normal(vanish)
+    position = _interpolate(w, corners, mesh.vertices)
+    normal = _shading_normals(mesh, corners, w)
     if mesh.uvs is None:
         uv = np.stack([w[:, 1] + w[:, 2], w[:, 2]], axis=1)  # pbrt: (0, 0), (1, 0), (1, 1)
     else:
-        uv = interpolate(mesh.uvs)
-    if camera.projection == "perspective":
-        view = np.asarray(camera.eye) - position
-        view /= np.linalg.norm(view, axis=1, keepdims=True)
-    else:
-        view = camera.basis()[2]
+        uv = _interpolate(w, corners, mesh.uvs)
+    view = _view_vectors(camera, position)
     g.position.reshape(-1, 3)[pixel] = position
     g.normal.reshape(-1, 3)[pixel] = normal
     g.uv.reshape(-1, 2)[pixel] = uv
@@ -462,6 +447,41 @@ def gbuffer_from_raster(
     g.object_id.reshape(-1)[pixel] = object_id
     g.mask.reshape(-1)[pixel] = True
     return g
+
+
+def _interpolate(w: np.ndarray, corners: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Per-vertex ``values`` at the pixels: face barycentrics ``w`` times ``values[corners]``."""
+    return np.einsum("nk,nkc->nc", w, values[corners])
+
+
+def _face_normals(vertices: np.ndarray, corners: np.ndarray) -> np.ndarray:
+    """Unit geometric normals of the faces whose vertex ids are ``corners`` (N, 3)."""
+    a, b, c = (vertices[corners[:, k]] for k in range(3))
+    n = np.cross(b - a, c - a)
+    return n / np.linalg.norm(n, axis=1, keepdims=True)  # non-zero: the face has area
+
+
+def _shading_normals(mesh: TriangleMesh, corners: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """The interpolated vertex normals, renormalised; the face normal where they are missing."""
+    if mesh.normals is None:
+        return _face_normals(mesh.vertices, corners)
+    normal = _interpolate(w, corners, mesh.normals)
+    # Renormalise; where opposite vertex normals cancel, fall back to the face normal.
+    length = np.linalg.norm(normal, axis=1, keepdims=True)
+    vanish = length[:, 0] <= 1e-12 * np.linalg.norm(mesh.normals[corners], axis=2).max(axis=1)
+    length[vanish] = 1.0
+    normal /= length
+    normal[vanish] = _face_normals(mesh.vertices, corners[vanish])
+    return normal
+
+
+def _view_vectors(camera: Camera, position: np.ndarray) -> np.ndarray:
+    """Unit vectors to the eye at ``position`` (N, 3); the camera's back axis if orthographic."""
+    if camera.projection == "perspective":
+        view = np.asarray(camera.eye) - position
+        view /= np.linalg.norm(view, axis=1, keepdims=True)
+        return view
+    return camera.basis()[2]
 
 
 def _example_triangles(rng) -> tuple:
