@@ -347,6 +347,18 @@ def display_from_measurements(doc: dict, where: str = "display measurements") ->
     )
     top = 2**bits - 1
     black = _vector(doc, "black_XYZ", where)
+    P = _primaries_matrix(doc, black, where)
+    ramps = doc.get("ramps")
+    require(isinstance(ramps, dict), f"{where}: missing key 'ramps' (R, G, B)")
+    luts = np.array([_ramp_lut(ramps, c, top, where) for c in "RGB"])
+    coefficients = _fit_angular(doc, where)
+    front = _front_surface(doc, where)
+    luts.setflags(write=False)
+    return DisplayModel(P, black, luts, coefficients, front, str(doc.get("name", where)))
+
+
+def _primaries_matrix(doc: dict, black: np.ndarray, where: str) -> np.ndarray:
+    """``P`` of Eq. (1), Ferwerda, from the measured primaries; refused if singular."""
     primaries = doc.get("primaries_XYZ")
     require(isinstance(primaries, dict), f"{where}: missing key 'primaries_XYZ' (R, G, B)")
     # Eq. (1), Ferwerda: columns XYZ_max − XYZ_K
@@ -355,32 +367,37 @@ def display_from_measurements(doc: dict, where: str = "display measurements") ->
         abs(np.linalg.det(P)) > 1e-9 * max(1.0, np.abs(P).max() ** 3),
         f"{where}: primaries_XYZ: the primaries are linearly dependent",
     )
-    ramps = doc.get("ramps")
-    require(isinstance(ramps, dict), f"{where}: missing key 'ramps' (R, G, B)")
-    luts = []
-    for c in "RGB":
-        ramp = ramps.get(c)
-        require(isinstance(ramp, dict), f"{where}: ramps: missing channel {c!r}")
-        counts = _vector(ramp, "counts", f"{where}: ramps.{c}", 0)
-        Y = _vector(ramp, "Y", f"{where}: ramps.{c}", 0)
-        require(
-            counts.size == Y.size and counts.size >= 2,
-            f"{where}: ramps.{c}: counts and Y must have the same length >= 2",
+    return P
+
+
+def _ramp_lut(ramps: dict, c: str, top: int, where: str) -> np.ndarray:
+    """Channel ``c``'s look-up table: linear scalar at every count 0..top, from its ramp."""
+    ramp = ramps.get(c)
+    require(isinstance(ramp, dict), f"{where}: ramps: missing channel {c!r}")
+    counts = _vector(ramp, "counts", f"{where}: ramps.{c}", 0)
+    Y = _vector(ramp, "Y", f"{where}: ramps.{c}", 0)
+    require(
+        counts.size == Y.size and counts.size >= 2,
+        f"{where}: ramps.{c}: counts and Y must have the same length >= 2",
+    )
+    require(
+        counts[0] == 0 and counts[-1] == top and (np.diff(counts) > 0).all(),
+        f"{where}: ramps.{c}.counts: must increase from 0 to {top}",
+    )
+    steps = np.diff(Y)
+    if (steps <= 0).any():
+        i = int(np.argmax(steps <= 0)) + 1
+        raise SpecrefError(
+            f"{where}: ramps.{c}.Y: must increase with the counts (a non-monotonic ramp "
+            f"cannot be inverted), got {Y[i]:g} after {Y[i - 1]:g} at index {i}"
         )
-        require(
-            counts[0] == 0 and counts[-1] == top and (np.diff(counts) > 0).all(),
-            f"{where}: ramps.{c}.counts: must increase from 0 to {top}",
-        )
-        steps = np.diff(Y)
-        if (steps <= 0).any():
-            i = int(np.argmax(steps <= 0)) + 1
-            raise SpecrefError(
-                f"{where}: ramps.{c}.Y: must increase with the counts (a non-monotonic ramp "
-                f"cannot be inverted), got {Y[i]:g} after {Y[i - 1]:g} at index {i}"
-            )
-        # The 11-bit LUT: normalised luminance at every count, interpolated between the steps.
-        normalised = (Y - Y[0]) / (Y[-1] - Y[0])
-        luts.append(np.interp(np.arange(top + 1), counts, normalised))
+    # The 11-bit LUT: normalised luminance at every count, interpolated between the steps.
+    normalised = (Y - Y[0]) / (Y[-1] - Y[0])
+    return np.interp(np.arange(top + 1), counts, normalised)
+
+
+def _fit_angular(doc: dict, where: str) -> tuple[float, float, float]:
+    """``L_factor``'s coefficients fitted to the angular measurements (:func:`fit_lfactor`)."""
     angular = doc.get("angular")
     require(isinstance(angular, dict), f"{where}: missing key 'angular'")
     theta = _vector(angular, "theta_deg", f"{where}: angular", 0)
@@ -390,7 +407,11 @@ def display_from_measurements(doc: dict, where: str = "display measurements") ->
         theta.size == phi.size == Y_rel.size and theta.size >= 3,
         f"{where}: angular: theta_deg, phi_deg and Y_relative must have the same length >= 3",
     )
-    coefficients = fit_lfactor(np.radians(theta), np.radians(phi), Y_rel)
+    return fit_lfactor(np.radians(theta), np.radians(phi), Y_rel)
+
+
+def _front_surface(doc: dict, where: str) -> dict:
+    """The front-surface reflection: the paper's figures, overridden by the document's."""
     front = {"diffuse": 0.002, "specular_peak": 0.011, "specular_cutoff_deg": 10.0}
     front.update(doc.get("front_surface", {}))
     for key, value in front.items():
@@ -398,9 +419,7 @@ def display_from_measurements(doc: dict, where: str = "display measurements") ->
             isinstance(value, int | float) and np.isfinite(value) and value >= 0,
             f"{where}: front_surface.{key}: must be a number >= 0, got {value!r}",
         )
-    luts = np.array(luts)
-    luts.setflags(write=False)
-    return DisplayModel(P, black, luts, coefficients, front, str(doc.get("name", where)))
+    return front
 
 
 def load_display_measurements(path) -> DisplayModel:
