@@ -10,7 +10,7 @@ from phong_table.interpolation import interval_index
 from phong_table.render import compiled_shader, shading_buffer, sphere_gbuffer
 from validation.studies.phong import rising_material
 
-#: Materials outside R1-R3 (issue 17 §6): the exponent rises steadily across the spectrum to a
+#: Materials outside R1-R3 (erratum E39): the exponent rises steadily across the spectrum to a
 #: few thousand (every band its own power), linearly and quadratically
 RISING = {
     "rising2000": lambda: rising_material(2000.0),

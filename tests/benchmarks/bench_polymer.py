@@ -5,7 +5,7 @@ its luminance on the 16-band 400-700/20 nm grid of the session demo), cube faces
 pigment. "Re-shade" is a dynamic change (a new thickness every round, so no result is reused), the
 session's frame and the radiance of the covered pixels to XYZ: what a user pays per frame while
 dragging a thickness, TiO2, tint, transparency or Mod_effect slider. Groups (report section
-"Polymer scenes", targets of issue 14):
+"Polymer scenes"; erratum E61):
 
 - ``polymer-dynamic-cold``: the re-shade against a cold render of the same frame by a new session
   without a persistent cache (baseline: environment projection, Lambert and Phong maps, Fresnel

@@ -1,7 +1,8 @@
 """Scale-out: a 32-task sweep on a 2-worker LocalCluster against the same sweep serially, and the
 streamed SH projection of a Zarr panorama against the in-memory projection, in one run.
 
-Group ``scaleout-sweep`` (issue target: distributed / serial speed-up >= 1.6 on 2 cores):
+Group ``scaleout-sweep`` (target: distributed / serial speed-up >= 1.6 on 2 cores;
+``docs/scale-out.md``, "How it scales, and what does not"):
 
 - ``serial``: 32 independent SH projections (seeded 1024×2048×3 maps, order 128, the numba
   path: single-threaded, no cached table, about 0.15 s each with the map's generation), one

@@ -1,6 +1,6 @@
 """Spectralizing speed: a 2048×1024 panorama to 41 bands, against a bare matrix product, same run.
 
-Group ``spectral-env-2k`` (target of issue 15: spectralize throughput >= 50 % of the baseline):
+Group ``spectral-env-2k`` (target: spectralize throughput >= 50 % of the baseline; erratum E45):
 
 - ``baseline``: ``np.matmul`` of the panorama's precomputed feature matrix (shipped model:
   root-polynomial degree 4, 22 features, float64) by the coefficients, into a preallocated output;

@@ -1,6 +1,6 @@
 """RGB → spectrum upsampling of a real 1k environment map, every method against Mallett's, same run.
 
-Group ``upsampling-1k`` (issue 17 §3: a 1k map upsamples in seconds): ``studio_small_03_1k.hdr``
+Group ``upsampling-1k`` (target: a 1k map upsamples in seconds): ``studio_small_03_1k.hdr``
 (1024×512, shipped in ``data:environments``) to 41 bands by each ``UPSAMPLING_METHODS`` entry
 through :func:`reference.colour.upsampling.RGB_to_radiance_spectra`, what rendering a scene runs.
 The baseline is ``mallett2019`` (one matrix product). ``jakob2019`` looks its coefficients up in the

@@ -1,6 +1,6 @@
 """Out of core at full size: a 12k×6k×41 panorama in Zarr projected to L = 100, in bounded memory.
 
-Group ``scaleout-zarr-12k`` (issue 18 target: peak resident memory <= 2 GB). The store is a
+Group ``scaleout-zarr-12k`` (target: peak resident memory <= 2 GB; erratum E49). The store is a
 synthetic panorama, 6000 × 12000 × 41 float32 (11.8 GB as float32), generated chunk by chunk by
 :func:`panorama_rows` (erratum E49): a smooth analytic sky at half-float precision, as an OpenEXR
 half panorama stores it, so that blosc-lz4 packs it about four times and the store fits this

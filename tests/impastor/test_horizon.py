@@ -143,7 +143,7 @@ def test_finer_march_never_lowers_the_horizon(rng):
 
 @pytest.mark.slow
 def test_horizon_map_within_two_percent_at_raking_light_on_high_relief():
-    # The fast part of the issue 22 target: relief ×4 on held-out painting seed 33, at the two
+    # The fast part of erratum E95's target: relief ×4 on held-out painting seed 33, at the two
     # elevations where the first version was worst (10° and 30°), two azimuths.
     from impastor.painting import HORIZON_SECTORS
     from validation.studies.impastor_lighting import shadow_agreement
@@ -158,8 +158,9 @@ def test_horizon_map_within_two_percent_at_raking_light_on_high_relief():
 @pytest.mark.xslow
 @pytest.mark.parametrize("seed", [31, 32])
 def test_horizon_map_agrees_with_ray_marching_at_every_elevation(seed):
-    # Issue 22 target: at most 2 % of pixels disagree with ray-marched shadows at every light
-    # elevation from 10° to 75°, relief up to ×4, at the renderer's sector count. Held-out
+    # Target (docs/impastor.md, "Horizon-map shadows"): at most 2 % of pixels disagree with
+    # ray-marched shadows at every light elevation from 10° to 75°, relief up to ×4, at the
+    # renderer's sector count. Held-out
     # painting seeds 31 and 32: the design (step, interpolation, 36 sectors) used seed 11 and the
     # report uses seed 4.
     from impastor.painting import HORIZON_SECTORS
@@ -177,5 +178,5 @@ def test_horizon_map_agrees_with_ray_marching_at_every_elevation(seed):
         assert max(result["reference_error"][label]) < 0.01
         per_elevation = np.asarray(result["disagreement"][label][0])
         assert (per_elevation <= 0.02).all(), (label, per_elevation.round(4))
-        # The first version (one-pixel steps, one sector) is what the issue measured.
+        # The first version (one-pixel steps, one sector; erratum E95) does worse.
         assert max(result["one_pixel_steps"][label]) > max(per_elevation)

@@ -40,8 +40,8 @@ def test_designs_are_normalised_and_non_negative(method, rng):
 @pytest.mark.parametrize("light", ["D65", "D50", "A"])
 def test_colorchecker_targets(design, mean_max, max_max, light):
     # Source: colour.sd_to_XYZ on the 5 nm N Ohta data
-    # (validation.studies.metrics.colorchecker_truth); targets from issue 6 (one matrix for all
-    # three lights; the chart is held out of the fit).
+    # (validation.studies.metrics.colorchecker_truth); targets: ours, checked by the report's
+    # ImpastoR section too (one matrix for all three lights; the chart is held out of the fit).
     from validation.studies.impastor import design_delta_E
 
     dE = design_delta_E(design, 6, light)

@@ -137,7 +137,7 @@ def test_failsafe_keeps_the_point_lights_where_fis_fails_on_a_peaked_ceiling():
     assert max(result["ratio"]) <= 1.1, result["ratio"]
 
 
-# Held-out cases for issue 22: painting seeds, lamp seeds and ceiling azimuths that the design
+# Held-out cases (erratum E17): painting seeds, lamp seeds and ceiling azimuths that the design
 # (validation.studies.impastor_hybrid.TRAINING: painting seeds 2, 5, 7, ceilings at azimuth 0°, lamp
 # 0) never used. The peaked ceiling is cut from studio_small_03_1k.hdr (dynamic range ~10⁶).
 HELD_OUT_SUBSET = (
@@ -168,7 +168,7 @@ def test_hybrid_within_one_and_a_half_of_the_better_method_on_held_out_cases(lig
 
 @pytest.mark.xslow
 def test_hybrid_on_the_held_out_sweep():
-    # The whole held-out sweep of issue 22: 24 painting seeds (201-224), both booth lights, the
+    # The whole held-out sweep (erratum E17): 24 painting seeds (201-224), both booth lights, the
     # lamp and panel, a ceiling cut from each shipped map, N in {8, 32, 64}, K in {16, 32, 64},
     # the report's alpha grid, 36 points, 64 x 32 light images.
     from validation.studies.impastor_hybrid import (

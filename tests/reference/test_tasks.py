@@ -51,7 +51,8 @@ TABLE1_FIGURES = ("scene", "view", "placement", "interpolation", "entries", "seg
 
 
 def test_phong_table1_on_a_cluster_equals_serial(client):
-    # issue 18: Table 1's scenes × views are tasks; the errors do not depend on where they ran
+    # docs/scale-out.md, "Sweeps as tasks": Table 1's scenes × views are tasks; the errors do not
+    # depend on where they ran
     from validation.studies.phong_table1 import run_table1
 
     def figures(result):
@@ -65,7 +66,8 @@ def test_phong_table1_on_a_cluster_equals_serial(client):
 
 
 def test_impastor_table1_on_a_cluster_equals_serial(client):
-    # issue 18: Ferwerda's Table 1 runs one task per light; the same table as serially
+    # docs/scale-out.md, "Sweeps as tasks": Ferwerda's Table 1 runs one task per light; the same
+    # table as serially
     import numpy as np
 
     from validation.studies.impastor import table1

@@ -1,4 +1,4 @@
-"""`--oracle` on every material type under an environment light (issue 21 §1).
+"""`--oracle` on every material type under an environment light (erratum E90).
 
 For each scene-file material type with an environment shader: the oracle and the default path
 differ, and the oracle equals a direct brute-force sum over the map's pixels on sampled pixels.
@@ -159,7 +159,7 @@ def test_scene_files_take_tabulated_brdfs(tmp_path):
 
 @pytest.mark.xfail(
     strict=True,
-    reason="erratum E94 (issue 21): a tabulated GGX on a 16-row map misses 1 % of the peak "
+    reason="erratum E94 (docs/errata.md): a tabulated GGX on a 16-row map misses 1 % of the peak "
     "at grazing pixels (F is capped at 7 by the map)",
 )
 def test_tabulated_brdf_split_within_one_percent_of_the_peak(tmp_path):

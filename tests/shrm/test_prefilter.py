@@ -21,7 +21,8 @@ from shrm.transform import project_latlong
 )
 def test_frequency_matches_bruteforce_at_L100(kernel, bound, package_data):
     # Same Fejér-1 weights: the two differ only by the kernel's truncation at L = 100 (addition
-    # theorem). Bounds are the targets, on venice_sunset (downsampled 4×, one channel).
+    # theorem). Bounds are the targets of docs/sh.md, on venice_sunset (downsampled 4×, one
+    # channel).
     image = read_hdr(package_data / "environments" / "venice_sunset_1k.hdr")[::4, ::4, :1].copy()
     d = cubemap_texel_directions(8)
     coeffs = prefilter_coefficients(project_latlong(image, 100), parse_kernel(kernel).Lambda(100))

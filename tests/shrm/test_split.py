@@ -125,8 +125,9 @@ def _errors(out, truth, y):
 
 
 def test_split_never_negative_where_the_sh_series_rings(studio):
-    # The case: GGX α 0.1 (ρ_d 0, F_0 1) under studio_small_03 went negative on the SH
-    # path. A sun of 1e4 on a black sky is the harshest map: the SH half is clamped, the sum >= 0.
+    # The case behind erratum E91: GGX α 0.1 (ρ_d 0, F_0 1) under studio_small_03 went negative on
+    # the SH path. A sun of 1e4 on a black sky is the harshest map: the SH half is clamped, the
+    # sum >= 0.
     y = _y_weights()
     n, v = _sphere_points(16)
     params = brdf_params_on_grid("ggx", GRID, {"alpha": 0.1, "rho_d": 0.0, "F_0": 1.0})

@@ -16,7 +16,7 @@ from shrm.transform import SH_BACKENDS, project_function, project_latlong, synth
 @pytest.mark.parametrize("backend", SH_BACKENDS.values(), ids=attrgetter("name"))
 def test_round_trip_band_limited_L100(backend, rng):
     # A band-limited random L = 100 map, synthesized and projected back, returns its coefficients
-    # (Fejér-1 is exact for 2L < H); the bound is RMS ≤ 1e-13 on the map.
+    # (Fejér-1 is exact for 2L < H); our bound is RMS ≤ 1e-13 on the map.
     L, H = 100, 202
     c = rng.normal(size=(1, (L + 1) ** 2)) / (L + 1)
     image = synthesize_latlong(c, H, backend=backend.name)

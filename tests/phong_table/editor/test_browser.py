@@ -1,4 +1,4 @@
-"""The material editor in a real browser (issue 19): headless Chromium through Selenium.
+"""The material editor in a real browser (errata E28, E29): headless Chromium through Selenium.
 
 Needs Debian's ``chromium`` and ``chromium-driver`` (``apt install chromium chromium-driver``;
 ``.ci/run`` installs them) and ``selenium`` (a test extra); skipped with that hint where missing.

@@ -1,4 +1,4 @@
-"""The material editor's Python side, without a browser (issue 19; §1, §5, Wang et al.)."""
+"""The material editor's Python side, without a browser (errata E28, E29; §1, §5, Wang et al.)."""
 
 import socket
 import threading

@@ -45,7 +45,8 @@ def test_band_weights_reproduce_colour_astm_e308_exactly(grid, light):
         np.testing.assert_allclose(100 * spectra_to_XYZ(R, W), expected, rtol=0, atol=1e-9)
 
 
-# Source of the targets: issue 3 (ΔE00 against colour.sd_to_XYZ on the native 5 nm N Ohta data).
+# Source of the targets: ours, for the band weights of erratum E7 (ΔE00 against colour.sd_to_XYZ
+# on the native 5 nm N Ohta data).
 TARGETS = {"D65": (0.03, 0.10), "A": (0.03, 0.10), "D50": (0.03, 0.10), "FL2": (0.06, 0.15)}
 
 
@@ -79,7 +80,7 @@ def test_colorchecker_delta_E_independent_recomputation():
 
 @pytest.mark.parametrize("grid", [GRID_41, GRID_31], ids=["41", "31"])
 def test_point_sampling_misses_fl2_lines(grid):
-    # Erratum E7: point-sampled light × CMF misses FL2's mercury lines (issue 3: ~4 mean, ~9 max).
+    # Erratum E7: point-sampled light × CMF misses FL2's mercury lines (E7: 4.0 mean, 9.0 max).
     dE_point = colorchecker_delta_E(grid, "FL2", "point")
     dE_e308 = colorchecker_delta_E(grid, "FL2", "astm_e308")
     assert dE_point.mean() > 3.0

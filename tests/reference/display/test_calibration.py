@@ -1,4 +1,5 @@
-"""Tests of reference.display.calibration: the targets of issue 16 for every white and curve."""
+"""Tests of reference.display.calibration: the targets of docs/display.md ("Calibrating") for every
+white and curve."""
 
 from __future__ import annotations
 
@@ -26,7 +27,7 @@ def display():
 @pytest.mark.parametrize("curve", CALIBRATION_CURVES.names())
 @pytest.mark.parametrize("white", list(WHITES))
 def test_targets_with_the_noise_free_spectroradiometer(display, white, curve):
-    # Issue 16: Δu'v' <= 0.001 for every gray above 5 % of white, luminance within 1 % of the
+    # Our targets: Δu'v' <= 0.001 for every gray above 5 % of white, luminance within 1 % of the
     # curve above 1 % of white, measured at all 256 input levels.
     cal = calibrate_display(display, white, curve, points=15, instrument="ideal")
     v = verify_calibration(display, cal)

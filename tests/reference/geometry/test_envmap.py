@@ -14,7 +14,7 @@ from reference.geometry.envmap import (
 
 
 def test_axes_follow_mitsuba3():
-    # Source: issue 3 / Mitsuba 3 envmap.cpp: u = atan2(d.x, -d.z)/2π, v = acos(d.y)/π.
+    # Source: Mitsuba 3 envmap.cpp (docs/conventions.md): u = atan2(d.x, -d.z)/2π, v = acos(d.y)/π.
     d = np.array([[0, 0, -1], [1, 0, 0], [0, 0, 1], [-1, 0, 0], [0, 1, 0], [0, -1, 0]], float)
     u, v = direction_to_latlong_uv(d)
     np.testing.assert_allclose(u[:4], [0.0, 0.25, 0.5, 0.75], atol=1e-15)

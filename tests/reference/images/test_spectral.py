@@ -66,7 +66,7 @@ def test_unknown_suffix(tmp_path):
 
 
 def test_spectralize_file_memory_is_bounded_by_blocks(tmp_path, rng):
-    # Issue 15: peak extra memory <= 2 × the output; the output itself is never held (memory map).
+    # Our target: peak extra memory <= 2 × the output; the output itself is never held (memory map).
     import tracemalloc
 
     from reference.colour.upsampling import default_regression
@@ -125,7 +125,8 @@ def test_flat_radiance_scanlines_and_float_tiff_rows(tmp_path, rng):
 
 
 def test_spectralize_reads_the_panorama_by_row_blocks(tmp_path, rng, monkeypatch):
-    # Issue 15: the input is never read whole; each block reads only its own rows, in order.
+    # docs/spectral-environments.md: the input is never read whole; each block reads only its own
+    # rows, in order.
     import reference.images.spectral as spectral_images
     from reference.colour.upsampling import default_regression
     from reference.images.formats import write_exr
@@ -149,7 +150,7 @@ def test_spectralize_reads_the_panorama_by_row_blocks(tmp_path, rng, monkeypatch
 
 
 def test_spectralize_input_memory_is_bounded_by_blocks(tmp_path, rng):
-    # Issue 15: with the input streamed as well, peak traced memory over a 256 × 1024 panorama
+    # With the input streamed as well, peak traced memory over a 256 × 1024 panorama
     # read 8 rows at a time stays below the input in float64 (a whole read, as before, allocates
     # the float32 decode and the float64 image: 1.5 × that), and far below the output (43 MB).
     import tracemalloc
@@ -188,9 +189,9 @@ def test_nan_in_a_late_block_leaves_no_output(tmp_path, rng):
 
 
 def test_spectralize_zarr_to_zarr_equals_in_memory(tmp_path, rng):
-    # Issue 18: a 512×1024 RGB store in, a 41-band store out, streamed by row blocks (7 rows, so
-    # blocks straddle the output's 64-row chunks); equal, bit for bit, to the blocks spectralized
-    # in memory (the same float32 arithmetic, erratum E45).
+    # docs/scale-out.md: a 512×1024 RGB store in, a 41-band store out, streamed by row blocks (7
+    # rows, so blocks straddle the output's 64-row chunks); equal, bit for bit, to the blocks
+    # spectralized in memory (the same float32 arithmetic, erratum E45).
     from reference.colour.spectral_regression import spectralize_blocks
     from reference.colour.upsampling import default_regression
     from reference.images.spectral import spectralize_file

@@ -163,7 +163,7 @@ def test_rendered_chart_reproduces_colour_science_E308(illuminant):
     result = render_scene(scene)
     rows, columns = colorchecker_patch_pixels(scene.camera, scene.objects[0], 66, 44).T
     rendered = result.XYZ[rows, columns]
-    # Source: colour.sd_to_XYZ(method="ASTM E308") on the same 10 nm data; the bound.
+    # Source: colour.sd_to_XYZ(method="ASTM E308") on the same 10 nm data, to rounding.
     expected = np.stack([E308_XYZ(OHTA[name], illuminant) for name in OHTA])
     assert np.abs(rendered - expected).max() * 100 <= 1e-9
 

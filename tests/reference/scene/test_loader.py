@@ -383,7 +383,7 @@ def test_malformed_and_missing_scene_files(tmp_path):
     ids=["arrays-100000", "arrays-100", "tables-50000"],
 )
 def test_deeply_nested_scenes_are_refused_in_one_line(text, tmp_path, capsys):
-    # Source: issue 17 §5 (a RecursionError with 3,000 lines of traceback before).
+    # Source: docs/bad-input.md (a RecursionError with 3,000 lines of traceback before).
     from reference.scene.loader import MAX_NESTING
     from validation.cli import main
 

@@ -1,4 +1,7 @@
-"""Render outputs (display, XYZ, spectral EXR) and the metadata every render states (issue 17)."""
+"""Render outputs (display, XYZ, spectral EXR) and the metadata every render states.
+
+See docs/render-outputs.md.
+"""
 
 from __future__ import annotations
 

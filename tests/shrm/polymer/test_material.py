@@ -143,8 +143,9 @@ def test_effect_term_is_the_effect_pigment_through_its_shrm():
     difference = shade_polymer_environment(surface, with_effect, light, ctx) - (
         shade_polymer_environment(surface, without, light, ctx)
     )
-    # The isotropic_brdf shader chooses its SHRM settings from a tolerance (issue 21, SH + angular
-    # split); the effect term uses the fixed preview SHRM (E60): they agree to the preview's error.
+    # The isotropic_brdf shader chooses its SHRM settings from a tolerance (errata E91, E92: SH +
+    # angular split); the effect term uses the fixed preview SHRM (E60): they agree to the
+    # preview's error.
     expected = shade_isotropic_brdf_environment(surface, effect, light, ctx)
     np.testing.assert_allclose(difference, expected, rtol=1e-2, atol=1e-12)
 

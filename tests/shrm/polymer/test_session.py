@@ -14,7 +14,7 @@ from shrm.session import POLYMER_PARAMETERS, POLYMER_STAGES, RenderSession, stag
 
 GRID = SpectralGrid(400.0, 700.0, 20.0)
 
-# Source: the issue's classification (§5.2, §8, Herbert et al.): thickness, TiO2, tint,
+# Source: erratum E61's classification (§5.2, §8, Herbert et al.): thickness, TiO2, tint,
 # transparency and Mod_effect change only the shading; gloss (the exponent) only the specular
 # prefilter; the index only the Fresnel table. The per-pixel look-ups of the maps and the table
 # (polymer_pixels) follow a new map or table; the effect pigment's BRDF re-creates its SHRM.

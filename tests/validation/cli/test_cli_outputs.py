@@ -310,7 +310,7 @@ def test_commands_refuse_unwritable_outputs_in_one_line(command, kind, tmp_path,
     ],
 )
 def test_hostile_arguments_are_refused_in_one_line(argv, message, tmp_path, capsys):
-    # Source: issue 17 §5, the cases found with hostile input.
+    # Source: docs/bad-input.md, the cases found with hostile input.
     (tmp_path / "m.toml").write_text("[material]\nk_d = 0.2\nk_s = 0.5\nn = 3\n")
     write_exr(tmp_path / "env.exr", np.random.default_rng(3).random((8, 16, 3)) + 0.1)
     argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]

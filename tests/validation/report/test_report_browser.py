@@ -1,4 +1,4 @@
-"""The report in a real browser (issue: the report for its readers).
+"""The report in a real browser, as its readers open it.
 
 Needs Debian's ``chromium`` and ``chromium-driver`` (``apt install chromium chromium-driver``;
 ``.ci/run`` installs them); skipped with that hint where they are missing.

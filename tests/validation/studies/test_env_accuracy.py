@@ -1,6 +1,6 @@
 """Tests of the environment order study (validation.studies.env_accuracy) and of shrm.accuracy
 against the
-brute-force oracle, on every shipped environment and on synthetic worst cases (issue 17 §1)."""
+brute-force oracle, on every shipped environment and on synthetic worst cases (erratum E75)."""
 
 from __future__ import annotations
 
@@ -32,7 +32,7 @@ MEASURED = 'type = "lambert"\nk_d = { csv = "%s", row = 0, extrapolation = "cons
 @pytest.mark.parametrize("name", ENVIRONMENTS)
 def test_default_render_meets_the_promised_bound_on_shipped_environments(package_data, name):
     # Source: brute force (specref render --oracle, the per-pixel angular integral). The default
-    # path promises 0.5 % mean and 2 % max relative error of Y over lit pixels; before issue 17
+    # path promises 0.5 % mean and 2 % max relative error of Y over lit pixels; before erratum E75
     # (order from the kernel's tail alone, 14) studio_small_03 was 1.8 % mean, 26 % max off.
     scene = loads_scene(sphere_scene_toml(package_data / "environments" / name, size=10))
     found = render_against_oracle(scene)

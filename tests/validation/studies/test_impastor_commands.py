@@ -129,7 +129,7 @@ def _tilted_booth():
 
 
 def test_specular_flare_is_subtracted():
-    # Issue 16 (g): with the specular flare subtracted, what the observer sees (emission at their
+    # Erratum E46: with the specular flare subtracted, what the observer sees (emission at their
     # angle plus the diffuse and the specular flare) is the intended painting; compensating the
     # diffuse flare alone (what the CLI did before) leaves the specular flare on the screen.
     from reference.display.model import screen_flare_XYZ, virtual_display

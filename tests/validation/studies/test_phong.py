@@ -138,7 +138,7 @@ def test_never_worse_interpolations_are_the_registered_ones_in_t(monkeypatch):
 
 
 def _held_out_material(seed):
-    # Material classes the placement was not designed on (issue 17 §6), drawn at random:
+    # Material classes the placement was not designed on (erratum E85), drawn at random:
     # one band (k_s in one band, n up to 1e4 there), an exponent rising steadily to a few
     # thousand, and two narrow bands with far-apart exponents; random illuminants.
     rng = np.random.default_rng(seed)
@@ -185,7 +185,7 @@ def test_error_placement_is_never_worse_on_held_out_material_classes(seed):
 
 
 def test_one_band_material_parabolic_error_table_beats_importance():
-    # Source: issue 17 §6: a one-band material (n = 1e4 in that band) where the ungraded error
+    # Source: erratum E85: a one-band material (n = 1e4 in that band) where the ungraded error
     # table with the parabola lost to the importance table (p = m) at m = 25 and 50.
     from phong_table.render import shade_pixels
     from phong_table.table import build_table

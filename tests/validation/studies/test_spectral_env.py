@@ -37,19 +37,19 @@ def test_delta_E94_against_colour_science():
 
 
 def test_in_sample_mean(root4):
-    # Issue 15 target: in-sample mean ΔE94 <= 0.8 (Herbert et al. §4 print 0.77, in-sample).
+    # Target (erratum E44): in-sample mean ΔE94 <= 0.8 (Herbert et al. §4 print 0.77, in-sample).
     assert root4[1]["D65 mean"] <= 0.8
 
 
 def test_held_out_colorchecker_mean_D65_and_A(root4):
-    # Issue 15 targets: held-out ColorChecker mean ΔE94 <= 0.77 (D65), relit under A <= 1.0.
+    # Targets (erratum E44): held-out ColorChecker mean ΔE94 <= 0.77 (D65), relit under A <= 1.0.
     figures = root4[2][CC]
     assert figures["D65 mean"] <= 0.77
     assert figures["A mean"] <= 1.0
 
 
 def test_held_out_colorchecker_max(root4):
-    # Issue 15 target: held-out ColorChecker max ΔE94 <= 1.5 (D65); with the products of the
+    # Target (erratum E44): held-out ColorChecker max ΔE94 <= 1.5 (D65); with the products of the
     # training patches (erratum E44; 1.51 without them).
     assert root4[2][CC]["D65 max"] <= 1.5
 
@@ -101,7 +101,8 @@ def test_products_chosen_by_cross_validation_lower_the_peaks(root4, unaugmented)
 
 @pytest.mark.parametrize("name", HELD_OUT_SETS[1:])
 def test_other_held_out_sets(root4, name):
-    # Our own bound (not the issue's): the sets the design never saw stay below 1 ΔE94 mean.
+    # Our own bound (not one of erratum E44's targets): the sets the design never saw stay below
+    # 1 ΔE94 mean.
     assert root4[2][name]["D65 mean"] <= 1.0
 
 

@@ -16,7 +16,8 @@ def test_report_display_section(tmp_path):
     assert instruments["spectro"]["bands"]["5-12.5 %"] < 0.002
     screen = section["screen"]
     assert screen["30° to the side, not compensated"]["max_abs_Y_error"] > 0.1
-    # issue 16: the painting off axis, uncompensated, is visibly wrong; compensated it is not
+    # docs/display.md, "ImpastoR's display per pixel": the painting off axis, uncompensated, is
+    # visibly wrong; compensated it is not
     painting = section["painting"]
     assert painting["30° to the side, not compensated"]["dE00_mean"] > 2.0
     assert painting["30° to the side, compensated"]["dE00_max"] < 1.0

@@ -39,8 +39,8 @@ def test_example_renders_present_and_check(tmp_path, small_renders):
     assert all(c.passed for c in examples.checks(small_renders))
     for entry in (scenes[name] for name, _ in examples.SCENES):
         assert entry["seconds"]["total"] > 0
-    # The rendered charts reproduce colour-science's E308 XYZ (Y = 1 scale), as the issue asks of
-    # the band weights: |ΔXYZ| <= 1e-9 on the Y = 100 scale.
+    # The rendered charts reproduce colour-science's E308 XYZ (Y = 1 scale), as the band weights
+    # of erratum E7 do: |ΔXYZ| <= 1e-9 on the Y = 100 scale.
     for name in ("colorchecker-d65.toml", "colorchecker-a.toml"):
         assert scenes[name]["accuracy"]["max_abs_dXYZ"] * 100 <= 1e-9
 

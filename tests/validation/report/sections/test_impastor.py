@@ -1,4 +1,4 @@
-"""Tests of the report section "ImpastoR": compute, checks (one per target of issue 6), images."""
+"""Tests of the report section "ImpastoR": compute, checks (one per target), images."""
 
 from __future__ import annotations
 
@@ -23,7 +23,7 @@ from validation.report.sections.impastor import (
 
 
 def _results(**changes):
-    # Figures that meet every target (the issue's limits, with margin), then one changed.
+    # Figures that meet every target (the section's limits, with margin), then one changed.
     results = {
         "channels": {
             design: {"6": {light: {"mean": 0.1, "max": 0.3} for light in ("D65", "D50", "A")}}
@@ -65,7 +65,7 @@ def test_checks_cover_every_target_and_pass_when_met():
 
 
 def test_a_failing_figure_fails_its_check():
-    # path: (value just past the issue's limit, words in the check's name, measured as shown)
+    # path: (value just past the limit, words in the check's name, measured as shown)
     cases = {
         "channels/optimized/6/A/max": (0.61, "optimized 6 channels, ColorChecker under A", 0.61),
         "channels/box/6/D50/mean": (0.81, "box 6 channels, ColorChecker under D50", 0.81),
@@ -167,7 +167,7 @@ def test_report_section_quick(tmp_path):
     found = {c["name"]: c for c in results["checks"] if c["section"] == "impastor"}
     assert len(found) == 21
     # Every target holds: colour, metamers, the hybrid (erratum E17), shadows and display; the
-    # hybrid's held-out distribution (issue 22) is a target of the full report only: quick mode's
+    # hybrid's held-out distribution (erratum E17) is a target of the full report only: quick mode's
     # two small cases are not the held-out set.
     failing = [name for name, c in found.items() if not c["passed"] and "held-out" not in name]
     assert not failing, failing

@@ -64,7 +64,7 @@ def _names(checks):
 
 
 def test_target_checks_pass_on_passing_figures():
-    # figures that meet every target of issue 4 (limits from the issue's Targets list)
+    # figures that meet every target (limits from docs/phong-tables.md, "Report checks")
     checks = target_checks(
         _records(1e-4, 0.2, 0.0),
         [{"entries": 40, "verified": True}],

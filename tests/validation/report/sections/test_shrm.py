@@ -41,7 +41,7 @@ def test_compute_on_tiny_settings(tiny):
 
 
 def test_checks_name_every_target(tiny):
-    # Every issue-7 target is a check; reduced runs name their settings.
+    # Every target of the section is a check; reduced runs name their settings.
     found = checks(tiny)
     assert len(found) == 2 * len(SUITE) + 3
     assert all(c.name.startswith("tiny (8-row environment, 8² image): ") for c in found)
@@ -119,7 +119,7 @@ def _normal_frame_errors(env, g, view, F, P, size, fits):
 
 
 def test_every_brdf_meets_one_percent_with_P_at_most_10_on_a_small_setting():
-    # §5.5's "SH order typically between 2 and 10" (issue 7, erratum E23): the quick study's
+    # §5.5's "SH order typically between 2 and 10" (erratum E23): the quick study's
     # environment (16×32) and image (20²), normal frame, F 12, P 10, 32² faces. Oracle: the
     # per-pixel brute-force render. The hemisphere fit meets 1 % of the peak for all four BRDFs;
     # R&H 2002's projection over all views (the even continuation below the horizon) does not.

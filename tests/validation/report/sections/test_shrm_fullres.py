@@ -60,7 +60,7 @@ def test_checks_follow_the_targets_and_quick_mode_has_none(sun_map, tmp_path):
 
 
 def test_a_tabulated_brdf_goes_through_the_same_path(sun_map):
-    # issue 21 item 4: a BRDF table (GGX alpha 0.3 tabulated) renders through the split like an
+    # erratum E94: a BRDF table (GGX alpha 0.3 tabulated) renders through the split like an
     # analytic BRDF, against a brute force over the same table
     table = fullres_case((sun_map, "table", 0.3, 8, None, 0.005))
     assert table["brdf"] == "table"
