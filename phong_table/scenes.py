@@ -12,7 +12,7 @@ properties the captions and the text describe, not the paper's data:
 - **R3**: a narrow-band specular with high exponents: FL11 (a tri-band lamp with lines), a grey
   ``k_d`` with a red edge, ``k_s`` a 15 nm-wide Gaussian at 530 nm, ``n(λ)`` from 2000 to 3000.
 
-Two failure cases from the issue (``docs/phong-tables.md``): ``bimodal`` (``n = 5`` below 580 nm,
+Two failure cases (``docs/phong-tables.md``): ``bimodal`` (``n = 5`` below 580 nm,
 500 above) and ``n2000`` (``n ≡ 2000``), both with flat ``k_d = 0.2``, ``k_s = 0.5`` under D65.
 
 Every scene is a unit sphere at the origin, seen from ``EYE`` and lit by one point light at

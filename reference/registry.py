@@ -2,8 +2,8 @@
 
 A registry maps the short key a user types (in a CLI flag or a scene file) to a :class:`Method`: the
 NumPy reference (the oracle), its numba twin if there is one, the equation it cites, and a function
-that makes small valid inputs for tests and docs. A later issue adds a method by registering it; it
-never edits a dispatcher.
+that makes small valid inputs for tests and docs. A new method is added by registering it; no
+dispatcher is edited.
 """
 
 from __future__ import annotations

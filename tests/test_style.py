@@ -313,7 +313,7 @@ def test_no_cli_option_spells_registry_keys_by_hand():
 
 
 def test_report_section_functions_stay_short():
-    # Sections read as compute -> present -> checks, in functions a reader can follow (issue 13).
+    # Sections read as compute -> present -> checks, in functions a reader can follow.
     long = []
     for path in sorted((ROOT / "validation" / "report" / "sections").glob("*.py")):
         for node in ast.walk(ast.parse(path.read_text())):

@@ -11,8 +11,9 @@ from a camera's spectral sensitivities and reflectance sets that colour-science 
   of :data:`HELD_OUT_SETS` or of the other ColorChecker measurements (BabelColor Average,
   ISO 17321-1, PMC); rawtoaces holds several ColorChecker-like patches, and a held-out figure on a
   patch the model was trained on would measure memory, not recovery.
-- **Held out** (:data:`HELD_OUT_SETS`): ColorChecker N Ohta (the issue's target), the CIE 2024 test
-  colour samples and the NIST CQS 9.0 samples (Munsell papers). The design never sees them.
+- **Held out** (:data:`HELD_OUT_SETS`): ColorChecker N Ohta (the chart of the section's targets),
+  the CIE 2024 test colour samples and the NIST CQS 9.0 samples (Munsell papers). The design never
+  sees them.
 - **A further test set** (:data:`OTHER_TEST_SET`, erratum E44): the 99 colour evaluation samples
   of CIE 224:2017 (colour fidelity index; real objects chosen to cover colour space uniformly)
   minus those with a look-alike in the training set (same thresholds), measured after every

@@ -2,7 +2,7 @@
 
 A material holds its spectral parameters already on the scene's wavelength grid, shape
 ``(n_bands,)``. The registry :data:`MATERIAL_TYPES` maps the ``type`` key of a scene file to the
-class and its parameters, so a later issue adds a material type by registering it; the scene loader
+class and its parameters, so a new material type is added by registering it; the scene loader
 and the renderer read the registry.
 
 - ``lambert``: diffuse reflectance ``k_d(λ)`` (the diffuse term of Eq. (2), Wang et al.).

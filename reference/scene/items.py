@@ -3,7 +3,7 @@
 Each entry is a :class:`SceneItemType`: the ``type`` key of an ``[[objects]]`` or ``[[lights]]``
 table and a parser from that table to a primitive (``Sphere``, ``Plane``, ``TriangleMesh``) or a
 light (``PointLight``, ``AmbientLight``, ``EnvironmentLight``). ``reference.scene.loader`` reads the
-registries, so a later issue adds an object or light type by registering it here or in its own
+registries, so a new object or light type is added by registering it here or in its own
 module. Values are read with ``reference.scene.values.SceneReader``, so errors name the file and the
 dotted key (``scene.toml: objects[0].radius: must be > 0, got -1``).
 """

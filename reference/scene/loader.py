@@ -6,7 +6,7 @@ encoding, exposure, chromatic adaptation), ``[materials.<name>]``, and the array
 ``[[objects]]`` and ``[[lights]]``. ``docs/scene-format.md`` gives every key, its type, default and
 allowed values.
 
-The loader is driven by registries, so a later issue adds a type without editing it:
+The loader is driven by registries, so a new type is added without editing it:
 
 - material ``type`` keys come from ``reference.materials.types.MATERIAL_TYPES``; a type reads its
   parameters as spectra on the grid unless its ``MaterialType.parse`` says otherwise;

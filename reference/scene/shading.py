@@ -3,9 +3,9 @@
 For each light and each material, a *shader* turns the G-buffer pixels of that material into XYZ (Y
 = 1 for a perfect white diffuser facing a unit light). Shaders are registered in :data:`SHADERS`
 under ``"<MaterialClass>/<LightClass>"``; :func:`shade_gbuffer` sums every light's contribution. A
-later issue adds a light or material type by registering shaders (the SH engine registers the
-environment-light shaders; the Phong-table issue registers accelerated Phong shaders as *methods*),
-never by editing this dispatcher.
+new light or material type is added by registering shaders (``shrm`` registers the environment-light
+shaders; ``phong_table`` registers accelerated Phong shaders as *methods*), never by editing this
+dispatcher.
 
 Point lights fold their spectrum into the band weights: a shader computes the per-band reflected
 fraction ``I(λ)/I_p(λ)`` and converts it with ``W = band_weights(grid, light.spectrum)``, so
@@ -321,7 +321,7 @@ def shade_ambient(surface: Surface, material, light: AmbientLight, ctx) -> np.nd
     k_a = material.k_a if isinstance(material, PhongMaterial) else material.k_d
     # Eq. (1), Wang et al.: ambient term I_a k_a
     XYZ = light.intensity * (k_a @ ctx.weights(light.spectrum))
-    return np.broadcast_to(XYZ, (surface.position.shape[0], 3)).copy()
+    return np.broadcast_to(XYZ, (surface.position.shape[0], XYZ.shape[-1])).copy()
 
 
 def shader_key(material, light) -> str:

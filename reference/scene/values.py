@@ -457,7 +457,7 @@ def _parse_arrays(reader: SceneReader, table: dict, key: str) -> Spectrum:
     return make_spectrum(arrays["wavelengths"], arrays["values"], f"{reader.file}: {key}")
 
 
-#: Spectrum forms by the table key that selects them; a later issue registers more.
+#: Spectrum forms by the table key that selects them; a new form is registered here.
 SPECTRUM_FORMS = Registry("spectrum form")
 SPECTRUM_FORMS.register(
     SpectrumForm("constant", _parse_constant, (), "a constant (a bare number works too)")

@@ -385,3 +385,19 @@ def test_environment_background_needs_a_map_that_covers_the_grid(tmp_path):
         r"400-700 nm but the grid needs 380-780 nm",
     ):
         render_scene(scene)
+
+
+def test_spectral_output_with_an_ambient_light_is_the_XYZ_render():
+    # The ambient shader returns one value per output (3 for XYZ, n_bands for spectral), so a scene
+    # with an ambient light renders spectrally; on the sphere XYZ is then spectral @ W_E
+    # (docs/render-outputs.md; a constant background has no spectrum, erratum E77).
+    from reference.colour.colorimetry import band_weights
+
+    scene = load_scene(EXAMPLES / "phong-sphere.toml")
+    assert any(type(light).__name__ == "AmbientLight" for light in scene.lights)
+    result = render_scene(scene, 8, 8, supersample=1, spectral=True)
+    W_E = band_weights(scene.grid, None, scene.weights_method, scene.observer)
+    assert result.spectral.shape == (8, 8, scene.grid.n_bands)
+    on = result.gbuffer.mask
+    assert on.any()
+    np.testing.assert_allclose((result.spectral @ W_E)[on], result.XYZ[on], rtol=1e-10, atol=1e-14)
