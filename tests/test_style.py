@@ -312,13 +312,24 @@ def test_no_cli_option_spells_registry_keys_by_hand():
     assert not offenders, "; ".join(offenders)
 
 
-def test_report_section_functions_stay_short():
-    # Sections read as compute -> present -> checks, in functions a reader can follow.
+#: The longest function a reader is asked to follow (STYLE.md §2); numba kernels are exempt.
+MAX_FUNCTION_LINES = 80
+
+
+def test_functions_stay_short():
+    # A function past 80 lines is several steps; name them. Counted from `def` to the last line,
+    # docstring included, in every package (the report's sections read compute -> present ->
+    # checks); numba kernels (`*_kernels.py`) keep their loops whole.
+    assert len(SOURCES) > 100  # the packages were found
     long = []
-    for path in sorted((ROOT / "validation" / "report" / "sections").glob("*.py")):
+    for path in SOURCES:
+        if path.name.endswith("_kernels.py"):
+            continue
         for node in ast.walk(ast.parse(path.read_text())):
-            if isinstance(node, ast.FunctionDef) and node.end_lineno - node.lineno + 1 > 80:
-                long.append(f"{path.name}:{node.name} ({node.end_lineno - node.lineno + 1} lines)")
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                lines = node.end_lineno - node.lineno + 1
+                if lines > MAX_FUNCTION_LINES:
+                    long.append(f"{path.relative_to(ROOT)}:{node.name} ({lines} lines)")
     assert not long, "; ".join(long)
 
 
