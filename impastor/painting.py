@@ -19,6 +19,7 @@ from __future__ import annotations
 import hashlib
 import time
 from collections import OrderedDict
+from dataclasses import dataclass
 from pathlib import Path
 from typing import NamedTuple
 
@@ -327,7 +328,7 @@ def render_painting(
     spectra = spectra or load_paint_spectra()
     d = MULTISPECTRAL_DESIGNS.lookup(design).reference(6)
     plane = booth_plane_light(_booth_kind(light), *light_resolution)
-    lights = point_lights_from_plane(plane, lighting.extra["sampling"], n_lights)
+    lights = point_lights_from_plane(plane, lighting.sampling, n_lights)
     S6 = light_to_channels(spectrum_from_dataset("illuminant", light), d)
     px = _canvas_pixels(painting, size)
     P, V, N = px.P, px.V, px.N
@@ -526,11 +527,25 @@ def _painting_example(rng):
     return P, N, V, rng.uniform(0.05, 0.3, 4), plane, lights, 8, None, "numpy"
 
 
-#: How the painting's gloss is lit: ``reference(P, N, V, alpha, plane, lights, n_samples,
-#: visibility, backend)`` returns the specular illuminance ``I_s`` per point; ``extra["sampling"]``
-#: is the key of :data:`impastor.point_lights.LIGHT_SAMPLING_METHODS` that makes the point lights
-#: (which the diffuse term always uses).
-PAINTING_LIGHTING_METHODS = Registry("lighting method")
+@dataclass(frozen=True, kw_only=True)
+class PaintingLighting(Method):
+    """How the painting's gloss is lit.
+
+    ``reference(P, N, V, alpha, plane, lights, n_samples, visibility, backend)`` returns the
+    specular illuminance ``I_s`` per point.
+
+    Parameters
+    ----------
+    sampling : str
+        The key of :data:`impastor.point_lights.LIGHT_SAMPLING_METHODS` that makes the point
+        lights (which the diffuse term always uses).
+    """
+
+    sampling: str
+
+
+#: The painting's lighting methods by key.
+PAINTING_LIGHTING_METHODS = Registry("lighting method", PaintingLighting)
 for _name, _function, _sampling, _cites in (
     ("median_cut", painting_specular_point_lights, "median_cut", "Eq. (2), Ferwerda"),
     ("variance_min", painting_specular_point_lights, "variance_min", "Eq. (2), Ferwerda"),
@@ -538,5 +553,5 @@ for _name, _function, _sampling, _cites in (
     ("hybrid", painting_specular_hybrid, "median_cut", "Eq. (4), Ferwerda"),
 ):
     PAINTING_LIGHTING_METHODS.register(
-        Method(_name, _function, None, _cites, _painting_example, extra={"sampling": _sampling})
+        PaintingLighting(_name, _function, None, _cites, _painting_example, sampling=_sampling)
     )

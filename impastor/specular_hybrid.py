@@ -24,6 +24,9 @@ References
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass
+
 import numpy as np
 
 from impastor._kernels import (
@@ -526,48 +529,63 @@ def _call_brute_force(x, backend, n_samples=16, supersample=2):
     return specular_brute_force(*x[:5], supersample, backend=backend)
 
 
-#: Specular lighting methods; ``reference`` is the NumPy function (``backend`` selects the numba
-#: twin named by ``kernel``); ``example_inputs(rng)`` returns ``(points, normals, views, alpha,
-#: plane, lights)``; ``extra["call"](inputs, backend, n_samples=16, supersample=2)`` runs the
-#: method on those inputs.
-SPECULAR_METHODS = Registry("specular lighting")
+@dataclass(frozen=True, kw_only=True)
+class SpecularMethod(Method):
+    """A specular lighting method of the Ward–Dür lobe.
+
+    ``reference`` is the NumPy function (``backend`` selects the numba twin named by ``kernel``);
+    ``example_inputs(rng)`` returns ``(points, normals, views, alpha, plane, lights)``.
+
+    Parameters
+    ----------
+    run : callable
+        ``run(inputs, backend, n_samples=16, supersample=2)``: the method on the inputs of
+        ``example_inputs``, each method taking the ones it uses (the methods differ in what they
+        read: the point lights, the plane, a sample count or a sub-pixel count).
+    """
+
+    run: Callable[..., np.ndarray]
+
+
+#: Specular lighting methods by key.
+SPECULAR_METHODS = Registry("specular lighting", SpecularMethod)
 SPECULAR_METHODS.register(
-    Method(
+    SpecularMethod(
         "point_lights",
         specular_point_lights,
         specular_point_lights_kernel,
         "Eq. (2), Ferwerda",
         _example_scene,
-        extra={"call": _call_point_lights},
+        run=_call_point_lights,
     )
 )
 SPECULAR_METHODS.register(
-    Method(
+    SpecularMethod(
         "fis",
         specular_fis,
         specular_fis_kernel,
         "Eq. (4), Ferwerda (FIS with the lookup of Eqs. (5)-(8), Ferwerda)",
         _example_scene,
-        extra={"call": _call_fis},
+        run=_call_fis,
     )
 )
 SPECULAR_METHODS.register(
-    Method(
+    SpecularMethod(
         "hybrid",
         specular_hybrid,
         None,
         "Eq. (4), Ferwerda",
         _example_scene,
-        extra={"call": _call_hybrid},
+        run=_call_hybrid,
     )
 )
 SPECULAR_METHODS.register(
-    Method(
+    SpecularMethod(
         "brute_force",
         specular_brute_force,
         specular_brute_force_kernel,
         "Eq. (4), Ferwerda",
         _example_scene,
-        extra={"call": _call_brute_force},
+        run=_call_brute_force,
     )
 )

@@ -37,6 +37,8 @@ References
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from phong_table import _kernels
@@ -326,72 +328,89 @@ def _example_inputs(rng):
     return nodes, np.stack([nodes**5] * 3, axis=-1), rng.uniform(0.0, 1.0, 20), 4.0
 
 
-#: Interpolations by the keys of ``--interp``. ``reference(nodes, values, t, an) -> (..., 3)``; the
-#: compiled twin is the branch ``extra["code"]`` of ``shade_table_kernel``; ``extra["min_entries"]``
-#: is the smallest table it accepts; ``extra["order"]`` its convergence order (error O(h^order) on
-#: smooth data); and
-#: ``extra["graded"]`` says that its stencil spans two intervals (the 3-point parabolas), so the
-#: error placement grades its nodes for it (``phong_table.placement.ERROR_GRADING``); and
-#: ``extra["coordinate"]`` is the coordinate it interpolates in: ``"t"`` (any node set) or ``"w"``
-#: (``w = ir(t)``, in which only importance nodes with ``p = m`` are uniform). Registration order is
-#: the order of Table 1's columns and of the report: the paper's parabola first, its reading in w,
-#: then the alternatives.
-INTERPOLATION_METHODS = Registry("interpolation")
+@dataclass(frozen=True, kw_only=True)
+class Interpolation(Method):
+    """An interpolation of a specular table: ``reference(nodes, values, t, an) -> (..., 3)``.
+
+    Parameters
+    ----------
+    code : int
+        Its branch of ``shade_table_kernel`` (the compiled twin).
+    min_entries : int
+        The smallest table it accepts.
+    order : int
+        Its convergence order: error O(h^order) on smooth data.
+    coordinate : {"t", "w"}
+        The coordinate it interpolates in: ``t`` (any node set) or ``w = ir(t)``, in which only
+        importance nodes with ``p = m`` are uniform.
+    graded : bool
+        Its stencil spans two intervals (the 3-point parabolas), so the error placement grades its
+        nodes for it (``phong_table.placement.ERROR_GRADING``).
+    """
+
+    code: int
+    min_entries: int
+    order: int
+    coordinate: str
+    graded: bool
+
+
+#: Interpolations by the keys of ``--interp``. Registration order is the order of Table 1's columns
+#: and of the report: the paper's parabola first, its reading in w, then the alternatives.
+INTERPOLATION_METHODS = Registry("interpolation", Interpolation)
 INTERPOLATION_METHODS.register(
-    Method(
+    Interpolation(
         "parabolic",
         interpolate_parabolic,
         None,
         "Eq. (11), Wang et al.",
         _example_inputs,
-        {
-            "code": _kernels.PARABOLIC,
-            "min_entries": 3,
-            "order": 3,
-            "coordinate": "t",
-            "graded": True,
-        },
+        code=_kernels.PARABOLIC,
+        min_entries=3,
+        order=3,
+        coordinate="t",
+        graded=True,
     )
 )
 INTERPOLATION_METHODS.register(
-    Method(
+    Interpolation(
         "parabolic_w",
         interpolate_parabolic_w,
         None,
         "Eq. (14), Wang et al.",
         _example_inputs,
-        {
-            "code": _kernels.PARABOLIC_W,
-            "min_entries": 3,
-            "order": 3,
-            "coordinate": "w",
-            "graded": True,
-        },
+        code=_kernels.PARABOLIC_W,
+        min_entries=3,
+        order=3,
+        coordinate="w",
+        graded=True,
     )
 )
 INTERPOLATION_METHODS.register(
-    Method(
+    Interpolation(
         "linear",
         interpolate_linear,
         None,
         "Eq. (11), Wang et al.",
         _example_inputs,
-        {"code": _kernels.LINEAR, "min_entries": 1, "order": 2, "coordinate": "t", "graded": False},
+        code=_kernels.LINEAR,
+        min_entries=1,
+        order=2,
+        coordinate="t",
+        graded=False,
     )
 )
 INTERPOLATION_METHODS.register(
-    Method(
+    Interpolation(
         "monotone",
         interpolate_monotone,
         None,
         "Eq. (11), Wang et al.",
         _example_inputs,
-        {
-            "code": _kernels.MONOTONE,
-            "min_entries": 1,
-            "order": 3,
-            "coordinate": "t",
-            "graded": False,
-        },
+        code=_kernels.MONOTONE,
+        min_entries=1,
+        order=3,
+        coordinate="t",
+        graded=False,
     )
 )

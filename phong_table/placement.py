@@ -67,6 +67,7 @@ References
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -104,7 +105,7 @@ ERROR_DENSITY_FLOOR = 0.1
 #: Uniform cells over the seen range on which :func:`pixel_density` counts the frame's pixels.
 PIXEL_DENSITY_CELLS = 64
 #: Largest growth of the interval width per unit ``t`` (``|dw/dt|``) of :func:`table_error` for
-#: the interpolations whose stencil spans two intervals (``extra["graded"]``, the 3-point
+#: the interpolations whose stencil spans two intervals (``Interpolation.graded``, the 3-point
 #: parabolas): neighbouring intervals then differ by at most a factor ``1/(1 − g) = 2``. Without
 #: it a lobe's narrow intervals meet the floor's wide ones in one step and the parabola through
 #: them swings far below 0 (Erratum E85).
@@ -425,7 +426,7 @@ def table_error(
         ``ShadingBuffer.t_density``): the density also equidistributes the pixels' RMS error.
     interpolation : str, optional
         The interpolation the table will be read with (``INTERPOLATION_METHODS``): for one whose
-        stencil spans two intervals (``extra["graded"]``, the parabolas) the nodes are graded
+        stencil spans two intervals (``Interpolation.graded``, the parabolas) the nodes are graded
         (:data:`ERROR_GRADING`). None: not graded (linear and monotone need no grading).
 
     Returns
@@ -501,7 +502,7 @@ def _grading(interpolation) -> float:
         return 0.0
     from phong_table.interpolation import INTERPOLATION_METHODS
 
-    return ERROR_GRADING if INTERPOLATION_METHODS.lookup(interpolation).extra["graded"] else 0.0
+    return ERROR_GRADING if INTERPOLATION_METHODS.lookup(interpolation).graded else 0.0
 
 
 def _error_nodes(model: SpectralPhong, m: int, floor: float, t_fine, p, grading: float = 0.0):
@@ -592,47 +593,67 @@ def _example_inputs(rng):
     return constant_material(float(rng.uniform(1.0, 100.0))), 16, None
 
 
-#: Placements by the keys of ``--placement``. ``reference(model, entries, segments) -> nodes``;
-#: ``kernel`` (if any) is the numba twin of its density computation and ``extra["compiled"]`` calls
-#: it with the reference's signature; ``extra["segments"]`` says whether ``segments`` applies and
-#: ``extra["t_range"]`` whether the placement reads the frame's range of ``t`` (``t_range=``);
-#: ``extra["interpolation"]`` whether it places for the interpolation used (``interpolation=``).
-#: Registration order is the order of Table 1's rows and of the report: the paper's placement, its
-#: uniform baseline, then ours.
-PLACEMENT_METHODS = Registry("placement")
+@dataclass(frozen=True, kw_only=True)
+class Placement(Method):
+    """A node placement: ``reference(model, entries, segments) -> nodes``.
+
+    ``kernel`` (if any) is the numba twin of its density computation and ``compiled`` calls it with
+    the reference's signature.
+
+    Parameters
+    ----------
+    source : str
+        Whose placement it is: the paper's, its baseline, or ours.
+    segments : bool
+        ``segments`` applies (the importance placement's p of Eq. (16), Wang et al.).
+    t_range : bool
+        It reads the frame's range of ``t`` (``t_range=``).
+    interpolation : bool
+        It places for the interpolation used (``interpolation=``).
+    """
+
+    source: str
+    segments: bool
+    t_range: bool = False
+    interpolation: bool = False
+
+
+#: Placements by the keys of ``--placement``. Registration order is the order of Table 1's rows and
+#: of the report: the paper's placement, its uniform baseline, then ours.
+PLACEMENT_METHODS = Registry("placement", Placement)
 PLACEMENT_METHODS.register(
-    Method(
+    Placement(
         "importance",
         table_importance_Wang,
         None,
         "Eq. (16), Wang et al.",
         _example_inputs,
-        {"segments": True, "source": "Wang et al."},
+        source="Wang et al.",
+        segments=True,
     )
 )
 PLACEMENT_METHODS.register(
-    Method(
+    Placement(
         "uniform",
         table_uniform,
         None,
         "Eq. (16), Wang et al.",
         _example_inputs,
-        {"segments": False, "source": "Wang et al. (baseline)"},
+        source="Wang et al. (baseline)",
+        segments=False,
     )
 )
 PLACEMENT_METHODS.register(
-    Method(
+    Placement(
         "error",
         table_error,
         _kernels.table_error_kernel,
         "Eq. (11), Wang et al.",
         _example_inputs,
-        {
-            "segments": False,
-            "source": "ours",
-            "compiled": _table_error_compiled,
-            "t_range": True,
-            "interpolation": True,
-        },
+        compiled=_table_error_compiled,
+        source="ours",
+        segments=False,
+        t_range=True,
+        interpolation=True,
     )
 )

@@ -334,7 +334,7 @@ def compiled_shader(
         table.guide,
         table.steps,
         table.uniform,
-        INTERPOLATION_METHODS.lookup(interpolation).extra["code"],
+        INTERPOLATION_METHODS.lookup(interpolation).code,
         table.an + 1.0,
         table.zero_below,
     )
@@ -354,8 +354,8 @@ def _table_compiled(buffer: ShadingBuffer, model, table: SpecularTable, interpol
 
 
 #: The kernels of the render path, each a NumPy reference with its numba twin: the two shading
-#: paths (``extra["compiled"]`` calls the kernel on a :class:`ShadingBuffer`), the per-pixel
-#: geometry and the tabulation of a table's values, slopes and index.
+#: paths (``compiled`` calls the kernel on a :class:`ShadingBuffer`), the per-pixel geometry and
+#: the tabulation of a table's values, slopes and index.
 RENDER_METHODS = Registry("shading path")
 RENDER_METHODS.register(
     Method(
@@ -363,7 +363,7 @@ RENDER_METHODS.register(
         shade_exact,
         _kernels.shade_exact_kernel,
         "Eq. (2), Wang et al.",
-        extra={"compiled": _exact_compiled},
+        compiled=_exact_compiled,
     )
 )
 RENDER_METHODS.register(
@@ -372,7 +372,7 @@ RENDER_METHODS.register(
         shade_table,
         _kernels.shade_table_kernel,
         "Eq. (11), Wang et al.",
-        extra={"compiled": _table_compiled},
+        compiled=_table_compiled,
     )
 )
 RENDER_METHODS.register(
@@ -381,7 +381,7 @@ RENDER_METHODS.register(
         light_geometry,
         _kernels.light_geometry_kernel,
         "Eq. (1), Wang et al.",
-        extra={"compiled": _kernels.light_geometry_kernel},
+        compiled=_kernels.light_geometry_kernel,
     )
 )
 RENDER_METHODS.register(
@@ -390,7 +390,7 @@ RENDER_METHODS.register(
         tabulate,
         _kernels.tabulate_kernel,
         "Eq. (11), Wang et al.",
-        extra={"compiled": _kernels.tabulate_kernel},
+        compiled=_kernels.tabulate_kernel,
     )
 )
 #: The keys of :data:`RENDER_METHODS` that shade (``render_sphere``'s ``method``).
@@ -451,8 +451,8 @@ def shade_pixels(
     if out is None:
         out = np.empty((buffer.t.size, 3))
     if method == "exact":
-        return entry.extra["compiled"](buffer, model, out)
-    return entry.extra["compiled"](buffer, model, table, interpolation, out)
+        return entry.compiled(buffer, model, out)
+    return entry.compiled(buffer, model, table, interpolation, out)
 
 
 def render_sphere(

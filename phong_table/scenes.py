@@ -181,7 +181,7 @@ class Scene:
 
 
 #: Scenes by key: the Table 1 reconstructions R1-R3 and the failure cases.
-SCENES = Registry("Phong scene")
+SCENES = Registry("Phong scene", Scene)
 SCENES.register(Scene("R1", _R1, "reconstruction: smooth spectra, n = 20-80, D65"))
 SCENES.register(Scene("R2", _R2, "reconstruction: n = 10-1000 across wavelengths, illuminant A"))
 SCENES.register(Scene("R3", _R3, "reconstruction: narrow-band k_s at 530 nm, n = 2000-3000, FL11"))

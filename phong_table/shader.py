@@ -100,5 +100,5 @@ def shade_phong_point_table(surface, material, light, ctx) -> np.ndarray:
 
 
 PHONG_POINT_METHODS.register(
-    Method("table", shade_phong_point_table, None, "Eq. (11), Wang et al.", extra=OPTION_KEYS)
+    Method("table", shade_phong_point_table, None, "Eq. (11), Wang et al.")
 )

@@ -49,7 +49,7 @@ def check_interpolation(interpolation: str, entries: int) -> None:
     reference.errors.SpecrefError: table: entries: parabolic interpolation needs entries >= 3, got 2
     """
     method = INTERPOLATION_METHODS.lookup(interpolation)
-    least = method.extra["min_entries"]
+    least = method.min_entries
     require(
         entries >= least,
         f"table: entries: {interpolation} interpolation needs entries >= {least}, got {entries}",
@@ -322,7 +322,7 @@ def build_table(
     """
     method, m, p = _checked_placement(material, placement, entries, segments)
     frame = _frame_keywords(method, m, t_range, t_density, interpolation)
-    place = method.extra.get("compiled", method.reference) if compiled else method.reference
+    place = (method.compiled or method.reference) if compiled else method.reference
     nodes = np.ascontiguousarray(place(material, m, p, **frame), dtype=np.float64)
     # the compiled build runs no NumPy array operation between its kernels (phong_table._kernels)
     require(
@@ -341,7 +341,7 @@ def _checked_placement(material, placement: str, entries, segments):
         f"build_table: material must be a SpectralPhong, got {type(material).__name__}",
     )
     require(
-        segments is None or method.extra["segments"],
+        segments is None or method.segments,
         f"{placement} table: segments: only the importance placement takes segments, got "
         f"{segments!r}",
     )
@@ -352,9 +352,9 @@ def _checked_placement(material, placement: str, entries, segments):
 def _frame_keywords(method, m: int, t_range, t_density, interpolation) -> dict:
     """The frame as the placement reads it: the range and pixel density of t, the interpolation."""
     seen = {}
-    if method.extra.get("t_range") and t_range is not None:
+    if method.t_range and t_range is not None:
         seen = {"t_range": t_range, "t_density": t_density}
-    if method.extra.get("interpolation") and interpolation is not None:
+    if method.interpolation and interpolation is not None:
         check_interpolation(interpolation, m)
         seen["interpolation"] = interpolation
     return seen

@@ -4,17 +4,22 @@ A registry maps the short key a user types (in a CLI flag or a scene file) to a 
 NumPy reference (the oracle), its numba twin if there is one, the equation it cites, and a function
 that makes small valid inputs for tests and docs. A new method is added by registering it; no
 dispatcher is edited.
+
+What a family needs beyond that is a typed field of the family's own subclass of :class:`Method`
+(``BRDFMethod.sample``, ``Interpolation.order``), declared where the registry is, so a misspelt or
+missing field is an error where the method is written, and a registry refuses an entry of another
+kind (``Registry(family, kind)``).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 from reference.errors import SpecrefError, format_allowed
 
-__all__ = ["Method", "Registry"]
+__all__ = ["Method", "ParametricMethod", "Registry"]
 
 
 @dataclass(frozen=True)
@@ -33,8 +38,10 @@ class Method:
         The equation, in the fixed format ``"Eq. (N), Author"`` (STYLE.md §5).
     example_inputs : callable or None
         ``example_inputs(rng) -> tuple`` of small valid positional inputs for tests and docs.
-    extra : dict
-        Family-specific metadata (for example whether a placement needs ``segments``).
+    compiled : callable or None
+        The kernel called with the reference's signature (it allocates and packs what the kernel
+        writes into), where the kernel's own signature differs; the twin-equality tests compare
+        ``compiled(*inputs)`` with ``reference(*inputs)``.
 
     Examples
     --------
@@ -48,7 +55,29 @@ class Method:
     kernel: Callable[..., Any] | None
     cites: str
     example_inputs: Callable[..., tuple] | None = None
-    extra: dict = field(default_factory=dict)
+    compiled: Callable[..., Any] | None = None
+
+
+@dataclass(frozen=True, kw_only=True)
+class ParametricMethod(Method):
+    """A method that takes one parameter, written ``key:VALUE`` in CLI flags (``gaussian:0.1``).
+
+    Parameters
+    ----------
+    param : str
+        The parameter's name as help texts show it (``key[:PARAM]``).
+
+    Examples
+    --------
+    >>> ParametricMethod("lobe", abs, None, "Eq. (0), nobody", param="S").param
+    'S'
+    >>> ParametricMethod("lobe", abs, None, "Eq. (0), nobody", parm="S")
+    Traceback (most recent call last):
+    ...
+    TypeError: ParametricMethod.__init__() got an unexpected keyword argument 'parm'
+    """
+
+    param: str
 
 
 class Registry:
@@ -58,6 +87,8 @@ class Registry:
     ----------
     family : str
         What the entries are, used in messages: ``"placement"``, ``"report section"``.
+    kind : type
+        What an entry must be (default :class:`Method`); :meth:`register` refuses anything else.
 
     Examples
     --------
@@ -71,8 +102,9 @@ class Registry:
     reference.errors.SpecrefError: unknown placement 'unifrom'; allowed: uniform
     """
 
-    def __init__(self, family: str):
+    def __init__(self, family: str, kind: type = Method):
         self.family = family
+        self.kind = kind
         self._entries: dict[str, Any] = {}
 
     def register(self, entry: Any, name: str | None = None) -> Any:
@@ -81,8 +113,14 @@ class Registry:
         Raises
         ------
         SpecrefError
-            When the key is already taken: two methods must never share a key.
+            When the key is already taken (two methods must never share a key) or the entry is not
+            of the registry's kind.
         """
+        if not isinstance(entry, self.kind):
+            raise SpecrefError(
+                f"{self.family} registry takes {self.kind.__name__} entries, got "
+                f"{type(entry).__name__}"
+            )
         key = name if name is not None else entry.name
         if key in self._entries:
             raise SpecrefError(f"{self.family} {key!r} is registered twice")

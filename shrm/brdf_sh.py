@@ -233,9 +233,9 @@ def shrm_brdf_parts(name: str, params: dict, split: bool = True):
     Hanrahan 2001) and expand only the rest. A registry entry of
     :data:`reference.materials.brdf.BRDF_METHODS` declares
 
-    - ``extra["lambert"]``: the name of its Lambertian albedo parameter (``ρ_d/π`` is added to
+    - ``BRDFMethod.lambert``: the name of its Lambertian albedo parameter (``ρ_d/π`` is added to
       the rest of the model), which is split off and set to 0 in the part to expand;
-    - ``extra["grazing_view_power"]``: k where the model grows like ``cos^{−k} θ_o`` towards
+    - ``BRDFMethod.grazing_view_power``: k where the model grows like ``cos^{−k} θ_o`` towards
       grazing views (Ward: ``1/sqrt(cos θ_i cos θ_o)``, Eq. (4), Ward 1992, k = 1/2); the SHRM
       expands ``cos^k θ_o ρ̃`` instead, which has no singularity.
 
@@ -275,12 +275,12 @@ def shrm_brdf_parts(name: str, params: dict, split: bool = True):
 
     method = BRDF_METHODS.lookup(name)
     require(
-        bool(method.extra.get("isotropic")),
+        method.isotropic,
         f"SHRM: BRDF {name!r} is not an isotropic 3-D BRDF; allowed: "
-        + ", ".join(n for n, m in BRDF_METHODS.items() if m.extra.get("isotropic")),
+        + ", ".join(n for n, m in BRDF_METHODS.items() if m.isotropic),
     )
-    view_power = float(method.extra.get("grazing_view_power", 0.0))
-    key = method.extra.get("lambert")
+    view_power = float(method.grazing_view_power)
+    key = method.lambert
     expand, lambert = dict(params), None
     if key is not None and (split or view_power) and key in params:
         lambert = np.atleast_1d(np.asarray(params[key], dtype=np.float64))

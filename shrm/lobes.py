@@ -38,7 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from reference.errors import SpecrefError, require
-from reference.registry import Method, Registry
+from reference.registry import Method, ParametricMethod, Registry
 from shrm.sh import check_order
 
 __all__ = [
@@ -257,13 +257,11 @@ PREFILTER_KERNELS.register(
     Method("lambert", kernel_lambert, None, "Eq. (8), Ramamoorthi & Hanrahan 2001")
 )
 PREFILTER_KERNELS.register(
-    Method(
-        "phong", kernel_phong, None, "Eq. (7), Ramamoorthi & Hanrahan 2001", extra={"param": "S"}
-    )
+    ParametricMethod("phong", kernel_phong, None, "Eq. (7), Ramamoorthi & Hanrahan 2001", param="S")
 )
 PREFILTER_KERNELS.register(
-    Method(
-        "table", kernel_table, None, "Eq. (7), Ramamoorthi & Hanrahan 2001", extra={"param": "FILE"}
+    ParametricMethod(
+        "table", kernel_table, None, "Eq. (7), Ramamoorthi & Hanrahan 2001", param="FILE"
     )
 )
 
@@ -289,10 +287,10 @@ def parse_kernel(spec) -> RadialKernel:
         return spec
     name, _, param = str(spec).partition(":")
     entry = PREFILTER_KERNELS.lookup(name)
-    if "param" not in entry.extra:
+    if not isinstance(entry, ParametricMethod):
         require(not param, f"kernel {name!r} takes no parameter, got {spec!r}")
         return entry.reference()
-    require(param, f"kernel {name!r} needs a parameter: {name}:{entry.extra['param']}")
+    require(param, f"kernel {name!r} needs a parameter: {name}:{entry.param}")
     if name == "phong":
         try:
             exponent = float(param)

@@ -46,7 +46,7 @@ class IsotropicBRDFMaterial:
     Attributes
     ----------
     brdf : str
-        A key of ``reference.materials.brdf.BRDF_METHODS`` with ``extra["isotropic"]``.
+        A key of ``reference.materials.brdf.BRDF_METHODS`` that is ``isotropic``.
     params : dict
         Its parameters on the scene's grid (spectral ones per band, :func:`brdf_params_on_grid`).
     name : str
@@ -60,7 +60,7 @@ class IsotropicBRDFMaterial:
 def analytic_isotropic_brdf_names() -> list[str]:
     """Keys of ``reference.materials.brdf.BRDF_METHODS`` that ``isotropic_brdf`` materials take.
 
-    The isotropic 3-D BRDFs given by formulas (``extra["isotropic"]``), not the tabulated one,
+    The isotropic 3-D BRDFs given by formulas (``BRDFMethod.isotropic``), not the tabulated one,
     which needs a file.
 
     Examples
@@ -70,11 +70,7 @@ def analytic_isotropic_brdf_names() -> list[str]:
     """
     from reference.materials.brdf import BRDF_METHODS
 
-    return [
-        n
-        for n, m in BRDF_METHODS.items()
-        if m.extra.get("isotropic") and "table" not in m.extra.get("params", {})
-    ]
+    return [n for n, m in BRDF_METHODS.items() if m.isotropic and "table" not in m.params]
 
 
 def _isotropic_method(brdf: str):
@@ -103,7 +99,7 @@ def brdf_params_on_grid(brdf: str, grid, params: dict | None = None) -> dict:
     ([0.5, 0.3, 0.1], 0.3)
     """
     method = _isotropic_method(brdf)
-    out = {**dict(method.extra["params"]), **(params or {})}
+    out = {**dict(method.params), **(params or {})}
     for key, value in out.items():
         if key == "wavelengths_nm":
             out[key] = grid.wavelengths_nm
@@ -127,7 +123,7 @@ def _parse_isotropic_brdf(reader, table: dict, key: str, name: str):
         return IsotropicBRDFMaterial("table", _table_on_grid(reader, table, key), name)
     with reader.context(f"{key}.brdf"):
         method = _isotropic_method(brdf)
-    defaults = {k: v for k, v in method.extra["params"].items() if k != "wavelengths_nm"}
+    defaults = {k: v for k, v in method.params.items() if k != "wavelengths_nm"}
     reader.table(table, key, ("type", "brdf", *defaults))
     params = {}
     for p, default in defaults.items():

@@ -375,7 +375,7 @@ def _stage_brdf_coeffs(state, inputs):
     if params is None:
         from reference.materials.brdf import BRDF_METHODS
 
-        params = dict(BRDF_METHODS.lookup(method).extra["params"])
+        params = dict(BRDF_METHODS.lookup(method).params)
     # R&H 2002: the Lambertian part goes to an irradiance map, the rest is expanded
     function, expand, lambert, k = shrm_brdf_parts(method, params)
     # The orders from the tails of the projection over all views; the hemisphere fit of the normal

@@ -20,6 +20,7 @@ References
 from __future__ import annotations
 
 import functools
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -448,33 +449,40 @@ def synthesize_latlong(
     return out[..., 0] if single else out
 
 
-#: The projection paths: ``reference`` is ``project(image (H, W, C), L, w (H,), method)``.
-SH_BACKENDS = Registry("SH backend")
+@dataclass(frozen=True, kw_only=True)
+class SHBackend(Method):
+    """A projection path, ``project(image (H, W, C), L, w (H,), method)``, and how it computes."""
+
+    description: str
+
+
+#: The projection paths by the keys of ``--backend``.
+SH_BACKENDS = Registry("SH backend", SHBackend)
 SH_BACKENDS.register(
-    Method(
+    SHBackend(
         "numpy",
         _project_numpy,
         None,
         "Eq. (4), Ramamoorthi & Hanrahan 2001",
-        extra={"description": "rFFT over φ, Legendre sum over θ in NumPy (the oracle)"},
+        description="rFFT over φ, Legendre sum over θ in NumPy (the oracle)",
     )
 )
 SH_BACKENDS.register(
-    Method(
+    SHBackend(
         "numba",
         _project_numba,
         None,
         "Eq. (4), Ramamoorthi & Hanrahan 2001",
-        extra={"description": "rFFT over φ, Legendre recurrence and sum in one numba kernel"},
+        description="rFFT over φ, Legendre recurrence and sum in one numba kernel",
     )
 )
 SH_BACKENDS.register(
-    Method(
+    SHBackend(
         "ducc0",
         _project_ducc0,
         None,
         "Eq. (4), Ramamoorthi & Hanrahan 2001",
-        extra={"description": "ducc0.sht adjoint synthesis on the F1 grid, Fejér-1 ring weights"},
+        description="ducc0.sht adjoint synthesis on the F1 grid, Fejér-1 ring weights",
     )
 )
 

@@ -32,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 
 from reference.errors import SpecrefError, require
-from reference.registry import Method, Registry
+from reference.registry import Method, ParametricMethod, Registry
 
 __all__ = [
     "DEFAULT_WINDOW",
@@ -123,7 +123,7 @@ WINDOWS.register(Method("none", window_none, None, "Eq. (2), Ramamoorthi & Hanra
 WINDOWS.register(Method("hanning", window_hanning, None, "§7.3, Herbert et al."))
 WINDOWS.register(Method("lanczos", window_lanczos, None, "§7.3, Herbert et al."))
 WINDOWS.register(
-    Method("gaussian", window_gaussian, None, "§7.3, Herbert et al.", extra={"param": "sigma"})
+    ParametricMethod("gaussian", window_gaussian, None, "§7.3, Herbert et al.", param="sigma")
 )
 
 
@@ -149,7 +149,9 @@ def parse_window(spec: str) -> tuple[str, tuple]:
     entry = WINDOWS.lookup(name)
     if not param:
         return name, ()
-    require("param" in entry.extra, f"window {name!r} takes no parameter, got {spec!r}")
+    require(
+        isinstance(entry, ParametricMethod), f"window {name!r} takes no parameter, got {spec!r}"
+    )
     try:
         value = float(param)
     except ValueError:

@@ -67,6 +67,24 @@ def test_registered_references_cite_their_equation_and_have_examples(where, meth
         assert f"Eq. ({number})" in doc, f"{where}: the docstring does not cite {method.cites}"
 
 
+#: Registries whose entries are plain values rather than one class (their docstrings say why).
+UNTYPED_REGISTRIES = {"target augmentation"}  # a function, or None for "no augmentation"
+
+
+def test_registries_are_typed():
+    # Family metadata lives in typed fields of the family's Method subclass, so a wrong key fails
+    # where it is written; a registry refuses entries of another kind.
+    import dataclasses
+
+    assert "extra" not in {f.name for f in dataclasses.fields(Method)}
+    for where, registry in REGISTRIES:
+        if registry.family in UNTYPED_REGISTRIES:
+            continue
+        assert registry.kind is not object, f"{where}: Registry({registry.family!r}) has no kind"
+        for key, entry in registry.items():
+            assert isinstance(entry, registry.kind), f"{where}:{key}"
+
+
 def _njit_functions():
     found = []
     for path in SOURCES:

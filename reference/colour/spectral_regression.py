@@ -125,14 +125,14 @@ FORMAT_VERSION = 3
 _READABLE_VERSIONS = (1, 2, 3)
 
 #: Losses of :func:`fit_regression` by key (module docstring).
-REGRESSION_LOSSES = Registry("regression losses")
+REGRESSION_LOSSES = Registry("regression losses", str)
 REGRESSION_LOSSES.register("ΔE94 (capture illuminant and A) plus β · spectral", "colorimetric")
 REGRESSION_LOSSES.register("spectral least squares", "spectral")
 #: The loss `specref env fit` and the shipped model use (erratum E44).
 DEFAULT_LOSS = "colorimetric"
 
 #: Feature families by key: the range of degrees each allows.
-REGRESSION_FEATURES = Registry("regression features")
+REGRESSION_FEATURES = Registry("regression features", range)
 REGRESSION_FEATURES.register(range(1, 6), "polynomial")
 REGRESSION_FEATURES.register(range(1, 5), "root_polynomial")
 

@@ -205,7 +205,7 @@ def _sensitivities(camera: str) -> np.ndarray:
 
 
 #: Cameras by key: colour-science's measured sensitivities, and the sRGB "camera".
-CAMERAS = Registry("camera")
+CAMERAS = Registry("camera", functools.partial)
 for _camera in ("Nikon 5100 (NPL)", "Sigma SDMerill (NPL)", "sRGB"):
     CAMERAS.register(functools.partial(_sensitivities, _camera), _camera)
 
@@ -379,7 +379,7 @@ def _all_products(data: bytes, n: int, camera: str, illuminant: str):
 
 
 #: How a synthetic target may be augmented, by key (``specref env fit --augment``; E44).
-TARGET_AUGMENTATIONS = Registry("target augmentation")
+TARGET_AUGMENTATIONS = Registry("target augmentation", object)
 TARGET_AUGMENTATIONS.register(product_augmentation, "products")
 TARGET_AUGMENTATIONS.register(None, "none")
 #: The augmentation of ``specref env fit`` and the report (its weight by cross-validation); the

@@ -47,6 +47,7 @@ References
 from __future__ import annotations
 
 import functools
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -266,32 +267,39 @@ def RGB_to_spectra_regression(RGB, grid: SpectralGrid, model=None) -> np.ndarray
     return S[..., lo] * (1.0 - t) + S[..., hi] * t
 
 
-#: RGB → spectrum methods by key. ``extra["exact"]``: the spectrum renders back to its RGB by
-#: construction (the fits); the regression is a least-squares model and reproduces RGB only to
-#: within its fit (docs/spectral-environments.md).
-UPSAMPLING_METHODS = Registry("RGB upsampling")
+@dataclass(frozen=True, kw_only=True)
+class Upsampler(Method):
+    """An RGB → spectrum method.
+
+    Parameters
+    ----------
+    exact : bool
+        The spectrum renders back to its RGB by construction (the fits); the regression is a
+        least-squares model and reproduces RGB only to within its fit
+        (docs/spectral-environments.md).
+    """
+
+    exact: bool
+
+
+#: RGB → spectrum methods by key.
+UPSAMPLING_METHODS = Registry("RGB upsampling", Upsampler)
 UPSAMPLING_METHODS.register(
-    Method(
+    Upsampler(
         "mallett2019",
         RGB_to_spectra_Mallett2019,
         None,
         "Eq. (4), Mallett & Yuksel 2019",
-        extra={"exact": True},
+        exact=True,
     )
 )
 UPSAMPLING_METHODS.register(
-    Method(
-        "jakob2019",
-        RGB_to_spectra_Jakob2019,
-        None,
-        "Eq. (3), Jakob & Hanika 2019",
-        extra={"exact": True},
+    Upsampler(
+        "jakob2019", RGB_to_spectra_Jakob2019, None, "Eq. (3), Jakob & Hanika 2019", exact=True
     )
 )
 UPSAMPLING_METHODS.register(
-    Method(
-        "regression", RGB_to_spectra_regression, None, "§4, Herbert et al.", extra={"exact": False}
-    )
+    Upsampler("regression", RGB_to_spectra_regression, None, "§4, Herbert et al.", exact=False)
 )
 
 

@@ -17,6 +17,9 @@ References
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
 import numpy as np
 
 from reference.registry import Method, Registry
@@ -153,31 +156,40 @@ def encode_linear(values):
     return np.clip(np.asarray(values, dtype=np.float64), 0.0, 1.0)
 
 
-#: Display encodings by the keys of scene files (``display.encoding``) and the CLI. Each entry's
-#: ``reference`` encodes linear values, ``extra["decode"]`` goes back, and ``extra["kwargs"]`` are
-#: passed to both.
-ENCODINGS = Registry("encoding")
-ENCODINGS.register(
-    Method("srgb", encode_srgb, None, "IEC 61966-2-1", extra={"decode": decode_srgb})
-)
-ENCODINGS.register(Method("linear", encode_linear, None, "none", extra={"decode": encode_linear}))
+@dataclass(frozen=True, kw_only=True)
+class Encoding(Method):
+    """A display encoding: ``reference`` encodes linear values, ``decode`` goes back.
+
+    Parameters
+    ----------
+    decode : callable
+        The inverse of ``reference`` on [0, 1].
+    kwargs : dict
+        Keyword arguments passed to both (``{"gamma": 2.2}``).
+    """
+
+    decode: Callable[..., np.ndarray]
+    kwargs: dict = field(default_factory=dict)
+
+
+#: Display encodings by the keys of scene files (``display.encoding``) and the CLI.
+ENCODINGS = Registry("encoding", Encoding)
+ENCODINGS.register(Encoding("srgb", encode_srgb, None, "IEC 61966-2-1", decode=decode_srgb))
+ENCODINGS.register(Encoding("linear", encode_linear, None, "none", decode=encode_linear))
 for _gamma in (1.8, 2.2):
     ENCODINGS.register(
-        Method(
+        Encoding(
             f"gamma_{_gamma}",
             encode_gamma,
             None,
             "Eq. (6), Herbert et al.",
-            extra={"decode": decode_gamma, "kwargs": {"gamma": _gamma}},
+            decode=decode_gamma,
+            kwargs={"gamma": _gamma},
         )
     )
 ENCODINGS.register(
-    Method(
-        "lstar",
-        encode_lstar_Herbert,
-        None,
-        "Eq. (7), Herbert et al.",
-        extra={"decode": decode_lstar_Herbert},
+    Encoding(
+        "lstar", encode_lstar_Herbert, None, "Eq. (7), Herbert et al.", decode=decode_lstar_Herbert
     )
 )
 
@@ -205,9 +217,7 @@ def linear_to_display(linear, encoding: str = "srgb", exposure: float = 1.0) -> 
     array([[0.    , 0.4614, 1.    ]])
     """
     entry = ENCODINGS.lookup(encoding)
-    return entry.reference(
-        np.asarray(linear, dtype=np.float64) * exposure, **entry.extra.get("kwargs", {})
-    )
+    return entry.reference(np.asarray(linear, dtype=np.float64) * exposure, **entry.kwargs)
 
 
 def display_to_linear(encoded, encoding: str = "srgb") -> np.ndarray:
@@ -219,7 +229,7 @@ def display_to_linear(encoded, encoding: str = "srgb") -> np.ndarray:
     array([0.5])
     """
     entry = ENCODINGS.lookup(encoding)
-    return entry.extra["decode"](encoded, **entry.extra.get("kwargs", {}))
+    return entry.decode(encoded, **entry.kwargs)
 
 
 def to_8bit(encoded) -> np.ndarray:

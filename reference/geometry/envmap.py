@@ -25,6 +25,8 @@ References
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from reference.errors import require
@@ -270,24 +272,41 @@ def latlong_rows_mitsuba_to_centred(image) -> np.ndarray:
 #: The default texel placement of lat-long maps: specref's pixel-centred rows.
 DEFAULT_TEXEL_PLACEMENT = "centred"
 
+
+@dataclass(frozen=True, kw_only=True)
+class TexelPlacement(Method):
+    """A lat-long texel placement: where row j and column i of a map look, as render metadata says.
+
+    Parameters
+    ----------
+    rows, columns : str
+        The texel centres, ``"v = (j + 1/2)/H"``, ``"u = (i + 1/2)/W"``.
+    """
+
+    rows: str
+    columns: str
+
+
 #: Lat-long texel placements (scene key ``texel_placement`` of environment lights, ``specref render
 #: --texel-placement``): each entry turns a map read under that placement into specref's rows.
-TEXEL_PLACEMENTS = Registry("texel placement")
+TEXEL_PLACEMENTS = Registry("texel placement", TexelPlacement)
 TEXEL_PLACEMENTS.register(
-    Method(
+    TexelPlacement(
         "centred",
         latlong_rows_centred,
         None,
         "Fejér's first rule: rows at v = (j + 1/2)/H",
-        extra={"rows": "v = (j + 1/2)/H", "columns": "u = (i + 1/2)/W"},
+        rows="v = (j + 1/2)/H",
+        columns="u = (i + 1/2)/W",
     )
 )
 TEXEL_PLACEMENTS.register(
-    Method(
+    TexelPlacement(
         "mitsuba",
         latlong_rows_mitsuba_to_centred,
         None,
         "Mitsuba 3, src/emitters/envmap.cpp: rows at v = j/(H - 1)",
-        extra={"rows": "v = j/(H - 1)", "columns": "u = (i + 1/2)/W"},
+        rows="v = j/(H - 1)",
+        columns="u = (i + 1/2)/W",
     )
 )

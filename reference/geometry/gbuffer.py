@@ -162,7 +162,7 @@ def _gbuffer_plane(obj: Plane, camera: Camera, width: int, height: int, object_i
 
 
 #: G-buffer writers by primitive class name: ``f(obj, camera, width, height, object_id)``.
-PRIMITIVES = Registry("primitive")
+PRIMITIVES = Registry("primitive", Callable)
 PRIMITIVES.register(_gbuffer_sphere, "Sphere")
 PRIMITIVES.register(_gbuffer_plane, "Plane")
 

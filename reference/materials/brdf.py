@@ -19,8 +19,8 @@ carry the channel axis last, ``(..., C)`` (one value per spectral or six-channel
 gives ``C = 1``. Each sampler maps uniform numbers ``u`` in ``[0, 1)²`` to directions and has a pdf
 with respect to solid angle on the whole sphere; samples below the horizon carry zero BRDF.
 
-:data:`BRDF_METHODS` registers each BRDF with its sampler and pdf (``extra["sample"]``,
-``extra["pdf"]``), default parameters (``extra["params"]``) and the albedo bound it claims.
+:data:`BRDF_METHODS` registers each BRDF as a :class:`BRDFMethod`: its sampler and pdf, default
+parameters and the albedo bound it claims.
 
 References
 ----------
@@ -31,6 +31,9 @@ References
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -522,42 +525,68 @@ def _ward_duer_example(rng):
     return {"rho_d": 0.3, "rho_s": 0.5, "alpha": 0.15}
 
 
-#: BRDFs by key. ``reference(wi, wo, normal, **params)`` is the BRDF; ``extra["sample"](wi,
-#: normal, u, **params)`` and ``extra["pdf"](wi, wo, normal, **params)`` its sampler and pdf;
-#: ``extra["params"]`` default parameters; ``extra["albedo_bound"]`` what the source claims.
-#: Isotropic 3-D BRDFs also set ``extra["isotropic"]`` and may name their Lambertian albedo
-#: parameter (``extra["lambert"]``) and their grazing view power (``extra["grazing_view_power"]``),
-#: which SHRMs read (``shrm.brdf_sh.shrm_brdf_parts``).
-BRDF_METHODS = Registry("brdf")
+@dataclass(frozen=True, kw_only=True)
+class BRDFMethod(Method):
+    """A registered BRDF: ``reference(wi, wo, normal, **params)``, with its sampler and defaults.
+
+    Parameters
+    ----------
+    sample : callable
+        ``sample(wi, normal, u, **params) -> wo``, directions from uniform ``u`` in ``[0, 1)²``.
+    pdf : callable
+        ``pdf(wi, wo, normal, **params)``, the sampler's density in solid angle.
+    params : dict
+        Default parameters (the tests, the report and the orbit use them).
+    albedo_bound : str
+        The bound on the directional albedo that the source claims (the white-furnace tests).
+    isotropic : bool
+        A 3-D isotropic BRDF ``f(θ_i, θ_o, Δφ)``, which SHRMs, tables and orbits take.
+    lambert : str or None
+        The name of its Lambertian albedo parameter (``ρ_d/π`` is added to the lobe), which SHRMs
+        render with an irradiance map (``shrm.brdf_sh.shrm_brdf_parts``).
+    grazing_view_power : float
+        k where the model grows like ``cos^-k θ_o`` towards grazing views (SHRMs bound it).
+    """
+
+    sample: Callable[..., np.ndarray]
+    pdf: Callable[..., np.ndarray]
+    params: dict
+    albedo_bound: str
+    isotropic: bool = False
+    lambert: str | None = None
+    grazing_view_power: float = 0.0
+
+
+def _sample_ward_duer(wi, normal, u, rho_d, rho_s, alpha):
+    """``sample_ward_duer`` in the registry's argument order (``u`` third)."""
+    return sample_ward_duer(wi, normal, rho_d, rho_s, alpha, u)
+
+
+#: BRDFs by key.
+BRDF_METHODS = Registry("brdf", BRDFMethod)
 BRDF_METHODS.register(
-    Method(
+    BRDFMethod(
         "lambert",
         brdf_lambert,
         None,
         "Eq. (3), Ferwerda",
         _lambert_example,
-        extra={
-            "sample": _brdf_lambert_sample,
-            "pdf": _brdf_lambert_pdf,
-            "params": {"rho_d": 0.7},
-            "albedo_bound": "equal to rho_d",
-        },
+        sample=_brdf_lambert_sample,
+        pdf=_brdf_lambert_pdf,
+        params={"rho_d": 0.7},
+        albedo_bound="equal to rho_d",
     )
 )
 BRDF_METHODS.register(
-    Method(
+    BRDFMethod(
         "ward_duer",
         brdf_ward_duer,
         None,
         "Eq. (4), Ferwerda",
         _ward_duer_example,
-        extra={
-            "sample": lambda wi, normal, u, rho_d, rho_s, alpha: sample_ward_duer(
-                wi, normal, rho_d, rho_s, alpha, u
-            ),
-            "pdf": pdf_ward_duer,
-            "params": {"rho_d": 0.3, "rho_s": 0.5, "alpha": 0.15},
-            "albedo_bound": "at most rho_d + rho_s <= 1 (Dür 2006), except at grazing incidence",
-        },
+        sample=_sample_ward_duer,
+        pdf=pdf_ward_duer,
+        params={"rho_d": 0.3, "rho_s": 0.5, "alpha": 0.15},
+        albedo_bound="at most rho_d + rho_s <= 1 (Dür 2006), except at grazing incidence",
     )
 )

@@ -43,8 +43,7 @@ from __future__ import annotations
 import numpy as np
 
 from reference.errors import require, require_nonnegative
-from reference.materials.brdf import BRDF_METHODS, _dot, pdf_cosine, sample_cosine
-from reference.registry import Method
+from reference.materials.brdf import BRDF_METHODS, BRDFMethod, _dot, pdf_cosine, sample_cosine
 
 __all__ = [
     "brdf_ggx",
@@ -344,7 +343,7 @@ _LAFORTUNE_PARAMS = {
 }
 
 
-def register_brdf(method: Method) -> None:
+def register_brdf(method: BRDFMethod) -> None:
     """Register ``method`` in :data:`reference.materials.brdf.BRDF_METHODS`, once per key.
 
     A second import of the defining module (pytest's doctest collector imports modules by path)
@@ -367,24 +366,21 @@ def register_brdf(method: Method) -> None:
 
 def _register(name, function, cites, params, bound, grazing_view_power=0.0):
     register_brdf(
-        Method(
+        BRDFMethod(
             name,
             function,
             None,
             cites,
             lambda rng, params=params: dict(params),
-            extra={
-                # A valid, not importance-matched sampler: cosine-weighted directions.
-                "sample": _cosine_sample,
-                "pdf": _cosine_pdf,
-                "params": params,
-                "albedo_bound": bound,
-                "isotropic": True,
-                # The model adds rho_d/pi: SHRMs render that part with an irradiance map.
-                "lambert": "rho_d",
-                # k where the model grows like cos^-k(theta_o) towards grazing views.
-                "grazing_view_power": grazing_view_power,
-            },
+            # A valid, not importance-matched sampler: cosine-weighted directions.
+            sample=_cosine_sample,
+            pdf=_cosine_pdf,
+            params=params,
+            albedo_bound=bound,
+            isotropic=True,
+            # The model adds rho_d/pi: SHRMs render that part with an irradiance map.
+            lambert="rho_d",
+            grazing_view_power=grazing_view_power,
         )
     )
 

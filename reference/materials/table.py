@@ -36,6 +36,7 @@ import numpy as np
 
 from reference.errors import SpecrefError, require
 from reference.files import write_text_atomic
+from reference.materials.brdf import BRDFMethod
 from reference.materials.isotropic import (
     _cosine_pdf,
     _cosine_sample,
@@ -43,7 +44,6 @@ from reference.materials.isotropic import (
     isotropic_directions,
     register_brdf,
 )
-from reference.registry import Method
 
 __all__ = [
     "MAX_TABLE_ANGLES",
@@ -185,7 +185,7 @@ def tabulate_brdf(
 def tabulable_brdf_names() -> list[str]:
     """Keys of ``BRDF_METHODS`` that :func:`tabulate_registered_brdf` takes.
 
-    The isotropic 3-D BRDFs (``extra["isotropic"]``) and Lambert, in registry order.
+    The isotropic 3-D BRDFs (``BRDFMethod.isotropic``) and Lambert, in registry order.
 
     Examples
     --------
@@ -194,7 +194,7 @@ def tabulable_brdf_names() -> list[str]:
     """
     from reference.materials.brdf import BRDF_METHODS
 
-    return [n for n, m in BRDF_METHODS.items() if m.extra.get("isotropic") or n == "lambert"]
+    return [n for n, m in BRDF_METHODS.items() if m.isotropic or n == "lambert"]
 
 
 def tabulate_registered_brdf(
@@ -244,7 +244,7 @@ def tabulate_registered_brdf(
         f"brdf tabulate: the steps give {angles:,} angle triples; at most {MAX_TABLE_ANGLES:,} "
         "(a 1-degree theta step and a 2-degree phi step fit)",
     )
-    params = dict(method.extra["params"])
+    params = dict(method.params)
     theta = np.linspace(0.0, 90.0, round(90.0 / theta_step_deg) + 1)
     phi = np.linspace(0.0, 180.0, round(180.0 / phi_step_deg) + 1)
     probe = method.reference(
@@ -534,18 +534,16 @@ def _table_example(rng):
 
 
 register_brdf(
-    Method(
+    BRDFMethod(
         "table",
         brdf_tabulated,
         None,
         "Nicodemus et al. 1977 (tabulated f(θ_i, θ_o, Δφ))",
         _table_example,
-        extra={
-            "sample": _cosine_sample,
-            "pdf": _cosine_pdf,
-            "params": _table_example(None),
-            "albedo_bound": "that of the tabulated data",
-            "isotropic": True,
-        },
+        sample=_cosine_sample,
+        pdf=_cosine_pdf,
+        params=_table_example(None),
+        albedo_bound="that of the tabulated data",
+        isotropic=True,
     )
 )

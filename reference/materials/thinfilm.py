@@ -39,7 +39,7 @@ from __future__ import annotations
 import numpy as np
 
 from reference.errors import require, require_finite, require_nonnegative
-from reference.materials.brdf import _dot
+from reference.materials.brdf import BRDFMethod, _dot
 from reference.materials.isotropic import (
     _cosine_pdf,
     _cosine_sample,
@@ -48,7 +48,6 @@ from reference.materials.isotropic import (
     ggx_smith_G1,
     register_brdf,
 )
-from reference.registry import Method
 
 __all__ = ["airy_reflectance", "brdf_effect_pigment"]
 
@@ -186,18 +185,16 @@ _PIGMENT_PARAMS = {
 }
 
 register_brdf(
-    Method(
+    BRDFMethod(
         "effect_pigment",
         brdf_effect_pigment,
         None,
         "Eq. (20), Walter et al. 2007",
         lambda rng: dict(_PIGMENT_PARAMS),
-        extra={
-            "sample": _cosine_sample,
-            "pdf": _cosine_pdf,
-            "params": _PIGMENT_PARAMS,
-            "albedo_bound": "at most 1: flakes reflect R, the base receives (1 - R)^2 rho_base",
-            "isotropic": True,
-        },
+        sample=_cosine_sample,
+        pdf=_cosine_pdf,
+        params=_PIGMENT_PARAMS,
+        albedo_bound="at most 1: flakes reflect R, the base receives (1 - R)^2 rho_base",
+        isotropic=True,
     )
 )

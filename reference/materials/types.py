@@ -154,7 +154,7 @@ class MaterialType:
 
 
 #: Material types by scene-file key.
-MATERIAL_TYPES = Registry("material type")
+MATERIAL_TYPES = Registry("material type", MaterialType)
 MATERIAL_TYPES.register(
     MaterialType("lambert", LambertMaterial, ("k_d",), (), "Eq. (2), Wang et al. (diffuse term)")
 )

@@ -207,7 +207,7 @@ def _parse_environment_light(reader: SceneReader, table: dict, key: str) -> Envi
 
 
 #: Object types of scene files (``[[objects]] type = ...``).
-OBJECT_TYPES = Registry("object type")
+OBJECT_TYPES = Registry("object type", SceneItemType)
 OBJECT_TYPES.register(
     SceneItemType("sphere", _parse_sphere, ("material", "center", "radius"), "an analytic sphere")
 )
@@ -233,7 +233,7 @@ OBJECT_TYPES.register(
 )
 
 #: Light types of scene files (``[[lights]] type = ...``).
-LIGHT_TYPES = Registry("light type")
+LIGHT_TYPES = Registry("light type", SceneItemType)
 LIGHT_TYPES.register(
     SceneItemType(
         "point",

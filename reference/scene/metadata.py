@@ -26,6 +26,7 @@ shaders (the SHRM shaders, say) records under its own group name and needs no ch
 from __future__ import annotations
 
 import json
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -71,7 +72,7 @@ def _placement_rows(name: str) -> str:
     # the row convention the light's texel placement reads its map with (reference.geometry.envmap)
     from reference.geometry.envmap import TEXEL_PLACEMENTS
 
-    return str(TEXEL_PLACEMENTS.lookup(name).extra.get("rows", name))
+    return TEXEL_PLACEMENTS.lookup(name).rows
 
 
 def check_accuracy(tol, where: str = "--accuracy") -> float:
@@ -141,36 +142,41 @@ def _spectral(result):
     return result.spectral, spectral_channel_names(result.scene.grid.wavelengths_nm)
 
 
+@dataclass(frozen=True, kw_only=True)
+class RenderOutput(Method):
+    """An output kind of ``specref render --exr-output``; ``units`` says what its values are."""
+
+    units: str
+
+
 #: What the EXR holds (``specref render --exr-output``); ``reference(result) -> (image, names)``.
-RENDER_OUTPUTS = Registry("render output")
+RENDER_OUTPUTS = Registry("render output", RenderOutput)
 RENDER_OUTPUTS.register(
-    Method(
+    RenderOutput(
         "display",
         _display,
         None,
         "Eq. (5), Wang et al.",
-        extra={"units": "linear display RGB of the scene's colourspace, before exposure"},
+        units="linear display RGB of the scene's colourspace, before exposure",
     )
 )
 RENDER_OUTPUTS.register(
-    Method(
+    RenderOutput(
         "xyz",
         _xyz,
         None,
         "Eq. (4), Wang et al.",
-        extra={"units": f"CIE XYZ of the scene's observer, {NORMALISATION}"},
+        units=f"CIE XYZ of the scene's observer, {NORMALISATION}",
     )
 )
 RENDER_OUTPUTS.register(
-    Method(
+    RenderOutput(
         "spectral",
         _spectral,
         None,
         "Eq. (4), Wang et al.",
-        extra={
-            "units": "relative spectral radiance per band; times spectral.band_weights "
-            f"(equal-energy) it gives XYZ with {NORMALISATION}"
-        },
+        units="relative spectral radiance per band; times spectral.band_weights "
+        f"(equal-energy) it gives XYZ with {NORMALISATION}",
     )
 )
 
@@ -252,7 +258,7 @@ def render_metadata(result, output: str = "display", records=None, oracle: bool 
         "supersample": scene.render.supersample,
         "output": output,
         "channels": channels,
-        "units": entry.extra["units"],
+        "units": entry.units,
         "normalisation": NORMALISATION,
         "colourspace": {
             "name": scene.display.colourspace,

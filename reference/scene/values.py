@@ -458,7 +458,7 @@ def _parse_arrays(reader: SceneReader, table: dict, key: str) -> Spectrum:
 
 
 #: Spectrum forms by the table key that selects them; a new form is registered here.
-SPECTRUM_FORMS = Registry("spectrum form")
+SPECTRUM_FORMS = Registry("spectrum form", SpectrumForm)
 SPECTRUM_FORMS.register(
     SpectrumForm("constant", _parse_constant, (), "a constant (a bare number works too)")
 )

@@ -512,7 +512,7 @@ def _register_kernels():
             polymer_shade_parts_kernel,
             "Eq. (1), Herbert et al.",
             _shade_parts_example,
-            extra={"compiled": functools.partial(polymer_shade_parts, compiled=True)},
+            compiled=functools.partial(polymer_shade_parts, compiled=True),
         )
     )
 

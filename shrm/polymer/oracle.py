@@ -462,7 +462,7 @@ def _register():
             k.rough_specular_samples_kernel,
             "Eq. (1), Herbert et al.",
             _example_specular_inputs,
-            extra={"call": _rough_specular_kernel_call},
+            compiled=_rough_specular_kernel_call,
         )
     )
 

@@ -46,7 +46,7 @@ def test_bench_specular(benchmark, method, specular_scene):
     )
     # 32 FIS samples per point (the report's setting); one sub-pixel per light pixel for the
     # brute-force baseline
-    call = functools.partial(method.extra["call"], backend="numba", n_samples=32, supersample=1)
+    call = functools.partial(method.run, backend="numba", n_samples=32, supersample=1)
     call(inputs)  # JIT warm-up outside the timing
     benchmark.extra_info["points"] = len(inputs[0])
     benchmark(call, inputs)

@@ -201,7 +201,7 @@ def test_hybrid_within_the_two_methods_and_best_at_the_ends():
 
 @pytest.mark.parametrize("method", SPECULAR_METHODS.values(), ids=attrgetter("name"))
 def test_registry_calls_pass_the_sample_settings_on(method, rng):
-    # extra["call"] is how tests and benchmarks run a method: its n_samples and supersample
+    # SpecularMethod.run is how tests and benchmarks run a method: its n_samples and supersample
     # reach the function (the benchmarks ask for 32 FIS samples and one sub-pixel).
     P, N, V, a, plane, lights = inputs = method.example_inputs(rng)
     direct = {
@@ -210,5 +210,5 @@ def test_registry_calls_pass_the_sample_settings_on(method, rng):
         "hybrid": specular_hybrid(P, N, V, a, plane, lights, 32, backend="numpy"),
         "brute_force": specular_brute_force(P, N, V, a, plane, 1, backend="numpy"),
     }
-    got = method.extra["call"](inputs, "numpy", n_samples=32, supersample=1)
+    got = method.run(inputs, "numpy", n_samples=32, supersample=1)
     np.testing.assert_array_equal(got, direct[method.name])

@@ -28,8 +28,8 @@ UP = np.array([0.0, 1.0, 0.0])
 )
 def test_specular_numpy_and_numba_twins_agree(method, rng):
     inputs = method.example_inputs(rng)
-    reference = method.extra["call"](inputs, "numpy")
-    kernel = method.extra["call"](inputs, "numba")
+    reference = method.run(inputs, "numpy")
+    kernel = method.run(inputs, "numba")
     np.testing.assert_allclose(kernel, reference, rtol=1e-12, atol=1e-14)
 
 

@@ -63,7 +63,7 @@ def test_table_reproduces_t_to_the_n_at_the_nodes(placement, n):
 def test_error_placement_kernel_equals_numpy():
     for scene in SCENES.names():
         model = SCENES.lookup(scene).build()
-        compiled = PLACEMENT_METHODS.lookup("error").extra["compiled"](model, 200)
+        compiled = PLACEMENT_METHODS.lookup("error").compiled(model, 200)
         np.testing.assert_allclose(compiled, table_error(model, 200), rtol=0, atol=1e-12)
 
 
@@ -101,7 +101,7 @@ def test_seen_range_nodes_are_monotone_sized_and_twins_agree(t_range, entries):
     # below the seen range: at most node 0 and the margin's node
     if t_range[0] < t_range[1]:
         assert (nodes < t_range[0]).sum() <= 2
-    compiled = PLACEMENT_METHODS.lookup("error").extra["compiled"](model, entries, t_range=t_range)
+    compiled = PLACEMENT_METHODS.lookup("error").compiled(model, entries, t_range=t_range)
     np.testing.assert_allclose(compiled, nodes, rtol=0, atol=1e-12)
 
 
@@ -115,7 +115,7 @@ def test_pixel_weighted_nodes_twins_agree_and_follow_the_pixels(view):
     t_range, t_density = buffer.t_range, buffer.t_density
     np.testing.assert_array_equal(t_density, pixel_density(buffer.t, t_range))
     nodes = table_error(model, 50, t_range=t_range, t_density=t_density)
-    compiled = PLACEMENT_METHODS.lookup("error").extra["compiled"]
+    compiled = PLACEMENT_METHODS.lookup("error").compiled
     np.testing.assert_allclose(
         compiled(model, 50, t_range=t_range, t_density=t_density), nodes, rtol=0, atol=1e-12
     )
@@ -164,7 +164,7 @@ def test_graded_nodes_twins_agree_and_neighbouring_widths_stay_alike(scene, t_ra
     model = _one_band() if scene == "one band" else SCENES.lookup(scene).build()
     for entries in (25, 200):
         graded = table_error(model, entries, t_range=t_range, interpolation="parabolic")
-        compiled = PLACEMENT_METHODS.lookup("error").extra["compiled"]
+        compiled = PLACEMENT_METHODS.lookup("error").compiled
         np.testing.assert_allclose(
             compiled(model, entries, t_range=t_range, interpolation="parabolic"),
             graded,

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 import json
 
+from reference.registry import ParametricMethod
+
 __all__ = ["Parser", "registry_option", "write_json"]
 
 
@@ -64,7 +66,7 @@ def registry_option(parser, flag: str, registry, help: str, where=None, **kwargs
     """Add an option whose values are the keys of ``registry``; its help lists them from it.
 
     The CLI never spells a registry key by hand: the help text is built from ``registry`` (keys
-    whose entry takes a parameter, ``extra["param"]``, are shown as ``key[:PARAM]``), and the
+    whose entry takes a parameter, a ``ParametricMethod``, are shown as ``key[:PARAM]``), and the
     library checks the value with ``registry.lookup``, so a wrong key gets the library's one-line
     error (exit 2).
     ``tests/test_style.py`` checks every such option against its registry.
@@ -90,10 +92,10 @@ def registry_option(parser, flag: str, registry, help: str, where=None, **kwargs
 
     Examples
     --------
-    >>> from reference.registry import Method, Registry
+    >>> from reference.registry import Method, ParametricMethod, Registry
     >>> shapes = Registry("shape")
     >>> _ = shapes.register(Method("disc", abs, None, "Eq. (0), nobody"))
-    >>> _ = shapes.register(Method("lobe", abs, None, "Eq. (0), nobody", extra={"param": "S"}))
+    >>> _ = shapes.register(ParametricMethod("lobe", abs, None, "Eq. (0), nobody", param="S"))
     >>> action = registry_option(Parser(prog="x"), "--shape", shapes, "the shape", default="disc")
     >>> action.help
     'the shape: disc, lobe[:S] (default disc)'
@@ -101,8 +103,8 @@ def registry_option(parser, flag: str, registry, help: str, where=None, **kwargs
     keys = [key for key in registry if where is None or where(key, _entry(registry, key))]
     shown = []
     for key in keys:
-        extra = getattr(_entry(registry, key), "extra", None) or {}
-        shown.append(f"{key}[:{extra['param']}]" if "param" in extra else key)
+        entry = _entry(registry, key)
+        shown.append(f"{key}[:{entry.param}]" if isinstance(entry, ParametricMethod) else key)
     text = f"{help}: {', '.join(shown)}"
     if kwargs.get("default") is not None:
         text += f" (default {kwargs['default']})"

@@ -148,7 +148,7 @@ def _quiet() -> bool:
 
 
 #: Report sections by key (``specref report --only`` takes the keys).
-REPORT_SECTIONS = Registry("report section")
+REPORT_SECTIONS = Registry("report section", ReportSection)
 for _section in SECTIONS:
     REPORT_SECTIONS.register(_section)
 
@@ -238,7 +238,7 @@ def run_report(
 def _chosen_sections(sections: list, only: list[str] | None) -> list:
     """The sections named in ``only`` (all when it is empty); an unknown key is refused."""
     if only:
-        known = Registry("report section")
+        known = Registry("report section", ReportSection)
         for section in sections:
             known.register(section)
         for name in only:

@@ -60,7 +60,7 @@ class Chi2Case:
 
 
 #: Every chi-square test the suite runs; ``len(CHI2_CASES)`` is the Šidák family size.
-CHI2_CASES = Registry("chi-square case")
+CHI2_CASES = Registry("chi-square case", Chi2Case)
 
 
 def cases_for(module: str) -> list[Chi2Case]:
@@ -150,10 +150,10 @@ def _brdf_sampler(name: str, params: dict, theta_deg: float):
         z = np.array([0.0, 0.0, 1.0])
 
         def sample(u):
-            return method.extra["sample"](np.broadcast_to(wi, (len(u), 3)), z, u, **params)
+            return method.sample(np.broadcast_to(wi, (len(u), 3)), z, u, **params)
 
         def pdf(d):
-            return method.extra["pdf"](np.broadcast_to(wi, d.shape), d, z, **params)
+            return method.pdf(np.broadcast_to(wi, d.shape), d, z, **params)
 
         return sample, pdf
 
@@ -173,12 +173,12 @@ def _register_brdf_cases():
     mixed = {"rho_d": 0.4, "rho_s": 0.4, "alpha": 0.15}
     _register_brdf_case("ward_duer_45_mixed", "ward_duer", mixed, 45.0)
     # Every other distinct sampler of the registry, at its default parameters.
-    covered = {id(BRDF_METHODS.lookup(name).extra["sample"]) for name in ("lambert", "ward_duer")}
+    covered = {id(BRDF_METHODS.lookup(name).sample) for name in ("lambert", "ward_duer")}
     for method in BRDF_METHODS.values():
-        sampler = method.extra.get("sample")
+        sampler = method.sample
         if sampler is not None and id(sampler) not in covered:
             covered.add(id(sampler))
-            _register_brdf_case(f"{method.name}_30", method.name, method.extra["params"], 30.0)
+            _register_brdf_case(f"{method.name}_30", method.name, method.params, 30.0)
 
 
 _register_brdf_cases()

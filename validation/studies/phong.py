@@ -121,7 +121,7 @@ def _no_segments(m: int) -> None:
 def table_variants() -> list[TableVariant]:
     """The tables of Table 1 and the sweeps: every registered placement, in registry order.
 
-    The rule: a placement that takes segments (``extra["segments"]``, the importance placement)
+    The rule: a placement that takes segments (``Placement.segments``, the importance placement)
     is studied at ``p = m`` (the paper's setting, named ``"<placement> p=m"``) and at ``p = m/10``
     (``"<placement> p=m/10"``; ``p = 1`` where 10 does not divide ``m``); every other placement
     once, under its key.
@@ -133,7 +133,7 @@ def table_variants() -> list[TableVariant]:
     """
     variants = []
     for name, method in PLACEMENT_METHODS.items():
-        if method.extra["segments"]:
+        if method.segments:
             variants.append(TableVariant(f"{name} p=m", name, _segments_m))
             variants.append(TableVariant(f"{name} p=m/10", name, _segments_m10))
         else:
@@ -144,17 +144,17 @@ def table_variants() -> list[TableVariant]:
 def never_worse_interpolations() -> list[str]:
     """The interpolations of the "never worse" target and the failure sweeps.
 
-    Every registered interpolation in ``t`` (``extra["coordinate"] == "t"``): the parabola in
+    Every registered interpolation in ``t`` (``Interpolation.coordinate == "t"``): the parabola in
     ``w`` is Wang's importance coordinate, meaningless on other node sets, and is compared in the
-    report only. Ordered by convergence order (``extra["order"]``), then registry order.
+    report only. Ordered by convergence order (``Interpolation.order``), then registry order.
 
     Examples
     --------
     >>> never_worse_interpolations()
     ['linear', 'parabolic', 'monotone']
     """
-    in_t = [m for m in INTERPOLATION_METHODS.values() if m.extra["coordinate"] == "t"]
-    return [m.name for m in sorted(in_t, key=lambda m: m.extra["order"])]
+    in_t = [m for m in INTERPOLATION_METHODS.values() if m.coordinate == "t"]
+    return [m.name for m in sorted(in_t, key=lambda m: m.order)]
 
 
 @dataclass(frozen=True, eq=False)
@@ -348,7 +348,7 @@ def time_row(state: ViewState, row: dict, exact_shade_s: float, shared_s: float,
 
 def _segments(placement: str, entries: int) -> int | None:
     """The segments of a table: ``p = m`` for a placement that takes segments, else None."""
-    return entries if PLACEMENT_METHODS.lookup(placement).extra["segments"] else None
+    return entries if PLACEMENT_METHODS.lookup(placement).segments else None
 
 
 def _rms_by_entries(state: ViewState, placement: str, interpolation: str):

@@ -262,7 +262,7 @@ def _shrm_kind() -> SweepKind:
 
 
 #: The kinds of sweep ``specref sweep`` runs, by the sweep file's ``kind``.
-SWEEP_KINDS = Registry("sweep kind")
+SWEEP_KINDS = Registry("sweep kind", SweepKind)
 SWEEP_KINDS.register(_phong_kind(), "phong")
 SWEEP_KINDS.register(_impastor_kind(), "impastor")
 SWEEP_KINDS.register(_shrm_kind(), "shrm")

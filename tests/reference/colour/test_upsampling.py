@@ -54,10 +54,10 @@ def test_upsampling_white_is_flat_and_renders_white():
     # As radiance: times D65/Y(D65), so XYZ (E weights) -> sRGB gives back the white texel.
     # Source: colour-science D65 and sRGB; tolerance: D65 sampled at 10 nm vs its 5 nm table.
     M = spectra_to_RGB_matrix(band_weights(GRID_41, None))
-    # A fitted model (extra["exact"] False) reproduces white only to within its fit: 1 %.
+    # A fitted model (Upsampler.exact False) reproduces white only to within its fit: 1 %.
     for name, method in UPSAMPLING_METHODS.items():
         R = RGB_to_radiance_spectra(np.array([[3.0, 3.0, 3.0]]), GRID_41, name)
-        np.testing.assert_allclose(R @ M, 3.0, rtol=2e-3 if method.extra["exact"] else 1e-2)
+        np.testing.assert_allclose(R @ M, 3.0, rtol=2e-3 if method.exact else 1e-2)
 
 
 @pytest.mark.parametrize("method", UPSAMPLING_METHODS.values(), ids=attrgetter("name"))

@@ -114,7 +114,7 @@ def test_frame_from_normal_is_orthonormal(rng):
 @pytest.mark.parametrize("method", BRDF_METHODS.values(), ids=attrgetter("name"))
 def test_brdf_reciprocity(method, rng):
     wi, wo = _random_dirs(rng, 200), _random_dirs(rng, 200)
-    params = method.extra["params"]
+    params = method.params
     np.testing.assert_allclose(
         method.reference(wi, wo, Z, **params), method.reference(wo, wi, Z, **params), rtol=1e-12
     )
@@ -123,8 +123,8 @@ def test_brdf_reciprocity(method, rng):
 def _albedo_sampler(method, params, wi, n, seed):
     rng = np.random.default_rng(seed)
     u = rng.random((n, 2))
-    wo = method.extra["sample"](np.broadcast_to(wi, (n, 3)), Z, u, **params)
-    pdf = method.extra["pdf"](np.broadcast_to(wi, (n, 3)), wo, Z, **params)
+    wo = method.sample(np.broadcast_to(wi, (n, 3)), Z, u, **params)
+    pdf = method.pdf(np.broadcast_to(wi, (n, 3)), wo, Z, **params)
     f = method.reference(np.broadcast_to(wi, (n, 3)), wo, Z, **params)[..., 0]
     weight = np.where(pdf > 0, f * np.maximum(wo[:, 2], 0.0) / np.where(pdf > 0, pdf, 1.0), 0.0)
     return weight.mean(), weight.std() / np.sqrt(n)

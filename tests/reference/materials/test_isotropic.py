@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from reference.errors import SpecrefError
-from reference.materials.brdf import BRDF_METHODS
+from reference.materials.brdf import BRDF_METHODS, BRDFMethod
 from reference.materials.isotropic import (
     brdf_ggx,
     brdf_lafortune,
@@ -18,7 +18,7 @@ from reference.materials.isotropic import (
 from reference.registry import Method
 
 Z = np.array([0.0, 0.0, 1.0])
-ISOTROPIC = [m for m in BRDF_METHODS.values() if m.extra.get("isotropic")]
+ISOTROPIC = [m for m in BRDF_METHODS.values() if m.isotropic]
 
 
 def _upper(rng, n):
@@ -135,8 +135,19 @@ def test_bad_parameters(call, match):
 
 
 def test_register_brdf_refuses_a_different_function_under_a_taken_key():
+    import dataclasses
+
+    other = dataclasses.replace(BRDF_METHODS.lookup("ggx"), reference=brdf_lafortune)
     with pytest.raises(SpecrefError, match="brdf 'ggx' is registered twice"):
-        register_brdf(Method("ggx", brdf_lafortune, None, "none"))
+        register_brdf(other)
+
+
+def test_brdf_registry_takes_brdf_methods_only():
+    # A BRDF without a sampler, pdf and defaults cannot be registered: the registry is typed.
+    with pytest.raises(SpecrefError, match="brdf registry takes BRDFMethod entries, got Method"):
+        register_brdf(Method("new_brdf", brdf_lafortune, None, "none"))
+    with pytest.raises(TypeError, match="unexpected keyword argument 'extra'"):
+        BRDFMethod("new_brdf", brdf_lafortune, None, "none", extra={"params": {}})
 
 
 # --- white furnace ---------------------------------------------------------------------------

@@ -20,7 +20,7 @@ from reference.materials.table import (
 
 Z = np.array([0.0, 0.0, 1.0])
 ROOT = Path(__file__).resolve().parents[3]
-ANALYTIC = [m for m in BRDF_METHODS.values() if m.extra.get("isotropic") and m.name != "table"]
+ANALYTIC = [m for m in BRDF_METHODS.values() if m.isotropic and m.name != "table"]
 
 
 def _bands(method, params):

@@ -39,7 +39,7 @@ def test_shading_kernel_matches_reference(name, case, rng):
         Mod = 0.0
         parts = {**parts, "L": np.full_like(parts["L"], np.nan), "E_effect": parts["L"] * np.nan}
     expected = method.reference(parts, look, Mod)
-    got = method.extra["compiled"](parts, look, Mod)
+    got = method.compiled(parts, look, Mod)
     assert np.isfinite(got).all()
     np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-14)
 

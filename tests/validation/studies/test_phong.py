@@ -104,13 +104,15 @@ def test_table_variants_follow_the_placement_registry(monkeypatch):
     # a newly registered placement joins every study at once; one that takes segments is studied
     # at p = m and p = m/10 (p = 1 where 10 does not divide m)
     import validation.studies.phong as phong
-    from phong_table.placement import PLACEMENT_METHODS
-    from reference.registry import Method, Registry
+    from phong_table.placement import PLACEMENT_METHODS, Placement
+    from reference.registry import Registry
 
-    registry = Registry("placement")
+    registry = Registry("placement", Placement)
     for method in PLACEMENT_METHODS.values():
         registry.register(method)
-    registry.register(Method("demo", abs, None, "Eq. (16), Wang et al.", None, {"segments": True}))
+    registry.register(
+        Placement("demo", abs, None, "Eq. (16), Wang et al.", source="a test", segments=True)
+    )
     monkeypatch.setattr(phong, "PLACEMENT_METHODS", registry)
     variants = phong.table_variants()
     assert [v.name for v in variants][-2:] == ["demo p=m", "demo p=m/10"]
@@ -123,15 +125,18 @@ def test_table_variants_follow_the_placement_registry(monkeypatch):
 
 def test_never_worse_interpolations_are_the_registered_ones_in_t(monkeypatch):
     import validation.studies.phong as phong
-    from phong_table.interpolation import INTERPOLATION_METHODS
-    from reference.registry import Method, Registry
+    from phong_table.interpolation import INTERPOLATION_METHODS, Interpolation
+    from reference.registry import Registry
 
-    registry = Registry("interpolation")
+    registry = Registry("interpolation", Interpolation)
     for method in INTERPOLATION_METHODS.values():
         registry.register(method)
     for name, coordinate, order in (("demo_w", "w", 1), ("demo_t", "t", 1)):
-        extra = {"coordinate": coordinate, "order": order}
-        registry.register(Method(name, abs, None, "Eq. (11), Wang et al.", None, extra))
+        fields = {"code": -1, "min_entries": 1, "graded": False}
+        registry.register(
+            Interpolation(name, abs, None, "Eq. (11), Wang et al.", None, **fields,
+                          coordinate=coordinate, order=order)
+        )  # fmt: skip
     monkeypatch.setattr(phong, "INTERPOLATION_METHODS", registry)
     # in t only, from the lowest convergence order up
     assert phong.never_worse_interpolations() == ["demo_t", "linear", "parabolic", "monotone"]

@@ -1,6 +1,6 @@
 """Report section "Spherical harmonics": basis accuracy to l = 2000, ringing, prefiltering, speed.
 
-The figures (issue 5; Herbert et al. §5.3-5.4, §7.1, §7.3):
+The figures (Herbert et al. §5.3-5.4, §7.1, §7.3):
 
 - basis error against degree, float64 against mpmath (``validation/data/sh_basis.json``), for the
   plain and the scaled recurrence, with the plain recurrence's limit marked;
@@ -30,6 +30,7 @@ from reference.display.encodings import linear_to_display
 from reference.errors import require
 from reference.files import write_text_atomic
 from reference.images.formats import read_hdr
+from reference.registry import ParametricMethod
 from shrm.lobes import (
     PREFILTER_KERNELS,
     adaptive_order,
@@ -372,12 +373,12 @@ def kernel_specs(parameters: dict) -> list[str]:
     """
     specs = []
     for name, entry in PREFILTER_KERNELS.items():
-        if "param" not in entry.extra:
+        if not isinstance(entry, ParametricMethod):
             specs.append(name)
             continue
         require(
             name in parameters,
-            f"validation/report/sections/sh.py: kernel {name!r} takes {entry.extra['param']}; "
+            f"validation/report/sections/sh.py: kernel {name!r} takes {entry.param}; "
             "give its "
             f"study values (studied: {', '.join(sorted(parameters))})",
         )
@@ -563,7 +564,7 @@ def _lambda_chart(ctx, curves):
 
 
 def checks(data: SectionData) -> list[Check]:
-    """Basis, ringing and prefilter accuracy (issue 5), then the speed targets of ``make bench``."""
+    """Basis, ringing and prefilter accuracy, then the speed targets of ``make bench``."""
     return _accuracy_checks(data.results) + benchmark_checks(data.arrays["bench"])
 
 
