@@ -55,6 +55,7 @@ __all__ = [
     "HORIZON_SECTORS",
     "PAINTING_LIGHTING_METHODS",
     "PAINT_SPECTRA",
+    "booth_lamp_kind",
     "booth_plane_light",
     "cached_horizon_map",
     "impasto_painting",
@@ -102,7 +103,14 @@ def booth_plane_light(kind: str = "fluorescent", width: int = 128, height: int =
     return PlaneLight(image, (-0.6, 0.6, -1.0), (1.0, 0.0, 0.0), (0.0, 0.0, 1.0), 1.2, 0.8)
 
 
-def _booth_kind(light: str) -> str:
+def booth_lamp_kind(light: str) -> str:
+    """The booth's lamp for an illuminant: ``"incandescent"`` under A, else ``"fluorescent"``.
+
+    Examples
+    --------
+    >>> booth_lamp_kind("A"), booth_lamp_kind("D65")
+    ('incandescent', 'fluorescent')
+    """
     return "incandescent" if light == "A" else "fluorescent"
 
 
@@ -327,7 +335,7 @@ def render_painting(
     painting = painting or impasto_painting(size)
     spectra = spectra or load_paint_spectra()
     d = MULTISPECTRAL_DESIGNS.lookup(design).reference(6)
-    plane = booth_plane_light(_booth_kind(light), *light_resolution)
+    plane = booth_plane_light(booth_lamp_kind(light), *light_resolution)
     lights = point_lights_from_plane(plane, lighting.sampling, n_lights)
     S6 = light_to_channels(spectrum_from_dataset("illuminant", light), d)
     px = _canvas_pixels(painting, size)

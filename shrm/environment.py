@@ -56,6 +56,7 @@ from shrm.sh import sh_evaluate
 from shrm.transform import project_latlong
 
 __all__ = [
+    "cached_map_names",
     "cached_spectral_radiance",
     "environment_spectral_radiance",
     "phong_environment_Lambda",
@@ -112,6 +113,25 @@ def _state(light: EnvironmentLight, ctx) -> dict:
         radiance = environment_spectral_radiance(light, ctx.grid, key[1], key[2])
         per_light[key] = {"radiance": radiance}
     return per_light[key]
+
+
+def cached_map_names(light: EnvironmentLight) -> list[str]:
+    """The maps this process holds for ``light``, by name (``"lambert"``, ``"normalized-phong:8"``).
+
+    The cache keeps one entry per light, grid and upsampling; a map's key starts with its kernel's
+    name. The report's scene section counts them to show that material groups share maps.
+
+    Examples
+    --------
+    >>> cached_map_names(EnvironmentLight(np.ones((2, 4, 3))))
+    []
+    """
+    return [
+        str(key[0])
+        for state in _CACHE.get(light, {}).values()
+        for key in state
+        if isinstance(key, tuple)
+    ]
 
 
 def cached_spectral_radiance(light: EnvironmentLight, ctx) -> np.ndarray:

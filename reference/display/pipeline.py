@@ -31,7 +31,12 @@ from reference.display.model import (
 )
 from reference.errors import require, require_finite
 
-__all__ = ["ScreenGeometry", "image_to_display_counts", "screen_view_angles"]
+__all__ = [
+    "ScreenGeometry",
+    "image_to_display_counts",
+    "off_mirror_angle_deg",
+    "screen_view_angles",
+]
 
 
 @dataclass(frozen=True)
@@ -95,8 +100,29 @@ def screen_view_angles(geometry: ScreenGeometry, observer, height: int, width: i
     return theta, phi
 
 
-def _off_mirror_deg(geometry, observer, light_position, height, width):
-    """Angle between each pixel's mirror direction of the view and the direction to the light."""
+def off_mirror_angle_deg(geometry, observer, light_position, height, width) -> np.ndarray:
+    """Angle between each pixel's mirror direction of the view and the direction to a light.
+
+    Parameters
+    ----------
+    geometry : ScreenGeometry
+        The screen.
+    observer, light_position : array_like, shape (3,)
+        The eye and the light (or its reflection's source), in the screen's frame (m).
+    height, width : int
+        The image's pixels on the screen.
+
+    Returns
+    -------
+    ndarray, shape (height, width)
+        Degrees; 0 where the light is seen in the pixel's mirror direction (the screen's glare).
+
+    Examples
+    --------
+    >>> g = ScreenGeometry()
+    >>> bool(off_mirror_angle_deg(g, [0, 0, 0.6], [0, 0, 2.0], 3, 3)[1, 1] < 1e-6)
+    True
+    """
     n = geometry.normal
     points = geometry.points(height, width)
     to_eye = np.asarray(observer, float) - points
@@ -159,7 +185,7 @@ def image_to_display_counts(
         mirror = None
         if light_XYZ is not None:
             require(light_position is not None, "light_position: needed with light_XYZ")
-            mirror = _off_mirror_deg(geometry, observer, light_position, height, width)
+            mirror = off_mirror_angle_deg(geometry, observer, light_position, height, width)
         E = np.zeros(3) if E_XYZ is None else np.asarray(E_XYZ, float)
         # §3.4.3, Ferwerda: the screen's diffuse and specular reflection (Erratum E57)
         flare = flare + screen_flare_XYZ(model, np.broadcast_to(E, XYZ.shape), light_XYZ, mirror)

@@ -121,9 +121,9 @@ def render_for_cli(
             "in front of the screen (the side it faces), or it is not mirrored by it",
         )
         if light_luminance is None:
-            from impastor.painting import _booth_kind, booth_light_image
+            from impastor.painting import booth_lamp_kind, booth_light_image
 
-            light_luminance = float(booth_light_image(_booth_kind(light)).mean())
+            light_luminance = float(booth_light_image(booth_lamp_kind(light)).mean())
         require(
             np.isfinite(light_luminance) and light_luminance >= 0,
             f"--light-luminance: must be >= 0 cd/m², got {light_luminance!r}",
@@ -176,7 +176,7 @@ def _write_counts(XYZ, path, geometry, observer, flare: dict) -> str:
     import imagecodecs
 
     from reference.display.model import screen_flare_XYZ, virtual_display
-    from reference.display.pipeline import _off_mirror_deg
+    from reference.display.pipeline import off_mirror_angle_deg
     from reference.files import write_bytes_atomic
 
     out = painting_on_display(XYZ, geometry, observer, flare)
@@ -184,7 +184,7 @@ def _write_counts(XYZ, path, geometry, observer, flare: dict) -> str:
     lit = XYZ[..., 1] > 1.0
     error = np.abs(out["seen_XYZ"][..., 1][lit] / XYZ[..., 1][lit] - 1.0)
     # §3.4.3, Ferwerda: the specular part of the flare subtracted, at its largest on the screen
-    mirror = _off_mirror_deg(geometry, observer, flare["position"], *XYZ.shape[:2])
+    mirror = off_mirror_angle_deg(geometry, observer, flare["position"], *XYZ.shape[:2])
     display = virtual_display()
     diffuse = screen_flare_XYZ(display, [0.0, flare["screen_lux"], 0.0])[1]
     specular = screen_flare_XYZ(display, np.zeros(3), [0.0, flare["luminance"], 0.0], mirror)

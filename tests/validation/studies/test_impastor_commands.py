@@ -133,7 +133,7 @@ def test_specular_flare_is_subtracted():
     # angle plus the diffuse and the specular flare) is the intended painting; compensating the
     # diffuse flare alone (what the CLI did before) leaves the specular flare on the screen.
     from reference.display.model import screen_flare_XYZ, virtual_display
-    from reference.display.pipeline import _off_mirror_deg
+    from reference.display.pipeline import off_mirror_angle_deg
     from validation.studies.impastor_commands import painting_on_display
 
     geometry, eye, flare = _tilted_booth()
@@ -143,7 +143,7 @@ def test_specular_flare_is_subtracted():
     assert both["in_gamut"].all()
     assert np.abs(both["seen_XYZ"][..., 1] / XYZ[..., 1] - 1).max() < 5e-3
     diffuse_only = painting_on_display(XYZ, geometry, eye, {**flare, "luminance": 0.0})
-    mirror = _off_mirror_deg(geometry, eye, flare["position"], 12, 16)
+    mirror = off_mirror_angle_deg(geometry, eye, flare["position"], 12, 16)
     specular = screen_flare_XYZ(virtual_display(), np.zeros(3), flare["luminance"] * white, mirror)
     seen = diffuse_only["seen_XYZ"] + specular  # the light is there all the same
     assert specular[..., 1].max() > 5.0  # cd/m²: a visible veil
