@@ -1,4 +1,7 @@
-"""``specref display``: calibrate the simulated display to a white and a tone curve (issue 16)."""
+"""``specref display``: calibrate the simulated display to a white and a tone curve.
+
+Herbert et al. §6; docs/display.md.
+"""
 
 from __future__ import annotations
 

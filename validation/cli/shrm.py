@@ -11,7 +11,7 @@ from validation.cli.parser import Parser, input_file, registry_option
 
 
 def _check_arguments(args) -> None:
-    """The arguments that need no data, before any work (issue 17 §5)."""
+    """The arguments that need no data, before any work (docs/bad-input.md)."""
     from reference.files import check_output_folder
     from shrm.brdf_sh import P_RANGE
 

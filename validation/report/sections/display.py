@@ -39,7 +39,7 @@ FIG6_CURVES = ("gamma1.8", "gamma2.2", "lstar")
 BANDS = ((0.5, 1.01), (0.25, 0.5), (0.125, 0.25), (0.05, 0.125), (0.02, 0.05))
 #: Δu'v' below which a calibration "holds" the white (a just-noticeable difference, about 0.004).
 HOLD_DUV = 0.004
-# Issue 16's targets with the noise-free spectroradiometer.
+# The calibration targets with the noise-free spectroradiometer (docs/display.md, "Calibrating").
 TARGET_DUV, TARGET_Y = 0.001, 0.01
 #: ΔE00 below which a displayed image counts as the intended one (about one just-noticeable step).
 TARGET_SCENE_DE = 1.0
@@ -165,7 +165,7 @@ def _delta_E00(XYZ, reference_XYZ, white_XYZ) -> np.ndarray:
 def scene_on_calibrated_display(display) -> tuple[dict, dict]:
     """A scene with ``[display] calibration``: what the display emits against the intended XYZ.
 
-    Issue 16: the ColorChecker example is calibrated for (:data:`SCENE_CALIBRATION`, 15 points,
+    Erratum E47: the ColorChecker example is calibrated for (:data:`SCENE_CALIBRATION`, 15 points,
     noise-free instrument), written as ``CAL.cal`` and named by the scene file; the render's device
     values are sent through the ``.cal`` tables to the simulated spectral display
     (``measure_through_calibration``, noise-free) and compared, in CIEDE2000 relative to the
@@ -205,7 +205,7 @@ def scene_on_calibrated_display(display) -> tuple[dict, dict]:
     intended = result.XYZ * scene.display.exposure * cal.Y_white
     dE = _delta_E00(emitted, intended, white_XYZ)
     inside = dE[in_gamut]
-    # the range issue 16's calibration targets speak for: above 5 % of white luminance
+    # the range the calibration targets speak for: above 5 % of white luminance
     lit = dE[in_gamut & (intended[..., 1] > 0.05 * white_XYZ[1])]
     found = {
         "scene": SCENE_FILE,
@@ -298,7 +298,7 @@ def _to_sRGB(XYZ, white_XYZ) -> np.ndarray:
 
 
 def _scene_blocks(ctx: ReportContext, data: SectionData) -> list:
-    """A scene through its calibration: emitted against intended (issue 16)."""
+    """A scene through its calibration: emitted against intended (erratum E47)."""
     import matplotlib.pyplot as plt
 
     r, a = data.results["scene"], data.arrays["scene"]
@@ -475,7 +475,7 @@ def _screen_table(data: SectionData) -> Table:
 
 
 def checks(data: SectionData) -> list[Check]:
-    """Issue 16's targets for every white and curve, and the colorimeter's shadow failure."""
+    """The calibration targets for every white and curve, and the colorimeter's shadow failure."""
     found = []
     for key, r in data.results["targets"].items():
         found.append(

@@ -41,7 +41,8 @@ EXAMPLES_DIR = data_path("examples")
 SCENES = (("colorchecker-d65.toml", 120), ("colorchecker-a.toml", 120), ("phong-sphere.toml", 128))
 #: The environment-lit example, rendered by the frequency path and by the oracle, at this width.
 ENV_SCENE, ENV_WIDTH, ENV_WIDTH_QUICK = "env-lambert-sphere.toml", 48, 20
-#: Issue 3: the ColorChecker render reproduces colour.sd_to_XYZ(ASTM E308) to this (Y = 100 scale).
+#: The band weights of erratum E7: the ColorChecker render reproduces colour.sd_to_XYZ(ASTM E308)
+#: to this (Y = 100 scale).
 CHART_DXYZ_TARGET = 1e-9
 
 

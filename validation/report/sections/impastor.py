@@ -37,15 +37,15 @@ __all__ = [
     "impastor_validation",
 ]
 
-#: Targets of issue 6 for the held-out ColorChecker (mean, max ΔE00 per light, one matrix).
+#: Our targets for the held-out ColorChecker (mean, max ΔE00 per light, one matrix).
 TARGETS = {"box": (0.8, 2.2), "optimized": (0.25, 0.6)}
-#: Other targets of issue 6: metamers (ΔE00 under A below, under D65 above), the hybrid against
+#: Other targets: metamers (ΔE00 under A below, under D65 above), the hybrid against
 #: the better of median cut and FIS, and horizon-map disagreement at every elevation at the
-#: renderer's sector count (``impastor.painting.HORIZON_SECTORS``; issue 22).
+#: renderer's sector count (``impastor.painting.HORIZON_SECTORS``; erratum E95).
 METAMER_TARGETS = {"A": 0.5, "D65": 3.0}
 HYBRID_LIMIT = 1.1
-#: Issue 22 on held-out cases: within HYBRID_LIMIT in this share of (case, α) pairs, and never
-#: worse than HELD_OUT_MAX times the better method.
+#: The hybrid on held-out cases (erratum E17): within HYBRID_LIMIT in this share of (case, α)
+#: pairs, and never worse than HELD_OUT_MAX times the better method.
 HELD_OUT_SHARE = 0.95
 HELD_OUT_MAX = 1.5
 SHADOW_LIMIT = 0.02
@@ -80,7 +80,7 @@ class ImpastorSettings:
     every_frame_method : bool
         Time a frame per lighting method, or one per specular estimator (:func:`frame_methods`).
     held_out : dict
-        The hybrid's held-out sweep (issue 22): ``n_paintings`` and ``first_seed`` of
+        The hybrid's held-out sweep (erratum E17): ``n_paintings`` and ``first_seed`` of
         :func:`validation.studies.impastor_hybrid.held_out_cases`, and keywords of
         ``hybrid_case_ratios``.
     """
@@ -98,7 +98,7 @@ class ImpastorSettings:
     held_out: dict = field(default_factory=lambda: dict(HELD_OUT_FULL))
 
 
-#: The held-out sweep of issue 22 in the full report: painting seeds 201-224 (never used by the
+#: The held-out sweep (erratum E17) in the full report: painting seeds 201-224 (never used by the
 #: design, ``validation.studies.impastor_hybrid.TRAINING``), the report's α grid, 36 points,
 #: 64 × 32 lights.
 HELD_OUT_FULL = {"n_paintings": 24, "first_seed": 201, "supersample": 6}
@@ -262,7 +262,7 @@ def _held_out_task(task) -> dict:
 
 
 def _held_out_figures(settings: ImpastorSettings, run) -> dict:
-    """The hybrid over the better method on cases the design never saw (issue 22), per case."""
+    """The hybrid over the better method on cases the design never saw (erratum E17), per case."""
     from validation.studies.impastor_hybrid import held_out_cases, ratio_distribution
 
     options = dict(settings.held_out)
@@ -568,7 +568,7 @@ def _held_out_blocks(ctx, result) -> list:
         Table(
             ["held-out case", "worst α", "worst ratio", "best ratio"],
             rows,
-            "The hybrid on cases the design never saw (issue 22; painting seeds from "
+            "The hybrid on cases the design never saw (erratum E17; painting seeds from "
             "validation.studies.impastor_hybrid.held_out_cases)",
             "{:.3g}",
         ),
@@ -820,7 +820,7 @@ def _bound_checks(round_trip: dict, albedo: dict) -> list:
 
 
 def checks(data: SectionData) -> list[Check]:
-    """One check per target of issue 6, from ``data.results`` alone.
+    """One check per target, from ``data.results`` alone.
 
     Six channels on the ColorChecker (:data:`TARGETS`, per design and booth light), metamers,
     the hybrid against the better of median cut and FIS at every α, horizon-map shadows at every
@@ -907,7 +907,7 @@ def headlines(data: SectionData) -> list[Headline]:
                 f"on {d['n']} held-out (case, α) pairs the hybrid is within {HYBRID_LIMIT:g}× of "
                 f"the better method in {100 * d['share_within_1.1']:.1f} % (worst "
                 f"{d['max']:.2f}×)",
-                f"issue 22: ≥ {100 * HELD_OUT_SHARE:g} %, never above {HELD_OUT_MAX:g}×",
+                f"target ≥ {100 * HELD_OUT_SHARE:g} %, never above {HELD_OUT_MAX:g}×",
             )
         )
     return lines

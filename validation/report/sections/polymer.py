@@ -46,7 +46,7 @@ from validation.studies.metrics import delta_E_stats
 #: TiO2 loads of the Fig. 2 reproduction, % by weight.
 FIG2_TIO2_PCT = np.array([0.0, 0.02, 0.05, 0.1, 0.2, 0.35, 0.5, 0.75, 1.0, 1.5, 2.0])
 ILLUMINANTS = ("D65", "A")
-#: Issue 14's target for the interpolation between chips: mean ΔE00 below 0.5.
+#: Our target for the interpolation between chips (erratum E37): mean ΔE00 below 0.5.
 INTERPOLATION_TARGET = 0.5
 #: The chip and finish the term images show.
 DEMO = {"thickness_mm": 1.524, "tio2_pct": 0.2, "gloss": 0.8, "phong_exponent": 64.0}

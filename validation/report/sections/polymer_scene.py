@@ -52,9 +52,11 @@ GROUPS = (
     ),
     ("cap", 'thickness = 3.048\ntio2 = 2.0\ntint = "pb-orange"\ngloss_exponent = 40.0'),
 )
-#: Issue 14: the demo object has at least this many triangles (full mode) and three groups.
+#: Ours (erratum E62): the demo object has at least this many triangles (full mode) and three
+#: groups.
 TRIANGLES_TARGET = 100_000
-#: Issue 14 (§5.2): re-shade after a dynamic change vs a cold frame, and vs a Lambert re-shade.
+#: Herbert et al. §5.2 (erratum E61): re-shade after a dynamic change vs a cold frame, and vs a
+#: Lambert re-shade.
 COLD_RATIO, LAMBERT_RATIO = 20.0, 3.0
 
 
@@ -307,7 +309,7 @@ def present(ctx: ReportContext, data: SectionData) -> list:
             )
         )
     else:
-        blocks.append(Text("Run `make bench` for the dynamic re-shade ratios (issue 14)."))
+        blocks.append(Text("Run `make bench` for the dynamic re-shade ratios (erratum E61)."))
     return blocks
 
 

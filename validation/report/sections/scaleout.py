@@ -25,9 +25,9 @@ from validation.report import (
     Text,
 )
 
-#: Targets of the scale-out issue: distributed / serial on 2 cores, streamed / in-memory throughput.
+#: Targets (docs/scale-out.md): distributed / serial on 2 cores, streamed / in-memory throughput.
 SWEEP_TARGET, ZARR_TARGET = 1.6, 0.7
-#: The issue's bound on the 12k×6k×41 projection's peak resident memory (bytes).
+#: The bound on the 12k×6k×41 projection's peak resident memory (bytes).
 PEAK_RSS_TARGET = 2e9
 
 
@@ -218,7 +218,7 @@ def _present_zarr(full: dict | None, layout: list[dict]) -> list:
 
 
 def checks(data: SectionData) -> list[Check]:
-    """The scale-out issue's targets, when the benchmarks ran."""
+    """The scale-out targets, when the benchmarks ran."""
     r = data.results
     if not r["measured"]:
         return []

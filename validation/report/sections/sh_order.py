@@ -1,6 +1,6 @@
 """Report section "Environment SH order from an accuracy": error against order, and renders.
 
-The figures (issue 17 §1; ``shrm.accuracy``, ``validation.studies.env_accuracy``):
+The figures (erratum E75; ``shrm.accuracy``, ``validation.studies.env_accuracy``):
 
 - error against order: the relative error of Y of the SH-only frequency path against the
   brute-force angular oracle (mean and max over lit directions of a Fibonacci set), per order, for
@@ -9,7 +9,7 @@ The figures (issue 17 §1; ``shrm.accuracy``, ``validation.studies.env_accuracy`
   plus SH for the residual) and its measured error;
 - the default render of a Lambertian sphere (ρ = 0.5, the path of ``specref render``) against
   ``specref render --oracle``, before (order from the kernel's tail alone, tolerance 1e-2) and
-  after issue 17, with the order and exact texels each used.
+  after erratum E75, with the order and exact texels each used.
 
 compute → :func:`sh_order_study`; present → :func:`present`; checks → :func:`checks`.
 """
@@ -172,7 +172,7 @@ def present(ctx: ReportContext, data: SectionData) -> list:
                 for name, r in renders.items()
             ],
             "Lambertian sphere (ρ = 0.5), default render against --oracle, relative error of Y "
-            "over lit pixels: before issue 17 (kernel tail 1e-2) and now",
+            "over lit pixels: the former order rule (kernel tail 1e-2) and now (erratum E75)",
             "{:.3g}",
         ),
     ]
@@ -204,7 +204,7 @@ def _order_chart(ctx, by_order):
 
 
 def checks(data: SectionData) -> list[Check]:
-    """The default render meets the promised bound on every map (issue 17 §1)."""
+    """The default render meets the promised bound on every map (erratum E75)."""
     found = []
     for name, r in data.results["renders"].items():
         new = r["new"]

@@ -2,7 +2,7 @@
 
 The ``sh-*`` groups of ``tests/benchmarks/bench_sh.py`` (``make bench``): each benchmark as a ratio
 to its group's same-run baseline, projection time against order per path, memory bandwidth as a
-share of ``np.copyto``'s, and issue 5's speed targets as checks. Without a benchmark file there are
+share of ``np.copyto``'s, and the speed targets as checks. Without a benchmark file there are
 no speed figures and no speed checks.
 """
 
@@ -62,7 +62,7 @@ def benchmark_figures(groups: dict) -> tuple[dict, list[dict]]:
 
 
 def benchmark_checks(records: list[dict]) -> list[Check]:
-    """The speed targets of issue 5 on the records of :func:`benchmark_figures`, in their order.
+    """The speed targets on the records of :func:`benchmark_figures`, in their order.
 
     Examples
     --------

@@ -17,7 +17,7 @@
   (:mod:`validation.report.sections.shrm_speed`).
 
 compute → :func:`shrm_study_and_speed`; present → :func:`present`; checks → :func:`checks`.
-Every issue-7 target is a :class:`validation.report.Check`; ``--quick`` checks reduced versions
+Every target is a :class:`validation.report.Check`; ``--quick`` checks reduced versions
 (named so).
 """
 
@@ -334,7 +334,7 @@ def checks(data: SectionData) -> list[Check]:
                 err <= TOLERANCE,
             )
         )
-        # the same target inside the issue's and §5.5's view orders, P from 2 to 10 (erratum E23)
+        # the same target inside §5.5's view orders, P from 2 to 10 (erratum E23)
         found.append(
             Check(
                 f"{label}image within 1 % of peak of brute force with P <= 10 (§5.5), {name} "

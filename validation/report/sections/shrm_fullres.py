@@ -1,4 +1,4 @@
-"""Report section "SHRMs on full-resolution maps": the default path against brute force (issue 21).
+"""Report section "SHRMs on full-resolution maps": the default path against brute force.
 
 The figures (``validation.studies.shrm_fullres``): for every shipped environment map at its full
 resolution and every BRDF of :data:`validation.studies.shrm_fullres.FULLRES_BRDFS`, an orthographic
@@ -24,7 +24,8 @@ from validation.studies.shrm_fullres import FULLRES_BRDFS, fullres_case, sphere_
 
 __all__ = ["SETTINGS", "fullres_study"]
 
-#: Issue 21's targets: within 1 % of the peak, mean |ΔY/Y| <= 1 % over pixels above 1 % of it.
+#: The targets (docs/shrm.md, §6): within 1 % of the peak, mean |ΔY/Y| <= 1 % over pixels above
+#: 1 % of it.
 PEAK_LIMIT_PCT = 1.0
 MEAN_LIMIT_PCT = 1.0
 #: The split's per-pixel tolerance (``render.options.shrm_tol``'s default).
@@ -178,7 +179,7 @@ def present(ctx: ReportContext, data: SectionData) -> list:
     """The table of cases, the time–error chart and the per-case speed–accuracy panels."""
     rows = data.results["cases"]
     sizes = " or ".join(f"{n} × {n}" for n in sorted({r["side"] for r in rows}))
-    # the brute force of the issue's 128 × 128 sphere, from this run's seconds per point
+    # the brute force of a 128 × 128 sphere (as in erratum E94), from this run's seconds per point
     per_point = np.median([r["bruteforce_seconds"] / r["pixels"] for r in rows])
     minutes_128 = per_point * len(sphere_points(128)[0]) / 60
     table = [
@@ -203,8 +204,8 @@ def present(ctx: ReportContext, data: SectionData) -> list:
     ]
     return [
         Text(
-            f"Issue 21 measured on the shipped maps ({data.results['label']}): an orthographic "
-            f"sphere at the pixel centres of a {sizes} image (the issue's 128 × 128 would take "
+            f"Measured on the shipped maps ({data.results['label']}): an orthographic "
+            f"sphere at the pixel centres of a {sizes} image (a 128 × 128 image would take "
             f"about {minutes_128:.0f} minutes of brute force per case at this run's speed) of each "
             "BRDF (GGX with ρ_d 0 and F_0 1, Ward, the thin-film effect pigment, GGX α 0.3 "
             "tabulated at 5° × 15° through the BRDF-table path) rendered by the "
@@ -246,7 +247,7 @@ def present(ctx: ReportContext, data: SectionData) -> list:
 
 
 def checks(data: SectionData) -> list[Check]:
-    """One check per map and BRDF: both of issue 21's targets, on the split (the default).
+    """One check per map and BRDF: both targets, on the split (the default).
 
     None in quick mode: the targets are for the full-resolution maps.
     """

@@ -1,6 +1,6 @@
 """The speed half of the report section "SHRMs" (:mod:`validation.report.sections.shrm`).
 
-§5.5-5.6, Herbert et al.; the targets of issue 7 as checks:
+§5.5-5.6, Herbert et al.; the speed targets as checks:
 
 - creation in frequency space against angular (brute-force) creation, on the same input and the
   same texels, per texel and at equal error (>= 100×);
@@ -26,7 +26,7 @@ from validation.report.sections.shrm_study import TOLERANCE, create_timed, rho_c
 
 __all__ = ["bench_ratio", "bench_rows", "creation_speed", "extraction_speed", "speed_checks"]
 
-#: Targets of issue 7 (ratios measured in one run).
+#: The speed targets (ratios measured in one run).
 CREATION_RATIO, EXTRACTION_RATIO, CACHE_RATIO = 100.0, 50.0, 20.0
 #: Cube size of the creation comparison (frequency path on all its texels).
 CREATION_SIZE = 8
@@ -259,7 +259,7 @@ def _creation_check(what, ratio, err_f, err_a) -> Check:
 
 
 def speed_checks(groups: dict, results: dict, label: str = "") -> list:
-    """The speed targets of issue 7 as checks: from ``make bench`` groups when present, else in-run.
+    """The speed targets as checks: from ``make bench`` groups when present, else in-run.
 
     Each check's name says its source. Creation (frequency ≥ 100× faster than angular per texel
     at equal error) is one check per ``shrm-create-<brdf>`` group, or the in-run GGX measurement;

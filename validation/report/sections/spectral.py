@@ -22,7 +22,8 @@ from validation.studies.metrics import COLORCHECKER, colorchecker_delta_E, delta
 LIGHTS = ("D65", "A", "D50", "FL2")
 GRIDS = (GRID_41, GRID_31)
 BAND_WEIGHTS = ("astm_e308", "point")
-# Targets of issue 3: ΔE00 against the 5 nm truth, (mean, max), for the shipped E308 weights.
+# Our targets for the band weights of erratum E7: ΔE00 against the 5 nm truth, (mean, max), for
+# the shipped E308 weights.
 TARGETS = {"D65": (0.03, 0.10), "A": (0.03, 0.10), "D50": (0.03, 0.10), "FL2": (0.06, 0.15)}
 
 
@@ -90,7 +91,7 @@ def present(ctx: ReportContext, data: SectionData) -> list:
 
 
 def checks(data: SectionData) -> list[Check]:
-    """Mean and max ΔE00 of the E308 weights against issue 3's targets, per grid and light."""
+    """Mean and max ΔE00 of the E308 weights against their targets, per grid and light."""
     found = []
     for grid in GRIDS:
         for light in LIGHTS:

@@ -37,7 +37,7 @@ PANORAMA = data_path("environments/venice_sunset_1k.hdr")
 PICKS = {"sun": (0.47, 0.52), "sky": (0.2, 0.3), "water": (0.8, 0.5), "building": (0.55, 0.1)}
 # Rows of the methods table that quick mode leaves out (features, degree).
 QUICK_LEAVE_OUT = (("polynomial", 4), ("polynomial", 5))
-# Targets of issue 15 (ΔE94, held-out ColorChecker unless said otherwise).
+# Targets (erratum E44; ΔE94, held-out ColorChecker unless said otherwise).
 TARGETS = {"D65 mean": 0.77, "D65 max": 1.5, "A mean": 1.0, "in-sample mean": 0.8}
 
 
@@ -350,7 +350,7 @@ def _panorama_blocks(ctx: ReportContext, data: SectionData) -> list:
 
 
 def checks(data: SectionData) -> list[Check]:
-    """Issue 15's targets for the shipped choice (root-polynomial, degree 4, noise-free)."""
+    """The targets (erratum E44) for the shipped choice (root-polynomial, degree 4, noise-free)."""
     row = _row(*SHIPPED, False, data)
     cc = row["held_out"][CC]
     measured = {
