@@ -232,13 +232,13 @@ def painting_on_screen(size: int) -> tuple[dict, dict]:
     CIEDE2000 of what the observer sees against the intended painting, relative to the display
     white, over the pixels the display can show.
     """
-    from impastor.painting import _booth_kind, booth_light_image, render_painting
+    from impastor.painting import booth_lamp_kind, booth_light_image, render_painting
     from reference.display.model import virtual_display
     from reference.display.pipeline import ScreenGeometry
     from validation.studies.impastor_commands import DEFAULT_LIGHT_POSITION, painting_on_display
 
     XYZ = render_painting("D65", size, "median_cut")["XYZ"]
-    luminance = float(booth_light_image(_booth_kind("D65")).mean())
+    luminance = float(booth_light_image(booth_lamp_kind("D65")).mean())
     flare = {"screen_lux": 1000.0, "position": DEFAULT_LIGHT_POSITION, "luminance": luminance}
     white = virtual_display().white_XYZ
     found, seen = {}, {}

@@ -183,13 +183,12 @@ file = "data:environments/venice_sunset_1k.hdr"
 
 def _cache_entries(scene) -> dict:
     """Maps the environment's cache holds for the scene's light, by kind (not the chosen orders)."""
-    from shrm.environment import _CACHE
+    from shrm.environment import cached_map_names
 
     kinds = {"lambert": 0, "normalized-phong": 0, "polymer-effect": 0}
-    for state in _CACHE.get(scene.lights[0], {}).values():
-        for key in state:
-            if isinstance(key, tuple) and str(key[0]).split(":")[0] in kinds:
-                kinds[str(key[0]).split(":")[0]] += 1
+    for name in cached_map_names(scene.lights[0]):
+        if name.split(":")[0] in kinds:
+            kinds[name.split(":")[0]] += 1
     return kinds
 
 
