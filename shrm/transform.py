@@ -458,33 +458,16 @@ class SHBackend(Method):
 
 #: The projection paths by the keys of ``--backend``.
 SH_BACKENDS = Registry("SH backend", SHBackend)
-SH_BACKENDS.register(
-    SHBackend(
-        "numpy",
-        _project_numpy,
-        None,
-        "Eq. (4), Ramamoorthi & Hanrahan 2001",
-        description="rFFT over φ, Legendre sum over θ in NumPy (the oracle)",
+for _name, _project, _description in (
+    ("numpy", _project_numpy, "rFFT over φ, Legendre sum over θ in NumPy (the oracle)"),
+    ("numba", _project_numba, "rFFT over φ, Legendre recurrence and sum in one numba kernel"),
+    ("ducc0", _project_ducc0, "ducc0.sht adjoint synthesis on the F1 grid, Fejér-1 ring weights"),
+):
+    SH_BACKENDS.register(
+        SHBackend(
+            _name, _project, None, "Eq. (4), Ramamoorthi & Hanrahan 2001", description=_description
+        )
     )
-)
-SH_BACKENDS.register(
-    SHBackend(
-        "numba",
-        _project_numba,
-        None,
-        "Eq. (4), Ramamoorthi & Hanrahan 2001",
-        description="rFFT over φ, Legendre recurrence and sum in one numba kernel",
-    )
-)
-SH_BACKENDS.register(
-    SHBackend(
-        "ducc0",
-        _project_ducc0,
-        None,
-        "Eq. (4), Ramamoorthi & Hanrahan 2001",
-        description="ducc0.sht adjoint synthesis on the F1 grid, Fejér-1 ring weights",
-    )
-)
 
 
 def _example_table_inputs(rng):

@@ -100,7 +100,7 @@ def check_report_page(page, width: int = 1280, height: int = 900) -> dict:
     Raises
     ------
     SpecrefError
-        Chromium, chromedriver or Selenium missing (with how to install them).
+        As :func:`reference.browser.chromium_driver`, when the browser cannot be driven.
 
     Examples
     --------

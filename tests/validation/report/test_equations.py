@@ -106,10 +106,18 @@ def _section(text: str, heading: str) -> str:
     return text.split(f"### {heading}\n", 1)[1].split("\n#", 1)[0]
 
 
-def test_a_body_comment_marks_the_computing_function(tmp_path, monkeypatch):
-    package = tmp_path / "fake_computing_code"
+def _fake_package(tmp_path, monkeypatch, name: str, files: dict) -> list:
+    """Write a package of ``files`` under ``tmp_path``, importable, and read its citations."""
+    package = tmp_path / name
     package.mkdir()
-    (package / "__init__.py").write_text(
+    for filename, text in files.items():
+        (package / filename).write_text(text)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    return collect_citations(tmp_path, (name,))
+
+
+def test_a_body_comment_marks_the_computing_function(tmp_path, monkeypatch):
+    init = (
         "def average(n):\n"
         '    """The average exponent an of the proxy, Eq. (13), Wang et al."""\n'
         "    return sum(n) / len(n)\n\n\n"
@@ -124,7 +132,7 @@ def test_a_body_comment_marks_the_computing_function(tmp_path, monkeypatch):
         '    """Eq. (15), Wang et al., used but computed nowhere."""\n'
         "    return t ** (1 / (an + 1))\n"
     )
-    (package / "_kernels.py").write_text(
+    kernels = (
         "def mean_exponent_kernel(n, out):\n"
         "    acc = 0.0\n"
         "    for x in n:\n"
@@ -133,8 +141,8 @@ def test_a_body_comment_marks_the_computing_function(tmp_path, monkeypatch):
         "def _ratio(t, an):\n"
         "    return t ** (an + 1)  # Eq. (14), Wang et al.\n"
     )
-    monkeypatch.syspath_prepend(str(tmp_path))
-    found = collect_citations(tmp_path, ("fake_computing_code",))
+    files = {"__init__.py": init, "_kernels.py": kernels}
+    found = _fake_package(tmp_path, monkeypatch, "fake_computing_code", files)
     calls = called_names(tmp_path, ("fake_computing_code",))
     rows = {(r.author, r.number): r for r in equation_index(citations=found, calls=calls)}
 
@@ -236,16 +244,13 @@ def test_computes_follows_the_rule_on_the_whole_tree(citations, rows):
 
 
 def test_ranges_and_lists_are_expanded_and_flagged(tmp_path, monkeypatch):
-    package = tmp_path / "fake_paper_code"
-    package.mkdir()
-    (package / "__init__.py").write_text(
+    init = (
         'def f():\n    """Eqs. (12)-(14), Wang et al."""\n\n\n'
         'def g():\n    """Eq. (13), Wang et al."""\n'
         "    # Eq. (5) and Eq. (6), Ferwerda: a list in a comment\n"
         "    return 1\n"
     )
-    monkeypatch.syspath_prepend(str(tmp_path))
-    found = collect_citations(tmp_path, ("fake_paper_code",))
+    found = _fake_package(tmp_path, monkeypatch, "fake_paper_code", {"__init__.py": init})
     cited = sorted((c.owner, c.number, c.grouped) for c in found if c.author == "Wang et al.")
     assert cited == [
         ("fake_paper_code.f", "12", True),
