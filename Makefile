@@ -44,7 +44,7 @@ bench: bench-json
 
 ## make results: benchmarks, then the full report; regenerates docs/results.md and docs/results/
 results: bench-json
-	$(VENV)/bin/specref report --out docs/results --bench bench.json \
+	$(VENV)/bin/specref report --full --out docs/results --bench bench.json \
 		--markdown docs/results.md --markdown-image-prefix results/
 
 ## make equations: regenerate docs/equations.md, the equation index (tests/validation/test_equations.py)

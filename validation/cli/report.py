@@ -8,9 +8,10 @@ from validation.cli.parser import registry_option
 def _cmd_report(args) -> int:
     from validation.report.runner import run_report
 
+    effort = "quick" if args.quick else "full" if args.full else "default"
     results = run_report(
         out_dir=args.out,
-        quick=args.quick,
+        effort=effort,
         only=args.only,
         bench_json=args.bench,
         markdown=args.markdown,
@@ -33,10 +34,26 @@ def add_parser(sub) -> None:
     from validation.report.runner import REPORT_SECTIONS
 
     p = sub.add_parser(
-        "report", help="run the main job: every section's figures, charts and images"
+        "report",
+        help="run the main job: every section's figures, charts and images",
+        description="Every section's figures, charts, images and target checks, each section at "
+        "the settings its checks need (the full-resolution studies and long sweeps at their "
+        "quick settings: --full runs them in full). index.html is rewritten after every "
+        "section, so a stopped run leaves a readable page.",
     )
     p.add_argument("--out", default="report", help="output folder (default: report)")
-    p.add_argument("--quick", action="store_true", help="small sizes; under a minute")
+    effort = p.add_mutually_exclusive_group()
+    effort.add_argument(
+        "--quick",
+        action="store_true",
+        help="every section at its quick settings (a first look; what the tests run)",
+    )
+    effort.add_argument(
+        "--full",
+        action="store_true",
+        help="every section at its full settings: the full-resolution maps and long sweeps "
+        "(make results; about an hour on two cores)",
+    )
     registry_option(
         p, "--only", REPORT_SECTIONS, "run only these sections", nargs="+", metavar="SECTION"
     )

@@ -215,8 +215,21 @@ def _html_section(section: ReportSection, result: SectionResult) -> list[str]:
             + "</details>"
         )
     out.extend(_html_blocks(result.blocks))
-    out.append(f"<p class='meta'>Section time {result.seconds:.1f} s.</p></section>")
+    settings = "quick" if result.quick else "full"
+    out.append(
+        f"<p class='meta'>Section time {result.seconds:.1f} s ({settings} settings).</p></section>"
+    )
     return out
+
+
+def _html_pending(pending) -> list[str]:
+    """The sections a run has not reached yet: a heading each, saying so."""
+    esc = html.escape
+    return [
+        f"<section id='{esc(s.name)}' class='pending'><h2>{esc(s.title)}</h2>"
+        "<p class='meta'>Still to come: this run has not reached this section yet.</p></section>"
+        for s in pending
+    ]
 
 
 def _meta_line(meta: dict) -> str:
@@ -225,7 +238,7 @@ def _meta_line(meta: dict) -> str:
     return ", ".join(f"{names.get(k, k)}: {meta[k]}" for k in keys if k in meta)
 
 
-def render_html(title: str, meta: dict, sections, parts=None) -> str:
+def render_html(title: str, meta: dict, sections, parts=None, pending=()) -> str:
     """The report as one HTML page: provenance, summary, the sections, then every target.
 
     Parameters
@@ -238,6 +251,8 @@ def render_html(title: str, meta: dict, sections, parts=None) -> str:
         The sections that ran, in order.
     parts : list of ReportPart, optional
         The summary's parts; default one part holding every section.
+    pending : sequence of ReportSection
+        Sections still to come (a run in progress): listed as such in the contents and the page.
 
     Examples
     --------
@@ -248,6 +263,8 @@ def render_html(title: str, meta: dict, sections, parts=None) -> str:
     >>> "<code>b</code>" in page, "1 of 1 targets hold" in page
     (True, True)
     >>> page.index("id='summary'") < page.index("id='demo'") < page.index("id='targets'")
+    True
+    >>> "Still to come" in render_html("t", {}, [], pending=[ReportSection("later", "Later")])
     True
     """
     esc = html.escape
@@ -268,6 +285,11 @@ def render_html(title: str, meta: dict, sections, parts=None) -> str:
             f"<li><a href='#{esc(section.name)}'>{esc(section.title)}</a> "
             f"<span class='meta'>({result.seconds:.1f} s)</span></li>"
         )
+    for section in pending:
+        parts_html.append(
+            f"<li><a href='#{esc(section.name)}'>{esc(section.title)}</a> "
+            "<span class='meta'>(still to come)</span></li>"
+        )
     parts_html.append("<li><a href='#targets'>All targets</a></li></ul></nav>")
     by_name = {s.name: (s, r) for s, r in sections}
     for part in parts:
@@ -280,10 +302,11 @@ def render_html(title: str, meta: dict, sections, parts=None) -> str:
             )
         for section, result in members:
             parts_html += _html_section(section, result)
+    parts_html += _html_pending(pending)
     checks = [(s, c) for s, r in sections for c in r.checks]
-    parts_html.append(
-        f"<section id='targets'><h2>All targets</h2><p>{_count([c for _, c in checks])}.</p>"
-    )
+    count = _count([c for _, c in checks])
+    count += f" so far ({len(pending)} sections still to come)" if pending else ""
+    parts_html.append(f"<section id='targets'><h2>All targets</h2><p>{count}.</p>")
     if checks:
         parts_html.append(_html_checks(checks, with_section=True))
     parts_html.append("</section></body></html>")

@@ -1,9 +1,12 @@
 """The main job, ``specref report``: run every section and write the report.
 
-:func:`run_report` runs the sections of :data:`SECTIONS` in order, with tqdm progress on stderr, and
-writes, each atomically:
+:func:`run_report` runs the sections of :data:`SECTIONS` in order at an effort (:data:`EFFORTS`:
+``quick``, ``default``, ``full``; each section's ``default_effort`` says which of its settings the
+default run uses), says on stderr what it runs (a bar on a terminal; otherwise one line per section
+with its time) and writes, each atomically:
 
-- ``DIR/index.html``: the readable report;
+- ``DIR/index.html``: the readable report, rewritten after every section with the sections still
+  to come listed as such, so a run stopped half-way leaves a readable page;
 - ``DIR/results.json``: every figure, by section;
 - ``DIR/images/*.png``: images and matplotlib charts;
 - ``DIR/first-screen.png``: the first screen in headless Chromium, where Chromium is installed,
@@ -24,9 +27,10 @@ import platform
 import subprocess
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
-from reference.errors import require
+from reference.errors import require, require_choice
 from reference.files import read_json, write_text_atomic
 from reference.registry import Registry
 from reference.tasks import LOCAL, SERIAL, dask_client, scheduler_address
@@ -49,6 +53,7 @@ from validation.report.sections import (
     spectral_env,
 )
 from validation.report.types import (
+    EFFORTS,
     ReportContext,
     ReportPart,
     ReportSection,
@@ -56,7 +61,7 @@ from validation.report.types import (
     to_jsonable,
 )
 
-__all__ = ["PARTS", "REPORT_SECTIONS", "SECTIONS", "run_report"]
+__all__ = ["EFFORTS", "PARTS", "REPORT_SECTIONS", "SECTIONS", "run_report"]
 
 #: The report's parts, one per paper and one for the shared core, each with its sections in the
 #: order a reader meets them. The summary shows one block per part.
@@ -155,7 +160,7 @@ for _section in SECTIONS:
 
 def run_report(
     out_dir="report",
-    quick: bool = False,
+    effort: str = "default",
     only: list[str] | None = None,
     bench_json=None,
     markdown=None,
@@ -171,8 +176,8 @@ def run_report(
     ----------
     out_dir : str or Path
         Output folder (created).
-    quick : bool
-        Small sizes (under a minute in all).
+    effort : {"quick", "default", "full"}
+        How much to compute (:data:`EFFORTS`; ``default``: each section's ``default_effort``).
     only : list of str, optional
         Section keys to run; default all.
     bench_json : str or Path, optional
@@ -180,9 +185,10 @@ def run_report(
     markdown : str or Path, optional
         Also write a Markdown rendering here (``docs/results.md``).
     markdown_image_prefix : str
-        Prefix for image links in the Markdown (the path from the Markdown file to ``out_dir``).
+        Image links' prefix in the Markdown (the path from it to ``out_dir``).
     progress : bool
-        Show a progress bar per section on stderr (never under CI or without a terminal).
+        Say what runs on stderr: a bar per section on a terminal, else one line per section with
+        its time.
     sections : sequence of ReportSection, optional
         The sections to choose from (default :data:`SECTIONS`).
     screenshot : bool
@@ -201,26 +207,25 @@ def run_report(
     Raises
     ------
     SpecrefError
-        Unknown section key, unreadable benchmark file.
+        Unknown section key or effort, unreadable benchmark file.
 
     Examples
     --------
     >>> import tempfile
     >>> with tempfile.TemporaryDirectory() as folder:
-    ...     results = run_report(folder, quick=True, only=["spectral-core"], progress=False)
+    ...     results = run_report(folder, "quick", only=["spectral-core"], progress=False)
     >>> round(results["sections"]["spectral-core"]["380-780/10 FL2 point"]["mean"], 1)
     4.0
     """
+    require_choice(effort, EFFORTS, "report effort")
     out_dir = Path(out_dir)
     sections = _chosen_sections(list(SECTIONS if sections is None else sections), only)
     bench = _read_bench(bench_json)
     address = scheduler_address(scheduler, default=SERIAL)
-    meta = _meta(quick, bench_json, address)
-    # Run the sections, timed.
-    started = time.perf_counter()
-    done = _run_sections(sections, out_dir, quick, bench, progress and not _quiet(), address)
-    meta["total_seconds"] = round(time.perf_counter() - started, 1)
-    meta["section_seconds"] = {s.name: round(r.seconds, 1) for s, r in done}
+    meta = _meta(effort, bench_json, address)
+    # Run the sections, timed; the page is rewritten after each (the rest listed as to come).
+    run = _Run(out_dir, effort, bench, address, meta, sections)
+    done = _run_sections(run, progress)
     # Write the page, the figures and, on request, the Markdown and the first screen.
     results = _results(meta, done)
     parts = _parts(done, sections)
@@ -256,12 +261,12 @@ def _read_bench(bench_json) -> dict | None:
     return bench
 
 
-def _meta(quick: bool, bench_json, address: str | None) -> dict:
-    """The run's description: commit, date, mode, machine, benchmark file and scheduler."""
+def _meta(effort: str, bench_json, address: str | None) -> dict:
+    """The run's description: commit, date, effort, machine, benchmark file and scheduler."""
     return {
         "commit": _commit(),
         "date": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M UTC"),
-        "mode": "quick" if quick else "full",
+        "mode": effort,
         "cores": os.cpu_count(),
         "python": platform.python_version(),
         "machine": platform.machine(),
@@ -298,27 +303,69 @@ def _write_results(out_dir: Path, results: dict) -> None:
     write_text_atomic(out_dir / "results.json", json.dumps(results, indent=1, sort_keys=False))
 
 
-def _run_sections(sections, out_dir, quick, bench, progress, address) -> list:
-    """Run each section under its own progress bar; returns ``[(section, result), ...]``.
+@dataclass(frozen=True)
+class _Run:
+    """What every section of one run shares: where it writes, its effort and its inputs."""
+
+    out_dir: Path
+    effort: str
+    bench: dict | None
+    address: str | None
+    meta: dict
+    sections: list
+
+
+def _run_sections(run: _Run, progress: bool) -> list:
+    """Run each section; returns ``[(section, result), ...]``.
 
     The sections draw in :data:`CHART_STYLE` and run their tasks on one Dask client at
-    ``address`` (a local cluster for None), or serially for ``reference.tasks.SERIAL``.
+    ``run.address`` (a local cluster for None), or serially for ``reference.tasks.SERIAL``. After
+    each section the page is rewritten with the sections still to come, and stderr gets a line
+    with the section's time (or a bar, on a terminal).
     """
     import matplotlib
     from tqdm import tqdm
 
     done: list[tuple[ReportSection, SectionResult]] = []
-    width = max((len(s.title) for s in sections), default=0)
+    started = time.perf_counter()
+    bars = progress and not _quiet()
+    width = max((len(s.title) for s in run.sections), default=0)
     with matplotlib.rc_context(CHART_STYLE), contextlib.ExitStack() as stack:
-        client = None if address == SERIAL else stack.enter_context(dask_client(address or LOCAL))
-        for i, section in enumerate(sections, 1):
-            desc = f"[{i}/{len(sections)}] {section.title:<{width}}"
-            with tqdm(total=1, desc=desc, file=sys.stderr, disable=not progress, leave=True) as bar:
-                ctx = ReportContext(out_dir, quick, bench, section.name, client)
-                start = time.perf_counter()
-                result = section.run(ctx)
-                result.seconds = time.perf_counter() - start
-                result.results.setdefault("section_seconds", result.seconds)
+        client = (
+            None
+            if run.address == SERIAL
+            else stack.enter_context(dask_client(run.address or LOCAL))
+        )
+        for i, section in enumerate(run.sections, 1):
+            desc = f"[{i}/{len(run.sections)}] {section.title:<{width}}"
+            with tqdm(total=1, desc=desc, file=sys.stderr, disable=not bars, leave=True) as bar:
+                result = _run_section(run, section, client)
                 bar.update(1)
             done.append((section, result))
+            run.meta["total_seconds"] = round(time.perf_counter() - started, 1)
+            run.meta["section_seconds"] = {s.name: round(r.seconds, 1) for s, r in done}
+            if progress and not bars:
+                sys.stderr.write(f"{desc.rstrip()}: {result.seconds:.1f} s\n")
+                sys.stderr.flush()
+            _write_partial_page(run, done)
     return done
+
+
+def _run_section(run: _Run, section: ReportSection, client) -> SectionResult:
+    """One section at the settings the run's effort gives it, timed."""
+    quick = section.quick_under(run.effort)
+    ctx = ReportContext(run.out_dir, quick, run.bench, section.name, client)
+    start = time.perf_counter()
+    result = section.run(ctx)
+    result.seconds = time.perf_counter() - start
+    result.quick = quick
+    result.results.setdefault("section_seconds", result.seconds)
+    return result
+
+
+def _write_partial_page(run: _Run, done: list) -> None:
+    """``index.html`` with the sections done so far; the others are listed as still to come."""
+    names = {s.name for s, _ in done}
+    pending = [s for s in run.sections if s.name not in names]
+    page = render_html("specref report", run.meta, done, _parts(done, run.sections), pending)
+    write_text_atomic(run.out_dir / "index.html", page)

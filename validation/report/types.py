@@ -21,9 +21,11 @@ from pathlib import Path
 
 import numpy as np
 
+from reference.errors import require_choice
 from reference.images.formats import write_png
 
 __all__ = [
+    "EFFORTS",
     "Check",
     "Headline",
     "Image",
@@ -36,6 +38,12 @@ __all__ = [
     "Text",
     "to_jsonable",
 ]
+
+
+#: How much a report run computes: ``quick`` (every section at its quick settings: tests and a
+#: first look), ``default`` (``specref report``: each section at the settings its
+#: ``default_effort`` names) and ``full`` (every section at its full settings: ``make results``).
+EFFORTS = ("quick", "default", "full")
 
 
 @dataclass(frozen=True)
@@ -118,6 +126,7 @@ class SectionResult:
     checks: list = field(default_factory=list)
     headlines: list = field(default_factory=list)
     seconds: float = 0.0
+    quick: bool = False
 
 
 @dataclass
@@ -170,6 +179,11 @@ class ReportSection:
     hero : str
         Name of the image (as given to ``ctx.image``/``ctx.figure``) that stands for the
         section in the summary; empty: the section's first image.
+    default_effort : {"full", "quick"}
+        The settings the default ``specref report`` runs this section with: ``"full"`` where
+        they cost seconds, ``"quick"`` where the full settings take minutes (full-resolution maps,
+        long sweeps); ``specref report --full`` runs every section at its full settings and
+        ``--quick`` every section at its quick ones.
 
     Examples
     --------
@@ -192,6 +206,21 @@ class ReportSection:
     checks: Callable[[SectionData], list] = _no_checks
     headlines: Callable[[SectionData], list] | None = None
     hero: str = ""
+    default_effort: str = "full"
+
+    def quick_under(self, effort: str) -> bool:
+        """Whether this section runs its quick settings under a report ``effort``.
+
+        Examples
+        --------
+        >>> heavy = ReportSection("maps", "Maps", default_effort="quick")
+        >>> [heavy.quick_under(e) for e in ("quick", "default", "full")]
+        [True, True, False]
+        >>> [ReportSection("x", "X").quick_under(e) for e in ("quick", "default", "full")]
+        [True, False, False]
+        """
+        require_choice(effort, EFFORTS, "report effort")
+        return effort == "quick" or (effort == "default" and self.default_effort == "quick")
 
     def run(self, ctx: ReportContext) -> SectionResult:
         """Compute, present and check: the section's blocks, results, checks and headlines."""

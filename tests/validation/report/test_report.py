@@ -19,7 +19,7 @@ from validation.report.runner import REPORT_SECTIONS, SECTIONS, run_report
 def test_report_spectral_section_quick(tmp_path):
     md = tmp_path / "results.md"
     results = run_report(
-        tmp_path / "r", quick=True, only=["spectral-core"], markdown=md, progress=False
+        tmp_path / "r", effort="quick", only=["spectral-core"], markdown=md, progress=False
     )
     stored = json.loads((tmp_path / "r" / "results.json").read_text())
     assert stored == json.loads(json.dumps(results))
@@ -67,7 +67,7 @@ def test_registered_section_renders_blocks(tmp_path):
 
     section = ReportSection("test-only", "Test only", compute, present, checks)
     results = run_report(
-        tmp_path, quick=True, only=["test-only"], progress=False, sections=[section]
+        tmp_path, effort="quick", only=["test-only"], progress=False, sections=[section]
     )
     section = results["sections"]["test-only"]
     assert section["value"] == 2.5
@@ -121,7 +121,7 @@ def test_sections_compute_present_check(tmp_path):
         return [Check("x", "<= 1", data.results["x"], data.results["x"] <= 1)]
 
     section = ReportSection("three-steps", "Three steps", compute, present, checks)
-    results = run_report(tmp_path, quick=True, progress=False, sections=[section])
+    results = run_report(tmp_path, effort="quick", progress=False, sections=[section])
     assert calls == ["compute", "present", "checks"]
     # The presenter's arrays stay out of results.json; the results go in.
     stored = json.loads((tmp_path / "results.json").read_text())["sections"]["three-steps"]
@@ -153,7 +153,7 @@ def test_summary_shows_headlines_and_hero(tmp_path):
         hero="hero",
     )
     md = tmp_path / "results.md"
-    run_report(tmp_path / "r", quick=True, progress=False, sections=[section], markdown=md)
+    run_report(tmp_path / "r", effort="quick", progress=False, sections=[section], markdown=md)
     html = (tmp_path / "r" / "index.html").read_text()
     summary = html[html.index("id='summary'") : html.index("<nav>")]
     assert "table 12.8× faster than exact" in summary
@@ -187,3 +187,54 @@ def test_comparison_layout(tmp_path):
     assert (tmp_path / image.path).is_file()
     assert image.width > 3 * 200
     assert image.height > 150
+
+
+def _recording_section(name, seen, stop_at=None, default_effort="full"):
+    """A section that records the quick flag it ran with, and raises if it is ``stop_at``."""
+
+    def compute(ctx):
+        if name == stop_at:
+            raise KeyboardInterrupt  # a user's Ctrl-C in the middle of the run
+        seen[name] = ctx.quick
+        return SectionData({"quick": ctx.quick})
+
+    return ReportSection(
+        name, name.title(), compute, lambda ctx, data: [], default_effort=default_effort
+    )
+
+
+def test_each_effort_runs_the_settings_it_names(tmp_path):
+    for effort, expected in (
+        ("quick", {"light": True, "heavy": True}),
+        ("default", {"light": False, "heavy": True}),
+        ("full", {"light": False, "heavy": False}),
+    ):
+        seen = {}
+        sections = [
+            _recording_section("light", seen),
+            _recording_section("heavy", seen, default_effort="quick"),
+        ]
+        results = run_report(tmp_path / effort, effort, progress=False, sections=sections)
+        assert seen == expected, effort
+        assert results["meta"]["mode"] == effort
+    with pytest.raises(
+        SpecrefError, match="unknown report effort 'fast'; allowed: default, full, quick"
+    ):
+        run_report(tmp_path / "x", "fast", progress=False, sections=sections)
+
+
+def test_a_stopped_run_leaves_a_page_with_the_rest_to_come(tmp_path, capsys):
+    seen = {}
+    sections = [_recording_section(n, seen, stop_at="third") for n in ("first", "second", "third")]
+    with pytest.raises(KeyboardInterrupt):
+        run_report(tmp_path, "default", progress=True, sections=sections)
+    page = (tmp_path / "index.html").read_text()
+    assert "id='first'" in page
+    assert "id='second'" in page
+    assert page.count("Still to come") == 1
+    assert "id='third' class='pending'" in page
+    assert "(1 sections still to come)" in page
+    # Without a terminal, one line per finished section with its time.
+    lines = [line for line in capsys.readouterr().err.splitlines() if line.startswith("[")]
+    assert [line.split("]")[0] for line in lines] == ["[1/3", "[2/3"]
+    assert all(line.endswith(" s") for line in lines)

@@ -20,7 +20,7 @@ pytestmark = pytest.mark.skipif(
 @pytest.fixture(scope="module")
 def quick_report(tmp_path_factory):
     out = tmp_path_factory.mktemp("report")
-    results = run_report(out, quick=True, progress=False, screenshot=True)
+    results = run_report(out, effort="quick", progress=False, screenshot=True)
     return out, results
 
 

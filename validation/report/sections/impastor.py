@@ -921,4 +921,5 @@ SECTION = ReportSection(
     checks,
     headlines=headlines,
     hero="painting-D65",
+    default_effort="quick",  # the full settings take minutes: specref report --full
 )

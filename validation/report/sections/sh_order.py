@@ -240,5 +240,10 @@ def checks(data: SectionData) -> list[Check]:
 
 
 SECTION = ReportSection(
-    "sh-order", "Environment SH order from an accuracy", sh_order_study, present, checks
+    "sh-order",
+    "Environment SH order from an accuracy",
+    sh_order_study,
+    present,
+    checks,
+    default_effort="quick",  # the full settings take minutes: specref report --full
 )

@@ -347,4 +347,11 @@ def checks(data: SectionData) -> list[Check]:
     return found + speed_checks(data.arrays["bench_groups"], data.results, label)
 
 
-SECTION = ReportSection("shrm", "SHRMs", shrm_study_and_speed, present, checks)
+SECTION = ReportSection(
+    "shrm",
+    "SHRMs",
+    shrm_study_and_speed,
+    present,
+    checks,
+    default_effort="quick",  # the full settings take minutes: specref report --full
+)

@@ -267,5 +267,10 @@ def checks(data: SectionData) -> list[Check]:
 
 
 SECTION = ReportSection(
-    "shrm-fullres", "SHRMs on full-resolution maps", fullres_study, present, checks
+    "shrm-fullres",
+    "SHRMs on full-resolution maps",
+    fullres_study,
+    present,
+    checks,
+    default_effort="quick",  # the full settings take minutes: specref report --full
 )

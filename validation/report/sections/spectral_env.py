@@ -414,4 +414,5 @@ SECTION = ReportSection(
     present,
     checks,
     headlines=headlines,
+    default_effort="quick",  # the full settings take minutes: specref report --full
 )

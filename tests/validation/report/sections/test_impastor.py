@@ -163,7 +163,7 @@ def test_frame_methods_come_from_the_registry():
 
 
 def test_report_section_quick(tmp_path):
-    results = run_report(tmp_path, quick=True, only=["impastor"], progress=False)
+    results = run_report(tmp_path, effort="quick", only=["impastor"], progress=False)
     found = {c["name"]: c for c in results["checks"] if c["section"] == "impastor"}
     assert len(found) == 21
     # Every target holds: colour, metamers, the hybrid (erratum E17), shadows and display; the

@@ -112,7 +112,7 @@ def test_report_phong_section_quick(tmp_path):
     bench_json = tmp_path / "bench.json"
     bench_json.write_text(json.dumps(BENCH))
     results = run_report(
-        tmp_path / "r", quick=True, only=["phong"], bench_json=bench_json, progress=False
+        tmp_path / "r", effort="quick", only=["phong"], bench_json=bench_json, progress=False
     )
     found = results["checks"]
     assert [next(t for t in TARGETS if t in c["name"]) for c in found] == list(TARGETS)

@@ -15,7 +15,7 @@ def test_polymer_section_follows_the_shrm_sections():
 
 @pytest.mark.slow
 def test_report_polymer_section_quick(tmp_path):
-    results = run_report(tmp_path, quick=True, only=["polymer"], progress=False)
+    results = run_report(tmp_path, effort="quick", only=["polymer"], progress=False)
     section = results["sections"]["polymer"]
     # Fig. 2: three thicknesses (0.03", 0.06", 0.120"), 11 loads, over black and in transmission
     assert sorted(section["fig2"]) == ["0.762", "1.524", "3.048"]

@@ -50,7 +50,7 @@ def test_report_polymer_scene_section_tiny(tmp_path, monkeypatch):
     monkeypatch.setitem(
         polymer_scene.SETTINGS, "quick", {"around": 16, "profile": 13, "width": 16, "height": 20}
     )
-    results = run_report(tmp_path, quick=True, only=["polymer-scene"], progress=False)
+    results = run_report(tmp_path, effort="quick", only=["polymer-scene"], progress=False)
     section = results["sections"]["polymer-scene"]
     assert section["groups"] == ["body", "band", "cap"]
     assert section["maps"] == {"lambert": 1, "normalized-phong": 2, "polymer-effect": 1}

@@ -27,7 +27,7 @@ def test_report_rasterizer_section_quick(tmp_path):
     bench_json = tmp_path / "bench.json"
     bench_json.write_text(json.dumps(bench))
     results = run_report(
-        tmp_path / "r", quick=True, only=["rasterizer"], bench_json=bench_json, progress=False
+        tmp_path / "r", effort="quick", only=["rasterizer"], bench_json=bench_json, progress=False
     )
     section = results["sections"]["rasterizer"]
     assert [c["passed"] for c in results["checks"]] == [True] * len(results["checks"])

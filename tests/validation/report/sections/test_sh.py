@@ -117,7 +117,7 @@ def test_report_sh_section_quick(tmp_path):
     bench_json = tmp_path / "bench.json"
     bench_json.write_text(json.dumps(BENCH))
     results = run_report(
-        tmp_path / "r", quick=True, only=["sh"], bench_json=bench_json, progress=False
+        tmp_path / "r", effort="quick", only=["sh"], bench_json=bench_json, progress=False
     )
     checks_by_name = {c["name"]: c for c in results["checks"]}
     assert checks_by_name["prefilter speed-up over brute force"]["measured"] == 2000.0

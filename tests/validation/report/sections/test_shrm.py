@@ -73,7 +73,7 @@ def test_checks_are_a_pure_function_of_the_data(tiny):
 @pytest.mark.slow
 def test_shrm_section_quick(tmp_path):
     # The section through the report (quick): checks named as reduced, the chart and images.
-    report = run_report(tmp_path, quick=True, only=["shrm"], progress=False)
+    report = run_report(tmp_path, effort="quick", only=["shrm"], progress=False)
     checks_found = [c for c in report["checks"] if c["section"] == "shrm"]
     assert len(checks_found) == 2 * len(SUITE) + 3
     assert all(c["name"].startswith("quick") for c in checks_found)

@@ -7,7 +7,7 @@ from validation.report.runner import run_report
 
 @pytest.mark.slow
 def test_report_spectral_env_section_quick(tmp_path):
-    results = run_report(tmp_path / "r", quick=True, only=["spectral-env"], progress=False)
+    results = run_report(tmp_path / "r", effort="quick", only=["spectral-env"], progress=False)
     section = results["sections"]["spectral-env"]
     rows = section["regression"]
     # every degree of both families but polynomial 4 and 5 (quick mode), with and without noise
