@@ -51,7 +51,8 @@ SETTINGS = {
         "rows": 32,
         "pixels": 6,
         "brdfs": (("ggx", 0.3),),
-        "label": "quick mode: maps box-filtered to 32 rows",
+        "label": "quick settings: maps box-filtered to 32 rows; the full-resolution targets run "
+        "under specref report --full",
         "targets": False,
     },
 }

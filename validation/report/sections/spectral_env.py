@@ -221,9 +221,9 @@ def _method_tables(ctx: ReportContext, data: SectionData) -> list:
             rows,
             "Regression on the held-out ColorChecker (CC) and other held-out sets, ΔE94"
             + (
-                " (quick mode: "
+                " (quick settings: "
                 + ", ".join(f"{k} {d}" for k, d in data.results["left_out"])
-                + " left out)"
+                + " left out; specref report --full runs them)"
                 if data.results.get("left_out")
                 else ""
             ),
@@ -240,7 +240,11 @@ def _method_tables(ctx: ReportContext, data: SectionData) -> list:
                 for m, f in rec.items()
             ],
             "Upsamplers from the patches' XYZ under D65, the same ColorChecker patches, ΔE94"
-            + ("" if "Jakob 2019" in rec else " (quick mode: Jakob 2019 left out, 36 s)"),
+            + (
+                ""
+                if "Jakob 2019" in rec
+                else " (quick settings: Jakob 2019 left out, 36 s; specref report --full runs it)"
+            ),
             "{:.3g}",
         )
     )
