@@ -17,7 +17,6 @@ J. A. Ferwerda, "ImpastoR: A Realistic Surface Display System", ACM TAP 12(4), 2
 from __future__ import annotations
 
 import hashlib
-import time
 from collections import OrderedDict
 from dataclasses import dataclass
 from pathlib import Path
@@ -48,6 +47,7 @@ from reference.colour.spectra import resample_spectrum, spectrum_from_csv, spect
 from reference.data import measured_spectra_folder
 from reference.display.encodings import linear_to_display
 from reference.errors import require, require_positive_int
+from reference.progress import StageTimer
 from reference.registry import Method, Registry
 
 __all__ = [
@@ -293,6 +293,7 @@ def render_painting(
     shadows: bool = True,
     spectra=None,
     backend: str = "numba",
+    progress=None,
 ) -> dict:
     """Render the demo painting under a booth light through the whole ImpastoR pipeline.
 
@@ -317,6 +318,8 @@ def render_painting(
         Kernels or their NumPy twins (no JIT warm-up: for small images).
     spectra : dict, optional
         From :func:`load_paint_spectra`.
+    progress : file-like, optional
+        Where to write a line per stage with its time (``specref impastor render``).
 
     Returns
     -------
@@ -340,27 +343,24 @@ def render_painting(
     S6 = light_to_channels(spectrum_from_dataset("illuminant", light), d)
     px = _canvas_pixels(painting, size)
     P, V, N = px.P, px.V, px.N
-    seconds = {}
-    start = time.perf_counter()
-    visibility = _horizon_visibility(painting, px, lights, backend) if shadows else None
-    seconds["shadows"] = time.perf_counter() - start
+    timer = StageTimer(progress, f"painting {size}×{size} under {light}")
+    with timer.stage("shadows"):
+        visibility = _horizon_visibility(painting, px, lights, backend) if shadows else None
     rho_d, rho_s, alpha = _canvas_materials(painting, spectra, d, px)
-    start = time.perf_counter()
-    # Eq. (2), Ferwerda: illuminance from the point lights (luminance image: one channel)
-    E = illuminance_point_lights(P, N, lights, visibility)
-    # Eq. (3), Ferwerda: L_out,j = ρ_d,j S_j E / π
-    L_diffuse = rho_d * S6 * E / np.pi
-    seconds["diffuse"] = time.perf_counter() - start
-    start = time.perf_counter()
-    I_s = lighting.reference(P, N, V, alpha, plane, lights, n_samples, visibility, backend)
-    L_specular = rho_s * S6 * I_s
-    seconds["specular"] = time.perf_counter() - start
+    with timer.stage("diffuse"):
+        # Eq. (2), Ferwerda: illuminance from the point lights (luminance image: one channel)
+        E = illuminance_point_lights(P, N, lights, visibility)
+        # Eq. (3), Ferwerda: L_out,j = ρ_d,j S_j E / π
+        L_diffuse = rho_d * S6 * E / np.pi
+    with timer.stage("specular"):
+        I_s = lighting.reference(P, N, V, alpha, plane, lights, n_samples, visibility, backend)
+        L_specular = rho_s * S6 * I_s
     XYZ = np.zeros((*px.gbuffer.shape, 3))
     XYZ[px.gbuffer.mask] = channels_to_XYZ(L_diffuse + L_specular, d)
     # Display: linear sRGB with the white diffuser under the booth light at 1/1.2 of white.
     white_Y = float(np.median(E)) / np.pi
     rgb = XYZ_to_display_RGB(XYZ / (1.2 * white_Y))
-    return {"XYZ": XYZ, "sRGB": linear_to_display(rgb, "srgb"), "seconds": seconds}
+    return {"XYZ": XYZ, "sRGB": linear_to_display(rgb, "srgb"), "seconds": timer.seconds}
 
 
 class _CanvasPixels(NamedTuple):

@@ -46,6 +46,7 @@ from reference.geometry.camera import downsample_box
 from reference.geometry.envmap import latlong_lookup_bilinear
 from reference.geometry.gbuffer import GBuffer, render_gbuffer
 from reference.images.formats import write_exr, write_png
+from reference.progress import Progress
 from reference.scene.lights import EnvironmentLight
 from reference.scene.loader import Scene, load_scene
 from reference.scene.shading import SHADERS, shade_gbuffer, shader_key
@@ -272,6 +273,7 @@ def shade_scene(
     options: Mapping | None = None,
     output: str = "XYZ",
     records: dict | None = None,
+    progress=None,
 ) -> np.ndarray:
     """XYZ of every G-buffer sample: deferred shading plus the background, shape ``(H, W, 3)``.
 
@@ -288,6 +290,10 @@ def shade_scene(
         output a constant background is 0 (it is display RGB, with no spectrum).
     records : dict, optional
         Filled with what the shaders chose (``ShadingContext.records``).
+    progress : file-like, optional
+        Where to say how the shading advances and how long it will take
+        (:class:`reference.progress.Progress`, by covered samples, in blocks of at most 1/32 of
+        the rows; the results do not depend on the blocks, shading being per sample).
 
     Returns
     -------
@@ -305,9 +311,15 @@ def shade_scene(
     H, W = gbuffer.shape
     XYZ = np.empty((H, W, ctx.n_outputs))
     rows = max(1, SHADING_TILE_SAMPLES // max(W, 1))
-    for start in range(0, H, rows):
-        tile = _gbuffer_rows(gbuffer, start, min(start + rows, H))
-        XYZ[start : start + rows] = shade_gbuffer(tile, scene.materials, scene.lights, ctx)
+    if progress is not None:  # blocks of at most 1/32 of the rows, so the estimate comes early
+        rows = min(rows, -(-H // 32))
+    # The work is in the covered samples (the background costs nothing): progress counts them.
+    covered = gbuffer.mask.sum(axis=1)
+    with Progress("shading", int(covered.sum()), progress, unit="covered samples") as bar:
+        for start in range(0, H, rows):
+            tile = _gbuffer_rows(gbuffer, start, min(start + rows, H))
+            XYZ[start : start + rows] = shade_gbuffer(tile, scene.materials, scene.lights, ctx)
+            bar.update(int(covered[start : start + rows].sum()))
     if records is not None:
         records.update(ctx.records)
     missed = ~gbuffer.mask
@@ -368,6 +380,7 @@ def render_scene(
     options: Mapping | None = None,
     gbuffer: GBuffer | None = None,
     spectral: bool = False,
+    progress=None,
 ) -> RenderResult:
     """Render a scene: G-buffer, shading, box resolve, display conversion and encoding.
 
@@ -387,6 +400,8 @@ def render_scene(
     spectral : bool
         Also keep the relative spectral radiance per band (``RenderResult.spectral``); XYZ is then
         its integral with the equal-energy band weights (docs/render-outputs.md).
+    progress : file-like, optional
+        Where to say how the shading advances, with its expected time (``specref render``).
 
     Returns
     -------
@@ -426,7 +441,7 @@ def render_scene(
     gbuffer = _render_gbuffer(scene, gbuffer)
     t_gbuffer = time.perf_counter()
     records: dict = {}
-    XYZ, spectral_image = _shade_and_resolve(scene, gbuffer, options, spectral, records)
+    XYZ, spectral_image = _shade_and_resolve(scene, gbuffer, options, spectral, records, progress)
     t_shading = time.perf_counter()
     RGB_linear, encoded = XYZ_to_display(scene, XYZ)
     t_display = time.perf_counter()
@@ -450,13 +465,15 @@ def _render_gbuffer(scene: Scene, gbuffer: GBuffer | None) -> GBuffer:
     return gbuffer
 
 
-def _shade_and_resolve(scene: Scene, gbuffer: GBuffer, options, spectral: bool, records: dict):
+def _shade_and_resolve(
+    scene: Scene, gbuffer: GBuffer, options, spectral: bool, records: dict, progress=None
+):
     """Stages 2 and 3: XYZ (and the spectral radiance when asked) box-filtered to the image size."""
     r = scene.render
     if not spectral:
-        XYZ = shade_scene(scene, gbuffer, options, records=records)
+        XYZ = shade_scene(scene, gbuffer, options, records=records, progress=progress)
         return downsample_box(XYZ, r.supersample), None
-    samples = shade_scene(scene, gbuffer, options, "spectral", records)
+    samples = shade_scene(scene, gbuffer, options, "spectral", records, progress)
     W_E = band_weights(scene.grid, None, scene.weights_method, scene.observer)
     XYZ = samples @ W_E
     if r.background != "environment":
@@ -564,6 +581,7 @@ def render_scene_file(
     exr_output: str = "display",
     accuracy: float | None = None,
     json=None,
+    progress=None,
 ) -> RenderResult:
     """Load a scene file, render it and write the outputs: what ``specref render`` does.
 
@@ -579,8 +597,7 @@ def render_scene_file(
         Set ``ShadingContext.options["environment"] = "bruteforce"``: environment lights are
         integrated by brute force (the SH engine's oracle path) instead of the fast method.
     texel_placement : str, optional
-        Override every environment light's ``texel_placement`` (``reference.geometry.envmap.
-        TEXEL_PLACEMENTS``: ``"mitsuba"`` reads the maps as Mitsuba 3 does).
+        Every environment light's ``texel_placement`` (``"mitsuba"``: read as Mitsuba 3 does).
     exr_output : {"display", "xyz", "spectral"}
         What the EXR holds (:func:`write_render`).
     accuracy : float, optional
@@ -589,6 +606,8 @@ def render_scene_file(
     json : str or Path, optional
         Write the render's metadata (``reference.scene.metadata.render_metadata``) there; ``-``
         writes nothing (the CLI prints ``RenderResult.metadata``).
+    progress : file-like, optional
+        Where to say how the shading advances and its expected time (the CLI's stderr).
 
     Returns
     -------
@@ -623,7 +642,8 @@ def render_scene_file(
         scene = scene.with_render(width, height, supersample, where="command line: render")
     if texel_placement is not None:
         scene = scene.with_texel_placement(texel_placement)
-    result = render_scene(scene, options=options, spectral=exr_output == "spectral")
+    spectral = exr_output == "spectral"
+    result = render_scene(scene, options=options, spectral=spectral, progress=progress)
     metadata = render_metadata(result, exr_output, result.records, oracle)
     write_render(result, png, exr, exr_output, metadata)
     if json is not None and str(json) != "-":

@@ -219,7 +219,11 @@ def test_report_sections_on_a_cluster_equal_serial(client, tmp_path):
 
     def held_out(scheduler, folder):
         results = run_report(
-            tmp_path / folder, effort="quick", only=["impastor"], progress=False, scheduler=scheduler
+            tmp_path / folder,
+            effort="quick",
+            only=["impastor"],
+            progress=False,
+            scheduler=scheduler,
         )
         return results["sections"]["impastor"]["held_out_hybrid"], results["meta"]["scheduler"]
 

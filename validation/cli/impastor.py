@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import sys
+
 from reference.tasks import SERIAL, add_scheduler_option
 from validation.cli.parser import Parser, registry_option
 
@@ -51,6 +53,7 @@ def _cmd_impastor_render(args) -> int:
             args.screen_lux,
             lamp,
             args.light_luminance,
+            progress=sys.stderr,
         )
     )
     return 0

@@ -15,7 +15,7 @@ class Parser(argparse.ArgumentParser):
 
     def error(self, message):
         """Print a one-line usage error naming the subcommand's help, and exit with code 2."""
-        self.exit(2, f"specref: error: {message} (see specref {self.prog.split()[-1]} --help)\n")
+        self.exit(2, f"specref: error: {message} (see {self.prog} --help)\n")
 
 
 def input_file(value: str) -> str:

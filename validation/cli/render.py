@@ -8,6 +8,7 @@ from validation.cli.parser import input_file, registry_option
 
 def _cmd_render(args) -> int:
     import json
+    import sys
 
     import phong_table  # noqa: F401  (registers its shaders, if any)
     import shrm  # noqa: F401  (registers the environment-light shaders, if any)
@@ -25,6 +26,7 @@ def _cmd_render(args) -> int:
         exr_output=args.exr_output,
         accuracy=args.accuracy,
         json=args.json,
+        progress=sys.stderr,
     )
     if args.json == "-":
         print(json.dumps(result.metadata, indent=2))

@@ -82,8 +82,11 @@ def render_for_cli(
     screen_lux: float = 1000.0,
     light_position=DEFAULT_LIGHT_POSITION,
     light_luminance: float | None = None,
+    progress=None,
 ) -> str:
     """Render the demo painting and write it as a PNG; return a one-line summary.
+
+    ``progress`` (a stream) gets a line per stage of the render with its time.
 
     With ``counts_out``, the painting's XYZ also goes through the display per pixel (Eq. (1),
     Ferwerda: ``L_factor`` at the observer's angle from each screen point; the screen's diffuse
@@ -128,7 +131,7 @@ def render_for_cli(
             np.isfinite(light_luminance) and light_luminance >= 0,
             f"--light-luminance: must be >= 0 cd/m², got {light_luminance!r}",
         )
-    result = render_painting(light, size, method)
+    result = render_painting(light, size, method, progress=progress)
     write_png(out, result["sRGB"])
     seconds = sum(result["seconds"].values())
     summary = f"wrote {out} ({size}×{size}, {light}, {method}, shading {seconds:.2f} s)"

@@ -4,7 +4,9 @@ from validation.report.runner import run_report
 
 
 def test_report_display_section(tmp_path):
-    results = run_report(tmp_path / "r", effort="quick", only=["display-calibration"], progress=False)
+    results = run_report(
+        tmp_path / "r", effort="quick", only=["display-calibration"], progress=False
+    )
     section = results["sections"]["display-calibration"]
     # 4 whites x 5 curves x 2 targets, the instrument comparison, 3 compensated observers (a
     # gray and the painting), the scene on its calibrated display

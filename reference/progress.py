@@ -1,0 +1,151 @@
+"""Progress of long steps: what runs, an estimate of how long, and each stage's time.
+
+Every command that can run longer than a couple of seconds says what it is doing. Library
+functions take a ``progress`` stream (None: silent, the default, so tests and doctests print
+nothing); the command line passes ``sys.stderr``.
+
+- :class:`Progress` follows a loop of units (rows of an image, cases of a study). On a terminal it
+  is a tqdm bar; otherwise it writes a line when it starts, a line with the expected total time once
+  the first units have been measured, and a line when it ends: logs stay readable.
+- :class:`StageTimer` times the named stages of a pipeline and writes a line per stage.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import time
+from typing import TextIO
+
+__all__ = ["Progress", "StageTimer", "format_seconds"]
+
+
+def format_seconds(seconds: float) -> str:
+    """A duration as people read it: ``"0.4 s"``, ``"38 s"``, ``"4 min 10 s"``, ``"1 h 05 min"``.
+
+    Examples
+    --------
+    >>> [format_seconds(s) for s in (0.42, 38.2, 250, 3900)]
+    ['0.4 s', '38 s', '4 min 10 s', '1 h 05 min']
+    """
+    if seconds < 10:
+        return f"{seconds:.1f} s"
+    if seconds < 60:
+        return f"{seconds:.0f} s"
+    minutes, secs = divmod(round(seconds), 60)
+    if minutes < 60:
+        return f"{minutes} min {secs:02d} s" if secs else f"{minutes} min"
+    hours, minutes = divmod(minutes, 60)
+    return f"{hours} h {minutes:02d} min"
+
+
+class Progress:
+    """Progress through ``total`` units of work, with the expected total time.
+
+    Parameters
+    ----------
+    desc : str
+        What runs (``"shading 256 rows"``).
+    total : int
+        Units of work.
+    stream : file-like or None
+        Where to write (None: nothing). A terminal gets a tqdm bar, anything else lines.
+    unit : str
+        The unit's name, for the bar.
+    estimate_after : float
+        Seconds of work after which the expected total is written (line mode).
+
+    Examples
+    --------
+    >>> import io
+    >>> out = io.StringIO()
+    >>> with Progress("brute force", 4, out, estimate_after=0.0) as bar:
+    ...     for _ in range(4):
+    ...         bar.update(1)
+    >>> first, estimate, *_, last = out.getvalue().splitlines()
+    >>> first, estimate.startswith("brute force: about"), last.startswith("brute force: done")
+    ('brute force: 4 rows', True, True)
+    """
+
+    def __init__(
+        self,
+        desc: str,
+        total: int,
+        stream: TextIO | None = None,
+        unit: str = "rows",
+        estimate_after: float = 2.0,
+    ):
+        self.desc, self.total, self.stream, self.unit = desc, int(total), stream, unit
+        self.estimate_after = estimate_after
+        self.done = 0
+        self._estimated = False
+        self._bar = None
+        self._start = time.perf_counter()
+
+    def __enter__(self) -> Progress:
+        self._start = time.perf_counter()
+        if self.stream is None:
+            return self
+        if getattr(self.stream, "isatty", lambda: False)():
+            from tqdm import tqdm
+
+            self._bar = tqdm(total=self.total, desc=self.desc, unit=self.unit, file=self.stream)
+        else:
+            self._write(f"{self.total} {self.unit}")
+        return self
+
+    def update(self, n: int = 1) -> None:
+        """``n`` more units done."""
+        self.done += n
+        if self._bar is not None:
+            self._bar.update(n)
+            return
+        elapsed = time.perf_counter() - self._start
+        if self.stream is not None and not self._estimated and elapsed >= self.estimate_after:
+            self._estimated = True
+            expected = elapsed * self.total / max(self.done, 1)
+            self._write(
+                f"about {format_seconds(expected)} in all "
+                f"(measured on the first {self.done} of {self.total} {self.unit})"
+            )
+
+    def __exit__(self, kind, value, traceback) -> None:
+        if self._bar is not None:
+            self._bar.close()
+        elif self.stream is not None and kind is None:
+            self._write(f"done in {format_seconds(time.perf_counter() - self._start)}")
+
+    def _write(self, text: str) -> None:
+        self.stream.write(f"{self.desc}: {text}\n")
+        self.stream.flush()
+
+
+class StageTimer:
+    """Times the named stages of a pipeline; writes one line per stage to ``stream`` if given.
+
+    Examples
+    --------
+    >>> import io
+    >>> out = io.StringIO()
+    >>> timer = StageTimer(out, "painting")
+    >>> with timer.stage("shadows"):
+    ...     pass
+    >>> sorted(timer.seconds), out.getvalue().startswith("painting: shadows ...")
+    (['shadows'], True)
+    """
+
+    def __init__(self, stream: TextIO | None = None, prefix: str = ""):
+        self.stream, self.prefix = stream, prefix
+        self.seconds: dict[str, float] = {}
+
+    @contextlib.contextmanager
+    def stage(self, name: str):
+        """Time the block as stage ``name``."""
+        if self.stream is not None:
+            self.stream.write(f"{self.prefix}: {name} ...")
+            self.stream.flush()
+        start = time.perf_counter()
+        yield
+        self.seconds[name] = time.perf_counter() - start
+        if self.stream is not None:
+            self.stream.write(f" {format_seconds(self.seconds[name])}\n")
+            self.stream.flush()
