@@ -20,6 +20,7 @@ __all__ = [
     "WRITE_ERRORS",
     "atomic_path",
     "atomic_write",
+    "check_output_file",
     "check_output_folder",
     "default_cache_dir",
     "output_error",
@@ -200,6 +201,45 @@ def read_json(path, kind: str = "JSON"):
         raise SpecrefError(f"{path}: file not found") from None
     except (OSError, ValueError) as error:
         raise SpecrefError(f"{path}: not a {kind} ({error})") from None
+
+
+def check_output_file(path) -> Path:
+    """Prove, before any work, that ``path`` can be written; return it.
+
+    Commands whose output comes after a long computation call this first, so an output that
+    cannot be written (a folder there, a file in the path, a read-only or full file system) is
+    refused in one line at once rather than after the work. A small probe file is written beside
+    ``path`` and removed; ``path`` itself is not touched.
+
+    Raises
+    ------
+    SpecrefError
+        One line naming the file and the reason (:func:`output_error`).
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     check_output_file(os.path.join(d, "model.json")).name, os.listdir(d)
+    ('model.json', [])
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     check_output_file(d)
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: ...: cannot write (is a folder; give a file name)
+    """
+    path = Path(path)
+    with _write_errors(path):
+        require(not path.is_dir(), f"{path}: cannot write ({WRITE_ERRORS[errno.EISDIR]})")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, probe = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".probe", dir=path.parent)
+        try:
+            os.write(fd, b"specref")
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+            os.unlink(probe)
+    return path
 
 
 def check_output_folder(folder) -> Path:

@@ -401,7 +401,9 @@ def fit_file(
     reference.errors.SpecrefError: polynomial degree must be an integer in 1…5, got 9
     """
     from reference.colour.spectral_regression import save_regression
+    from reference.files import check_output_file
 
+    check_output_file(out)  # before the fit (seconds to minutes), not after it
     fit = _FitSettings(kind, degree, ridge, illuminant, loss, spectral_weight)
     if augmentation is not None:
         TARGET_AUGMENTATIONS.lookup(augmentation)
