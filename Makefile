@@ -26,8 +26,9 @@ demo: $(STAMP)
 	$(VENV)/bin/specref report --out report
 
 ## make test: install, then run the whole suite (doctests and docs examples included, benchmarks off)
+## on two worker processes (pytest-xdist; a module's tests stay together, so module fixtures run once)
 test: $(STAMP)
-	$(PY) -m pytest -q --durations=15
+	$(PY) -m pytest -q -n 2 --dist loadscope --durations=15
 
 ## make test-wheel: build the wheel, install it in a fresh venv outside the repository, use it there
 test-wheel: $(STAMP)

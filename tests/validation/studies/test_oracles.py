@@ -31,7 +31,9 @@ CLOSED_FORMS = [
 ]
 
 
-@pytest.mark.parametrize(("degree", "m", "closed_form"), CLOSED_FORMS, ids=lambda v: str(v))
+@pytest.mark.parametrize(
+    ("degree", "m", "closed_form"), CLOSED_FORMS, ids=[f"l{d}-m{m}" for d, m, _ in CLOSED_FORMS]
+)
 def test_sh_basis_mp_matches_closed_forms(degree, m, closed_form):
     # Points: the pole region (θ = 1e-8), a generic point, and near the south pole.
     for theta, phi in ((1e-8, 0.4), (0.7, 0.3), (math.pi - 1e-3, 5.0)):

@@ -182,7 +182,47 @@ def example_renders(
             "dY_of_peak": (fast.XYZ[..., 1] - slow.XYZ[..., 1]) / slow.XYZ[..., 1].max(),
         },
     }
+    results["startup"] = startup_figures(ctx.bench_groups("startup") if ctx else {})
     return SectionData(results, arrays)
+
+
+#: A warm kernel cache makes the first render of a fresh process cost at most this many times the
+#: second render of the same process (``reference.jit``; ``make bench``, group startup-render).
+WARM_START_TARGET = 1.5
+
+
+def startup_figures(groups: dict) -> dict | None:
+    """The first render in a fresh process, with numba's cache cold and warm (``make bench``).
+
+    Parameters
+    ----------
+    groups : dict
+        ``ReportContext.bench_groups("startup")``.
+
+    Returns
+    -------
+    dict or None
+        Per cache state (``cold``, ``warm``): the process's seconds and its ``import_s``,
+        ``first_s``, ``second_s``; and ``warm_ratio`` (first over second render, warm cache).
+        None without benchmarks.
+
+    Examples
+    --------
+    >>> startup_figures({}) is None
+    True
+    """
+    records = {r["extra_info"].get("cache"): r for r in groups.get("startup-render", [])}
+    if not {"cold", "warm"} <= set(records):
+        return None
+    found = {
+        cache: {"process_s": r["stats"]["min"], **{k: r["extra_info"][k] for k in _STARTUP}}
+        for cache, r in records.items()
+    }
+    found["warm_ratio"] = found["warm"]["first_s"] / found["warm"]["second_s"]
+    return found
+
+
+_STARTUP = ("import_s", "first_s", "second_s")
 
 
 _ACCURACY = ("max_abs_dXYZ", "mean_dE00", "max_dE00")
@@ -228,6 +268,25 @@ def _images(ctx: ReportContext, data: SectionData) -> list:
     ]
 
 
+def _startup_blocks(startup: dict | None) -> list:
+    """The first render of a fresh process, cold and warm kernel cache (or how to measure it)."""
+    if startup is None:
+        return [Text("First render in a fresh process: run `make bench` (group startup-render).")]
+    rows = [[cache, *(startup[cache][k] for k in ("process_s", *_STARTUP))] for cache in _CACHES]
+    return [
+        Table(
+            ["numba cache", "process s", "imports s", "first render s", "second render s"],
+            rows,
+            "phong-sphere.toml at its own size through the compiled table shader, in a fresh "
+            "`python` process (make bench, group startup-render)",
+            "{:.3g}",
+        )
+    ]
+
+
+_CACHES = ("cold", "warm")
+
+
 def present(ctx: ReportContext, data: SectionData) -> list:
     """The renders, their times and the chart accuracy table."""
     scenes = data.results["scenes"]
@@ -255,6 +314,7 @@ def present(ctx: ReportContext, data: SectionData) -> list:
             "them yourself with `specref render data:examples/<name>.toml -o <name>.png`."
         ),
         *_images(ctx, data),
+        *_startup_blocks(data.results["startup"]),
         Table(
             ["scene", "size", "supersample", "G-buffer s", "shading s", "total s"],
             rows,
@@ -295,13 +355,21 @@ def checks(data: SectionData) -> list[Check]:
             env["max_error_of_peak"] <= env["tolerance"],
         )
     )
+    startup = data.results.get("startup")
+    if startup is not None:
+        found.append(
+            Check(
+                "first render in a fresh process, warm kernel cache, over the second render",
+                f"<= {WARM_START_TARGET:g}",
+                startup["warm_ratio"],
+                startup["warm_ratio"] <= WARM_START_TARGET,
+            )
+        )
     return found
 
 
 def headlines(data: SectionData) -> list[Headline]:
     """The summary's figures: the ColorChecker renders and the environment render."""
-    if "missing" in data.results:
-        return []
     scenes = data.results["scenes"]
     chart = max(
         100 * scenes[f"colorchecker-{label}.toml"]["accuracy"]["max_abs_dXYZ"]
