@@ -5,8 +5,9 @@ functions take a ``progress`` stream (None: silent, the default, so tests and do
 nothing); the command line passes ``sys.stderr``.
 
 - :class:`Progress` follows a loop of units (rows of an image, cases of a study). On a terminal it
-  is a tqdm bar; otherwise it writes a line when it starts, a line with the expected total time once
-  the first units have been measured, and a line when it ends: logs stay readable.
+  is a tqdm bar; otherwise, once the work has run for a couple of seconds, it writes a line with
+  the expected total time (measured on the units done so far) and a line when it ends. Work that
+  ends sooner writes nothing, so logs stay readable.
 - :class:`StageTimer` times the named stages of a pipeline and writes a line per stage.
 """
 
@@ -61,9 +62,9 @@ class Progress:
     >>> with Progress("brute force", 4, out, estimate_after=0.0) as bar:
     ...     for _ in range(4):
     ...         bar.update(1)
-    >>> first, estimate, *_, last = out.getvalue().splitlines()
-    >>> first, estimate.startswith("brute force: about"), last.startswith("brute force: done")
-    ('brute force: 4 rows', True, True)
+    >>> estimate, done = out.getvalue().splitlines()
+    >>> estimate.startswith("brute force: 4 rows, about"), done.startswith("brute force: done")
+    (True, True)
     """
 
     def __init__(
@@ -89,8 +90,6 @@ class Progress:
             from tqdm import tqdm
 
             self._bar = tqdm(total=self.total, desc=self.desc, unit=self.unit, file=self.stream)
-        else:
-            self._write(f"{self.total} {self.unit}")
         return self
 
     def update(self, n: int = 1) -> None:
@@ -104,14 +103,14 @@ class Progress:
             self._estimated = True
             expected = elapsed * self.total / max(self.done, 1)
             self._write(
-                f"about {format_seconds(expected)} in all "
-                f"(measured on the first {self.done} of {self.total} {self.unit})"
+                f"{self.total} {self.unit}, about {format_seconds(expected)} in all "
+                f"(measured on the first {self.done})"
             )
 
     def __exit__(self, kind, value, traceback) -> None:
         if self._bar is not None:
             self._bar.close()
-        elif self.stream is not None and kind is None:
+        elif self._estimated and kind is None:
             self._write(f"done in {format_seconds(time.perf_counter() - self._start)}")
 
     def _write(self, text: str) -> None:

@@ -41,7 +41,7 @@ from reference.colour.spectra import make_spectrum, resample_spectrum
 from reference.colour.upsampling import DEFAULT_UPSAMPLING, RGB_to_radiance_spectra
 from reference.display.encodings import linear_to_display
 from reference.errors import SpecrefError, format_allowed, require
-from reference.files import write_text_atomic
+from reference.files import check_output_file, write_text_atomic
 from reference.geometry.camera import downsample_box
 from reference.geometry.envmap import latlong_lookup_bilinear
 from reference.geometry.gbuffer import GBuffer, render_gbuffer
@@ -493,13 +493,14 @@ def _stage_timings(start: float, t_gbuffer: float, t_shading: float, t_display: 
 
 
 def _check_output(path, suffix: str, flag: str) -> Path:
+    """An output's name, and proof that it can be written (before the render, not after it)."""
     path = Path(path)
     require(
         path.suffix.lower() == suffix,
         f"{flag}: the output must end in {suffix}, got {str(path)!r}",
     )
     require(not path.is_dir(), f"{flag}: {path} is a folder; give a file name")
-    return path
+    return check_output_file(path)
 
 
 def write_render(
