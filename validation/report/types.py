@@ -116,6 +116,17 @@ class Check:
     measured: float | str
     passed: bool
 
+    @classmethod
+    def at_most(cls, name: str, measured: float, limit: float) -> Check:
+        """The check ``measured <= limit``, its target written ``<= limit``.
+
+        Examples
+        --------
+        >>> Check.at_most("warm start / second render", 2.1, 1.5)
+        Check(name='warm start / second render', target='<= 1.5', measured=2.1, passed=False)
+        """
+        return cls(name, f"<= {limit:g}", measured, bool(measured <= limit))
+
 
 @dataclass
 class SectionResult:
