@@ -6,7 +6,12 @@ from validation.cli.parser import registry_option
 
 
 def _cmd_report(args) -> int:
+    import os
+
+    from reference.errors import require_positive_int
     from validation.report.runner import run_report
+
+    jobs = min(2, os.cpu_count() or 1) if args.jobs is None else args.jobs
 
     effort = "quick" if args.quick else "full" if args.full else "default"
     results = run_report(
@@ -18,6 +23,7 @@ def _cmd_report(args) -> int:
         markdown_image_prefix=args.markdown_image_prefix,
         screenshot=not args.no_screenshot,
         scheduler=args.scheduler,
+        jobs=require_positive_int(jobs, "--jobs", 64),
     )
     print(f"wrote {args.out}/index.html and {args.out}/results.json")
     shot = results["meta"].get("screenshot")
@@ -70,6 +76,13 @@ def add_parser(sub) -> None:
         "--no-screenshot",
         action="store_true",
         help="do not write first-screen.png (written with headless Chromium where installed)",
+    )
+    p.add_argument(
+        "--jobs",
+        type=int,
+        default=None,
+        help="sections side by side in this many processes (default: the cores, at most 2; "
+        "1 with --scheduler, whose cluster runs the sections' tasks)",
     )
     add_scheduler_option(p, default=SERIAL)
     p.set_defaults(func=_cmd_report)

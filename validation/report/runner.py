@@ -169,6 +169,7 @@ def run_report(
     sections=None,
     screenshot: bool = False,
     scheduler: str | None = None,
+    jobs: int = 1,
 ) -> dict:
     """Run the report sections and write ``index.html`` and ``results.json`` into ``out_dir``.
 
@@ -181,23 +182,22 @@ def run_report(
     only : list of str, optional
         Section keys to run; default all.
     bench_json : str or Path, optional
-        pytest-benchmark JSON from ``make bench``, shown by the sections that read benchmarks.
-    markdown : str or Path, optional
-        Also write a Markdown rendering here (``docs/results.md``).
-    markdown_image_prefix : str
-        Image links' prefix in the Markdown (the path from it to ``out_dir``).
+        pytest-benchmark JSON from ``make bench`` (the sections that read benchmarks show it).
+    markdown, markdown_image_prefix : str or Path, optional
+        Also write a Markdown rendering there (``docs/results.md``), its image links prefixed with
+        the path from it to ``out_dir``.
     progress : bool
-        Say what runs on stderr: a bar per section on a terminal, else one line per section with
-        its time.
+        Say on stderr what runs: a bar on a terminal, else a line per section with its time.
     sections : sequence of ReportSection, optional
         The sections to choose from (default :data:`SECTIONS`).
     screenshot : bool
-        Also write ``first-screen.png`` with headless Chromium (skipped, with the reason in
-        ``results.json``, where Chromium is not installed).
+        Also write ``first-screen.png`` with headless Chromium (where it is installed).
     scheduler : str, optional
         Where the sections' independent tasks run (:meth:`ReportContext.run_tasks`): a scheduler
         address, ``"local"`` or ``"serial"``; default ``$SPECREF_SCHEDULER``, else serial (the
         sections time methods, and a cluster's workers would share the cores they measure).
+    jobs : int
+        Sections side by side in this many processes (serial scheduler only).
 
     Returns
     -------
@@ -224,7 +224,7 @@ def run_report(
     address = scheduler_address(scheduler, default=SERIAL)
     meta = _meta(effort, bench_json, address)
     # Run the sections, timed; the page is rewritten after each (the rest listed as to come).
-    run = _Run(out_dir, effort, bench, address, meta, sections)
+    run = _Run(out_dir, effort, bench, address, meta, sections, jobs if address == SERIAL else 1)
     done = _run_sections(run, progress)
     # Write the page, the figures and, on request, the Markdown and the first screen.
     results = _results(meta, done)
@@ -313,42 +313,95 @@ class _Run:
     address: str | None
     meta: dict
     sections: list
+    jobs: int = 1
 
 
 def _run_sections(run: _Run, progress: bool) -> list:
-    """Run each section; returns ``[(section, result), ...]``.
+    """Run each section; returns ``[(section, result), ...]`` in reading order.
 
     The sections draw in :data:`CHART_STYLE` and run their tasks on one Dask client at
-    ``run.address`` (a local cluster for None), or serially for ``reference.tasks.SERIAL``. After
-    each section the page is rewritten with the sections still to come, and stderr gets a line
-    with the section's time (or a bar, on a terminal).
+    ``run.address`` (a local cluster for None), or serially for ``reference.tasks.SERIAL``; with
+    ``run.jobs`` > 1 they run side by side in as many forked processes. After each section the page
+    is rewritten with the sections still to come, and stderr gets a line with the section's time
+    (or a bar, on a terminal).
     """
     import matplotlib
-    from tqdm import tqdm
 
-    done: list[tuple[ReportSection, SectionResult]] = []
-    started = time.perf_counter()
-    bars = progress and not _quiet()
-    width = max((len(s.title) for s in run.sections), default=0)
+    done: dict[str, tuple[ReportSection, SectionResult]] = {}
+    tracker = _Tracker(run, progress and not _quiet(), progress)
     with matplotlib.rc_context(CHART_STYLE), contextlib.ExitStack() as stack:
-        client = (
-            None
-            if run.address == SERIAL
-            else stack.enter_context(dask_client(run.address or LOCAL))
+        if run.jobs > 1:
+            finished = _side_by_side(run, stack)
+        else:
+            client = (
+                None
+                if run.address == SERIAL
+                else stack.enter_context(dask_client(run.address or LOCAL))
+            )
+            finished = ((s, _run_section(run, s, client)) for s in run.sections)
+        for section, result in finished:
+            done[section.name] = (section, result)
+            tracker.finished(
+                section, result, [done[s.name] for s in run.sections if s.name in done]
+            )
+    return [done[s.name] for s in run.sections]
+
+
+class _Tracker:
+    """What the run says as sections finish: a bar or a line each, and the partial page."""
+
+    def __init__(self, run: _Run, bars: bool, lines: bool):
+        from tqdm import tqdm
+
+        self.run, self.lines = run, lines and not bars
+        self.bar = tqdm(total=len(run.sections), file=sys.stderr, disable=not bars)
+        self.started = time.perf_counter()
+        self.count = 0
+
+    def finished(self, section: ReportSection, result: SectionResult, done: list) -> None:
+        """Note one finished section: progress, the run's times, the page so far."""
+        self.count += 1
+        self.bar.set_description(section.title)
+        self.bar.update(1)
+        self.run.meta["total_seconds"] = round(time.perf_counter() - self.started, 1)
+        self.run.meta["section_seconds"] = {s.name: round(r.seconds, 1) for s, r in done}
+        if self.lines:
+            n = len(self.run.sections)
+            sys.stderr.write(f"[{self.count}/{n}] {section.title}: {result.seconds:.1f} s\n")
+            sys.stderr.flush()
+        _write_partial_page(self.run, done)
+        if self.count == len(self.run.sections):
+            self.bar.close()
+
+
+#: The sections of a run with ``jobs`` > 1, as forked processes see them.
+_FORKED: dict = {}
+
+
+def _run_forked(index: int) -> tuple[int, SectionResult]:
+    """Run section ``index`` of the forked run (in a worker process, in the chart style)."""
+    import matplotlib
+
+    run = _FORKED["run"]
+    with matplotlib.rc_context(CHART_STYLE):
+        return index, _run_section(run, run.sections[index], None)
+
+
+def _side_by_side(run: _Run, stack: contextlib.ExitStack):
+    """Yield ``(section, result)`` as the sections finish in ``run.jobs`` forked processes."""
+    import concurrent.futures
+    import multiprocessing
+
+    _FORKED["run"] = run
+    pool = stack.enter_context(
+        concurrent.futures.ProcessPoolExecutor(
+            run.jobs, mp_context=multiprocessing.get_context("fork")
         )
-        for i, section in enumerate(run.sections, 1):
-            desc = f"[{i}/{len(run.sections)}] {section.title:<{width}}"
-            with tqdm(total=1, desc=desc, file=sys.stderr, disable=not bars, leave=True) as bar:
-                result = _run_section(run, section, client)
-                bar.update(1)
-            done.append((section, result))
-            run.meta["total_seconds"] = round(time.perf_counter() - started, 1)
-            run.meta["section_seconds"] = {s.name: round(r.seconds, 1) for s, r in done}
-            if progress and not bars:
-                sys.stderr.write(f"{desc.rstrip()}: {result.seconds:.1f} s\n")
-                sys.stderr.flush()
-            _write_partial_page(run, done)
-    return done
+    )
+    futures = [pool.submit(_run_forked, i) for i in range(len(run.sections))]
+    for future in concurrent.futures.as_completed(futures):
+        index, result = future.result()
+        yield run.sections[index], result
 
 
 def _run_section(run: _Run, section: ReportSection, client) -> SectionResult:

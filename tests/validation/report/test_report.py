@@ -238,3 +238,17 @@ def test_a_stopped_run_leaves_a_page_with_the_rest_to_come(tmp_path, capsys):
     lines = [line for line in capsys.readouterr().err.splitlines() if line.startswith("[")]
     assert [line.split("]")[0] for line in lines] == ["[1/3", "[2/3"]
     assert all(line.endswith(" s") for line in lines)
+
+
+def test_sections_side_by_side_give_the_serial_report(tmp_path):
+    # Two processes, results in reading order and equal to the serial run's (timings aside).
+    only = ["spectral-core", "rasterizer"]
+    serial = run_report(tmp_path / "serial", "quick", only=only, progress=False)
+    forked = run_report(tmp_path / "forked", "quick", only=only, progress=False, jobs=2)
+    assert list(forked["sections"]) == only
+    # The spectral core's figures have no timings: equal to the last digit.
+    a, b = serial["sections"]["spectral-core"], forked["sections"]["spectral-core"]
+    a.pop("section_seconds"), b.pop("section_seconds")
+    assert json.dumps(a, sort_keys=True) == json.dumps(b, sort_keys=True)
+    names = [(c["section"], c["name"], c["passed"]) for c in serial["checks"]]
+    assert [(c["section"], c["name"], c["passed"]) for c in forked["checks"]] == names
