@@ -102,7 +102,7 @@ def relative_errors(approx, exact) -> tuple[float, float]:
     return float(relative.mean()), float(relative.max())
 
 
-def error_by_order(luminance, kernel, orders, directions, split: bool = True) -> dict:
+def error_by_order(luminance, kernel, orders, directions, split: bool = True, exact=None) -> dict:
     """Error of the order-L frequency path of Y against brute force, per order.
 
     Eq. (7), Ramamoorthi & Hanrahan 2001 for the frequency path (``Λ_l L_lm`` summed to L at each
@@ -119,12 +119,14 @@ def error_by_order(luminance, kernel, orders, directions, split: bool = True) ->
     directions : ndarray, shape (N, 3)
     split : bool
         Light the bright texels exactly (the default render path).
+    exact : ndarray, shape (N,), optional
+        The oracle at ``directions``, when a call on the same map and kernel has computed it.
 
     Returns
     -------
     dict
-        ``orders``, ``mean``, ``max`` (lists) and ``chosen``: the :class:`OrderChoice` as a dict
-        with its ``measured_mean`` and ``measured_max``.
+        ``orders``, ``mean``, ``max`` (lists), ``chosen``: the :class:`OrderChoice` as a dict
+        with its ``measured_mean`` and ``measured_max``, and ``exact`` (the oracle's values).
 
     Examples
     --------
@@ -135,7 +137,8 @@ def error_by_order(luminance, kernel, orders, directions, split: bool = True) ->
     """
     luminance = np.asarray(luminance, dtype=np.float64)
     k = parse_kernel(kernel)
-    exact = prefilter_bruteforce(luminance[..., None], k, directions)[:, 0]
+    if exact is None:
+        exact = prefilter_bruteforce(luminance[..., None], k, directions)[:, 0]
     bright = bright_texels(luminance) if split else None
     chosen = accuracy_order(luminance, k, bright=bright).as_dict()
     band_limit = luminance.shape[1] // 2 - 1
@@ -160,6 +163,7 @@ def error_by_order(luminance, kernel, orders, directions, split: bool = True) ->
         if chosen["order"] == L:
             chosen["measured_mean"], chosen["measured_max"] = mean, worst
     out["chosen"] = chosen
+    out["exact"] = exact
     return out
 
 
@@ -192,14 +196,18 @@ def sphere_scene_toml(environment, material: str = 'type = "lambert"\nk_d = 0.5'
     )
 
 
-def render_against_oracle(scene, options=None) -> dict:
+def render_against_oracle(scene, options=None, oracle=None) -> dict:
     """A scene rendered with default settings (plus ``options``) against ``--oracle``, in Y.
+
+    ``oracle`` is the ``oracle`` of an earlier call on the same scene (it does not depend on
+    ``options``), so a second setting is measured without integrating the scene again.
 
     Returns
     -------
     dict
         ``mean``, ``max``: relative error of Y over lit sphere pixels (:func:`relative_errors`);
-        ``records``: what the shaders chose (orders and promised bounds).
+        ``records``: what the shaders chose (orders and promised bounds); ``oracle``: the
+        brute-force render.
 
     Examples
     --------
@@ -216,7 +224,8 @@ def render_against_oracle(scene, options=None) -> dict:
     from reference.scene.render import render_scene
 
     fast = render_scene(scene, options=options)
-    oracle = render_scene(scene, options={"environment": "bruteforce"}, gbuffer=fast.gbuffer)
+    if oracle is None:
+        oracle = render_scene(scene, options={"environment": "bruteforce"}, gbuffer=fast.gbuffer)
     mask = fast.gbuffer.mask
     mean, worst = relative_errors(fast.XYZ[..., 1][mask], oracle.XYZ[..., 1][mask])
-    return {"mean": mean, "max": worst, "records": fast.records}
+    return {"mean": mean, "max": worst, "records": fast.records, "oracle": oracle}
