@@ -31,6 +31,10 @@ collect_ignore = [] if os.environ.get("SPECREF_BENCH") else ["tests/benchmarks"]
 # ``python -m validation.cli`` runs the command on import: never collect it for doctests.
 collect_ignore += ["validation/cli/__main__.py", "phong_table/editor/__main__.py"]
 
+# An unreachable scheduler is refused after two seconds here rather than the default ten (the
+# tests prove the refusal, not the patience); a value set outside the suite wins.
+os.environ.setdefault("SPECREF_DASK_TIMEOUT", "2")
+
 
 @pytest.fixture
 def rng():
@@ -44,6 +48,19 @@ def package_data() -> Path:
     from reference.data import data_root
 
     return data_root()
+
+
+@pytest.fixture(scope="session")
+def dask_local_client():
+    """One local Dask cluster for the session: two single-threaded worker processes on 127.0.0.1.
+
+    Starting a cluster costs seconds; every test that only needs *a* cluster shares this one.
+    Tests that kill workers or start their own ``dask scheduler`` make their own.
+    """
+    from reference.tasks import dask_client
+
+    with dask_client("local", n_workers=2) as client:
+        yield client
 
 
 @pytest.fixture(autouse=True)

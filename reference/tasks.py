@@ -28,7 +28,9 @@ __all__ = [
     "LOCAL",
     "SCHEDULER_ENV",
     "SERIAL",
+    "TIMEOUT_ENV",
     "add_scheduler_option",
+    "connect_timeout",
     "dask_client",
     "run_tasks",
     "scheduler_address",
@@ -36,6 +38,12 @@ __all__ = [
 
 #: The environment variable that names a remote scheduler.
 SCHEDULER_ENV = "SPECREF_SCHEDULER"
+
+#: The environment variable that sets how long to wait for a remote scheduler, in seconds.
+TIMEOUT_ENV = "SPECREF_DASK_TIMEOUT"
+
+#: The wait for a remote scheduler when ``$SPECREF_DASK_TIMEOUT`` is unset, in seconds.
+DEFAULT_TIMEOUT = 10.0
 
 #: The scheduler name that runs tasks in this process, one after another.
 SERIAL = "serial"
@@ -67,6 +75,44 @@ def scheduler_address(scheduler: str | None = None, default: str | None = None) 
     return str(address)
 
 
+def connect_timeout(environ=None) -> float:
+    """Seconds to wait for a remote scheduler: ``$SPECREF_DASK_TIMEOUT``, else 10.
+
+    A setting rather than a constant: a scheduler across a slow network needs longer, and a test
+    that proves an unreachable address is refused needs no more than a second or two.
+
+    Parameters
+    ----------
+    environ : mapping, optional
+        The environment to read (default ``os.environ``).
+
+    Raises
+    ------
+    SpecrefError
+        The variable is not a positive number of seconds (one line naming it).
+
+    Examples
+    --------
+    >>> connect_timeout({"SPECREF_DASK_TIMEOUT": "2.5"})
+    2.5
+    >>> connect_timeout({})
+    10.0
+    >>> connect_timeout({"SPECREF_DASK_TIMEOUT": "soon"})
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: $SPECREF_DASK_TIMEOUT: 'soon' is not a number of seconds > 0
+    """
+    text = (os.environ if environ is None else environ).get(TIMEOUT_ENV, "").strip()
+    if not text:
+        return DEFAULT_TIMEOUT
+    try:
+        seconds = float(text)
+    except ValueError:
+        seconds = float("nan")
+    require(seconds > 0, f"${TIMEOUT_ENV}: {text!r} is not a number of seconds > 0")
+    return seconds
+
+
 def add_scheduler_option(parser, default: str | None = None) -> None:
     """The ``--scheduler`` option of every command that runs tasks (one help text for all).
 
@@ -93,7 +139,9 @@ def add_scheduler_option(parser, default: str | None = None) -> None:
 
 
 @contextlib.contextmanager
-def dask_client(scheduler: str | None = None, n_workers: int | None = None, timeout: float = 10.0):
+def dask_client(
+    scheduler: str | None = None, n_workers: int | None = None, timeout: float | None = None
+):
     """A ``distributed.Client``: on ``scheduler`` if given, else on a new local cluster.
 
     Parameters
@@ -103,8 +151,9 @@ def dask_client(scheduler: str | None = None, n_workers: int | None = None, time
         else a ``LocalCluster`` of ``n_workers`` single-threaded processes on 127.0.0.1.
     n_workers : int, optional
         Local workers (default: the machine's cores).
-    timeout : float
-        Seconds to wait for a remote scheduler.
+    timeout : float, optional
+        Seconds to wait for a remote scheduler; default :func:`connect_timeout`
+        (``$SPECREF_DASK_TIMEOUT``, else 10).
 
     Raises
     ------
@@ -122,6 +171,7 @@ def dask_client(scheduler: str | None = None, n_workers: int | None = None, time
     from distributed import Client, LocalCluster
 
     address = scheduler_address(scheduler)
+    timeout = connect_timeout() if timeout is None else timeout
     require(address != SERIAL, "dask_client: 'serial' runs without a client")
     if address:
         try:

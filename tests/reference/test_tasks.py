@@ -34,10 +34,10 @@ def worker_pid(dask_worker=None):
 TASKS = [(seed, 1000 + seed) for seed in range(24)]
 
 
-@pytest.fixture(scope="module")
-def client():
-    with dask_client(n_workers=2) as c:
-        yield c
+@pytest.fixture
+def client(dask_local_client):
+    # the session's local cluster (conftest.py): two single-threaded workers on 127.0.0.1
+    return dask_local_client
 
 
 def test_local_cluster_equals_serial(client):
@@ -144,6 +144,19 @@ def test_unreachable_scheduler_is_one_line():
     and not os.path.exists(os.path.join(os.path.dirname(sys.executable), "dask")),
     reason="pip install distributed",
 )
+def test_the_wait_for_a_scheduler_is_a_setting(monkeypatch):
+    # $SPECREF_DASK_TIMEOUT, not a constant, bounds the wait; the refusal says how long it waited
+    monkeypatch.setenv("SPECREF_DASK_TIMEOUT", "1")
+    address = f"tcp://127.0.0.1:{_free_port()}"
+    refused = r"no Dask scheduler answered within 1 s"
+    with pytest.raises(SpecrefError, match=refused), dask_client(address):
+        pass
+    monkeypatch.setenv("SPECREF_DASK_TIMEOUT", "-3")
+    invalid = r"\$SPECREF_DASK_TIMEOUT: '-3' is not a number"
+    with pytest.raises(SpecrefError, match=invalid), dask_client(address):
+        pass
+
+
 def test_real_scheduler_and_workers_on_loopback(tmp_path):
     # As a user would start them: `dask scheduler`, two `dask worker`s; stopped by process id.
     dask = os.path.join(os.path.dirname(sys.executable), "dask")

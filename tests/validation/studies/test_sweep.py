@@ -91,18 +91,16 @@ def test_cli_exit_code_two_without_traceback(tmp_path, capsys):
     assert "file not found" in capsys.readouterr().err
 
 
-def test_local_cluster_sweep_is_identical_to_serial(tmp_path):
+def test_local_cluster_sweep_is_identical_to_serial(tmp_path, dask_local_client):
     path = tmp_path / "s.toml"
     path.write_text(GRID.replace('"R1", "R3"', '"R3"'))
     serial = sweep_csv(run_sweep(path, scheduler="serial", progress=False))
-    from reference.tasks import dask_client
-
     painting = tmp_path / "p.toml"
     painting.write_text(PAINTING_GRID)
     serial_painting = sweep_csv(run_sweep(painting, scheduler="serial", progress=False))
-    with dask_client(n_workers=2) as client:
-        distributed = sweep_csv(run_sweep(path, client=client, progress=False))
-        distributed_painting = sweep_csv(run_sweep(painting, client=client, progress=False))
+    client = dask_local_client
+    distributed = sweep_csv(run_sweep(path, client=client, progress=False))
+    distributed_painting = sweep_csv(run_sweep(painting, client=client, progress=False))
     assert distributed == serial
     assert distributed_painting == serial_painting
 
