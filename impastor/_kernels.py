@@ -222,6 +222,53 @@ def horizon_map_kernel(h, pixel_size, n_sectors, max_steps, step, out):
 
 
 @njit
+def horizon_at_texels_kernel(h, pixel_size, rows, cols, n_sectors, max_steps, step, out):
+    """Twin of ``horizon_at_texels``: the horizon map's sectors at the listed texels only."""
+    for n in range(rows.shape[0]):
+        for s in range(n_sectors):
+            phi = (s + 0.5) * 2.0 * math.pi / n_sectors
+            out[n, s] = _horizon_along(h, pixel_size, rows[n], cols[n], phi, max_steps, step)
+
+
+@njit
+def diffuse_brute_force_kernel(P, N, horizon, frame, position, L, n_light, pixel_area, out):
+    """Twin of ``diffuse_brute_force``: Eq. (2), Ferwerda, over every light pixel, shadowed."""
+    S = horizon.shape[1]
+    width = 2.0 * math.pi / S
+    for n in range(P.shape[0]):
+        for m in range(position.shape[0]):
+            dx, dy, dz = (
+                position[m, 0] - P[n, 0],
+                position[m, 1] - P[n, 1],
+                position[m, 2] - P[n, 2],
+            )
+            d2 = dx * dx + dy * dy + dz * dz
+            r = math.sqrt(d2)
+            ix, iy, iz = dx / r, dy / r, dz / r
+            cos_s = max(ix * N[n, 0] + iy * N[n, 1] + iz * N[n, 2], 0.0)
+            cos_l = max(-(ix * n_light[0] + iy * n_light[1] + iz * n_light[2]), 0.0)
+            if cos_s == 0.0 or cos_l == 0.0:
+                continue
+            # light_azimuth_elevation in the canvas frame (T, B, N) = frame's rows
+            t = ix * frame[0, 0] + iy * frame[0, 1] + iz * frame[0, 2]
+            b = ix * frame[1, 0] + iy * frame[1, 1] + iz * frame[1, 2]
+            z = ix * frame[2, 0] + iy * frame[2, 1] + iz * frame[2, 2]
+            beta = math.asin(min(max(z, -1.0), 1.0))
+            if beta <= 0.0:
+                continue
+            phi = math.atan2(b, t) % (2.0 * math.pi)
+            x = phi / width
+            s0 = math.floor(x - 0.5)
+            f = x - 0.5 - s0
+            critical = (1.0 - f) * horizon[n, int(s0) % S] + f * horizon[n, int(s0 + 1) % S]
+            if beta <= critical:
+                continue
+            g = cos_s * cos_l * pixel_area / d2
+            for c in range(L.shape[1]):
+                out[n, c] += g * L[m, c]
+
+
+@njit
 def ray_march_shadows_kernel(h, pixel_size, phi, beta, max_steps, step, out):
     """Twin of ``ray_march_shadows``: lit where β exceeds the horizon along the exact azimuth."""
     H, W = h.shape

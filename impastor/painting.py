@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import hashlib
 from collections import OrderedDict
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import NamedTuple
 
@@ -55,16 +55,23 @@ __all__ = [
     "HORIZON_SECTORS",
     "PAINTING_LIGHTING_METHODS",
     "PAINT_SPECTRA",
+    "PaintingScene",
     "booth_lamp_kind",
     "booth_plane_light",
     "cached_horizon_map",
+    "canvas_frame",
+    "canvas_materials",
+    "canvas_pixels",
     "impasto_painting",
+    "lights_visibility",
     "load_paint_spectra",
     "painting_samples",
+    "painting_scene",
     "painting_specular_fis",
     "painting_specular_hybrid",
     "painting_specular_point_lights",
     "render_painting",
+    "shade_canvas",
 ]
 
 #: Measured reflectances used for the painting's strokes (shipped: ``reference.data``).
@@ -294,12 +301,14 @@ def render_painting(
     spectra=None,
     backend: str = "numba",
     progress=None,
+    n_sectors: int = HORIZON_SECTORS,
+    failsafe: bool = True,
 ) -> dict:
     """Render the demo painting under a booth light through the whole ImpastoR pipeline.
 
-    G-buffer of the canvas plane, normal map from the height map, six-channel ρ_d from measured
-    spectra, diffuse light from median-cut lights (Eqs. (2)-(3), Ferwerda) with horizon-map
-    shadows, specular light by ``method``, and XYZ through the 3×N matrix.
+    G-buffer of the canvas, normals from the height map, six-channel ρ_d from measured spectra,
+    diffuse light from median-cut lights (Eqs. (2)-(3), Ferwerda) with horizon-map shadows,
+    specular light by ``method`` (:func:`shade_canvas`), and XYZ through the 3×N matrix.
 
     Parameters
     ----------
@@ -312,12 +321,13 @@ def render_painting(
         of the point lights that the diffuse term always uses.
     painting : dict, optional
         From :func:`impasto_painting` (default: one at ``size``).
-    design, n_lights, n_samples, light_resolution, shadows
-        Pipeline settings.
+    design, light_resolution, shadows, spectra
+        Pipeline settings (``spectra``: :func:`load_paint_spectra`).
+    n_lights, n_samples, n_sectors, failsafe
+        Point lights N, FIS samples K, horizon sectors S and the hybrid's fail-safe: fixed here
+        (32, 32, 36, on); :func:`impastor.settings.render_painting_to_tolerance` chooses them.
     backend : {"numba", "numpy"}
         Kernels or their NumPy twins (no JIT warm-up: for small images).
-    spectra : dict, optional
-        From :func:`load_paint_spectra`.
     progress : file-like, optional
         Where to write a line per stage with its time (``specref impastor render``).
 
@@ -326,41 +336,128 @@ def render_painting(
     dict
         ``XYZ`` (H, W, 3) in cd/m², ``sRGB`` encoded (H, W, 3) in [0, 1] (white = 1.2× the
         white diffuser's luminance), ``seconds`` per stage (``shadows`` is the horizon lookup,
-        plus the horizon map the first time a height field is rendered: :func:`cached_horizon_map`).
+        plus the horizon map the first time a height field is rendered: :func:`cached_horizon_map`),
+        ``settings`` (N, K, S and the fail-safe used).
 
     Examples
     --------
     >>> out = render_painting("D65", size=32, method="median_cut", light_resolution=(32, 16))
-    >>> out["XYZ"].shape, sorted(out["seconds"])
-    ((32, 32, 3), ['diffuse', 'shadows', 'specular'])
+    >>> out["XYZ"].shape, sorted(out["seconds"]), out["settings"]["n_lights"]
+    ((32, 32, 3), ['diffuse', 'shadows', 'specular'], 32)
     """
-    lighting = PAINTING_LIGHTING_METHODS.lookup(method)
     painting = painting or impasto_painting(size)
-    spectra = spectra or load_paint_spectra()
-    d = MULTISPECTRAL_DESIGNS.lookup(design).reference(6)
-    plane = booth_plane_light(booth_lamp_kind(light), *light_resolution)
-    lights = point_lights_from_plane(plane, lighting.sampling, n_lights)
-    S6 = light_to_channels(spectrum_from_dataset("illuminant", light), d)
-    px = _canvas_pixels(painting, size)
-    P, V, N = px.P, px.V, px.N
+    scene = painting_scene(light, method, painting, design, light_resolution, spectra)
+    px = canvas_pixels(painting, size)
     timer = StageTimer(progress, f"painting {size}×{size} under {light}")
-    with timer.stage("shadows"):
-        visibility = _horizon_visibility(painting, px, lights, backend) if shadows else None
-    rho_d, rho_s, alpha = _canvas_materials(painting, spectra, d, px)
-    with timer.stage("diffuse"):
-        # Eq. (2), Ferwerda: illuminance from the point lights (luminance image: one channel)
-        E = illuminance_point_lights(P, N, lights, visibility)
-        # Eq. (3), Ferwerda: L_out,j = ρ_d,j S_j E / π
-        L_diffuse = rho_d * S6 * E / np.pi
-    with timer.stage("specular"):
-        I_s = lighting.reference(P, N, V, alpha, plane, lights, n_samples, visibility, backend)
-        L_specular = rho_s * S6 * I_s
+    settings = {"n_lights": n_lights, "n_samples": n_samples, "n_sectors": n_sectors} | {
+        "failsafe": bool(failsafe)
+    }
+
+    def horizon():
+        # Once per height field, not per frame (§3.5.3, Ferwerda: a precomputed map).
+        height, pixel_size = painting["height"], painting["pixel_size"]
+        return cached_horizon_map(height, pixel_size, n_sectors, 32, backend)[px.row, px.col]
+
+    L, E = shade_canvas(scene, px, settings, horizon if shadows else None, backend, timer)
     XYZ = np.zeros((*px.gbuffer.shape, 3))
-    XYZ[px.gbuffer.mask] = channels_to_XYZ(L_diffuse + L_specular, d)
+    XYZ[px.gbuffer.mask] = channels_to_XYZ(L, scene.design)
     # Display: linear sRGB with the white diffuser under the booth light at 1/1.2 of white.
     white_Y = float(np.median(E)) / np.pi
     rgb = XYZ_to_display_RGB(XYZ / (1.2 * white_Y))
-    return {"XYZ": XYZ, "sRGB": linear_to_display(rgb, "srgb"), "seconds": timer.seconds}
+    sRGB = linear_to_display(rgb, "srgb")
+    return {"XYZ": XYZ, "sRGB": sRGB, "seconds": timer.seconds, "settings": settings}
+
+
+class PaintingScene(NamedTuple):
+    """What a frame of the painting needs besides its pixels and settings (:func:`painting_scene`).
+
+    ``painting`` (from :func:`impasto_painting`), ``spectra`` (paint reflectances), ``design``
+    (the six-channel design), ``plane`` (the booth's ceiling), ``S6`` (the illuminant in the six
+    channels) and ``lighting`` (the :class:`PaintingLighting` method).
+    """
+
+    painting: dict
+    spectra: dict
+    design: object
+    plane: PlaneLight
+    S6: np.ndarray
+    lighting: object
+
+
+def painting_scene(
+    light: str = "D65",
+    method: str = "hybrid",
+    painting=None,
+    design: str = "optimized",
+    light_resolution: tuple = (128, 64),
+    spectra=None,
+) -> PaintingScene:
+    """The painting, its paints, the channel design and the booth light, ready to shade.
+
+    Examples
+    --------
+    >>> scene = painting_scene("A", "median_cut", impasto_painting(16), light_resolution=(16, 8))
+    >>> scene.plane.shape, scene.S6.shape
+    ((8, 16), (6,))
+    """
+    lighting = PAINTING_LIGHTING_METHODS.lookup(method)
+    painting = painting or impasto_painting(256)
+    spectra = spectra or load_paint_spectra()
+    d = MULTISPECTRAL_DESIGNS.lookup(design).reference(6)
+    plane = booth_plane_light(booth_lamp_kind(light), *light_resolution)
+    S6 = light_to_channels(spectrum_from_dataset("illuminant", light), d)
+    return PaintingScene(painting, spectra, d, plane, S6, lighting)
+
+
+def shade_canvas(scene: PaintingScene, px, settings: dict, horizon, backend: str, timer=None):
+    """Six-channel radiance at canvas pixels: Eqs. (2)-(4), Ferwerda, at the given settings.
+
+    Parameters
+    ----------
+    scene : PaintingScene
+    px : _CanvasPixels
+        The pixels (:func:`canvas_pixels`).
+    settings : dict
+        ``n_lights``, ``n_samples``, ``failsafe`` (the hybrid's; other methods ignore it).
+    horizon : callable or None
+        Returns the horizon angles ``(n, S)`` at the pixels' texels; None for no shadows.
+    backend : {"numba", "numpy"}
+    timer : StageTimer, optional
+
+    Returns
+    -------
+    L : ndarray, shape (n, 6)
+        Radiance per channel (cd/m² in the design's channels).
+    E : ndarray, shape (n, 1)
+        Illuminance from the point lights, lux.
+
+    Examples
+    --------
+    >>> scene = painting_scene("D65", "median_cut", impasto_painting(16), light_resolution=(16, 8))
+    >>> px = canvas_pixels(scene.painting, 8)
+    >>> settings = {"n_lights": 4, "n_samples": 4, "failsafe": False}
+    >>> L, E = shade_canvas(scene, px, settings, None, "numpy")
+    >>> L.shape == (px.P.shape[0], 6), bool((E > 0).all())
+    (True, True)
+    """
+    timer = timer or StageTimer(None, "")
+    lights = point_lights_from_plane(scene.plane, scene.lighting.sampling, settings["n_lights"])
+    with timer.stage("shadows"):
+        visibility = None if horizon is None else lights_visibility(horizon(), px.P, lights)
+    rho_d, rho_s, alpha = canvas_materials(scene.painting, scene.spectra, scene.design, px)
+    with timer.stage("diffuse"):
+        # Eq. (2), Ferwerda: illuminance from the point lights (luminance image: one channel)
+        E = illuminance_point_lights(px.P, px.N, lights, visibility)
+        # Eq. (3), Ferwerda: L_out,j = ρ_d,j S_j E / π
+        L_diffuse = rho_d * scene.S6 * E / np.pi
+    with timer.stage("specular"):
+        extra = {"failsafe": settings["failsafe"]} if scene.lighting.failsafe else {}
+        I_s = scene.lighting.reference(
+            px.P, px.N, px.V, alpha, scene.plane, lights, settings["n_samples"], visibility,
+            backend, **extra,
+        )  # fmt: skip
+        L_specular = rho_s * scene.S6 * I_s
+    return L_diffuse + L_specular, E
 
 
 class _CanvasPixels(NamedTuple):
@@ -374,8 +471,18 @@ class _CanvasPixels(NamedTuple):
     N: np.ndarray
 
 
-def _canvas_pixels(painting: dict, size: int) -> _CanvasPixels:
-    """The canvas seen from :data:`EYE` at ``size²`` pixels, normals from the height map."""
+def canvas_pixels(painting: dict, size: int) -> _CanvasPixels:
+    """The canvas seen from :data:`EYE` at ``size²`` pixels, normals from the height map.
+
+    Returns the visible pixels' G-buffer, points P, views V, texel rows and columns and
+    normal-mapped normals N.
+
+    Examples
+    --------
+    >>> px = canvas_pixels(impasto_painting(16), 8)
+    >>> px.P.shape == px.N.shape == px.V.shape, px.row.shape == px.P.shape[:1]
+    (True, True)
+    """
     g = _painting_gbuffer(size, painting["width_m"])
     mask = g.mask
     P, V = g.position[mask], g.view[mask]
@@ -383,30 +490,65 @@ def _canvas_pixels(painting: dict, size: int) -> _CanvasPixels:
     n_tex = painting["height"].shape[0]
     col = np.clip((g.uv[mask][:, 0] * n_tex).astype(int), 0, n_tex - 1)
     row = np.clip((g.uv[mask][:, 1] * n_tex).astype(int), 0, n_tex - 1)
-    T, B, N_geo = _canvas_frame()
+    T, B, N_geo = canvas_frame()
     normals_tangent = normal_map_from_height(painting["height"], painting["pixel_size"])
     N = tangent_to_world(normals_tangent[row, col], T, B, N_geo)
     return _CanvasPixels(g, P, V, row, col, N)
 
 
-def _canvas_frame() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The canvas's tangent frame T, B, N in world axes: u along +x, v along +z, up +y."""
+def canvas_frame() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The canvas's tangent frame T, B, N in world axes: u along +x, v along +z, up +y.
+
+    Examples
+    --------
+    >>> canvas_frame()[2]
+    array([0., 1., 0.])
+    """
     return np.array([1.0, 0, 0]), np.array([0, 0, 1.0]), np.array([0, 1.0, 0])
 
 
-def _horizon_visibility(painting: dict, px: _CanvasPixels, lights, backend: str) -> np.ndarray:
-    """Each pixel's visibility (0 or 1) of each point light, by its texel's horizon (§3.5.3)."""
-    # Once per height field, not per frame (§3.5.3, Ferwerda: a precomputed map).
-    hmap = cached_horizon_map(
-        painting["height"], painting["pixel_size"], HORIZON_SECTORS, 32, backend
-    )
-    to_light = lights.position[None] - px.P[:, None]
-    phi, beta = light_azimuth_elevation(to_light, *_canvas_frame())
-    return horizon_lookup(hmap[px.row, px.col][:, None, :], phi, beta).astype(float)
+def lights_visibility(horizon: np.ndarray, P: np.ndarray, lights) -> np.ndarray:
+    """Each point's visibility (0 or 1) of each point light, by its texel's horizon (§3.5.3).
+
+    Parameters
+    ----------
+    horizon : ndarray, shape (n, S)
+        Horizon angles at each point's texel (:func:`cached_horizon_map` or
+        :func:`impastor.horizon.horizon_at_texels`).
+    P : ndarray, shape (n, 3)
+        Points on the canvas, m.
+    lights : PointLights
+
+    Returns
+    -------
+    ndarray, shape (n, N)
+
+    Examples
+    --------
+    >>> lights = point_lights_from_plane(booth_plane_light("fluorescent", 8, 4), "median_cut", 2)
+    >>> lights_visibility(np.zeros((1, 4)), np.zeros((1, 3)), lights)
+    array([[1., 1.]])
+    """
+    to_light = lights.position[None] - P[:, None]
+    phi, beta = light_azimuth_elevation(to_light, *canvas_frame())
+    return horizon_lookup(horizon[:, None, :], phi, beta).astype(float)
 
 
-def _canvas_materials(painting: dict, spectra: dict, d, px: _CanvasPixels):
-    """Six-channel materials per pixel: ρ_d from the measured spectra, ρ_s and α from the maps."""
+def canvas_materials(painting: dict, spectra: dict, d, px: _CanvasPixels):
+    """Six-channel materials per pixel: ρ_d from the measured spectra, ρ_s and α from the maps.
+
+    Returns ``rho_d`` (n, 6), ``rho_s`` (n, 1) and the Ward–Dür ``alpha`` (n,) at the pixels'
+    texels.
+
+    Examples
+    --------
+    >>> painting = impasto_painting(16)
+    >>> px = canvas_pixels(painting, 8)
+    >>> d = MULTISPECTRAL_DESIGNS.lookup("optimized").reference(6)
+    >>> rho_d, rho_s, alpha = canvas_materials(painting, load_paint_spectra(), d, px)
+    >>> rho_d.shape[1], bool((alpha > 0).all())
+    (6, True)
+    """
     names = list(PAINT_SPECTRA)
     R6 = spectra_to_channels(np.stack([spectra[n] for n in names]), d)
     canvas = spectra_to_channels(spectra.get("office-paper", np.full(81, 0.85)), d)
@@ -510,11 +652,14 @@ def painting_specular_fis(P, N, V, alpha, plane, lights, n_samples, visibility, 
     return specular_fis(P, N, V, alpha, plane, n_samples, backend=backend)
 
 
-def painting_specular_hybrid(P, N, V, alpha, plane, lights, n_samples, visibility, backend):
+def painting_specular_hybrid(
+    P, N, V, alpha, plane, lights, n_samples, visibility, backend, failsafe: bool = True
+):
     """The painting's gloss by the per-pixel hybrid of point lights and FIS.
 
     Eq. (4), Ferwerda, estimated both ways and mixed per pixel by the error estimates of
-    :func:`specular_hybrid`. Parameters and result as in :func:`painting_specular_point_lights`.
+    :func:`specular_hybrid`. Parameters and result as in :func:`painting_specular_point_lights`;
+    ``failsafe=False`` skips the hybrid's fail-safe (its unbiased check of the choice).
 
     Examples
     --------
@@ -522,7 +667,9 @@ def painting_specular_hybrid(P, N, V, alpha, plane, lights, n_samples, visibilit
     >>> painting_specular_hybrid(*inputs).shape
     (4, 1)
     """
-    return specular_hybrid(P, N, V, alpha, plane, lights, n_samples, visibility, backend)
+    return specular_hybrid(
+        P, N, V, alpha, plane, lights, n_samples, visibility, backend, failsafe=failsafe
+    )
 
 
 def _painting_example(rng):
@@ -547,9 +694,12 @@ class PaintingLighting(Method):
     sampling : str
         The key of :data:`impastor.point_lights.LIGHT_SAMPLING_METHODS` that makes the point
         lights (which the diffuse term always uses).
+    failsafe : bool
+        ``reference`` takes ``failsafe=`` (the hybrid's fail-safe, which a tolerance may drop).
     """
 
     sampling: str
+    failsafe: bool = False
 
 
 #: The painting's lighting methods by key.
@@ -560,6 +710,7 @@ for _name, _function, _sampling, _cites in (
     ("fis", painting_specular_fis, "median_cut", "Eq. (4), Ferwerda"),
     ("hybrid", painting_specular_hybrid, "median_cut", "Eq. (4), Ferwerda"),
 ):
-    PAINTING_LIGHTING_METHODS.register(
-        PaintingLighting(_name, _function, None, _cites, _painting_example, sampling=_sampling)
+    _method = PaintingLighting(
+        _name, _function, None, _cites, _painting_example, sampling=_sampling, failsafe=False
     )
+    PAINTING_LIGHTING_METHODS.register(replace(_method, failsafe=_name == "hybrid"))

@@ -393,6 +393,7 @@ def specular_hybrid_parts(
     n_samples: int = 32,
     visibility=None,
     backend: str = "numpy",
+    failsafe: bool = True,
 ) -> dict:
     """The hybrid and what it is made of: both estimates, their errors and the weights.
 
@@ -401,7 +402,7 @@ def specular_hybrid_parts(
 
     Parameters
     ----------
-    points, normals, views, alpha, light, lights, n_samples, visibility, backend
+    points, normals, views, alpha, light, lights, n_samples, visibility, backend, failsafe
         As in :func:`specular_hybrid`.
 
     Returns
@@ -434,8 +435,10 @@ def specular_hybrid_parts(
     w_pl = np.where(choose, (e_pl < e_fis).astype(np.float64), w_pl)
     # The fail-safe: the hybrid, the point lights or FIS, whichever an unbiased estimate favours
     P, N, V, a, vis = flat  # the inputs as _evaluate checked and flattened them
-    failsafe = _failsafe(P, N, V, a, light, lights, vis, backend, I_pl, I_fis, w_pl)
-    w_pl = np.select([failsafe == 1, failsafe == 2], [1.0, 0.0], w_pl)
+    kept = np.zeros(P.shape[0], dtype=np.int64)
+    if failsafe:
+        kept = _failsafe(P, N, V, a, light, lights, vis, backend, I_pl, I_fis, w_pl)
+    w_pl = np.select([kept == 1, kept == 2], [1.0, 0.0], w_pl)
     I_hybrid = w_pl[:, None] * I_pl + (1.0 - w_pl[:, None]) * I_fis
     return {
         "hybrid": I_hybrid.reshape((*shape, -1)),
@@ -444,7 +447,7 @@ def specular_hybrid_parts(
         "e_point_lights": e_pl.reshape(shape),
         "e_fis": e_fis.reshape(shape),
         "w_point_lights": w_pl.reshape(shape),
-        "failsafe": failsafe.reshape(shape),
+        "failsafe": kept.reshape(shape),
     }
 
 
@@ -458,6 +461,7 @@ def specular_hybrid(
     n_samples: int = 32,
     visibility=None,
     backend: str = "numpy",
+    failsafe: bool = True,
 ) -> np.ndarray:
     """Per-pixel hybrid of point lights and FIS (§3.5.2, Ferwerda).
 
@@ -474,6 +478,10 @@ def specular_hybrid(
     ----------
     points, normals, views, alpha, light, lights, n_samples, visibility, backend
         As in :func:`specular_point_lights` and :func:`specular_fis`; ``n_samples >= 2``.
+    failsafe : bool
+        Check the choice per group of similar α against an unbiased estimate (default); False
+        keeps the per-pixel hybrid as its error estimates have it, for a scene whose tolerance
+        does not need the check (:mod:`impastor.settings`).
 
     Returns
     -------
@@ -489,7 +497,7 @@ def specular_hybrid(
     array([99.51])
     """
     return specular_hybrid_parts(
-        points, normals, views, alpha, light, lights, n_samples, visibility, backend
+        points, normals, views, alpha, light, lights, n_samples, visibility, backend, failsafe
     )["hybrid"]
 
 

@@ -46,8 +46,8 @@ __all__ = [
 MAX_IMAGE_PIXELS = 16384 * 16384
 
 
-def write_png(path, image) -> Path:
-    """Write an 8-bit PNG atomically (imageio).
+def write_png(path, image, text: dict | None = None) -> Path:
+    """Write an 8-bit PNG atomically (imageio), with optional text chunks.
 
     Parameters
     ----------
@@ -55,6 +55,9 @@ def write_png(path, image) -> Path:
         Destination.
     image : ndarray, shape (H, W) or (H, W, 3|4)
         uint8 values, or floats in [0, 1] that are quantized with round-half-up.
+    text : dict of str, optional
+        ``tEXt`` chunks (key → value): the render's settings, read back by
+        ``imageio.v3.immeta`` or Pillow's ``Image.text``.
 
     Returns
     -------
@@ -63,19 +66,24 @@ def write_png(path, image) -> Path:
     Examples
     --------
     >>> import tempfile, os
+    >>> import imageio.v3 as iio
     >>> with tempfile.TemporaryDirectory() as d:
-    ...     p = write_png(os.path.join(d, "a.png"), np.zeros((2, 3, 3)))
-    ...     read_png(p).shape
-    (2, 3, 3)
+    ...     p = write_png(os.path.join(d, "a.png"), np.zeros((2, 3, 3)), {"specref": "N=8"})
+    ...     read_png(p).shape, iio.immeta(p)["specref"]
+    ((2, 3, 3), 'N=8')
     """
     import imageio.v3 as iio
+    from PIL.PngImagePlugin import PngInfo
 
     from reference.display.encodings import to_8bit
 
     image = np.asarray(image)
     if image.dtype != np.uint8:
         image = to_8bit(image)
-    data = iio.imwrite("<bytes>", image, extension=".png")
+    info = PngInfo()
+    for key, value in (text or {}).items():
+        info.add_text(str(key), str(value))
+    data = iio.imwrite("<bytes>", image, extension=".png", pnginfo=info)
     return write_bytes_atomic(path, data)
 
 

@@ -26,6 +26,8 @@ def test_horizon_twins_agree(method, rng):
     h, pixel = method.example_inputs(rng)
     if method.name == "horizon_map":
         args = (h, pixel, 7, 9)
+    elif method.name == "horizon_at_texels":
+        args = (h, pixel, rng.integers(0, 16, 20), rng.integers(0, 16, 20), 7, 9)
     else:
         args = (h, pixel, rng.uniform(0, 2 * np.pi, h.shape), rng.uniform(0, 1, h.shape), 9)
     reference = method.reference(*args, backend="numpy")

@@ -54,6 +54,7 @@ def _cmd_impastor_render(args) -> int:
             lamp,
             args.light_luminance,
             progress=sys.stderr,
+            tolerance=args.tolerance,
         )
     )
     return 0
@@ -103,5 +104,13 @@ def add_parser(sub) -> None:
         type=float,
         default=None,
         help="booth light luminance, cd/m² (default: the booth ceiling's mean)",
+    )
+    r.add_argument(
+        "--tolerance",
+        type=float,
+        metavar="T",
+        help="choose the lights N, samples K, horizon sectors and the hybrid's fail-safe from a "
+        "relative RMS error T of the frame against brute force (0.02 is 2 %%) instead of the "
+        "fixed 32/32/36 with the fail-safe; the PNG records the settings and the promised bound",
     )
     r.set_defaults(func=_cmd_impastor_render)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 
 from impastor.multispectral import MIN_CHANNELS, MULTISPECTRAL_DESIGNS
@@ -83,10 +85,14 @@ def render_for_cli(
     light_position=DEFAULT_LIGHT_POSITION,
     light_luminance: float | None = None,
     progress=None,
+    tolerance: float | None = None,
 ) -> str:
     """Render the demo painting and write it as a PNG; return a one-line summary.
 
-    ``progress`` (a stream) gets a line per stage of the render with its time.
+    ``progress`` (a stream) gets a line per stage of the render with its time. With
+    ``tolerance``, N, K, S and the fail-safe come from it (:mod:`impastor.settings`); the
+    settings used and the promised bound are in the summary and in the PNG's ``specref`` text
+    chunk (JSON) either way.
 
     With ``counts_out``, the painting's XYZ also goes through the display per pixel (Eq. (1),
     Ferwerda: ``L_factor`` at the observer's angle from each screen point; the screen's diffuse
@@ -131,14 +137,35 @@ def render_for_cli(
             np.isfinite(light_luminance) and light_luminance >= 0,
             f"--light-luminance: must be >= 0 cd/m², got {light_luminance!r}",
         )
-    result = render_painting(light, size, method, progress=progress)
-    write_png(out, result["sRGB"])
+    if tolerance is None:
+        result = render_painting(light, size, method, progress=progress)
+    else:
+        from impastor.settings import render_painting_to_tolerance
+
+        result = render_painting_to_tolerance(light, size, tolerance, method, progress=progress)
+    write_png(out, result["sRGB"], {"specref": json.dumps(result["settings"])})
     seconds = sum(result["seconds"].values())
-    summary = f"wrote {out} ({size}×{size}, {light}, {method}, shading {seconds:.2f} s)"
+    summary = f"wrote {out} ({size}×{size}, {light}, {method}, shading {seconds:.2f} s"
+    summary += f"; {_describe_settings(result['settings'])})"
     if counts_out is not None:
         flare = {"screen_lux": screen_lux, "position": lamp, "luminance": light_luminance}
         summary += "; " + _write_counts(result["XYZ"], counts_out, geometry, observer, flare)
     return summary
+
+
+def _describe_settings(settings: dict) -> str:
+    """``N=32 K=32 S=36 fail-safe on``, and the tolerance's promise when there is one."""
+    text = (
+        f"N={settings['n_lights']} K={settings['n_samples']} S={settings['n_sectors']} "
+        f"fail-safe {'on' if settings['failsafe'] else 'off'}"
+    )
+    if settings.get("tolerance") is not None:
+        verdict = "within" if settings["met"] else "MISSES"
+        text += (
+            f", pilot error {100 * settings['pilot_error']:.2f} % {verdict} the tolerance "
+            f"{100 * settings['tolerance']:g} % (chosen in {settings['choose_seconds']:.1f} s)"
+        )
+    return text
 
 
 def painting_on_display(XYZ, geometry, observer, flare: dict, compensate: bool = True) -> dict:

@@ -201,13 +201,13 @@ def test_computing_functions_found_in_the_source(rows):
     } <= used
     # Source: impastor/point_lights.py, illuminance_point_lights's body comments "Eq. (2),
     # Ferwerda: ..."; median_cut places the lights (docstring and registry cites);
-    # impastor/painting.py, render_painting comments "Eq. (2), Ferwerda" over a call of it
+    # impastor/painting.py, shade_canvas comments "Eq. (2), Ferwerda" over a call of it
     row = rows["Ferwerda", 2]
     names = [f.name for f in row.computed_by]
     assert "impastor.point_lights.illuminance_point_lights" in names
     used = {f.name: f for f in row.used_by}
     assert "impastor.point_lights.median_cut" in used
-    assert used["impastor.painting.render_painting"].calls == (
+    assert used["impastor.painting.shade_canvas"].calls == (
         "impastor.point_lights.illuminance_point_lights",
     )
     # Source: phong_table/placement.py, table_importance_Wang's "Eq. (15), Wang et al." comment

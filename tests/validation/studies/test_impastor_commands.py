@@ -99,6 +99,7 @@ def test_cli_table1_writes_json(tmp_path, capsys):
         (["impastor", "table1", "--display", "/no/such.json"], "file not found"),
         (["impastor", "render", "--method", "nearest"], "unknown lighting method"),
         (["impastor", "render", "--light", "D66"], "unknown illuminant 'D66'"),
+        (["impastor", "render", "--tolerance", "0"], "--tolerance: must be a relative error > 0"),
     ],
 )
 def test_cli_bad_input_exits_2(argv, message, capsys):
@@ -115,6 +116,24 @@ def test_cli_render(tmp_path, capsys, monkeypatch):
         == 0
     )
     assert read_png(out).shape[:2] == (24, 24)
+
+
+def test_cli_render_to_a_tolerance_records_its_settings(tmp_path, capsys):
+    # the settings chosen and the promised bound: in the summary and in the PNG's text chunk
+    import json
+
+    import imageio.v3 as iio
+
+    out = tmp_path / "p.png"
+    argv = ["impastor", "render", "--size", "24", "--light", "A", "--tolerance", "0.05"]
+    assert main([*argv, "--out", str(out)]) == 0
+    summary = capsys.readouterr().out
+    assert "within the tolerance 5 %" in summary
+    settings = json.loads(iio.immeta(out)["specref"])
+    assert settings["tolerance"] == 0.05
+    assert settings["met"]
+    assert settings["pilot_error"] <= 0.05
+    assert f"N={settings['n_lights']} K={settings['n_samples']}" in summary
 
 
 def _tilted_booth():
@@ -185,6 +204,7 @@ def test_render_light_options_reach_the_counts(tmp_path, capsys, monkeypatch):
     import impastor.painting
 
     gray = {"XYZ": np.full((6, 6, 3), 40.0), "sRGB": np.full((6, 6, 3), 0.5), "seconds": {}}
+    gray["settings"] = {"n_lights": 32, "n_samples": 32, "n_sectors": 36, "failsafe": True}
     monkeypatch.setattr(impastor.painting, "render_painting", lambda *a, **k: gray)
     counts = {}
     for luminance in ("0", "2000"):

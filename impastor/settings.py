@@ -1,0 +1,443 @@
+"""The painting's settings from a tolerance: no more lights, samples and sectors than it needs.
+
+Ferwerda (§3.5) renders every painting with 32 median-cut lights N, 32 FIS samples K and a horizon
+map of 18 sectors (specref: 36, erratum E95), and specref's hybrid always runs its fail-safe
+(erratum E17). Whether a painting needs that much depends on its gloss, its relief and the light.
+:func:`settings_from_tolerance` asks the painting (erratum E96, specref's heuristic):
+
+1. a **pilot** (:class:`PaintingPilot`): the canvas's visible pixels at :data:`PILOT_SIZE`²
+   (about a thousand), with their brute-force radiance (:func:`painting_brute_force`: every light
+   pixel a point light with its own shadow test against a :data:`REFERENCE_SECTORS`-sector
+   horizon, and the specular integral summed over every light sub-pixel);
+2. a **descent** down each setting's ladder (:data:`LIGHT_LADDER`, :data:`SAMPLE_LADDER`,
+   :data:`SECTOR_LADDER`, the fail-safe off or on) from the top of all four: one rung at a time,
+   always the step that saves most of a frame's cost (:func:`frame_cost`), as long as the pilot's
+   error stays within :data:`PILOT_MARGIN` × the tolerance. When even the top misses it, the top
+   is kept and the settings say so (``met=False``).
+
+The error is the relative RMS of XYZ over the pixels (:func:`relative_rms_error`). The pilot's error
+at the chosen settings is the **promised bound**; the report checks the tolerance on held-out
+paintings, on frames at the render's resolution, against the same brute force, and times the
+frames against the fixed settings.
+
+References
+----------
+J. A. Ferwerda, "ImpastoR: A Realistic Surface Display System", ACM TAP 12(4), 2015.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from impastor._kernels import diffuse_brute_force_kernel
+from impastor.horizon import horizon_at_texels
+from impastor.multispectral import channels_to_XYZ
+from impastor.painting import (
+    HORIZON_SECTORS,
+    PaintingScene,
+    canvas_frame,
+    canvas_materials,
+    canvas_pixels,
+    impasto_painting,
+    lights_visibility,
+    painting_scene,
+    render_painting,
+    shade_canvas,
+)
+from impastor.point_lights import PointLights, illuminance_point_lights
+from impastor.specular_lighting import specular_brute_force
+from reference.errors import require
+from reference.registry import Method, Registry
+
+__all__ = [
+    "BRUTE_FORCE_METHODS",
+    "FIXED_SETTINGS",
+    "LIGHT_LADDER",
+    "PILOT_MARGIN",
+    "PILOT_SIZE",
+    "REFERENCE_SECTORS",
+    "SAMPLE_LADDER",
+    "SECTOR_LADDER",
+    "PaintingPilot",
+    "PaintingSettings",
+    "diffuse_brute_force",
+    "frame_cost",
+    "painting_brute_force",
+    "relative_rms_error",
+    "render_painting_to_tolerance",
+    "settings_from_tolerance",
+]
+
+#: The rungs each setting may take, cheapest first (N point lights, K FIS samples, S sectors).
+LIGHT_LADDER = (4, 8, 16, 32, 64)
+SAMPLE_LADDER = (4, 8, 16, 32, 64)
+SECTOR_LADDER = (6, 9, 12, 18, 24, 36, 48)
+#: The pilot's image side, pixels (the canvas's visible pixels at this resolution).
+PILOT_SIZE = 48
+#: The brute force's horizon: sectors (far beyond any rung) and specular sub-pixels per light pixel.
+REFERENCE_SECTORS = 144
+REFERENCE_SUPERSAMPLE = 2
+#: The pilot must meet this fraction of the tolerance: a frame's error was up to 1.27 times its
+#: pilot's on the design paintings (seeds 41-44).
+PILOT_MARGIN = 0.8
+
+
+@dataclass(frozen=True)
+class PaintingSettings:
+    """How much model a frame of the painting gets.
+
+    Attributes
+    ----------
+    n_lights, n_samples, n_sectors : int
+        Point lights N, FIS samples K and horizon sectors S.
+    failsafe : bool
+        Whether the hybrid runs its fail-safe (erratum E17).
+    tolerance : float or None
+        The relative RMS error asked for (None: fixed settings).
+    pilot_error : float or None
+        The pilot's error at these settings: the promised bound.
+    met : bool
+        False when even the top of every ladder missed the tolerance on the pilot.
+    """
+
+    n_lights: int
+    n_samples: int
+    n_sectors: int
+    failsafe: bool
+    tolerance: float | None = None
+    pilot_error: float | None = None
+    met: bool = True
+
+    def render_options(self) -> dict:
+        """The keyword arguments of :func:`render_painting` for these settings."""
+        return {
+            "n_lights": self.n_lights,
+            "n_samples": self.n_samples,
+            "n_sectors": self.n_sectors,
+            "failsafe": self.failsafe,
+        }
+
+
+#: The fixed settings: the paper's 32 lights and 32 samples, 36 sectors (E95), the fail-safe on.
+FIXED_SETTINGS = PaintingSettings(32, 32, HORIZON_SECTORS, True)
+
+
+def relative_rms_error(XYZ, XYZ_reference) -> float:
+    """Relative RMS error of a set of colours: ``‖XYZ − XYZ_ref‖ / ‖XYZ_ref‖`` over all pixels.
+
+    Parameters
+    ----------
+    XYZ, XYZ_reference : array_like, shape (n, 3)
+
+    Examples
+    --------
+    >>> relative_rms_error([[1.0, 1.0, 1.0], [2.0, 2.0, 2.0]], [[1.0, 1.0, 1.0], [2.0, 2.0, 1.0]])
+    0.28867513459481287
+    """
+    X, R = np.asarray(XYZ, dtype=np.float64), np.asarray(XYZ_reference, dtype=np.float64)
+    return float(np.sqrt(np.sum((X - R) ** 2) / np.sum(R**2)))
+
+
+def _every_pixel_lights(scene: PaintingScene) -> PointLights:
+    """Every pixel of the booth light a point light at its centre (the diffuse brute force)."""
+    plane = scene.plane
+    H, W = plane.shape
+    rows, cols = np.meshgrid(np.arange(H) + 0.5, np.arange(W) + 0.5, indexing="ij")
+    position = plane.pixel_positions(rows.ravel(), cols.ravel())
+    L = np.asarray(plane.image, dtype=np.float64).reshape(H * W, -1)
+    regions = [(i, i + 1, j, j + 1) for i in range(H) for j in range(W)]
+    spread = np.zeros(H * W)
+    return PointLights(position, L, regions, False, plane.n_light, plane.pixel_area, spread, "all")
+
+
+def diffuse_brute_force(scene: PaintingScene, px, horizon, backend: str = "numba", chunk=128):
+    """Illuminance at canvas pixels from every light pixel, each with its own shadow test.
+
+    Eq. (2), Ferwerda, with every pixel of the booth light a point light at its centre, shadowed
+    where its elevation is under the texel's horizon at its azimuth (``horizon_lookup``,
+    interpolated): the limit of the median-cut lights as N reaches the light's pixel count.
+
+    Parameters
+    ----------
+    scene : PaintingScene
+    px : canvas pixels (:func:`impastor.painting.canvas_pixels`)
+    horizon : ndarray, shape (n, S)
+        Horizon angles at the pixels' texels.
+    backend : {"numba", "numpy"}
+        The NumPy reference tests ``chunk`` pixels against all light pixels at a time.
+
+    Returns
+    -------
+    ndarray, shape (n, C)
+        Illuminance, lux (C = the light image's channels).
+
+    Examples
+    --------
+    >>> scene = painting_scene("D65", "hybrid", impasto_painting(16), light_resolution=(8, 4))
+    >>> px = canvas_pixels(scene.painting, 6)
+    >>> horizon = np.zeros((px.P.shape[0], 4))
+    >>> E = diffuse_brute_force(scene, px, horizon, "numpy")
+    >>> bool(np.allclose(E, diffuse_brute_force(scene, px, horizon, "numba"), rtol=1e-12))
+    True
+    """
+    every = _every_pixel_lights(scene)
+    horizon = np.ascontiguousarray(horizon, dtype=np.float64)
+    E = np.zeros((px.P.shape[0], every.L.shape[-1]))
+    if backend == "numba":
+        frame = np.array(canvas_frame())
+        diffuse_brute_force_kernel(
+            px.P, px.N, horizon, frame, every.position, every.L, np.asarray(every.n_light),
+            float(every.pixel_area), E,
+        )  # fmt: skip
+        return E
+    for start in range(0, px.P.shape[0], chunk):
+        block = slice(start, start + chunk)
+        visibility = lights_visibility(horizon[block], px.P[block], every)
+        E[block] = illuminance_point_lights(px.P[block], px.N[block], every, visibility)
+    return E
+
+
+def _diffuse_example(rng):
+    scene = painting_scene("D65", "hybrid", impasto_painting(16), light_resolution=(8, 4))
+    px = canvas_pixels(scene.painting, 6)
+    # horizons up to 75°: the ceiling (40°-90° above the canvas) is partly shadowed
+    return scene, px, rng.uniform(0.5, 1.3, (px.P.shape[0], 6))
+
+
+#: The brute-force references of the painting that have kernels (the specular one is
+#: ``impastor.specular_hybrid.SPECULAR_METHODS["brute_force"]``).
+BRUTE_FORCE_METHODS = Registry("painting brute force")
+BRUTE_FORCE_METHODS.register(
+    Method(
+        "diffuse",
+        diffuse_brute_force,
+        diffuse_brute_force_kernel,
+        "Eq. (2), Ferwerda (every light pixel, shadowed)",
+        _diffuse_example,
+    )
+)
+
+
+def painting_brute_force(scene: PaintingScene, px, backend: str = "numba"):
+    """Brute-force radiance of the painting at canvas pixels, per channel: the reference.
+
+    The diffuse radiance of Eq. (3), Ferwerda, from :func:`diffuse_brute_force` with the
+    horizon at :data:`REFERENCE_SECTORS` sectors, plus Eq. (4), Ferwerda, integrated over every
+    light sub-pixel (:func:`specular_brute_force`; no shadows, as FIS and the fail-safe's
+    unbiased estimate have none).
+
+    Parameters
+    ----------
+    scene : PaintingScene
+    px : canvas pixels (:func:`impastor.painting.canvas_pixels`)
+    backend : {"numba", "numpy"}
+
+    Returns
+    -------
+    ndarray, shape (n, 6)
+
+    Examples
+    --------
+    >>> scene = painting_scene("D65", "hybrid", impasto_painting(16), light_resolution=(8, 4))
+    >>> px = canvas_pixels(scene.painting, 6)
+    >>> painting_brute_force(scene, px, "numpy").shape == (px.P.shape[0], 6)
+    True
+    """
+    painting = scene.painting
+    horizon = horizon_at_texels(
+        painting["height"], painting["pixel_size"], px.row, px.col, REFERENCE_SECTORS, 32, backend
+    )
+    E = diffuse_brute_force(scene, px, horizon, backend)
+    rho_d, rho_s, alpha = canvas_materials(painting, scene.spectra, scene.design, px)
+    I_s = specular_brute_force(px.P, px.N, px.V, alpha, scene.plane, REFERENCE_SUPERSAMPLE, backend)
+    return rho_d * scene.S6 * E / np.pi + rho_s * scene.S6 * I_s
+
+
+class PaintingPilot:
+    """The pilot: a few thousand canvas pixels, their brute force, and any settings' error on them.
+
+    Parameters
+    ----------
+    scene : PaintingScene
+    size : int
+        The pilot's image side (its visible canvas pixels are the pilot's pixels).
+    backend : {"numba", "numpy"}
+
+    Attributes
+    ----------
+    reference : ndarray, shape (n, 3)
+        Brute-force XYZ at the pilot pixels (:func:`painting_brute_force`).
+    error : callable
+        ``error(n_lights, n_samples, n_sectors, failsafe)``: relative RMS error of the pipeline at
+        those settings on the pilot pixels (memoised).
+    """
+
+    def __init__(self, scene: PaintingScene, size: int = PILOT_SIZE, backend: str = "numba"):
+        painting = scene.painting
+        self.scene, self.backend = scene, backend
+        self.px = canvas_pixels(painting, size)
+        brute_force = painting_brute_force(scene, self.px, backend)
+        self.reference = channels_to_XYZ(brute_force, scene.design)
+        height, pixel_size, rows, cols = (
+            painting["height"], painting["pixel_size"], self.px.row, self.px.col
+        )  # fmt: skip
+        self.horizons = {
+            S: horizon_at_texels(height, pixel_size, rows, cols, S, 32, backend)
+            for S in SECTOR_LADDER
+        }
+        self.error = lru_cache(maxsize=None)(self._error)
+
+    def _error(self, n_lights: int, n_samples: int, n_sectors: int, failsafe: bool) -> float:
+        settings = {"n_lights": n_lights, "n_samples": n_samples, "failsafe": failsafe}
+        horizon = self.horizons[n_sectors]
+        L, _ = shade_canvas(self.scene, self.px, settings, lambda: horizon, self.backend)
+        return relative_rms_error(channels_to_XYZ(L, self.scene.design), self.reference)
+
+
+#: The ladders in the order of :class:`PaintingSettings`'s first four fields.
+_LADDERS = (LIGHT_LADDER, SAMPLE_LADDER, SECTOR_LADDER, (False, True))
+
+
+def frame_cost(n_lights: int, n_samples: int, n_sectors: int, failsafe: bool) -> float:
+    """A frame's cost model, in point-light evaluations per pixel (erratum E96).
+
+    The hybrid evaluates each point light six times per pixel (shadow test, diffuse, specular and
+    four sigma points), a FIS sample about as much as one and a half point lights over the K + K/2
+    samples of its two estimates, and its fail-safe about as much as 80 lights; a sector costs
+    only the horizon map's memory and precomputation (0.01). Fitted to frame times at 256²
+    on the design painting (seed 41); the report measures real frame times.
+
+    Examples
+    --------
+    >>> frame_cost(32, 32, 36, True), frame_cost(16, 16, 12, False)
+    (304.36, 112.12)
+    """
+    return 6.0 * n_lights + n_samples + 80.0 * bool(failsafe) + 0.01 * n_sectors
+
+
+def _descend(pilot: PaintingPilot, start: tuple, limit: float) -> tuple:
+    """From ``start``, one rung down at a time: the step that saves most cost within ``limit``."""
+    current = start
+    while True:
+        moves = []
+        for k, ladder in enumerate(_LADDERS):
+            rung = ladder.index(current[k])
+            if rung > 0:
+                candidate = (*current[:k], ladder[rung - 1], *current[k + 1 :])
+                moves.append((frame_cost(*current) - frame_cost(*candidate), candidate))
+        # cheapest first: the largest saving whose pilot error stays within the limit
+        for _, candidate in sorted(moves, key=lambda m: -m[0]):
+            if pilot.error(*candidate) <= limit:
+                current = candidate
+                break
+        else:
+            return current
+
+
+def _check_tolerance(tolerance) -> None:
+    require(
+        isinstance(tolerance, int | float) and np.isfinite(tolerance) and tolerance > 0,
+        f"--tolerance: must be a relative error > 0 (0.02 is 2 %), got {tolerance!r}",
+    )
+
+
+def settings_from_tolerance(
+    scene: PaintingScene,
+    tolerance: float,
+    pilot_size: int = PILOT_SIZE,
+    backend: str = "numba",
+    pilot: PaintingPilot | None = None,
+) -> PaintingSettings:
+    """The cheapest N, K, S and fail-safe whose pilot error is within ``tolerance`` (erratum E96).
+
+    From the top of every ladder, one rung down at a time, always the step that saves most of
+    :func:`frame_cost` while the pilot's error stays within ``PILOT_MARGIN × tolerance``.
+
+    Parameters
+    ----------
+    scene : PaintingScene
+        The painting, its light and its lighting method (:func:`painting_scene`).
+    tolerance : float
+        Relative RMS error of the frame's XYZ against brute force, > 0 (0.02 is 2 %).
+    pilot_size : int
+        The pilot's image side, pixels.
+    backend : {"numba", "numpy"}
+    pilot : PaintingPilot, optional
+        A pilot of this scene already made (several tolerances share one).
+
+    Returns
+    -------
+    PaintingSettings
+        With ``tolerance``, ``pilot_error`` (the promised bound) and ``met``.
+
+    Examples
+    --------
+    >>> scene = painting_scene("D65", "hybrid", impasto_painting(32, seed=5),
+    ...                        light_resolution=(16, 8))
+    >>> s = settings_from_tolerance(scene, 0.05, pilot_size=12, backend="numpy")
+    >>> s.met, s.pilot_error <= 0.05, s.n_lights in LIGHT_LADDER
+    (True, True, True)
+    """
+    _check_tolerance(tolerance)
+    pilot = pilot or PaintingPilot(scene, pilot_size, backend)
+    top = tuple(ladder[-1] for ladder in _LADDERS)
+    base = pilot.error(*top)
+    if base > PILOT_MARGIN * tolerance:
+        return PaintingSettings(*top, tolerance=float(tolerance), pilot_error=base, met=False)
+    chosen = _descend(pilot, top, PILOT_MARGIN * tolerance)
+    return PaintingSettings(*chosen, tolerance=float(tolerance), pilot_error=pilot.error(*chosen))
+
+
+def render_painting_to_tolerance(
+    light: str = "D65",
+    size: int = 256,
+    tolerance: float = 0.02,
+    method: str = "hybrid",
+    painting=None,
+    progress=None,
+    **options,
+) -> dict:
+    """:func:`render_painting` at the settings :func:`settings_from_tolerance` chooses.
+
+    Parameters
+    ----------
+    light, size, method, painting, progress
+        As in :func:`render_painting`.
+    tolerance : float
+        Relative RMS error against brute force, > 0.
+    **options
+        ``design``, ``light_resolution``, ``spectra``, ``backend`` of :func:`render_painting`.
+
+    Returns
+    -------
+    dict
+        As :func:`render_painting`; ``settings`` also holds ``tolerance``, ``pilot_error`` (the
+        promised bound), ``met`` and ``choose_seconds`` (the pilot's cost, not in ``seconds``).
+
+    Examples
+    --------
+    >>> out = render_painting_to_tolerance("A", 24, 0.05, painting=impasto_painting(32, seed=5),
+    ...     light_resolution=(16, 8), backend="numpy")
+    >>> out["settings"]["met"], out["settings"]["pilot_error"] <= 0.05
+    (True, True)
+    """
+    from reference.progress import StageTimer
+
+    _check_tolerance(tolerance)
+    painting = painting or impasto_painting(size)
+    keys = ("design", "light_resolution", "spectra")
+    scene_options = {k: options[k] for k in keys if k in options}
+    scene = painting_scene(light, method, painting, **scene_options)
+    timer = StageTimer(progress, f"settings for a tolerance of {tolerance:g}")
+    with timer.stage("pilot"):
+        chosen = settings_from_tolerance(
+            scene, tolerance, min(PILOT_SIZE, size), options.get("backend", "numba")
+        )
+    out = render_painting(
+        light, size, method, painting, progress=progress, **options, **chosen.render_options()
+    )
+    out["settings"] = asdict(chosen) | {"choose_seconds": timer.seconds["pilot"]}
+    return out

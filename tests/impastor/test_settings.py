@@ -1,0 +1,118 @@
+"""Settings from a tolerance: the brute force, the pilot's promise and the render's metadata."""
+
+import numpy as np
+import pytest
+
+from impastor.horizon import horizon_at_texels, horizon_map
+from impastor.multispectral import channels_to_XYZ
+from impastor.painting import canvas_pixels, impasto_painting, painting_scene, render_painting
+from impastor.settings import (
+    BRUTE_FORCE_METHODS,
+    FIXED_SETTINGS,
+    LIGHT_LADDER,
+    PaintingPilot,
+    diffuse_brute_force,
+    painting_brute_force,
+    relative_rms_error,
+    render_painting_to_tolerance,
+    settings_from_tolerance,
+)
+from reference.errors import SpecrefError
+
+
+@pytest.fixture(scope="module")
+def scene():
+    # a small held-out painting (seed 71; the ladders and the margin were set on seeds 41-44)
+    return painting_scene("A", "hybrid", impasto_painting(64, seed=71), light_resolution=(32, 16))
+
+
+def test_horizon_at_texels_is_the_map_at_those_texels(rng):
+    h = rng.random((24, 24)) * 2e-3
+    rows, cols = rng.integers(0, 24, 40), rng.integers(0, 24, 40)
+    full = horizon_map(h, 1e-3, 12, 8, "numba")
+    for backend in ("numpy", "numba"):
+        np.testing.assert_array_equal(
+            horizon_at_texels(h, 1e-3, rows, cols, 12, 8, backend), full[rows, cols]
+        )
+    with pytest.raises(SpecrefError, match="rows and cols must be indices"):
+        horizon_at_texels(h, 1e-3, [30], [0])
+
+
+@pytest.mark.parametrize("method", BRUTE_FORCE_METHODS.values(), ids=lambda m: m.name)
+def test_brute_force_kernels_agree_with_numpy(method, rng):
+    scene, px, horizon = method.example_inputs(rng)  # horizons on every side: shadows
+    numpy = method.reference(scene, px, horizon, "numpy")
+    kernel = method.reference(scene, px, horizon, "numba")
+    np.testing.assert_allclose(kernel, numpy, rtol=1e-12, atol=1e-12 * numpy.max())
+    # the horizons shadow part of the light, never add any
+    open_sky = diffuse_brute_force(scene, px, np.zeros_like(horizon), "numba")
+    assert (kernel <= open_sky * (1 + 1e-12)).all()
+    assert (kernel < 0.99 * open_sky).any()
+
+
+def test_many_median_cut_lights_converge_to_the_brute_force(scene):
+    # Eq. (2), Ferwerda: as N grows the median-cut lights' frame tends to the brute force
+    # (with the brute force's own horizon: only the lights' placement differs)
+    pilot = PaintingPilot(scene, 16)
+    errors = [pilot.error(n, 64, 48, True) for n in LIGHT_LADDER]
+    assert errors[-1] < errors[0] / 2
+    assert errors[-1] < 0.02
+
+
+def test_the_pilot_keeps_its_promise_on_the_frame(scene):
+    # the chosen settings meet the tolerance on the pilot and on a frame at a finer resolution,
+    # against the same brute force, and cost less than the fixed settings
+    from impastor.settings import frame_cost
+
+    pilot = PaintingPilot(scene, 24)
+    for tolerance in (0.02, 0.05):
+        chosen = settings_from_tolerance(scene, tolerance, pilot=pilot)
+        assert chosen.met
+        assert chosen.pilot_error <= tolerance
+        assert frame_cost(*chosen.render_options().values()) < frame_cost(
+            *FIXED_SETTINGS.render_options().values()
+        )
+        out = render_painting("A", 48, "hybrid", scene.painting, light_resolution=(32, 16),
+                              **chosen.render_options())  # fmt: skip
+        px = canvas_pixels(scene.painting, 48)
+        reference = channels_to_XYZ(painting_brute_force(scene, px), scene.design)
+        assert relative_rms_error(out["XYZ"][px.gbuffer.mask], reference) <= tolerance
+
+
+def test_an_unreachable_tolerance_says_so(scene):
+    pilot = PaintingPilot(scene, 16)
+    chosen = settings_from_tolerance(scene, 1e-5, pilot=pilot)
+    assert not chosen.met
+    assert chosen.render_options() == {
+        "n_lights": 64, "n_samples": 64, "n_sectors": 48, "failsafe": True
+    }  # fmt: skip
+    with pytest.raises(SpecrefError, match="--tolerance: must be a relative error > 0"):
+        settings_from_tolerance(scene, 0.0, pilot=pilot)
+
+
+def test_render_to_tolerance_records_its_settings(scene):
+    out = render_painting_to_tolerance(
+        "A", 32, 0.05, painting=scene.painting, light_resolution=(32, 16)
+    )
+    settings = out["settings"]
+    assert settings["tolerance"] == 0.05
+    assert settings["met"]
+    assert settings["pilot_error"] <= 0.05
+    assert settings["choose_seconds"] > 0
+    assert {"n_lights", "n_samples", "n_sectors", "failsafe"} <= set(settings)
+
+
+def test_without_the_failsafe_the_hybrid_is_its_per_pixel_blend(scene):
+    # failsafe=False keeps the per-pixel weights: the fail-safe's choice is all zeros
+    from impastor.painting import booth_plane_light
+    from impastor.point_lights import point_lights_from_plane
+    from impastor.specular_hybrid import specular_hybrid_parts
+
+    px = canvas_pixels(scene.painting, 12)
+    plane = booth_plane_light("incandescent", 32, 16)
+    lights = point_lights_from_plane(plane, "median_cut", 8)
+    alpha = np.full(px.P.shape[0], 0.08)
+    off = specular_hybrid_parts(px.P, px.N, px.V, alpha, plane, lights, 8, failsafe=False)
+    on = specular_hybrid_parts(px.P, px.N, px.V, alpha, plane, lights, 8)
+    assert not off["failsafe"].any()
+    np.testing.assert_array_equal(off["point_lights"], on["point_lights"])
