@@ -470,6 +470,10 @@ class _CanvasPixels(NamedTuple):
     col: np.ndarray
     N: np.ndarray
 
+    def subset(self, index) -> _CanvasPixels:
+        """The pixels at ``index`` (of the visible ones), without the G-buffer."""
+        return _CanvasPixels(None, *(x[index] for x in self[1:]))
+
 
 def canvas_pixels(painting: dict, size: int) -> _CanvasPixels:
     """The canvas seen from :data:`EYE` at ``size²`` pixels, normals from the height map.

@@ -40,6 +40,7 @@ from validation.report.sections import (
     display,
     examples,
     impastor,
+    impastor_settings,
     phong,
     polymer,
     polymer_scene,
@@ -103,7 +104,7 @@ PARTS: tuple[ReportPart, ...] = (
         "ferwerda",
         "Ferwerda: ImpastoR",
         "Six-channel multispectral rendering, Ward–Dür gloss, median cut, FIS and horizon shadows.",
-        (impastor.SECTION,),
+        (impastor.SECTION, impastor_settings.SECTION),
     ),
 )
 

@@ -1,0 +1,166 @@
+"""ImpastoR's settings from a tolerance against the fixed 32/32/36: frame time and error.
+
+:func:`tolerance_case` renders one held-out painting under one booth light at the fixed settings
+(:data:`impastor.settings.FIXED_SETTINGS`) and at the settings each tolerance chooses
+(:func:`impastor.settings.settings_from_tolerance`, one pilot for all), times the frames and
+measures each against the brute force (:func:`impastor.settings.painting_brute_force`) on pixels
+of the frame itself: the pilot's pixels are a coarser grid, so the promise is tested where it
+was not made. :func:`tolerance_study` runs the cases as tasks.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from impastor.multispectral import channels_to_XYZ
+from impastor.painting import (
+    cached_horizon_map,
+    canvas_pixels,
+    impasto_painting,
+    load_paint_spectra,
+    painting_scene,
+    render_painting,
+)
+from impastor.settings import (
+    FIXED_SETTINGS,
+    PILOT_SIZE,
+    PaintingPilot,
+    painting_brute_force,
+    relative_rms_error,
+    settings_from_tolerance,
+)
+
+__all__ = ["EQUAL_ERROR", "best_speedup_at_fixed_error", "tolerance_case", "tolerance_study"]
+
+
+def _frame(scene, light, size, settings, spectra, repeats, backend):
+    """The frame at ``settings`` and its best time of ``repeats`` (horizon map precomputed)."""
+    painting = scene.painting
+    cached_horizon_map(painting["height"], painting["pixel_size"], settings.n_sectors, 32, backend)
+    options = dict(
+        painting=painting, spectra=spectra, light_resolution=scene.plane.shape[::-1],
+        backend=backend, **settings.render_options(),
+    )  # fmt: skip
+    seconds = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        out = render_painting(light, size, "hybrid", **options)
+        seconds.append(time.perf_counter() - start)
+    return out["XYZ"], min(seconds)
+
+
+def tolerance_case(task) -> dict:
+    """One painting under one light: fixed settings and each tolerance's, timed and measured.
+
+    Parameters
+    ----------
+    task : tuple
+        ``(seed, light, tolerances, size, light_resolution, eval_pixels, repeats, backend)``:
+        the painting's seed, the illuminant, the tolerances (relative RMS), the frame's side,
+        the booth light's (W, H), how many frame pixels to measure (evenly spread), frames per
+        timing (the best counts) and the kernels' backend.
+
+    Returns
+    -------
+    dict
+        ``seed``, ``light``, ``pilot_seconds``, ``eval_pixels`` and ``rows``: per setting
+        (``"fixed"`` first, then each tolerance) ``label``, ``tolerance``, ``settings``
+        (N, K, S, fail-safe), ``pilot_error``, ``met``, ``choose_seconds``, ``frame_seconds``
+        and ``error`` (the frame's relative RMS against brute force).
+
+    Examples
+    --------
+    >>> case = tolerance_case((61, "A", (0.05,), 16, (16, 8), 40, 1, "numpy"))
+    >>> [r["label"] for r in case["rows"]], case["rows"][1]["met"]
+    (['fixed', '5 %'], True)
+    """
+    seed, light, tolerances, size, light_resolution, eval_pixels, repeats, backend = task
+    spectra = load_paint_spectra()
+    painting = impasto_painting(size, seed=seed)
+    scene = painting_scene(light, "hybrid", painting, light_resolution=light_resolution)
+    start = time.perf_counter()
+    pilot = PaintingPilot(scene, min(PILOT_SIZE, size), backend)
+    pilot_seconds = time.perf_counter() - start
+    px = canvas_pixels(painting, size)
+    index = np.unique(np.linspace(0, px.P.shape[0] - 1, eval_pixels).round().astype(int))
+    reference = channels_to_XYZ(
+        painting_brute_force(scene, px.subset(index), backend), scene.design
+    )
+    rows = []
+    for tolerance in (None, *tolerances):
+        start = time.perf_counter()
+        chosen = (
+            FIXED_SETTINGS
+            if tolerance is None
+            else settings_from_tolerance(scene, tolerance, pilot=pilot)
+        )
+        choose_seconds = time.perf_counter() - start
+        XYZ, seconds = _frame(scene, light, size, chosen, spectra, repeats, backend)
+        rows.append({
+            "label": "fixed" if tolerance is None else f"{100 * tolerance:g} %",
+            "tolerance": tolerance,
+            "settings": chosen.render_options(),
+            "pilot_error": chosen.pilot_error,
+            "met": chosen.met,
+            "choose_seconds": 0.0 if tolerance is None else choose_seconds,
+            "frame_seconds": seconds,
+            "error": relative_rms_error(XYZ[px.gbuffer.mask][index], reference),
+        })  # fmt: skip
+    return {
+        "seed": seed,
+        "light": light,
+        "pilot_seconds": pilot_seconds,
+        "eval_pixels": int(index.size),
+        "rows": rows,
+    }
+
+
+#: Errors within this factor of the fixed settings' count as equal: the frame's error is itself
+#: measured on a sample of its pixels.
+EQUAL_ERROR = 1.05
+
+
+def best_speedup_at_fixed_error(case: dict) -> float | None:
+    """The fixed frame's time over the fastest tolerance frame at no more than its error.
+
+    "No more" within :data:`EQUAL_ERROR`; None when no tolerance reached the fixed settings' error.
+
+    Examples
+    --------
+    >>> rows = [{"label": "fixed", "frame_seconds": 2.0, "error": 0.01},
+    ...         {"label": "1 %", "frame_seconds": 1.0, "error": 0.009},
+    ...         {"label": "2 %", "frame_seconds": 0.5, "error": 0.018}]
+    >>> best_speedup_at_fixed_error({"rows": rows})
+    2.0
+    """
+    fixed, *chosen = case["rows"]
+    times = [r["frame_seconds"] for r in chosen if r["error"] <= EQUAL_ERROR * fixed["error"]]
+    return fixed["frame_seconds"] / min(times) if times else None
+
+
+def tolerance_study(cases, run=None, **options) -> list[dict]:
+    """:func:`tolerance_case` for each ``(seed, light)`` of ``cases``, through ``run``.
+
+    Parameters
+    ----------
+    cases : sequence of (int, str)
+    run : callable, optional
+        ``run(function, tasks, desc)`` (the report's ``ctx.run_tasks``); default in turn.
+    **options
+        ``tolerances``, ``size``, ``light_resolution``, ``eval_pixels``, ``repeats``,
+        ``backend``.
+
+    Examples
+    --------
+    >>> cases = tolerance_study([(61, "D65")], tolerances=(0.05,), size=16,
+    ...                         light_resolution=(16, 8), eval_pixels=30, repeats=1,
+    ...                         backend="numpy")
+    >>> len(cases), cases[0]["light"]
+    (1, 'D65')
+    """
+    keys = ("tolerances", "size", "light_resolution", "eval_pixels", "repeats", "backend")
+    tasks = [(seed, light, *(options[k] for k in keys)) for seed, light in cases]
+    run = run or (lambda f, items, desc: [f(t) for t in items])
+    return run(tolerance_case, tasks, "ImpastoR settings from a tolerance")
