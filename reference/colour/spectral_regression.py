@@ -832,12 +832,18 @@ def _cv_scores(target: _Target, grid: _Grid) -> np.ndarray:
         augmented = target.augment is not None and max(weights) > 0
         extra = _augmentation_rows(target, train, held) if augmented else None
         for i, a in enumerate(weights):
-            for j, W in enumerate(_solutions(target, train, extra, a, points)):
-                P = X[held] @ W
-                if target.colorimetric:
-                    # the CV_PERCENTILE-th percentile of held-out ΔE94, both lights
-                    errors[i][j].extend(_delta_E94(spectra[held], P, Wl) for Wl in target.lights)
-                else:
+            estimates = np.array([X[held] @ W for W in _solutions(target, train, extra, a, points)])
+            if target.colorimetric:
+                # the CV_PERCENTILE-th percentile of held-out ΔE94, both lights: every grid
+                # point's estimates in one ΔE94 call per light (row by row, the same values)
+                truth = np.broadcast_to(spectra[held], estimates.shape)
+                for Wl in target.lights:
+                    dE = _delta_E94(truth.reshape(-1, truth.shape[-1]),
+                                    estimates.reshape(-1, truth.shape[-1]), Wl)  # fmt: skip
+                    for j, row in enumerate(dE.reshape(len(points), -1)):
+                        errors[i][j].append(row)
+            else:
+                for j, P in enumerate(estimates):
                     sq[i, j] += ((P - spectra[held]) ** 2).sum()
     if target.colorimetric:
         return np.array(
