@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import os
 from operator import attrgetter
 
 import numpy as np
@@ -108,12 +107,9 @@ def test_shipped_designs_record_their_provenance():
     assert training["n_kept"] + len(training["removed"]) == 220
 
 
-@pytest.mark.xslow
 def test_regenerating_a_box_design_reproduces_the_shipped_one():
     from validation.precompute.impastor_designs import Problem, fit_box, training_set
 
-    if not os.environ.get("SPECREF_XSLOW"):
-        pytest.fail("xslow test ran without SPECREF_XSLOW")
     R, _, _ = training_set()
     edges, _, M = fit_box(Problem(R), 4)
     shipped = json.loads(DESIGNS_FILE.read_text())["designs"]["box"]["4"]

@@ -188,9 +188,8 @@ def test_order_above_limit_refused():
         legendre_table(3001, [0.5])
 
 
-@pytest.mark.xslow
 def test_precomputed_sample_regenerates():
-    # Regenerate a sample of sh_basis.json with the script and compare (xslow).
+    # Regenerate a sample of sh_basis.json with the script and compare.
     from validation.precompute.sh_basis import compute
 
     _, points = _points()

@@ -125,7 +125,6 @@ def test_smits_round_trip_is_worse_than_the_regression(root4):
     assert np.isfinite(smits["A mean"])
 
 
-@pytest.mark.xslow
 @pytest.mark.parametrize(("kind", "degree"), [("root_polynomial", 4), ("polynomial", 4)])
 def test_smoothness_prior_does_not_reach_the_peak(kind, degree):
     # Erratum E44, what was tried: a second-difference smoothness prior with (λ, μ) chosen by
