@@ -380,11 +380,18 @@ _FORKED: dict = {}
 
 
 def _run_forked(index: int) -> tuple[int, SectionResult]:
-    """Run section ``index`` of the forked run (in a worker process, in the chart style)."""
+    """Run section ``index`` of the forked run (in a worker process, in the chart style).
+
+    Each process gets its share of the cores for BLAS and OpenMP (threadpoolctl): two
+    processes with a multithreaded BLAS each would run four threads on two cores, and such
+    oversubscription makes matrix-heavy sections two to three times slower.
+    """
     import matplotlib
+    from threadpoolctl import threadpool_limits
 
     run = _FORKED["run"]
-    with matplotlib.rc_context(CHART_STYLE):
+    share = max(1, (os.cpu_count() or 1) // run.jobs)
+    with threadpool_limits(limits=share), matplotlib.rc_context(CHART_STYLE):
         return index, _run_section(run, run.sections[index], None)
 
 
