@@ -80,7 +80,7 @@ PILOT_SIZE = 48
 #: The brute force's horizon: sectors (far beyond any rung) and specular sub-pixels per light pixel.
 REFERENCE_SECTORS = 144
 REFERENCE_SUPERSAMPLE = 2
-#: The pilot must meet this fraction of the tolerance: a frame's error was up to 1.27 times its
+#: The pilot must meet this fraction of the tolerance: a frame's error was up to 1.2 times its
 #: pilot's on the design paintings (seeds 41-44).
 PILOT_MARGIN = 0.8
 
