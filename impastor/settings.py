@@ -63,6 +63,7 @@ __all__ = [
     "SECTOR_LADDER",
     "PaintingPilot",
     "PaintingSettings",
+    "check_tolerance",
     "diffuse_brute_force",
     "frame_cost",
     "painting_brute_force",
@@ -337,11 +338,23 @@ def _descend(pilot: PaintingPilot, start: tuple, limit: float) -> tuple:
             return current
 
 
-def _check_tolerance(tolerance) -> None:
+def check_tolerance(tolerance) -> float:
+    """``tolerance`` as a float after checking it is a relative error > 0 (one-line error).
+
+    Examples
+    --------
+    >>> check_tolerance(0.02)
+    0.02
+    >>> check_tolerance(float("nan"))
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: --tolerance: must be a relative error > 0 (0.02 is 2 %), got nan
+    """
     require(
         isinstance(tolerance, int | float) and np.isfinite(tolerance) and tolerance > 0,
         f"--tolerance: must be a relative error > 0 (0.02 is 2 %), got {tolerance!r}",
     )
+    return float(tolerance)
 
 
 def settings_from_tolerance(
@@ -381,7 +394,7 @@ def settings_from_tolerance(
     >>> s.met, s.pilot_error <= 0.05, s.n_lights in LIGHT_LADDER
     (True, True, True)
     """
-    _check_tolerance(tolerance)
+    check_tolerance(tolerance)
     pilot = pilot or PaintingPilot(scene, pilot_size, backend)
     top = tuple(ladder[-1] for ladder in _LADDERS)
     base = pilot.error(*top)
@@ -426,7 +439,7 @@ def render_painting_to_tolerance(
     """
     from reference.progress import StageTimer
 
-    _check_tolerance(tolerance)
+    check_tolerance(tolerance)
     painting = painting or impasto_painting(size)
     keys = ("design", "light_resolution", "spectra")
     scene_options = {k: options[k] for k in keys if k in options}

@@ -93,6 +93,18 @@ def _write_errors(path):
         raise translated from None
 
 
+def _require_file_target(path: Path) -> None:
+    """Refuse a destination that is a folder or an existing special file (a device, a FIFO).
+
+    Writing is a rename onto ``path``: onto ``/dev/null`` it would replace the device node.
+    """
+    require(not path.is_dir(), f"{path}: cannot write ({WRITE_ERRORS[errno.EISDIR]})")
+    require(
+        not path.exists() or path.is_file(),
+        f"{path}: cannot write (a device or special file, not a regular file; give a file name)",
+    )
+
+
 @contextlib.contextmanager
 def atomic_write(path, mode: str = "wb"):
     """Open a temporary file beside ``path``; on success, sync it and rename it to ``path``.
@@ -124,7 +136,7 @@ def atomic_write(path, mode: str = "wb"):
     """
     path = Path(path)
     with _write_errors(path):
-        require(not path.is_dir(), f"{path}: cannot write ({WRITE_ERRORS[errno.EISDIR]})")
+        _require_file_target(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
         try:
@@ -159,7 +171,7 @@ def atomic_path(path, suffix: str = ""):
     """
     path = Path(path)
     with _write_errors(path):
-        require(not path.is_dir(), f"{path}: cannot write ({WRITE_ERRORS[errno.EISDIR]})")
+        _require_file_target(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
         os.close(fd)
@@ -227,10 +239,14 @@ def check_output_file(path) -> Path:
     Traceback (most recent call last):
     ...
     reference.errors.SpecrefError: ...: cannot write (is a folder; give a file name)
+    >>> check_output_file("/dev/null")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: /dev/null: cannot write (a device or special file, ...
     """
     path = Path(path)
     with _write_errors(path):
-        require(not path.is_dir(), f"{path}: cannot write ({WRITE_ERRORS[errno.EISDIR]})")
+        _require_file_target(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, probe = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".probe", dir=path.parent)
         try:

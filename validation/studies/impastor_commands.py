@@ -112,10 +112,19 @@ def render_for_cli(
     from impastor.painting import PAINTING_LIGHTING_METHODS, render_painting
     from reference.colour.spectra import spectrum_from_dataset
     from reference.errors import require_positive_int
+    from reference.files import check_output_file
     from reference.images.formats import write_png
 
     PAINTING_LIGHTING_METHODS.lookup(method)
     size = require_positive_int(size, "--size", 4096)
+    if tolerance is not None:
+        from impastor.settings import check_tolerance
+
+        check_tolerance(tolerance)
+    # outputs proved writable before the render (the pilot alone takes seconds)
+    for path in (out, counts_out):
+        if path is not None:
+            check_output_file(path)
     spectrum_from_dataset("illuminant", light)
     if counts_out is not None:
         from reference.display.pipeline import ScreenGeometry, screen_view_angles

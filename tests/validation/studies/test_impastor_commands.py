@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -216,3 +217,46 @@ def test_render_light_options_reach_the_counts(tmp_path, capsys, monkeypatch):
         counts[luminance] = read_png(out)
     assert (counts["2000"] <= counts["0"]).all()
     assert (counts["2000"] < counts["0"]).any()
+
+
+@pytest.mark.parametrize("value", ["nan", "-0.02", "inf", "0"])
+def test_cli_render_refuses_a_bad_tolerance_before_any_work(value, tmp_path, capsys):
+    out = tmp_path / "p.png"
+    argv = ["impastor", "render", "--size", "24", "--tolerance", value, "--out", str(out)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "--tolerance: must be a relative error > 0" in err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("where", ["folder", "file in the path", "device", "read-only"])
+def test_cli_render_refuses_an_unwritable_output_before_the_pilot(where, tmp_path, capsys):
+    # the pilot of --tolerance takes seconds: an output that cannot be written is refused first,
+    # in one line, and an earlier output is left as it was
+    import os
+
+    if where == "read-only" and os.geteuid() == 0:
+        pytest.skip("root writes anywhere")
+    earlier = tmp_path / "ro" / "p.png"
+    earlier.parent.mkdir()
+    earlier.write_bytes(b"earlier")
+    out = {
+        "folder": tmp_path,
+        "file in the path": earlier / "p.png",  # its parent is a file
+        "device": "/dev/null",  # a rename onto it would replace the device node
+        "read-only": earlier,
+    }
+    if where == "read-only":
+        earlier.parent.chmod(0o500)
+    argv = ["impastor", "render", "--size", "24", "--tolerance", "0.05", "--out", str(out[where])]
+    try:
+        assert main(argv) == 2
+    finally:
+        earlier.parent.chmod(0o700)
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "Traceback" not in err
+    assert "settings for a tolerance" not in err  # refused before the pilot started
+    assert earlier.read_bytes() == b"earlier"
+    assert not Path("/dev/null").is_file()
