@@ -112,19 +112,11 @@ def render_for_cli(
     from impastor.painting import PAINTING_LIGHTING_METHODS, render_painting
     from reference.colour.spectra import spectrum_from_dataset
     from reference.errors import require_positive_int
-    from reference.files import check_output_file
     from reference.images.formats import write_png
 
     PAINTING_LIGHTING_METHODS.lookup(method)
     size = require_positive_int(size, "--size", 4096)
-    if tolerance is not None:
-        from impastor.settings import check_tolerance
-
-        check_tolerance(tolerance)
-    # outputs proved writable before the render (the pilot alone takes seconds)
-    for path in (out, counts_out):
-        if path is not None:
-            check_output_file(path)
+    _check_before_render(tolerance, out, counts_out)
     spectrum_from_dataset("illuminant", light)
     if counts_out is not None:
         from reference.display.pipeline import ScreenGeometry, screen_view_angles
@@ -160,6 +152,19 @@ def render_for_cli(
         flare = {"screen_lux": screen_lux, "position": lamp, "luminance": light_luminance}
         summary += "; " + _write_counts(result["XYZ"], counts_out, geometry, observer, flare)
     return summary
+
+
+def _check_before_render(tolerance, out, counts_out) -> None:
+    """The tolerance, and outputs proved writable, before the render (the pilot takes seconds)."""
+    from reference.files import check_output_file
+
+    if tolerance is not None:
+        from impastor.settings import check_tolerance
+
+        check_tolerance(tolerance)
+    for path in (out, counts_out):
+        if path is not None:
+            check_output_file(path)
 
 
 def _describe_settings(settings: dict) -> str:
