@@ -7,7 +7,7 @@ from pathlib import Path
 
 
 def _cmd_equations(args) -> int:
-    from reference.files import write_text_atomic
+    from reference.files import check_output_file, write_text_atomic
     from validation.report.equations import (
         REGENERATE,
         collect_citations,
@@ -15,6 +15,8 @@ def _cmd_equations(args) -> int:
         render_equation_index,
     )
 
+    if args.out and not args.check:
+        check_output_file(args.out)  # before the index's seconds of parsing
     citations = collect_citations()
     text = render_equation_index(citations=citations)
     if args.check:

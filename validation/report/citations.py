@@ -175,7 +175,17 @@ def _comment_blocks(source: str) -> list[tuple[int, str]]:
 
 
 def _read(path: Path, root: Path):
-    """``(source, tree, module, owners)`` of one source file, its owners visited."""
+    """``(source, tree, module, owners)`` of one source file, its owners visited.
+
+    Parsed once per file version in a process (the index reads every file twice: citations and
+    calls); an edited file (another size or modification time) is parsed again.
+    """
+    stat = path.stat()
+    return _read_version(path, root, stat.st_mtime_ns, stat.st_size)
+
+
+@functools.lru_cache(maxsize=4096)
+def _read_version(path: Path, root: Path, mtime_ns: int, size: int):
     source = path.read_text(encoding="utf-8")
     tree = ast.parse(source)
     module = path.relative_to(root).as_posix()[:-3].replace("/", ".").removesuffix(".__init__")

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from reference.colour.spectral_regression import REGRESSION_LOSSES
+from reference.colour.spectral_regression import REGRESSION_FEATURES, REGRESSION_LOSSES
 from reference.colour.spectral_target import HELD_OUT_SETS, OTHER_TEST_SET, TARGET_AUGMENTATIONS
 from reference.data import data_path
 from validation.report import (
@@ -37,6 +37,33 @@ PANORAMA = data_path("environments/venice_sunset_1k.hdr")
 PICKS = {"sun": (0.47, 0.52), "sky": (0.2, 0.3), "water": (0.8, 0.5), "building": (0.55, 0.1)}
 # Rows of the methods table that quick mode leaves out (features, degree).
 QUICK_LEAVE_OUT = (("polynomial", 4), ("polynomial", 5))
+#: Sizes per mode: the methods table's rows left out (features, degree), the features whose fits
+#: the checks gate and the losses table fits (``shipped``), the colour.recovery upsamplers, and
+#: the panorama's box filter. ``tiny`` is for tests: every figure, table and check, on degree-1
+#: features (its checks gate nothing; the targets are for root-polynomial 4).
+SETTINGS = {
+    "full": {"leave_out": (), "shipped": SHIPPED, "recovery": RECOVERY_METHODS, "box": 2},
+    "quick": {
+        "leave_out": QUICK_LEAVE_OUT,
+        "shipped": SHIPPED,
+        # Jakob 2019 builds its coefficient table (36 s): the full report runs it
+        "recovery": tuple(m for m in RECOVERY_METHODS if m != "Jakob 2019"),
+        "box": 8,
+    },
+    "tiny": {
+        "leave_out": (
+            *(("polynomial", d) for d in REGRESSION_FEATURES.lookup("polynomial")),
+            *(
+                ("root_polynomial", d)
+                for d in REGRESSION_FEATURES.lookup("root_polynomial")
+                if d > 1
+            ),
+        ),
+        "shipped": ("root_polynomial", 1),
+        "recovery": ("Mallett 2019", "Otsu 2018", "Smits 1999"),
+        "box": 32,
+    },
+}
 # Targets (erratum E44; ΔE94, held-out ColorChecker unless said otherwise).
 TARGETS = {"D65 mean": 0.77, "D65 max": 1.5, "A mean": 1.0, "in-sample mean": 0.8}
 
@@ -54,12 +81,12 @@ def relit_sRGB(spectra, illuminant: str) -> np.ndarray:
     return XYZ_to_display_RGB(np.asarray(spectra) @ W, "sRGB", white_XYZ(W), "CAT02")
 
 
-def _panorama(quick: bool) -> dict:
+def _panorama(box: int) -> dict:
     from reference.colour.upsampling import default_regression
     from reference.geometry.camera import downsample_box
     from reference.images.formats import read_hdr
 
-    RGB = downsample_box(read_hdr(PANORAMA), 8 if quick else 2)
+    RGB = downsample_box(read_hdr(PANORAMA), box)
     spectra = default_regression().predict(RGB)
     picks = {
         name: spectra[int(r * RGB.shape[0]), int(c * RGB.shape[1])].tolist()
@@ -73,10 +100,10 @@ def _serial(function, tasks) -> list:
     return [function(task) for task in tasks]
 
 
-def _loss_figures(task: tuple[str, str]) -> dict:
+def _loss_figures(task: tuple[str, int, str, str]) -> dict:
     """A task of the section: the shipped features fitted with a loss and an augmentation."""
-    loss, augmentation = task
-    model, in_sample = fit_target(*SHIPPED, CAMERA, loss=loss, augmentation=augmentation)
+    kind, degree, loss, augmentation = task
+    model, in_sample = fit_target(kind, degree, CAMERA, loss=loss, augmentation=augmentation)
     return {
         "loss": loss,
         "augmentation": augmentation,
@@ -88,8 +115,12 @@ def _loss_figures(task: tuple[str, str]) -> dict:
     }
 
 
-def spectral_environments(ctx: ReportContext | None = None) -> SectionData:
+def spectral_environments(
+    ctx: ReportContext | None = None, settings: dict | None = None
+) -> SectionData:
     """Every feature family and degree, the colour.recovery upsamplers, and a relit panorama.
+
+    ``settings``: one of :data:`SETTINGS` (default: the context's quick or full ones).
 
     Returns
     -------
@@ -101,20 +132,23 @@ def spectral_environments(ctx: ReportContext | None = None) -> SectionData:
         ``results["recovery"]``: ``{method: figures on the ColorChecker}``; ``results["picks"]``:
         spectra of picked panorama pixels; ``arrays["panorama"]``: the RGB and relit images.
     """
-    quick = bool(ctx and ctx.quick)
+    s = settings or SETTINGS["quick" if ctx is None or ctx.quick else "full"]
     data = SectionData()
     data.results["camera"] = CAMERA
+    data.results["shipped"] = list(s["shipped"])
     run = ctx.run_tasks if ctx is not None else None
     # quick mode leaves out the two largest feature sets (about 90 s with the products, E44)
-    leave_out = QUICK_LEAVE_OUT if quick else ()
-    data.results["regression"] = regression_table(CAMERA, HELD_OUT_SETS, run, leave_out)
-    data.results["left_out"] = [list(pair) for pair in leave_out]
+    data.results["regression"] = regression_table(CAMERA, HELD_OUT_SETS, run, s["leave_out"])
+    data.results["left_out"] = [list(pair) for pair in s["leave_out"]]
     # Erratum E44: the shipped features fitted with each loss and augmentation, on every set the
     # design never saw
-    fits = [(loss, a) for loss in REGRESSION_LOSSES.names() for a in TARGET_AUGMENTATIONS.names()]
+    fits = [
+        (*s["shipped"], loss, a)
+        for loss in REGRESSION_LOSSES.names()
+        for a in TARGET_AUGMENTATIONS.names()
+    ]
     data.results["losses"] = (run or _serial)(_loss_figures, fits)
-    methods = [m for m in RECOVERY_METHODS if not (quick and m == "Jakob 2019")]
-    data.results["recovery"] = {m: recovery_figures(m, (CC,))[CC] for m in methods}
+    data.results["recovery"] = {m: recovery_figures(m, (CC,))[CC] for m in s["recovery"]}
     # Benchmark (make bench): spectralize throughput relative to the bare matrix product
     medians = {
         r.get("extra_info", {}).get("role"): r["stats"]["median"]
@@ -127,7 +161,7 @@ def spectral_environments(ctx: ReportContext | None = None) -> SectionData:
             "spectralize_s": medians["spectralize"],
             "throughput_ratio": medians["baseline"] / medians["spectralize"],
         }
-    panorama = _panorama(quick)
+    panorama = _panorama(s["box"])
     data.results["picks"] = panorama["picks"]
     data.arrays["panorama"] = panorama
     return data
@@ -244,11 +278,19 @@ def _method_tables(ctx: ReportContext, data: SectionData) -> list:
                 ""
                 if "Jakob 2019" in rec
                 else " (quick settings: Jakob 2019 left out, 36 s; specref report --full runs it)"
+                if data.results.get("left_out")
+                else ""
             ),
             "{:.3g}",
         )
     )
     return blocks
+
+
+def _features_label(data: SectionData) -> str:
+    """The shipped features as words, e.g. ``root-polynomial 4``."""
+    kind, degree = data.results.get("shipped", SHIPPED)
+    return f"{kind.replace('_', '-')} {degree}"
 
 
 def _loss_table(data: SectionData) -> list:
@@ -286,8 +328,9 @@ def _loss_table(data: SectionData) -> list:
                 "RMS",
             ],
             rows,
-            "Root-polynomial 4 fitted with each loss and augmentation (erratum E44), every set "
-            f"the design never saw; {OTHER_TEST_SET} was measured after the choices were made, "
+            f"{_features_label(data).capitalize()} fitted with each loss and augmentation "
+            f"(erratum E44), every set the design never saw; {OTHER_TEST_SET} was measured "
+            "after the choices were made, "
             "ΔE94",
             "{:.3g}",
         )
@@ -355,7 +398,8 @@ def _panorama_blocks(ctx: ReportContext, data: SectionData) -> list:
 
 def checks(data: SectionData) -> list[Check]:
     """The targets (erratum E44) for the shipped choice (root-polynomial, degree 4, noise-free)."""
-    row = _row(*SHIPPED, False, data)
+    kind, degree = data.results.get("shipped", SHIPPED)
+    row = _row(kind, degree, False, data)
     cc = row["held_out"][CC]
     measured = {
         "D65 mean": cc["D65 mean"],
@@ -365,7 +409,7 @@ def checks(data: SectionData) -> list[Check]:
     }
     found = [
         Check(
-            f"{key} ΔE94, root-polynomial 4, {CAMERA}",
+            f"{key} ΔE94, {_features_label(data)}, {CAMERA}",
             f"<= {TARGETS[key]}",
             value,
             value <= TARGETS[key],
@@ -397,10 +441,11 @@ def checks(data: SectionData) -> list[Check]:
 
 def headlines(data: SectionData) -> list[Headline]:
     """The summary's figures: the held-out ColorChecker under D65 and relit under A."""
-    cc = _row(*SHIPPED, False, data)["held_out"][CC]
+    kind, degree = data.results.get("shipped", SHIPPED)
+    cc = _row(kind, degree, False, data)["held_out"][CC]
     return [
         Headline(
-            f"camera RGB to 41 bands (root-polynomial 4, {CAMERA}): held-out ColorChecker "
+            f"camera RGB to 41 bands ({_features_label(data)}, {CAMERA}): held-out ColorChecker "
             f"ΔE94 mean {cc['D65 mean']:.2f}, max {cc['D65 max']:.2f}",
             "paper: 0.77 mean, 3.16 peak, in-sample; targets ≤ 0.77 and ≤ 1.5",
         ),

@@ -1,32 +1,77 @@
-"""The "Spectral environments" report section, quick mode, through the runner."""
+"""The "Spectral environments" report section: every figure, table and check on tiny settings.
+
+The targets themselves are the report's (``specref report``, root-polynomial 4); the suite checks
+the section's machinery here and the regression's figures in tests/validation/studies.
+"""
+
+import json
 
 import pytest
 
-from validation.report.runner import run_report
+from validation.report import ReportContext, to_jsonable
+from validation.report.sections.spectral_env import (
+    SETTINGS,
+    checks,
+    headlines,
+    present,
+    spectral_environments,
+)
 
 
-@pytest.mark.slow
-def test_report_spectral_env_section_quick(tmp_path):
-    results = run_report(tmp_path / "r", effort="quick", only=["spectral-env"], progress=False)
-    section = results["sections"]["spectral-env"]
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("spectral-env")
+    ctx = ReportContext(folder, quick=True, section="spectral-env")
+    data = spectral_environments(ctx, SETTINGS["tiny"])
+    return ctx, data, folder
+
+
+def test_tiny_settings_give_every_table_row_and_fit(tiny):
+    _, data, _ = tiny
+    section = data.results
     rows = section["regression"]
-    # every degree of both families but polynomial 4 and 5 (quick mode), with and without noise
-    assert len(rows) == 2 * (3 + 4)
-    assert section["left_out"] == [["polynomial", 4], ["polynomial", 5]]
+    # the one degree tiny keeps, with and without noise; the rest named as left out
+    assert [(r["features"], r["degree"], r["noise"]) for r in rows] == [
+        ("root_polynomial", 1, False),
+        ("root_polynomial", 1, True),
+    ]
+    assert ["root_polynomial", 2] in section["left_out"]
+    assert ["polynomial", 1] in section["left_out"]
     assert set(section["recovery"]) == {"Mallett 2019", "Otsu 2018", "Smits 1999"}
     # erratum E44: each loss with and without the products; the shipped row is the table's row
     fits = {(f["loss"], f["augmentation"]): f for f in section["losses"]}
     assert set(fits) == {(a, b) for a in ("colorimetric", "spectral") for b in ("products", "none")}
     assert fits["colorimetric", "none"]["augment_weight"] == 0.0
-    shipped = next(
-        r for r in rows if (r["features"], r["degree"], r["noise"]) == ("root_polynomial", 4, False)
-    )
+    shipped = rows[0]
     assert shipped["augment_weight"] == fits["colorimetric", "products"]["augment_weight"] > 0
-    names = [c["name"] for c in results["checks"] if c["section"] == "spectral-env"]
-    assert len(names) == 4
-    images = sorted(p.name for p in (tmp_path / "r" / "images").iterdir())
+    # the same fit: the losses table adds the set measured after the choices
+    loss_fit = fits["colorimetric", "products"]["held_out"]
+    assert {name: loss_fit[name] for name in shipped["held_out"]} == shipped["held_out"]
+    json.dumps(to_jsonable(section))
+
+
+def test_checks_and_headlines_name_the_features_they_gate(tiny):
+    _, data, _ = tiny
+    found = checks(data)
+    assert len(found) == 4
+    assert all("root-polynomial 1, " in c.name for c in found)
+    cc = data.results["regression"][0]["held_out"]["ColorChecker N Ohta"]
+    measured = {c.name.split(" ΔE94")[0]: c.measured for c in found}
+    assert measured["D65 mean"] == cc["D65 mean"]
+    assert measured["A mean"] == cc["A mean"]
+    assert all(c.passed == (c.measured <= float(c.target[3:])) for c in found)
+    assert "root-polynomial 1" in headlines(data)[0].text
+
+
+def test_present_writes_every_image_and_table(tiny):
+    ctx, data, folder = tiny
+    blocks = present(ctx, data)
+    images = sorted(p.name for p in (folder / "images").iterdir())
     assert images == [
         "spectral-env-degree.png",
         "spectral-env-panorama.png",
         "spectral-env-picks.png",
     ]
+    captions = " ".join(getattr(b, "caption", "") for b in blocks)
+    assert "Root-polynomial 1 fitted with each loss" in captions
+    assert "root_polynomial 2" in captions  # the left-out rows are named
