@@ -223,12 +223,19 @@ def test_real_scheduler_and_workers_on_loopback(tmp_path):
         logs.close()
 
 
-def test_report_sections_on_a_cluster_equal_serial(client, tmp_path):
-    # specref report --scheduler: a section's tasks (here the hybrid's held-out cases) run on
-    # the cluster and give the serial figures
+def test_report_sections_on_a_cluster_equal_serial(client, tmp_path, monkeypatch):
+    # specref report --scheduler: a section's tasks (here the hybrid's held-out cases, on the
+    # section's tiny sizes with two paintings) run on the cluster and give the serial figures
+    import dataclasses
+
     import numpy as np
 
     from validation.report.runner import run_report
+    from validation.report.sections import impastor
+
+    tiny = impastor.TINY
+    two = dataclasses.replace(tiny, held_out={**tiny.held_out, "n_paintings": 2})
+    monkeypatch.setattr(impastor, "QUICK", two)
 
     def held_out(scheduler, folder):
         results = run_report(
@@ -244,6 +251,7 @@ def test_report_sections_on_a_cluster_equal_serial(client, tmp_path):
     distributed, where_distributed = held_out(client.scheduler.address, "b")
     assert (where, where_distributed) == ("serial", client.scheduler.address)
     assert distributed["cases"] == serial["cases"]
+    assert len(serial["per_case"]) >= 2
     for got, want in zip(distributed["per_case"], serial["per_case"], strict=True):
         np.testing.assert_allclose(got["ratio"], want["ratio"], rtol=1e-12, atol=0)
 

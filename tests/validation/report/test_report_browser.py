@@ -11,6 +11,8 @@ import pytest
 from reference.browser import INSTALL_HINT, find_chromium
 from validation.report.browser import check_report_page
 from validation.report.runner import PARTS, run_report
+from validation.report.sections import impastor, phong
+from validation.report.sections.phong import PhongStudy
 
 pytestmark = pytest.mark.skipif(
     find_chromium() is None or shutil.which("chromedriver") is None, reason=INSTALL_HINT
@@ -23,10 +25,18 @@ pytestmark = pytest.mark.skipif(
 SMALL_REPORT = ("spectral-core", "phong", "display-calibration", "impastor")
 
 
+#: The Phong section's tiny sizes (an 8² image, one material): the page, not the figures, is tested.
+PHONG_TINY = PhongStudy(8, False, 1, (25,), ("R1",), ("near",), (10,), (50,), (10,), 64, True)
+
+
 @pytest.fixture(scope="module")
 def quick_report(tmp_path_factory):
+    # Every part's page on small sizes: the Phong and ImpastoR sections on their tiny settings
     out = tmp_path_factory.mktemp("report")
-    results = run_report(out, "quick", only=list(SMALL_REPORT), progress=False, screenshot=True)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(phong, "QUICK", PHONG_TINY)
+        patch.setattr(impastor, "QUICK", impastor.TINY)
+        results = run_report(out, "quick", only=list(SMALL_REPORT), progress=False, screenshot=True)
     return out, results
 
 

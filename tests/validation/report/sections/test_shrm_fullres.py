@@ -1,6 +1,6 @@
 """Report section "SHRMs on full-resolution maps" and validation.studies.shrm_fullres."""
 
-from pathlib import Path
+import copy
 
 import numpy as np
 import pytest
@@ -8,7 +8,7 @@ import pytest
 from reference.images.formats import write_exr
 from validation.report import ReportContext
 from validation.report.sections.shrm_fullres import SECTION, checks, fullres_study, present
-from validation.studies.shrm_fullres import fullres_case, sphere_points
+from validation.studies.shrm_fullres import sphere_points
 
 
 @pytest.fixture(scope="module")
@@ -20,8 +20,24 @@ def sun_map(tmp_path_factory):
     return write_exr(tmp_path_factory.mktemp("env") / "sun.exr", sky)
 
 
-def test_the_split_beats_the_shrm_alone_under_a_sun(sun_map):
-    row = fullres_case((sun_map, "ggx", 0.2, 8, None, 0.005))
+@pytest.fixture(scope="module")
+def study(sun_map, tmp_path_factory):
+    # The section's study on the sun map: GGX alpha 0.2 and the tabulated GGX alpha 0.3
+    folder = tmp_path_factory.mktemp("fullres")
+    settings = {
+        "rows": None,
+        "pixels": 8,
+        "brdfs": (("ggx", 0.2), ("table", 0.3)),
+        "label": "test",
+        "targets": True,
+    }
+    ctx = ReportContext(folder, section=SECTION.name)
+    return ctx, fullres_study(ctx, settings, [sun_map]), folder
+
+
+def test_the_split_beats_the_shrm_alone_under_a_sun(study):
+    row = study[1].results["cases"][0]
+    assert (row["brdf"], row["alpha"]) == ("ggx", 0.2)
     assert row["residual_texels"] > 0
     # the sun goes to the residual and is summed exactly: far closer than the SHRM alone
     assert row["split"]["pct_of_peak"] < 0.2 * row["shrm"]["pct_of_peak"]
@@ -34,16 +50,9 @@ def test_the_split_beats_the_shrm_alone_under_a_sun(sun_map):
     assert np.isfinite(row["mc"]["pct_of_peak"])
 
 
-def test_checks_follow_the_targets_and_quick_mode_has_none(sun_map, tmp_path):
-    settings = {
-        "rows": None,
-        "pixels": 6,
-        "brdfs": (("ggx", 0.3), ("ward_isotropic", 0.3)),
-        "label": "test",
-        "targets": True,
-    }
-    ctx = ReportContext(Path(tmp_path), section=SECTION.name)
-    data = fullres_study(ctx, settings, [sun_map])
+def test_checks_follow_the_targets_and_quick_mode_has_none(study):
+    ctx, data, folder = study
+    data = copy.deepcopy(data)
     found = checks(data)
     assert len(found) == 2
     for check, row in zip(found, data.results["cases"], strict=True):
@@ -55,14 +64,14 @@ def test_checks_follow_the_targets_and_quick_mode_has_none(sun_map, tmp_path):
     data.results["targets"] = False
     assert checks(data) == []
     blocks = present(ctx, data)
-    assert (tmp_path / "images" / "shrm-fullres-time-error.png").exists()
+    assert (folder / "images" / "shrm-fullres-time-error.png").exists()
     assert len(blocks[-1].rows) == 2
 
 
-def test_a_tabulated_brdf_goes_through_the_same_path(sun_map):
+def test_a_tabulated_brdf_goes_through_the_same_path(study):
     # erratum E94: a BRDF table (GGX alpha 0.3 tabulated) renders through the split like an
     # analytic BRDF, against a brute force over the same table
-    table = fullres_case((sun_map, "table", 0.3, 8, None, 0.005))
+    table = study[1].results["cases"][1]
     assert table["brdf"] == "table"
     assert table["residual_texels"] > 0
     assert table["split"]["pct_of_peak"] <= 1.0
