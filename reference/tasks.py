@@ -34,6 +34,9 @@ __all__ = [
     "dask_client",
     "run_tasks",
     "scheduler_address",
+    "specref_identity",
+    "usable_workers",
+    "worker_problems",
 ]
 
 #: The environment variable that names a remote scheduler.
@@ -183,8 +186,10 @@ def dask_client(
                 "for a local cluster"
             ) from None
         try:
+            usable_workers(client, address, timeout)
             yield client
         finally:
+            _USABLE.pop(id(client), None)
             client.close()
         return
     workers = n_workers or os.cpu_count() or 1
@@ -200,6 +205,98 @@ def dask_client(
         Client(cluster) as client,
     ):
         yield client
+
+
+def specref_identity() -> dict:
+    """What a process runs: specref's version and Python's, to compare a worker with its client.
+
+    Runs on each worker (``Client.run``); a worker that cannot import specref fails to load it.
+
+    Examples
+    --------
+    >>> sorted(specref_identity())
+    ['python', 'specref']
+    """
+    import importlib.metadata
+    import platform
+
+    return {
+        "specref": importlib.metadata.version("specref"),
+        "python": ".".join(platform.python_version_tuple()[:2]),
+    }
+
+
+def worker_problems(identities: dict, expected: dict) -> dict[str, str]:
+    """``worker -> why it cannot run this client's tasks``, from each worker's identity.
+
+    ``identities`` maps worker addresses to :func:`specref_identity` results, or to the exception
+    a worker returned instead (it could not import specref).
+
+    Examples
+    --------
+    >>> me = {"specref": "0.1.0", "python": "3.11"}
+    >>> found = {"tcp://a:1": me, "tcp://b:2": {**me, "specref": "0.0.9"},
+    ...          "tcp://c:3": ModuleNotFoundError("No module named 'reference'")}
+    >>> for worker, why in worker_problems(found, me).items():
+    ...     print(worker, why)
+    tcp://b:2 specref 0.0.9, the client runs 0.1.0
+    tcp://c:3 cannot import specref (ModuleNotFoundError: No module named 'reference')
+    """
+    problems = {}
+    for worker, found in sorted(identities.items()):
+        if isinstance(found, BaseException):
+            # Dask wraps an error it could not rebuild on the client in a plain Exception whose
+            # text is the worker's repr of it
+            why = str(found) if type(found) is Exception else f"{type(found).__name__}: {found}"
+            problems[worker] = f"cannot import specref ({why})"
+            continue
+        differ = [
+            f"{key} {found.get(key)}, the client runs {value}"
+            for key, value in expected.items()
+            if found.get(key) != value
+        ]
+        if differ:
+            problems[worker] = "; ".join(differ)
+    return problems
+
+
+def usable_workers(client, address: str, timeout: float | None = None) -> list[str]:
+    """The workers of a remote scheduler that run this specref; the others are refused.
+
+    Waits up to ``timeout`` seconds (:func:`connect_timeout`) for a first worker, asks every worker
+    for its :func:`specref_identity`, prints one line per refused worker on stderr (its address and
+    the difference) and keeps the rest. When a worker was refused, tasks go to the kept ones only
+    (:func:`run_tasks`); otherwise to any worker, so workers that join later or restart after a
+    crash take tasks too.
+
+    Raises
+    ------
+    SpecrefError
+        No worker joined within ``timeout``, or none can run this specref (one line naming each).
+    """
+    timeout = connect_timeout() if timeout is None else timeout
+    try:
+        client.wait_for_workers(1, timeout=timeout)
+    except TimeoutError:
+        raise SpecrefError(
+            f"--scheduler {address}: no worker joined within {timeout:g} s; start one with "
+            f"`dask worker {address} --preload validation.worker`"
+        ) from None
+    identities = client.run(specref_identity, on_error="return")
+    problems = worker_problems(identities, specref_identity())
+    good = sorted(set(identities) - set(problems))
+    if not good:
+        listed = "; ".join(f"{worker}: {problem}" for worker, problem in problems.items())
+        raise SpecrefError(f"--scheduler {address}: no usable worker ({listed})")
+    for worker, problem in problems.items():
+        sys.stderr.write(f"specref: refused worker {worker}: {problem}\n")
+    if problems:  # tasks go to the kept workers only (with none refused: to any, as workers come)
+        _USABLE[id(client)] = good
+    return good
+
+
+#: Workers :func:`usable_workers` kept, per client (``id``), for :func:`run_tasks`.
+_USABLE: dict[int, list[str]] = {}
 
 
 def run_tasks(
@@ -259,7 +356,9 @@ def _gather(client, function, tasks, show, desc, retries) -> list:
     from distributed import as_completed
     from tqdm import tqdm
 
-    futures = client.map(function, tasks, pure=False, retries=retries)
+    # a remote scheduler's workers that run this specref (usable_workers); None: any worker
+    workers = _USABLE.get(id(client))
+    futures = client.map(function, tasks, pure=False, retries=retries, workers=workers)
     with tqdm(total=len(futures), desc=desc, disable=not show, leave=False) as bar:
         for _ in as_completed(futures):
             bar.update()

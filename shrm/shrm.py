@@ -155,7 +155,13 @@ def _polar_rotate_each(x, a, P):
     """``Y(a) x`` with one angle per row or column (``a`` broadcast against ``x[..., :1]``)."""
     l, m = sh_degrees_orders(P)
     partner = l * l + l - m
-    return np.cos(np.abs(m) * a) * x + np.sign(m) * np.sin(np.abs(m) * a) * x[..., partner]
+    # cos(|m| a) x_m + sgn(m) sin(|m| a) x_-m, in place on two full-size arrays (x is large:
+    # rows × columns × channels × (P+1)²)
+    out = np.multiply(np.cos(np.abs(m) * a), x)
+    swapped = x[..., partner]
+    swapped *= np.sign(m) * np.sin(np.abs(m) * a)
+    out += swapped
+    return out
 
 
 @dataclass(frozen=True, eq=False)

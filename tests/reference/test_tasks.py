@@ -1,5 +1,6 @@
 """Tasks on Dask: identical to a serial run, survive a killed worker, and a real scheduler."""
 
+import contextlib
 import os
 import shutil
 import signal
@@ -157,60 +158,27 @@ def test_the_wait_for_a_scheduler_is_a_setting(monkeypatch):
         pass
 
 
-def test_real_scheduler_and_workers_on_loopback(tmp_path):
-    # As a user would start them: `dask scheduler`, two `dask worker`s; stopped by process id.
+@contextlib.contextmanager
+def _dask_processes(tmp_path, worker_envs, preload=True):
+    """A real `dask scheduler` and one `dask worker` per environment, on 127.0.0.1.
+
+    As a user would start them (with ``--preload validation.worker``); stopped by process id.
+    Yields the scheduler's address.
+    """
     dask = os.path.join(os.path.dirname(sys.executable), "dask")
     port = _free_port()
     address = f"tcp://127.0.0.1:{port}"
-    env = {**os.environ, "PYTHONPATH": os.getcwd()}
-    logs = open(tmp_path / "dask.log", "wb")  # noqa: SIM115 - closed in finally
-    procs = [
-        subprocess.Popen(
-            [
-                dask,
-                "scheduler",
-                "--host",
-                "127.0.0.1",
-                "--port",
-                str(port),
-                "--dashboard-address",
-                ":0",
-                "--no-show",
-            ],
-            stdout=logs,
-            stderr=logs,
-            env=env,
-        )
-    ]
+    logs = open(tmp_path / "dask.log", "ab")  # noqa: SIM115 - closed in finally
+    scheduler = [dask, "scheduler", "--host", "127.0.0.1", "--port", str(port)]
+    scheduler += ["--dashboard-address", ":0", "--no-show"]
+    worker = [dask, "worker", address, "--nthreads", "1", "--host", "127.0.0.1", "--no-dashboard"]
+    worker += ["--preload", "validation.worker"] if preload else []
+    base = {**os.environ, "PYTHONPATH": os.getcwd()}
+    procs = [subprocess.Popen(scheduler, stdout=logs, stderr=logs, env=base)]
     try:
-        for _ in range(2):
-            procs.append(
-                subprocess.Popen(
-                    [
-                        dask,
-                        "worker",
-                        address,
-                        "--nthreads",
-                        "1",
-                        "--host",
-                        "127.0.0.1",
-                        "--no-dashboard",
-                    ],
-                    stdout=logs,
-                    stderr=logs,
-                    env=env,
-                )
-            )
-        with dask_client(address, timeout=60) as c:
-            c.wait_for_workers(2, timeout=120)
-            results = run_tasks(seeded_sum, TASKS[:8], client=c, progress=False)
-        assert results == run_tasks(seeded_sum, TASKS[:8], scheduler="serial", progress=False)
-        # through the environment variable as well
-        os.environ["SPECREF_SCHEDULER"] = address
-        try:
-            assert run_tasks(abs, [-2, 3], progress=False) == [2, 3]
-        finally:
-            del os.environ["SPECREF_SCHEDULER"]
+        for env in worker_envs:
+            procs.append(subprocess.Popen(worker, stdout=logs, stderr=logs, env={**base, **env}))
+        yield address
     finally:
         for proc in reversed(procs):
             os.kill(proc.pid, signal.SIGTERM)
@@ -221,6 +189,68 @@ def test_real_scheduler_and_workers_on_loopback(tmp_path):
                 os.kill(proc.pid, signal.SIGKILL)
                 proc.wait()
         logs.close()
+
+
+def test_real_scheduler_and_workers_on_loopback(tmp_path):
+    # As a user would start them: `dask scheduler`, two `dask worker`s; stopped by process id.
+    with _dask_processes(tmp_path, [{}, {}]) as address:
+        with dask_client(address, timeout=60) as c:
+            c.wait_for_workers(2, timeout=120)
+            results = run_tasks(seeded_sum, TASKS[:8], client=c, progress=False)
+            # the preload ran: each worker imported specref and says which it runs
+            assert set(c.run(lambda dask_worker: dask_worker.specref_identity["specref"]).values())
+        assert results == run_tasks(seeded_sum, TASKS[:8], scheduler="serial", progress=False)
+        # through the environment variable as well
+        os.environ["SPECREF_SCHEDULER"] = address
+        try:
+            assert run_tasks(abs, [-2, 3], progress=False) == [2, 3]
+        finally:
+            del os.environ["SPECREF_SCHEDULER"]
+
+
+def _without_specref(tmp_path) -> dict:
+    # A worker environment where `import reference` fails, as on a machine without specref
+    fake = tmp_path / "no-specref" / "reference"
+    fake.mkdir(parents=True)
+    (fake / "__init__.py").write_text('raise ImportError("specref is not installed here")\n')
+    return {"PYTHONPATH": str(fake.parent)}
+
+
+def test_a_worker_without_specref_is_refused_in_one_line(tmp_path, capsys):
+    # A sweep whose only worker cannot import specref ends within 60 s: one line, exit 2
+    from validation.cli import main
+
+    sweep = tmp_path / "s.toml"
+    sweep.write_text(
+        'kind = "phong"\n[grid]\nmaterials = ["R1"]\nviews = ["near"]\nplacements = ["uniform"]\n'
+        'interpolations = ["linear"]\nentries = [25]\nresolution = 8\n'
+    )
+    with _dask_processes(tmp_path, [_without_specref(tmp_path)], preload=False) as address:
+        start = time.monotonic()
+        code = main(["sweep", str(sweep), "-o", str(tmp_path / "out.csv"), "--scheduler", address])
+        seconds = time.monotonic() - start
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2
+    assert seconds < 60
+    assert len(err) == 1, err
+    assert f"--scheduler {address}: no usable worker (" in err[0]
+    assert "cannot import specref (ImportError('specref is not installed here'))" in err[0]
+    assert not (tmp_path / "out.csv").exists()
+
+
+def test_a_mixed_cluster_runs_on_the_workers_that_have_specref(tmp_path, capsys):
+    # One worker with specref, one without: the second is refused in one line, the tasks run
+    with _dask_processes(tmp_path, [{}, _without_specref(tmp_path)], preload=False) as address:
+        from distributed import Client
+
+        with Client(address, timeout=60) as c:  # both workers joined
+            c.wait_for_workers(2, timeout=120)
+        with dask_client(address, timeout=60) as c:
+            results = run_tasks(seeded_sum, TASKS[:6], client=c, progress=False)
+    assert results == run_tasks(seeded_sum, TASKS[:6], scheduler="serial", progress=False)
+    refused = [line for line in capsys.readouterr().err.splitlines() if "refused worker" in line]
+    assert len(refused) >= 1
+    assert "cannot import specref" in refused[-1]
 
 
 def test_report_sections_on_a_cluster_equal_serial(client, tmp_path, monkeypatch):
