@@ -20,6 +20,7 @@ import contextlib
 import logging
 import os
 import sys
+import weakref
 from collections.abc import Callable, Sequence
 
 from reference.errors import SpecrefError, require
@@ -189,7 +190,7 @@ def dask_client(
             usable_workers(client, address, timeout)
             yield client
         finally:
-            _USABLE.pop(id(client), None)
+            _USABLE.pop(client, None)
             client.close()
         return
     workers = n_workers or os.cpu_count() or 1
@@ -273,6 +274,16 @@ def usable_workers(client, address: str, timeout: float | None = None) -> list[s
     ------
     SpecrefError
         No worker joined within ``timeout``, or none can run this specref (one line naming each).
+
+    Examples
+    --------
+    >>> class Client:  # a stand-in for distributed.Client: two workers, one without specref
+    ...     def wait_for_workers(self, n, timeout):
+    ...         pass
+    ...     def run(self, function, on_error):
+    ...         return {"tcp://a:1": function(), "tcp://b:2": ImportError("no specref")}
+    >>> usable_workers(Client(), "tcp://s:8786")  # stderr: specref: refused worker tcp://b:2: ...
+    ['tcp://a:1']
     """
     timeout = connect_timeout() if timeout is None else timeout
     try:
@@ -291,12 +302,12 @@ def usable_workers(client, address: str, timeout: float | None = None) -> list[s
     for worker, problem in problems.items():
         sys.stderr.write(f"specref: refused worker {worker}: {problem}\n")
     if problems:  # tasks go to the kept workers only (with none refused: to any, as workers come)
-        _USABLE[id(client)] = good
+        _USABLE[client] = good
     return good
 
 
-#: Workers :func:`usable_workers` kept, per client (``id``), for :func:`run_tasks`.
-_USABLE: dict[int, list[str]] = {}
+#: Workers :func:`usable_workers` kept, per client, for :func:`run_tasks` (gone with the client).
+_USABLE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def run_tasks(
@@ -357,7 +368,7 @@ def _gather(client, function, tasks, show, desc, retries) -> list:
     from tqdm import tqdm
 
     # a remote scheduler's workers that run this specref (usable_workers); None: any worker
-    workers = _USABLE.get(id(client))
+    workers = _USABLE.get(client)
     futures = client.map(function, tasks, pure=False, retries=retries, workers=workers)
     with tqdm(total=len(futures), desc=desc, disable=not show, leave=False) as bar:
         for _ in as_completed(futures):
