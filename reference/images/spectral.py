@@ -33,16 +33,11 @@ from pathlib import Path
 
 import numpy as np
 
-from reference.errors import SpecrefError, require
+from reference.errors import SpecrefError, require, require_positive_int
 from reference.files import atomic_path
 from reference.geometry.envmap import check_latlong_shape
 from reference.images.formats import exr_write_error, read_exr, read_hdr, spectral_channel_names
-from reference.images.zarr_store import (
-    open_zarr_image,
-    rows_per_chunk_for,
-    write_zarr_blocks,
-    write_zarr_image,
-)
+from reference.images.zarr_store import open_zarr_image, rows_per_chunk_for, write_zarr_blocks
 
 __all__ = [
     "SPECTRAL_FORMATS",
@@ -269,13 +264,16 @@ class PanoramaRows:
         self.streamed = streamed
         self._read, self._close = read, close
 
-    def read(self, row0: int, row1: int) -> np.ndarray:
-        """Rows ``row0 <= y < row1`` (top to bottom), ``(row1 - row0, W, C)`` float64."""
+    def read(self, row0: int, row1: int, dtype=np.float64) -> np.ndarray:
+        """Rows ``row0 <= y < row1`` (top to bottom), ``(row1 - row0, W, C)`` of ``dtype``.
+
+        ``float32`` (what the files hold) reads without a float64 copy: half the memory.
+        """
         require(
             0 <= row0 < row1 <= self.height,
             f"{self.path}: rows {row0}-{row1} outside 0-{self.height}",
         )
-        return self._read(row0, row1)
+        return self._read(row0, row1, np.dtype(dtype))
 
     def close(self) -> None:
         """Close the file."""
@@ -292,7 +290,12 @@ class PanoramaRows:
 
 def _whole(path, image, names) -> PanoramaRows:
     return PanoramaRows(
-        path, image.shape[0], image.shape[1], names, lambda a, b: image[a:b], streamed=False
+        path,
+        image.shape[0],
+        image.shape[1],
+        names,
+        lambda a, b, dtype: np.asarray(image[a:b], dtype=dtype),
+        streamed=False,
     )
 
 
@@ -327,8 +330,8 @@ def _open_exr_rows(path: Path) -> PanoramaRows:
         names.sort(key=lambda n: (order.get(n, 4), position[n]))
     FLOAT = Imath.PixelType(Imath.PixelType.FLOAT)
 
-    def read(row0, row1):
-        out = np.empty((row1 - row0, width, len(names)))
+    def read(row0, row1, dtype):
+        out = np.empty((row1 - row0, width, len(names)), dtype=dtype)
         try:
             for c, name in enumerate(names):
                 data = handle.channel(name, FLOAT, int(y0) + row0, int(y0) + row1 - 1)
@@ -387,7 +390,7 @@ def _open_hdr_rows(path: Path) -> PanoramaRows:
     state = {"buffer": b"", "row": 0}
     worst = 4 + 4 * width + 4 * (width // 128 + 1)  # a scanline's most bytes (RLE or flat)
 
-    def read(row0, row1):
+    def read(row0, row1, dtype):
         require(row0 == state["row"], f"{path}: Radiance rows are read in order, from row 0")
         buffer, p = state["buffer"], 0
         for row in range(row0, row1):
@@ -407,7 +410,7 @@ def _open_hdr_rows(path: Path) -> PanoramaRows:
                 f"{path}: cannot read Radiance HDR rows {row0}-{row1 - 1} "
                 f"({error.__class__.__name__})"
             ) from None
-        return np.asarray(image, dtype=np.float64).reshape(row1 - row0, width, 3)
+        return np.asarray(image, dtype=dtype).reshape(row1 - row0, width, 3)
 
     return PanoramaRows(path, height, width, ["R", "G", "B"], read, handle.close)
 
@@ -446,7 +449,7 @@ def _open_tiff_rows(path: Path) -> PanoramaRows:
         f"{path}: {image.shape[2]} samples per pixel but {len(names)} wavelengths",
     )
     return PanoramaRows(
-        path, image.shape[0], image.shape[1], names, lambda a, b: np.array(image[a:b], float)
+        path, image.shape[0], image.shape[1], names, lambda a, b, dtype: np.array(image[a:b], dtype)
     )
 
 
@@ -455,8 +458,8 @@ def _open_zarr_rows(path: Path) -> PanoramaRows:
     store = open_zarr_image(path)
     height, width, _ = store.shape
 
-    def read(row0, row1):
-        return np.asarray(store.array[row0:row1], dtype=np.float64)
+    def read(row0, row1, dtype):
+        return np.asarray(store.array[row0:row1], dtype=dtype)
 
     return PanoramaRows(path, height, width, store.channels, read)
 
@@ -576,10 +579,19 @@ def spectralize_file(panorama, model, out, rows_per_block: int | None = None) ->
 def convert_to_zarr(
     source, out, rows_per_chunk: int | None = None, compression: str = "blosc-lz4"
 ) -> dict:
-    """Convert a panorama file (``.exr``, ``.hdr``, spectral ``.tif``) to a Zarr store.
+    """Convert a panorama file (``.exr``, ``.hdr``, spectral ``.tif``) to a Zarr store, streamed.
 
-    The source is read by :func:`read_environment_file`; the store is
-    written chunk by chunk. Returns a summary (shape, chunks, compression ratio).
+    The source is read a chunk of rows at a time (:func:`open_panorama_rows`: OpenEXR scanline
+    windows, Radiance scanlines, a memory-mapped TIFF) and each chunk is written as it is read
+    (``write_zarr_blocks``), so the resident memory is a few chunks whatever the panorama's size:
+    one chunk of rows as float64 as read, its float32 copy and the compressor's output (about
+    3.5 × one float32 chunk, :data:`~reference.images.zarr_store.CHUNK_BYTES` by default;
+    docs/scale-out.md states the measured peak). Files that cannot be read by rows (compressed
+    TIFF, rotated Radiance; ``streamed`` False in the summary) are read whole. Nothing is left at
+    ``out`` when a chunk holds NaN or infinity.
+
+    Returns a summary: the shape, ``rows_per_chunk``, ``chunks``, the compression and its ratio,
+    and ``streamed``.
 
     Examples
     --------
@@ -588,17 +600,32 @@ def convert_to_zarr(
     >>> with tempfile.TemporaryDirectory() as d:
     ...     _ = write_exr(os.path.join(d, "m.exr"), np.ones((4, 8, 3), dtype=np.float32))
     ...     info = convert_to_zarr(os.path.join(d, "m.exr"), os.path.join(d, "m.zarr"), 2)
-    >>> info["chunks"], info["channels"], info["compression"]
-    (2, 3, 'blosc-lz4')
+    >>> info["chunks"], info["channels"], info["compression"], info["streamed"]
+    (2, 3, 'blosc-lz4', True)
     """
-    image, names = read_environment_file(source)
-    check_latlong_shape(image.shape, str(source))
-    require(np.isfinite(image).all(), f"{source}: radiance must be finite, found NaN or inf")
-    if rows_per_chunk is None:
-        rows_per_chunk = rows_per_chunk_for(image.shape[1], image.shape[2], image.shape[0])
-    write_zarr_image(out, image, names, rows_per_chunk=rows_per_chunk, compression=compression)
+    with open_panorama_rows(source) as rows:
+        height, width, n = rows.height, rows.width, len(rows.names)
+        check_latlong_shape((height, width, n), str(source))
+        if rows_per_chunk is None:
+            rows_per_chunk = rows_per_chunk_for(width, n, height)
+        rows_per_chunk = min(
+            require_positive_int(rows_per_chunk, "rows per chunk", 1 << 20), height
+        )
+
+        def chunks():
+            for row0 in range(0, height, rows_per_chunk):
+                row1 = min(row0 + rows_per_chunk, height)
+                block = rows.read(row0, row1, np.float32)  # the store's type: no float64 copy
+                require(
+                    np.isfinite(block).all(),
+                    f"{source}: radiance must be finite, found NaN or inf (rows {row0}-{row1 - 1})",
+                )
+                yield block
+
+        write_zarr_blocks(
+            out, height, width, rows.names, chunks(), rows_per_chunk, compression=compression
+        )
     stored = sum(f.stat().st_size for f in Path(out).rglob("*") if f.is_file())
-    height, width, n = image.shape
     return {
         "out": str(out),
         "height": height,
@@ -608,4 +635,5 @@ def convert_to_zarr(
         "chunks": -(-height // rows_per_chunk),
         "compression": compression,
         "ratio": height * width * n * 4 / max(stored, 1),
+        "streamed": rows.streamed,
     }

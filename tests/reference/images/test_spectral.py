@@ -138,7 +138,7 @@ def test_spectralize_reads_the_panorama_by_row_blocks(tmp_path, rng, monkeypatch
     def spy(path):
         rows = opened(path)
         read = rows._read
-        rows._read = lambda a, b: calls.append((a, b)) or read(a, b)
+        rows._read = lambda a, b, dtype: calls.append((a, b)) or read(a, b, dtype)
         return rows
 
     monkeypatch.setattr(spectral_images, "open_panorama_rows", spy)

@@ -173,7 +173,41 @@ def test_cli_convert_refuses_non_finite_input_in_one_line(tmp_path, capsys, bad)
     write_exr(tmp_path / "bad.exr", image)
     assert main(["env", "convert", str(tmp_path / "bad.exr"), str(tmp_path / "b.zarr")]) == 2
     err = capsys.readouterr().err.strip()
-    assert err.endswith("bad.exr: radiance must be finite, found NaN or inf")
+    # the chunk that holds it is named (8 rows: one chunk)
+    assert err.endswith("bad.exr: radiance must be finite, found NaN or inf (rows 0-7)")
     assert "\n" not in err
     assert "Traceback" not in err
     assert not (tmp_path / "b.zarr").exists()
+
+
+@pytest.mark.parametrize("suffix", [".exr", ".hdr"])
+def test_convert_streams_by_chunks_and_keeps_every_value(tmp_path, suffix, monkeypatch):
+    # OpenEXR scanlines and Radiance rows are read a chunk at a time, never the whole image; the
+    # store holds the values the whole-image reader gives
+    import imagecodecs
+
+    import reference.images.spectral as spectral
+    from reference.images.formats import read_image, write_exr
+
+    image = np.random.default_rng(3).random((24, 48, 3)).astype(np.float32) * 50
+    path = tmp_path / f"m{suffix}"
+    if suffix == ".exr":
+        write_exr(path, image)
+    else:
+        path.write_bytes(imagecodecs.rgbe_encode(image))
+    windows = []
+    opened = spectral.open_panorama_rows
+
+    def spy(source):
+        rows = opened(source)
+        read = rows._read
+        rows._read = lambda a, b, dtype: windows.append((a, b)) or read(a, b, dtype)
+        return rows
+
+    monkeypatch.setattr(spectral, "open_panorama_rows", spy)
+    info = spectral.convert_to_zarr(path, tmp_path / "m.zarr", rows_per_chunk=5)
+    assert info["streamed"]
+    assert windows == [(0, 5), (5, 10), (10, 15), (15, 20), (20, 24)]
+    np.testing.assert_array_equal(
+        open_zarr_image(tmp_path / "m.zarr").read(), read_image(path).astype(np.float32)
+    )
