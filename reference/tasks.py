@@ -26,15 +26,23 @@ from collections.abc import Callable, Sequence
 from reference.errors import SpecrefError, require
 
 __all__ = [
+    "CHUNKS_PER_WORKER",
     "LOCAL",
+    "MMAP_SETTING",
     "SCHEDULER_ENV",
     "SERIAL",
     "TIMEOUT_ENV",
+    "TRIM_SETTING",
+    "WORKER_MMAP_BYTES",
+    "WORKER_TRIM_BYTES",
     "add_scheduler_option",
+    "chunk_size",
     "connect_timeout",
     "dask_client",
+    "run_chunk",
     "run_tasks",
     "scheduler_address",
+    "set_malloc_trim",
     "specref_identity",
     "usable_workers",
     "worker_problems",
@@ -193,8 +201,11 @@ def dask_client(
             _USABLE.pop(client, None)
             client.close()
         return
+    import dask
+
     workers = n_workers or os.cpu_count() or 1
     with (
+        dask.config.set({TRIM_SETTING: WORKER_TRIM_BYTES, MMAP_SETTING: WORKER_MMAP_BYTES}),
         LocalCluster(
             n_workers=workers,
             threads_per_worker=1,
@@ -319,8 +330,16 @@ def run_tasks(
     desc: str = "tasks",
     retries: int = 3,
     default: str | None = None,
+    grain: int | None = None,
 ) -> list:
     """``[function(task) for task in tasks]``, on a Dask cluster or serially, in task order.
+
+    On a cluster, consecutive tasks go to a worker together, ``grain`` of them per Dask task
+    (default :func:`chunk_size`: about :data:`CHUNKS_PER_WORKER` chunks per worker). Small tasks
+    then pay the scheduler's per-task overhead once per chunk, and work that consecutive tasks
+    share (an exact render that a function remembers, ``functools.lru_cache``) is done once per
+    chunk rather than once per task on every worker: callers list their tasks with the shared
+    inputs outermost. The results are the same, in the same order.
 
     Parameters
     ----------
@@ -339,6 +358,8 @@ def run_tasks(
     default : str, optional
         Where the tasks run when neither ``scheduler`` nor ``$SPECREF_SCHEDULER`` says
         (:func:`scheduler_address`).
+    grain : int, optional
+        Tasks per Dask task on a cluster (default :func:`chunk_size`); 1 sends each alone.
 
     Returns
     -------
@@ -360,17 +381,90 @@ def run_tasks(
     with contextlib.ExitStack() as stack:
         if client is None:
             client = stack.enter_context(dask_client(address or LOCAL))
-        return _gather(client, function, tasks, show, desc, retries)
+        return _gather(client, function, tasks, show, desc, retries, grain)
 
 
-def _gather(client, function, tasks, show, desc, retries) -> list:
+#: glibc's trim threshold for worker processes. Dask's nanny sets ``MALLOC_TRIM_THRESHOLD_`` to
+#: 64 KiB, which also fixes glibc's mmap threshold, so every NumPy temporary above 128 KiB is an
+#: mmap and a munmap: a 2,400-cell Phong sweep spent 40 % more time on two workers than with this
+#: value (docs/scale-out.md). Local clusters get it through Dask's setting :data:`TRIM_SETTING`;
+#: ``dask worker --preload validation.worker`` sets it in a running worker
+#: (:func:`set_malloc_trim`).
+WORKER_TRIM_BYTES = 128 << 20
+TRIM_SETTING = "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_"
+#: glibc's mmap threshold for worker processes: the largest that glibc's own dynamic threshold
+#: reaches (32 MiB on 64-bit), so temporaries below it reuse the heap as in a plain process.
+WORKER_MMAP_BYTES = 32 << 20
+MMAP_SETTING = "distributed.nanny.pre-spawn-environ.MALLOC_MMAP_THRESHOLD_"
+
+
+def set_malloc_trim(threshold: int = WORKER_TRIM_BYTES) -> bool:
+    """Set glibc's trim and mmap thresholds in this process (``mallopt``); False without glibc.
+
+    Examples
+    --------
+    >>> set_malloc_trim() in (True, False)    # True on Linux with glibc
+    True
+    """
+    import ctypes
+    import ctypes.util
+
+    name = ctypes.util.find_library("c")
+    try:
+        libc = ctypes.CDLL(name) if name else None
+        mallopt = libc.mallopt if libc is not None else None
+    except (OSError, AttributeError):  # not glibc
+        return False
+    M_TRIM_THRESHOLD, M_MMAP_THRESHOLD = -1, -3
+    return bool(
+        mallopt
+        and mallopt(M_TRIM_THRESHOLD, int(threshold)) == 1
+        and mallopt(M_MMAP_THRESHOLD, WORKER_MMAP_BYTES) == 1
+    )
+
+
+#: Chunks per worker that :func:`chunk_size` aims at: enough that a slow or killed worker's share
+#: is redone or taken over in small pieces, few enough that each chunk is long against the
+#: scheduler's few milliseconds per task (docs/scale-out.md).
+CHUNKS_PER_WORKER = 4
+
+
+def chunk_size(n_tasks: int, n_workers: int) -> int:
+    """Tasks per chunk: ``n_tasks`` over :data:`CHUNKS_PER_WORKER` chunks per worker, at least 1.
+
+    Examples
+    --------
+    >>> chunk_size(2048, 2), chunk_size(5, 2), chunk_size(0, 4)
+    (256, 1, 1)
+    """
+    return max(1, -(-n_tasks // (CHUNKS_PER_WORKER * max(n_workers, 1))))
+
+
+def run_chunk(function: Callable, chunk: Sequence) -> list:
+    """``[function(task) for task in chunk]``: one Dask task of :func:`run_tasks`.
+
+    Examples
+    --------
+    >>> run_chunk(abs, [-1, -2])
+    [1, 2]
+    """
+    return [function(task) for task in chunk]
+
+
+def _gather(client, function, tasks, show, desc, retries, grain) -> list:
     from distributed import as_completed
     from tqdm import tqdm
 
     # a remote scheduler's workers that run this specref (usable_workers); None: any worker
     workers = _USABLE.get(client)
-    futures = client.map(function, tasks, pure=False, retries=retries, workers=workers)
-    with tqdm(total=len(futures), desc=desc, disable=not show, leave=False) as bar:
-        for _ in as_completed(futures):
-            bar.update()
-    return client.gather(futures)
+    n_workers = len(workers) if workers else max(len(client.scheduler_info()["workers"]), 1)
+    grain = chunk_size(len(tasks), n_workers) if grain is None else max(int(grain), 1)
+    chunks = [tasks[i : i + grain] for i in range(0, len(tasks), grain)]
+    futures = client.map(
+        run_chunk, [function] * len(chunks), chunks, pure=False, retries=retries, workers=workers
+    )
+    sizes = {future.key: len(chunk) for future, chunk in zip(futures, chunks, strict=True)}
+    with tqdm(total=len(tasks), desc=desc, disable=not show, leave=False) as bar:
+        for future in as_completed(futures):
+            bar.update(sizes[future.key])
+    return [result for results in client.gather(futures) for result in results]

@@ -28,8 +28,9 @@ PACKAGES = ("reference", "phong_table", "shrm", "impastor", "validation.studies"
 
 def dask_setup(worker) -> None:
     """Import specref's packages on a starting worker and record what it runs on the worker."""
-    from reference.tasks import specref_identity
+    from reference.tasks import set_malloc_trim, specref_identity
 
+    set_malloc_trim()  # Dask's 64 KiB trim threshold makes every large NumPy temporary an mmap
     for name in PACKAGES:
         importlib.import_module(name)
     worker.specref_identity = specref_identity()

@@ -308,3 +308,10 @@ def test_commands_refuse_an_unreachable_scheduler_in_one_line(command, tmp_path,
     assert address in err
     assert "Traceback" not in err
     assert not (out / "index.html").exists()
+
+
+@pytest.mark.parametrize("grain", [1, 3, None, 1000])
+def test_chunks_of_tasks_give_the_serial_results_in_order(client, grain):
+    # consecutive tasks go to a worker together (grain per Dask task; None: chunk_size)
+    serial = run_tasks(seeded_sum, TASKS[:10], scheduler="serial", progress=False)
+    assert run_tasks(seeded_sum, TASKS[:10], client=client, progress=False, grain=grain) == serial
