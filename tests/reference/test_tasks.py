@@ -225,7 +225,11 @@ def test_a_worker_without_specref_is_refused_in_one_line(tmp_path, capsys):
         'kind = "phong"\n[grid]\nmaterials = ["R1"]\nviews = ["near"]\nplacements = ["uniform"]\n'
         'interpolations = ["linear"]\nentries = [25]\nresolution = 8\n'
     )
+    from distributed import Client
+
     with _dask_processes(tmp_path, [_without_specref(tmp_path)], preload=False) as address:
+        with Client(address, timeout=60) as c:  # the scheduler is up and the worker joined
+            c.wait_for_workers(1, timeout=120)
         start = time.monotonic()
         code = main(["sweep", str(sweep), "-o", str(tmp_path / "out.csv"), "--scheduler", address])
         seconds = time.monotonic() - start
