@@ -120,7 +120,8 @@ def spectral_environments(
 ) -> SectionData:
     """Every feature family and degree, the colour.recovery upsamplers, and a relit panorama.
 
-    ``settings``: one of :data:`SETTINGS` (default: the context's quick or full ones).
+    ``settings``: one of :data:`SETTINGS` (default: the context's quick or full ones; full
+    without a context).
 
     Returns
     -------
@@ -132,7 +133,7 @@ def spectral_environments(
         ``results["recovery"]``: ``{method: figures on the ColorChecker}``; ``results["picks"]``:
         spectra of picked panorama pixels; ``arrays["panorama"]``: the RGB and relit images.
     """
-    s = settings or SETTINGS["quick" if ctx is None or ctx.quick else "full"]
+    s = settings or SETTINGS["quick" if ctx is not None and ctx.quick else "full"]
     data = SectionData()
     data.results["camera"] = CAMERA
     data.results["shipped"] = list(s["shipped"])
