@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+import errno
 import os
+import shutil
+import subprocess
+import tempfile
 from pathlib import Path
 
 import colour  # noqa: F401  (imported first: it sets NumPy's legacy print mode, which we undo below)
@@ -61,6 +65,78 @@ def dask_local_client():
 
     with dask_client("local", n_workers=2) as client:
         yield client
+
+
+# --- outputs that cannot be written: a read-only and a full file system ----------------------
+
+
+def _mount_tmpfs(folder: Path, options: str) -> bool:
+    """Mount a small tmpfs at ``folder``; False without root (the callers then simulate it)."""
+    folder.mkdir()
+    if os.geteuid() != 0 or shutil.which("mount") is None:
+        return False
+    done = subprocess.run(
+        ["mount", "-t", "tmpfs", "-o", options, "tmpfs", str(folder)], capture_output=True
+    )
+    return done.returncode == 0
+
+
+def _refuse_in(folder: Path, code: int, monkeypatch) -> None:
+    """Without root: every new file in ``folder`` fails with errno ``code``, as the real one does.
+
+    All of specref's writers create their temporary file with ``tempfile.mkstemp`` in the
+    destination folder, which is where a read-only or full file system refuses first.
+    """
+    real = tempfile.mkstemp
+
+    def mkstemp(*args, dir=None, **kwargs):
+        if dir is not None and Path(dir).resolve().is_relative_to(folder.resolve()):
+            raise OSError(code, os.strerror(code))
+        return real(*args, dir=dir, **kwargs)
+
+    monkeypatch.setattr(tempfile, "mkstemp", mkstemp)
+
+
+@pytest.fixture
+def full_folder(tmp_path, monkeypatch):
+    """A folder on a 64 KiB file system that is already full (simulated without root)."""
+    folder = tmp_path / "full"
+    if not _mount_tmpfs(folder, "size=64k"):
+        _refuse_in(folder, errno.ENOSPC, monkeypatch)
+        yield folder
+        return
+    filler = folder / "filler"
+    with pytest.raises(OSError, match="No space left"):
+        filler.write_bytes(b"\0" * (1 << 20))
+    yield folder
+    subprocess.run(["umount", str(folder)], check=False)
+
+
+#: The earlier output that :func:`read_only_folder` holds, and its bytes.
+EARLIER_OUTPUT = ("earlier.png", b"earlier")
+
+
+@pytest.fixture
+def read_only_folder(tmp_path, monkeypatch):
+    """A folder on a read-only file system holding an earlier output (simulated without root).
+
+    The file ``EARLIER_OUTPUT[0]`` holds ``EARLIER_OUTPUT[1]``: a command refused there must
+    leave it as it was. As root, a tmpfs written then remounted read-only; else every new file
+    there fails with EROFS.
+    """
+    folder = tmp_path / "ro"
+    name, content = EARLIER_OUTPUT
+    if not _mount_tmpfs(folder, "size=64k"):
+        (folder / name).write_bytes(content)
+        _refuse_in(folder, errno.EROFS, monkeypatch)
+        yield folder
+        return
+    (folder / name).write_bytes(content)
+    remount = subprocess.run(["mount", "-o", "remount,ro", str(folder)], capture_output=True)
+    if remount.returncode != 0:
+        _refuse_in(folder, errno.EROFS, monkeypatch)
+    yield folder
+    subprocess.run(["umount", str(folder)], check=False)
 
 
 @pytest.fixture(autouse=True)

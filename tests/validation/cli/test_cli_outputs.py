@@ -2,16 +2,14 @@
 
 Four ways an output cannot be written: the path is a folder; a part of its folder is a file; the
 folder is on a read-only file system; the disk is full. The last two are real file systems (a
-small tmpfs, mounted read-only or filled), which needs root; the tests skip without it.
+small tmpfs, mounted read-only or filled: the ``read_only_folder`` and ``full_folder`` fixtures of
+conftest.py), which needs root; without it they are simulated.
 """
 
 from __future__ import annotations
 
 import errno
 import os
-import shutil
-import subprocess
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -25,60 +23,6 @@ from validation.cli import main
 
 ROOT = Path(__file__).resolve().parents[3]
 EXAMPLES = data_path("examples")
-
-
-def _mount_tmpfs(folder: Path, options: str) -> bool:
-    """Mount a small tmpfs at ``folder``; False without root (the callers then simulate it)."""
-    folder.mkdir()
-    if os.geteuid() != 0 or shutil.which("mount") is None:
-        return False
-    done = subprocess.run(
-        ["mount", "-t", "tmpfs", "-o", options, "tmpfs", str(folder)], capture_output=True
-    )
-    return done.returncode == 0
-
-
-def _refuse_in(folder: Path, code: int, monkeypatch) -> None:
-    """Without root: every new file in ``folder`` fails with errno ``code``, as the real one does.
-
-    All of specref's writers create their temporary file with ``tempfile.mkstemp`` in the
-    destination folder, which is where a read-only or full file system refuses first.
-    """
-    real = tempfile.mkstemp
-
-    def mkstemp(*args, dir=None, **kwargs):
-        if dir is not None and Path(dir).resolve().is_relative_to(folder.resolve()):
-            raise OSError(code, os.strerror(code))
-        return real(*args, dir=dir, **kwargs)
-
-    monkeypatch.setattr(tempfile, "mkstemp", mkstemp)
-
-
-@pytest.fixture
-def full_folder(tmp_path, monkeypatch):
-    """A folder on a 64 KiB file system that is already full (simulated without root)."""
-    folder = tmp_path / "full"
-    if not _mount_tmpfs(folder, "size=64k"):
-        _refuse_in(folder, errno.ENOSPC, monkeypatch)
-        yield folder
-        return
-    filler = folder / "filler"
-    with pytest.raises(OSError, match="No space left"):
-        filler.write_bytes(b"\0" * (1 << 20))
-    yield folder
-    subprocess.run(["umount", str(folder)], check=False)
-
-
-@pytest.fixture
-def read_only_folder(tmp_path, monkeypatch):
-    """A folder on a read-only file system (simulated without root)."""
-    folder = tmp_path / "ro"
-    if not _mount_tmpfs(folder, "size=64k,ro"):
-        _refuse_in(folder, errno.EROFS, monkeypatch)
-        yield folder
-        return
-    yield folder
-    subprocess.run(["umount", str(folder)], check=False)
 
 
 def _outputs(tmp_path: Path, kind: str, request) -> Path:
