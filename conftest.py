@@ -67,6 +67,28 @@ def dask_local_client():
         yield client
 
 
+@pytest.fixture
+def row_windows(monkeypatch) -> list:
+    """The row windows ``(row0, row1)`` that panoramas opened by ``open_panorama_rows`` read.
+
+    Spies on ``reference.images.spectral.open_panorama_rows`` (the streamed commands' reader),
+    so a test sees that a file was read a block at a time, never whole.
+    """
+    import reference.images.spectral as spectral_images
+
+    windows = []
+    opened = spectral_images.open_panorama_rows
+
+    def spy(path):
+        rows = opened(path)
+        read = rows._read
+        rows._read = lambda a, b, dtype: windows.append((a, b)) or read(a, b, dtype)
+        return rows
+
+    monkeypatch.setattr(spectral_images, "open_panorama_rows", spy)
+    return windows
+
+
 # --- outputs that cannot be written: a read-only and a full file system ----------------------
 
 

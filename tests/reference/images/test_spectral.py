@@ -124,7 +124,7 @@ def test_flat_radiance_scanlines_and_float_tiff_rows(tmp_path, rng):
         assert_allclose(rows.read(2, 5), image[2:5], rtol=0, atol=0)
 
 
-def test_spectralize_reads_the_panorama_by_row_blocks(tmp_path, rng, monkeypatch):
+def test_spectralize_reads_the_panorama_by_row_blocks(tmp_path, rng, monkeypatch, row_windows):
     # docs/spectral-environments.md: the input is never read whole; each block reads only its own
     # rows, in order.
     import reference.images.spectral as spectral_images
@@ -132,16 +132,7 @@ def test_spectralize_reads_the_panorama_by_row_blocks(tmp_path, rng, monkeypatch
     from reference.images.formats import write_exr
 
     pano = write_exr(tmp_path / "pano.exr", rng.uniform(0, 2, (10, 16, 3)))
-    calls = []
-    opened = spectral_images.open_panorama_rows
-
-    def spy(path):
-        rows = opened(path)
-        read = rows._read
-        rows._read = lambda a, b, dtype: calls.append((a, b)) or read(a, b, dtype)
-        return rows
-
-    monkeypatch.setattr(spectral_images, "open_panorama_rows", spy)
+    calls = row_windows
     monkeypatch.setattr(spectral_images, "read_exr", None)  # a whole read would fail
     info = spectral_images.spectralize_file(pano, default_regression(), tmp_path / "o.exr", 4)
     assert calls == [(0, 4), (4, 8), (8, 10)]

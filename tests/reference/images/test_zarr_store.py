@@ -181,7 +181,7 @@ def test_cli_convert_refuses_non_finite_input_in_one_line(tmp_path, capsys, bad)
 
 
 @pytest.mark.parametrize("suffix", [".exr", ".hdr"])
-def test_convert_streams_by_chunks_and_keeps_every_value(tmp_path, suffix, monkeypatch):
+def test_convert_streams_by_chunks_and_keeps_every_value(tmp_path, suffix, row_windows):
     # OpenEXR scanlines and Radiance rows are read a chunk at a time, never the whole image; the
     # store holds the values the whole-image reader gives
     import imagecodecs
@@ -195,19 +195,9 @@ def test_convert_streams_by_chunks_and_keeps_every_value(tmp_path, suffix, monke
         write_exr(path, image)
     else:
         path.write_bytes(imagecodecs.rgbe_encode(image))
-    windows = []
-    opened = spectral.open_panorama_rows
-
-    def spy(source):
-        rows = opened(source)
-        read = rows._read
-        rows._read = lambda a, b, dtype: windows.append((a, b)) or read(a, b, dtype)
-        return rows
-
-    monkeypatch.setattr(spectral, "open_panorama_rows", spy)
     info = spectral.convert_to_zarr(path, tmp_path / "m.zarr", rows_per_chunk=5)
     assert info["streamed"]
-    assert windows == [(0, 5), (5, 10), (10, 15), (15, 20), (20, 24)]
+    assert row_windows == [(0, 5), (5, 10), (10, 15), (15, 20), (20, 24)]
     np.testing.assert_array_equal(
         open_zarr_image(tmp_path / "m.zarr").read(), read_image(path).astype(np.float32)
     )
