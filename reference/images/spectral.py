@@ -603,6 +603,10 @@ def convert_to_zarr(
     >>> info["chunks"], info["channels"], info["compression"], info["streamed"]
     (2, 3, 'blosc-lz4', True)
     """
+    require(
+        Path(out).resolve() != Path(source).resolve(),
+        f"{out}: the output is the input; write the store to another path",
+    )
     with open_panorama_rows(source) as rows:
         height, width, n = rows.height, rows.width, len(rows.names)
         check_latlong_shape((height, width, n), str(source))

@@ -201,3 +201,17 @@ def test_convert_streams_by_chunks_and_keeps_every_value(tmp_path, suffix, row_w
     np.testing.assert_array_equal(
         open_zarr_image(tmp_path / "m.zarr").read(), read_image(path).astype(np.float32)
     )
+
+
+def test_cli_convert_refuses_its_input_as_output(tmp_path, capsys):
+    # a store converted onto itself: one line, exit 2, the store as it was
+    from validation.cli import main
+
+    image = np.arange(8 * 16 * 3, dtype=np.float32).reshape(8, 16, 3)
+    store = write_zarr_image(tmp_path / "m.zarr", image, ["R", "G", "B"], rows_per_chunk=2)
+    assert main(["env", "convert", str(store), str(tmp_path / "." / "m.zarr"), "--rows", "4"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.endswith("m.zarr: the output is the input; write the store to another path")
+    assert "\n" not in err
+    assert open_zarr_image(store).rows_per_chunk == 2
+    np.testing.assert_array_equal(open_zarr_image(store).read(), image)
