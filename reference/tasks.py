@@ -386,8 +386,8 @@ def run_tasks(
 
 #: glibc's trim threshold for worker processes. Dask's nanny sets ``MALLOC_TRIM_THRESHOLD_`` to
 #: 64 KiB, which also switches off glibc's dynamic mmap threshold, so every NumPy temporary above
-#: 128 KiB is an mmap and a munmap: a 2,400-cell Phong sweep took 54 s on two workers with it and
-#: 29 s with this value and :data:`WORKER_MMAP_BYTES` (46 s serial; docs/scale-out.md).
+#: 128 KiB is an mmap and a munmap, which made a large Phong sweep slower on two workers than
+#: serially (docs/scale-out.md; the benchmark group ``scaleout-cli`` measures it).
 #: Local clusters get it through Dask's setting :data:`TRIM_SETTING`; ``dask worker --preload
 #: validation.worker`` sets it in a running worker (:func:`set_malloc_trim`).
 WORKER_TRIM_BYTES = 128 << 20

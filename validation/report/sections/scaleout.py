@@ -29,6 +29,88 @@ from validation.report import (
 SWEEP_TARGET, ZARR_TARGET = 1.6, 0.7
 #: The bound on the 12k×6k×41 projection's peak resident memory (bytes).
 PEAK_RSS_TARGET = 2e9
+#: Targets of the command-line figures (``tests/benchmarks/bench_scaleout_cli.py``): a cold
+#: two-worker sweep against the serial one, and ``env convert``'s peak resident memory above the
+#: same command's on a tiny map, in float32 chunks (three in flight and the output's buffer).
+CLI_SWEEP_TARGET, CONVERT_CHUNKS_TARGET = 1.7, 4.0
+
+
+def _cli_figures(groups: dict) -> dict | None:
+    """The command-line sweep's speed-up and env convert's memory, from group scaleout-cli."""
+    cli = _by_role(groups.get("scaleout-cli", []))
+    found = {}
+    if {"cli-serial", "cli-local"} <= set(cli):
+        serial, local = cli["cli-serial"], cli["cli-local"]
+        found["sweep"] = {
+            "cells": serial["extra_info"]["cells"],
+            "workers": local["extra_info"]["workers"],
+            "serial_s": serial["stats"]["min"],
+            "local_s": local["stats"]["min"],
+            "speedup": serial["stats"]["min"] / local["stats"]["min"],
+        }
+    if "convert-memory" in cli:
+        e = cli["convert-memory"]["extra_info"]
+        found["convert"] = {
+            **{k: e[k] for k in ("height", "width", "channels", "chunk_bytes", "float32_bytes")},
+            "peak_rss_bytes": e["peak_rss_bytes"],
+            "baseline_rss_bytes": e["baseline_rss_bytes"],
+            "above_chunks": (e["peak_rss_bytes"] - e["baseline_rss_bytes"]) / e["chunk_bytes"],
+            "seconds": cli["convert-memory"]["stats"]["min"],
+        }
+    return found or None
+
+
+def _present_cli(cli: dict | None) -> list:
+    """The command-line figures as a paragraph, when ``make bench`` measured them."""
+    if not cli:
+        return []
+    text = []
+    if "sweep" in cli:
+        s = cli["sweep"]
+        text.append(
+            f"From the command line, cold (new processes; the cluster's start, the workers' "
+            f"imports and exact renders included), a {s['cells']}-cell Phong sweep took "
+            f"{s['serial_s']:.1f} s serially and {s['local_s']:.1f} s on a local cluster of "
+            f"{s['workers']} workers: {s['speedup']:.2f}× (target ≥ {CLI_SWEEP_TARGET}×), the CSVs "
+            "byte-identical."
+        )
+    if "convert" in cli:
+        c = cli["convert"]
+        text.append(
+            f"`specref env convert` of a {c['width']}×{c['height']} RGB EXR "
+            f"({c['float32_bytes'] / 1e6:.0f} MB of float32) peaked at "
+            f"{c['peak_rss_bytes'] / 1e6:.0f} MB resident against "
+            f"{c['baseline_rss_bytes'] / 1e6:.0f} MB for a 16×32 map: "
+            f"{c['above_chunks']:.1f} chunks of {c['chunk_bytes'] / 1e6:.1f} MB above it "
+            f"(target ≤ {CONVERT_CHUNKS_TARGET:g}), in {c['seconds']:.1f} s."
+        )
+    return [Text(" ".join(text))]
+
+
+def _cli_checks(cli: dict | None) -> list[Check]:
+    found = []
+    if cli and "sweep" in cli:
+        s = cli["sweep"]
+        found.append(
+            Check(
+                f"{s['cells']}-cell sweep from the command line, cold: {s['workers']}-worker "
+                "local cluster / serial",
+                f">= {CLI_SWEEP_TARGET}×",
+                s["speedup"],
+                s["speedup"] >= CLI_SWEEP_TARGET,
+            )
+        )
+    if cli and "convert" in cli:
+        c = cli["convert"]
+        found.append(
+            Check.at_most(
+                f"env convert of a {c['width']}×{c['height']} EXR: peak resident memory above a "
+                "tiny map's, in float32 chunks",
+                c["above_chunks"],
+                CONVERT_CHUNKS_TARGET,
+            )
+        )
+    return found
 
 
 def _by_role(records: list[dict]) -> dict:
@@ -98,10 +180,11 @@ def scaleout_figures(ctx: ReportContext | None = None) -> SectionData:
     groups = ctx.bench_groups("scaleout") if ctx is not None else {}
     sweep = _by_role(groups.get("scaleout-sweep", []))
     zarr = _by_role(groups.get("scaleout-zarr", []))
+    cli = _cli_figures(groups)
     if not (
         {"serial", "distributed"} <= set(sweep) and {"in-memory", "zarr-streamed"} <= set(zarr)
     ):
-        return SectionData({"measured": False})
+        return SectionData({"measured": False, **({"cli": cli} if cli else {})})
     serial, dist = sweep["serial"], sweep["distributed"]
     n = serial["extra_info"]["tasks"]
     workers = dist["extra_info"]["workers"]
@@ -141,6 +224,7 @@ def scaleout_figures(ctx: ReportContext | None = None) -> SectionData:
             },
             "zarr_12k": full,
             "zarr_layout": layout,
+            "cli": cli,
         }
     )
 
@@ -149,7 +233,10 @@ def present(ctx: ReportContext, data: SectionData) -> list:
     """The sweep and Zarr figures, and the predicted speed-up on more machines."""
     r = data.results
     if not r["measured"]:
-        return [Text("Not measured in this run: `make bench` runs the scale-out benchmarks.")]
+        return [
+            Text("Not measured in this run: `make bench` runs the scale-out benchmarks."),
+            *_present_cli(r.get("cli")),
+        ]
     s, z = r["sweep"], r["zarr"]
     peak = z["peak_python_bytes"]
     return [
@@ -174,6 +261,7 @@ def present(ctx: ReportContext, data: SectionData) -> list:
             "Amdahl's law with this run's task time and overhead (docs/scale-out.md)",
             "{:.3g}",
         ),
+        *_present_cli(r.get("cli")),
         *_present_zarr(r.get("zarr_12k"), r.get("zarr_layout") or []),
     ]
 
@@ -221,7 +309,7 @@ def checks(data: SectionData) -> list[Check]:
     """The scale-out targets, when the benchmarks ran."""
     r = data.results
     if not r["measured"]:
-        return []
+        return _cli_checks(r.get("cli"))
     full = r.get("zarr_12k")
     memory = []
     if full is not None:
@@ -248,6 +336,7 @@ def checks(data: SectionData) -> list[Check]:
             r["zarr"]["throughput_ratio"] >= ZARR_TARGET,
         ),
         *memory,
+        *_cli_checks(r.get("cli")),
     ]
 
 

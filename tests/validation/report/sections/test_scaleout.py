@@ -98,3 +98,42 @@ def test_full_size_panorama_and_layout_figures():
     text = present(ctx, data)[2].text
     assert "12000×6000×41" in text
     assert "2.50 GB" in text
+
+
+def _cli_records(serial_s=46.0, local_s=29.0, peak=289e6):
+    return [
+        _record("scaleout-cli", "cli-serial", serial_s, cells=2400),
+        _record("scaleout-cli", "cli-local", local_s, cells=2400, workers=2),
+        _record(
+            "scaleout-cli",
+            "convert-memory",
+            9.0,
+            height=4096,
+            width=8192,
+            channels=3,
+            chunk_bytes=21.5e6,
+            float32_bytes=402.7e6,
+            peak_rss_bytes=peak,
+            baseline_rss_bytes=160e6,
+        ),
+    ]
+
+
+def test_command_line_figures_and_their_targets(tmp_path):
+    # The cold sweep from the command line (46 s serial, 29 s on two workers: 1.59x, below 1.7)
+    # and env convert's memory (129 MB above a tiny map's: 6 chunks of 21.5 MB, above 4)
+    data = scaleout_figures(ReportContext(out_dir=tmp_path, bench={"benchmarks": _cli_records()}))
+    cli = data.results["cli"]
+    assert cli["sweep"]["speedup"] == pytest.approx(46 / 29)
+    assert cli["convert"]["above_chunks"] == pytest.approx(129e6 / 21.5e6)
+    assert [(c.measured, c.passed) for c in checks(data)] == [
+        (pytest.approx(46 / 29), False),
+        (pytest.approx(6.0), False),
+    ]
+    text = present(ReportContext(out_dir=tmp_path), data)[-1].text
+    assert "46.0 s serially and 29.0 s on a local cluster of 2 workers: 1.59×" in text
+    assert "6.0 chunks of 21.5 MB above it" in text
+    # both met
+    met = _cli_records(serial_s=60.0, local_s=30.0, peak=230e6)
+    data = scaleout_figures(ReportContext(out_dir=tmp_path, bench={"benchmarks": met}))
+    assert [c.passed for c in checks(data)] == [True, True]
