@@ -23,7 +23,7 @@ import sys
 import weakref
 from collections.abc import Callable, Sequence
 
-from reference.errors import SpecrefError, require
+from reference.errors import SpecrefError, require, require_positive_int
 
 __all__ = [
     "CHUNKS_PER_WORKER",
@@ -458,7 +458,9 @@ def _gather(client, function, tasks, show, desc, retries, grain) -> list:
     # a remote scheduler's workers that run this specref (usable_workers); None: any worker
     workers = _USABLE.get(client)
     n_workers = len(workers) if workers else max(len(client.scheduler_info()["workers"]), 1)
-    grain = chunk_size(len(tasks), n_workers) if grain is None else max(int(grain), 1)
+    grain = (
+        chunk_size(len(tasks), n_workers) if grain is None else require_positive_int(grain, "grain")
+    )
     chunks = [tasks[i : i + grain] for i in range(0, len(tasks), grain)]
     futures = client.map(
         run_chunk, [function] * len(chunks), chunks, pure=False, retries=retries, workers=workers

@@ -319,3 +319,9 @@ def test_chunks_of_tasks_give_the_serial_results_in_order(client, grain):
     # consecutive tasks go to a worker together (grain per Dask task; None: chunk_size)
     serial = run_tasks(seeded_sum, TASKS[:10], scheduler="serial", progress=False)
     assert run_tasks(seeded_sum, TASKS[:10], client=client, progress=False, grain=grain) == serial
+
+
+@pytest.mark.parametrize("grain", [0, -3, 2.5, float("nan")])
+def test_a_bad_grain_is_one_line(client, grain):
+    with pytest.raises(SpecrefError, match="grain"):
+        run_tasks(seeded_sum, TASKS[:4], client=client, progress=False, grain=grain)
