@@ -21,7 +21,8 @@ import logging
 import os
 import sys
 import weakref
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Hashable, Sequence
+from dataclasses import dataclass
 
 from reference.errors import SpecrefError, require, require_positive_int
 
@@ -35,11 +36,13 @@ __all__ = [
     "TRIM_SETTING",
     "WORKER_MMAP_BYTES",
     "WORKER_TRIM_BYTES",
+    "Shared",
     "add_scheduler_option",
     "chunk_size",
     "connect_timeout",
     "dask_client",
     "run_chunk",
+    "run_shared_chunk",
     "run_tasks",
     "scheduler_address",
     "set_malloc_trim",
@@ -317,6 +320,43 @@ def usable_workers(client, address: str, timeout: float | None = None) -> list[s
     return good
 
 
+@dataclass(frozen=True)
+class Shared:
+    """Work that several tasks need, computed once: a dependency of the tasks that use it.
+
+    ``key(task)`` names the shared input a task needs (hashable, picklable); ``build(key)``
+    computes it. :func:`run_tasks` then calls ``function(task, build(key(task)))``, building each
+    key once: serially, in this process, dropped after its last task; on a cluster, as a Dask task
+    that the chunks needing it depend on, so they run where it lives (Dask's data locality) and it
+    is rebuilt from its key if its worker dies. Both functions are module-level and deterministic.
+
+    Examples
+    --------
+    >>> shared = Shared(key=lambda task: task % 2, build=lambda key: 10 * key)
+    >>> run_tasks(lambda task, built: task + built, [1, 2, 3], "serial", shared=shared,
+    ...           progress=False)
+    [11, 2, 13]
+    """
+
+    key: Callable[[object], Hashable]
+    build: Callable[[Hashable], object]
+
+
+def _shared_serial(function, tasks, shared: Shared, bar) -> list:
+    # each key built at its first task and dropped after its last one
+    keys = [shared.key(task) for task in tasks]
+    last = {key: i for i, key in enumerate(keys)}
+    built, results = {}, []
+    for i, (task, key) in enumerate(zip(tasks, keys, strict=True)):
+        if key not in built:
+            built[key] = shared.build(key)
+        results.append(function(task, built[key]))
+        if last[key] == i:
+            del built[key]
+        bar.update(1)
+    return results
+
+
 #: Workers :func:`usable_workers` kept, per client, for :func:`run_tasks` (gone with the client).
 _USABLE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
@@ -331,6 +371,7 @@ def run_tasks(
     retries: int = 3,
     default: str | None = None,
     grain: int | None = None,
+    shared: Shared | None = None,
 ) -> list:
     """``[function(task) for task in tasks]``, on a Dask cluster or serially, in task order.
 
@@ -339,7 +380,8 @@ def run_tasks(
     then pay the scheduler's per-task overhead once per chunk, and work that consecutive tasks
     share (an exact render that a function remembers, ``functools.lru_cache``) is done once per
     chunk rather than once per task on every worker: callers list their tasks with the shared
-    inputs outermost. The results are the same, in the same order.
+    inputs outermost. The results are the same, in the same order. Work that tasks share can
+    also be named (``shared``): it is then a task of its own, built once, that they depend on.
 
     Parameters
     ----------
@@ -360,6 +402,9 @@ def run_tasks(
         (:func:`scheduler_address`).
     grain : int, optional
         Tasks per Dask task on a cluster (default :func:`chunk_size`); 1 sends each alone.
+    shared : Shared, optional
+        Calls ``function(task, shared.build(shared.key(task)))`` instead, each key built once
+        (:class:`Shared`); a chunk then holds tasks of one key only.
 
     Returns
     -------
@@ -376,12 +421,17 @@ def run_tasks(
     tasks = list(tasks)
     show = progress and not os.environ.get("CI") and sys.stderr.isatty()
     address = scheduler_address(scheduler, default)
+    if grain is not None:
+        require_positive_int(grain, "grain")
     if client is None and address == SERIAL:
+        if shared is not None:
+            with tqdm(total=len(tasks), desc=desc, disable=not show, leave=False) as bar:
+                return _shared_serial(function, tasks, shared, bar)
         return [function(task) for task in tqdm(tasks, desc=desc, disable=not show, leave=False)]
     with contextlib.ExitStack() as stack:
         if client is None:
             client = stack.enter_context(dask_client(address or LOCAL))
-        return _gather(client, function, tasks, show, desc, retries, grain)
+        return _gather(client, function, tasks, show, desc, retries, grain, shared)
 
 
 #: glibc's trim threshold for worker processes. Dask's nanny sets ``MALLOC_TRIM_THRESHOLD_`` to
@@ -451,22 +501,69 @@ def run_chunk(function: Callable, chunk: Sequence) -> list:
     return [function(task) for task in chunk]
 
 
-def _gather(client, function, tasks, show, desc, retries, grain) -> list:
+def run_shared_chunk(function: Callable, built, chunk: Sequence) -> list:
+    """``[function(task, built) for task in chunk]``: a Dask task with a :class:`Shared` input.
+
+    ``built`` is the result of the shared task it depends on (:func:`run_tasks`).
+
+    Examples
+    --------
+    >>> run_shared_chunk(pow, 2, [3, 4])
+    [9, 16]
+    """
+    return [function(task, built) for task in chunk]
+
+
+def _chunks(tasks: list, grain: int, shared: Shared | None) -> list[tuple]:
+    # (key or None, task indices) per chunk: consecutive tasks, of one shared key when shared
+    if shared is None:
+        return [(None, range(i, min(i + grain, len(tasks)))) for i in range(0, len(tasks), grain)]
+    groups: dict = {}
+    for i, task in enumerate(tasks):
+        groups.setdefault(shared.key(task), []).append(i)
+    return [
+        (key, indices[i : i + grain])
+        for key, indices in groups.items()
+        for i in range(0, len(indices), grain)
+    ]
+
+
+def _submit(client, function, tasks, chunks, shared, retries, workers) -> list:
+    # one future per chunk; with shared work, one build per key that its chunks depend on
+    options = {"pure": False, "retries": retries, "workers": workers}
+    if shared is None:
+        return [
+            client.submit(run_chunk, function, [tasks[i] for i in indices], **options)
+            for _, indices in chunks
+        ]
+    built = {}
+    for key, _ in chunks:
+        if key not in built:
+            built[key] = client.submit(shared.build, key, **options)
+    return [
+        client.submit(
+            run_shared_chunk, function, built[key], [tasks[i] for i in indices], **options
+        )
+        for key, indices in chunks
+    ]
+
+
+def _gather(client, function, tasks, show, desc, retries, grain, shared=None) -> list:
     from distributed import as_completed
     from tqdm import tqdm
 
     # a remote scheduler's workers that run this specref (usable_workers); None: any worker
     workers = _USABLE.get(client)
     n_workers = len(workers) if workers else max(len(client.scheduler_info()["workers"]), 1)
-    grain = (
-        chunk_size(len(tasks), n_workers) if grain is None else require_positive_int(grain, "grain")
-    )
-    chunks = [tasks[i : i + grain] for i in range(0, len(tasks), grain)]
-    futures = client.map(
-        run_chunk, [function] * len(chunks), chunks, pure=False, retries=retries, workers=workers
-    )
-    sizes = {future.key: len(chunk) for future, chunk in zip(futures, chunks, strict=True)}
+    grain = chunk_size(len(tasks), n_workers) if grain is None else grain
+    chunks = _chunks(tasks, grain, shared)
+    futures = _submit(client, function, tasks, chunks, shared, retries, workers)
+    sizes = {future.key: len(indices) for future, (_, indices) in zip(futures, chunks, strict=True)}
     with tqdm(total=len(tasks), desc=desc, disable=not show, leave=False) as bar:
         for future in as_completed(futures):
             bar.update(sizes[future.key])
-    return [result for results in client.gather(futures) for result in results]
+    results = [None] * len(tasks)
+    for found, (_, indices) in zip(client.gather(futures), chunks, strict=True):
+        for i, result in zip(indices, found, strict=True):
+            results[i] = result
+    return results

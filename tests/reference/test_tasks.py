@@ -325,3 +325,83 @@ def test_chunks_of_tasks_give_the_serial_results_in_order(client, grain):
 def test_a_bad_grain_is_one_line(client, grain):
     with pytest.raises(SpecrefError, match="grain"):
         run_tasks(seeded_sum, TASKS[:4], client=client, progress=False, grain=grain)
+
+
+def shared_key(task):
+    # tasks (folder, seed, n) share the work of their n, in no particular order
+    folder, _, n = task
+    return (folder, n)
+
+
+def shared_build(key):
+    # the shared work: leaves a file per build, so that a test counts the builds on every worker
+    import uuid
+    from pathlib import Path
+
+    folder, n = key
+    (Path(folder) / f"built-{n}-{uuid.uuid4().hex}").touch()
+    return n * 1000
+
+
+def shared_task(task, built):
+    _, seed, n = task
+    return seeded_sum((seed, n)) + built
+
+
+def slow_shared_task(task, built):
+    time.sleep(0.3)
+    return shared_task(task, built)
+
+
+def _shared_tasks(folder) -> list:
+    return [(str(folder), seed, (100, 200, 300)[seed % 3]) for seed in range(18)]
+
+
+def _direct(tasks) -> list:
+    return [seeded_sum((seed, n)) + n * 1000 for _, seed, n in tasks]
+
+
+def _builds(folder) -> dict:
+    from collections import Counter
+
+    return Counter(path.name.split("-")[1] for path in folder.glob("built-*"))
+
+
+@pytest.mark.parametrize("grain", [None, 2])
+def test_shared_work_is_built_once_per_key_and_gives_the_direct_results(client, tmp_path, grain):
+    from reference.tasks import Shared
+
+    tasks = _shared_tasks(tmp_path)
+    shared = Shared(shared_key, shared_build)
+    serial = run_tasks(shared_task, tasks, scheduler="serial", progress=False, shared=shared)
+    assert serial == _direct(tasks)
+    assert _builds(tmp_path) == {"100": 1, "200": 1, "300": 1}
+    for path in tmp_path.glob("built-*"):
+        path.unlink()
+    found = run_tasks(shared_task, tasks, client=client, progress=False, shared=shared, grain=grain)
+    assert found == serial  # in task order, although the keys interleave
+    assert _builds(tmp_path) == {"100": 1, "200": 1, "300": 1}  # a task the chunks depend on
+
+
+def test_shared_work_survives_a_killed_worker(client, tmp_path):
+    # the worker holding a built input dies: Dask builds it again from its key, results unchanged
+    from reference.tasks import Shared
+
+    tasks = _shared_tasks(tmp_path)
+    pids = list(client.run(worker_pid).values())
+
+    def kill_one_later():
+        time.sleep(1.5)
+        os.kill(pids[0], signal.SIGKILL)
+
+    import threading
+
+    killer = threading.Thread(target=kill_one_later)
+    killer.start()
+    shared = Shared(shared_key, shared_build)
+    found = run_tasks(
+        slow_shared_task, tasks, client=client, progress=False, shared=shared, grain=1
+    )
+    killer.join()
+    assert found == _direct(tasks)
+    client.wait_for_workers(2, timeout=60)

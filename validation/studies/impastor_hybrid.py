@@ -206,6 +206,37 @@ def case_light(light: str, width: int = 64, height: int = 32) -> PlaneLight:
     return ceiling_from_environment(name, float(azimuth), width, height)
 
 
+def hybrid_brute_force(
+    seed: int,
+    light: str,
+    alpha: float,
+    n_side: int = 6,
+    painting_size: int = 128,
+    light_resolution: tuple = (64, 32),
+    supersample: int = 8,
+    backend: str = "numba",
+) -> tuple[np.ndarray, np.ndarray]:
+    """The brute-force specular reference of a painting under a light at one α, and its check.
+
+    What :func:`hybrid_case_ratios` measures against; it does not depend on the case's N and K,
+    so cases that differ only in those can share it. Returns the renders at ``2·supersample``
+    (the reference) and at ``supersample`` (its own error), each shape (n_side², C).
+
+    Examples
+    --------
+    >>> reference, coarse = hybrid_brute_force(3, "fluorescent", 0.1, 2, 16, (16, 8), 2, "numpy")
+    >>> reference.shape == coarse.shape, bool((reference >= 0).all())
+    (True, True)
+    """
+    painting = impasto_painting(painting_size, seed=seed)
+    P, N, V = painting_samples(n_side, painting)
+    plane = case_light(light, *light_resolution)
+    a = np.full(len(P), float(alpha))
+    reference = specular_brute_force(P, N, V, a, plane, 2 * supersample, backend)[..., 0]
+    coarse = specular_brute_force(P, N, V, a, plane, supersample, backend)[..., 0]
+    return reference, coarse
+
+
 def hybrid_case_ratios(
     case: HybridCase,
     alphas=ALPHAS,
@@ -214,8 +245,12 @@ def hybrid_case_ratios(
     light_resolution: tuple = (64, 32),
     supersample: int = 8,
     backend: str = "numba",
+    brute_force: dict | None = None,
 ) -> dict:
     """Relative RMS errors of median cut, FIS and the hybrid against brute force, per α.
+
+    ``brute_force`` maps α to :func:`hybrid_brute_force`'s pair for this case's painting and
+    light, when already rendered (a sweep shares it between cases of other N and K).
 
     Returns
     -------
@@ -236,10 +271,19 @@ def hybrid_case_ratios(
     lights = point_lights_from_plane(plane, "median_cut", case.n_lights)
     out = {k: [] for k in ("alpha", "median_cut", "fis", "hybrid", "reference_error", "ratio")}
     rms = lambda x, ref: float(np.sqrt(np.mean((x - ref) ** 2) / np.mean(ref**2)))  # noqa: E731
+    brute_force = brute_force or {}
     for alpha in alphas:
         a = np.full(len(P), float(alpha))
-        reference = specular_brute_force(P, N, V, a, plane, 2 * supersample, backend)[..., 0]
-        coarse = specular_brute_force(P, N, V, a, plane, supersample, backend)[..., 0]
+        reference, coarse = brute_force.get(alpha) or hybrid_brute_force(
+            case.painting_seed,
+            case.light,
+            alpha,
+            n_side,
+            painting_size,
+            light_resolution,
+            supersample,
+            backend,
+        )
         parts = specular_hybrid_parts(P, N, V, a, plane, lights, case.n_samples, backend=backend)
         pairs = (("median_cut", "point_lights"), ("fis", "fis"), ("hybrid", "hybrid"))
         errors = {k: rms(parts[m][..., 0], reference) for k, m in pairs}

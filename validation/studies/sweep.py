@@ -1,9 +1,12 @@
 """User-defined sweeps (``specref sweep FILE.toml``): a grid of methods × materials, as Dask tasks.
 
 A sweep file names a kind of study (:data:`SWEEP_KINDS`) and the grid to run it over; every cell
-of the grid is one independent task, run through :func:`reference.tasks.run_tasks` (a local Dask
-cluster, a remote scheduler, or serially), and the output is a tidy table: one row per cell, one
-column per grid key and per figure, written as CSV.
+of the grid is one task, run through :func:`reference.tasks.run_tasks` (a local Dask cluster, a
+remote scheduler, or serially), and the output is a tidy table: one row per cell, one column per
+grid key and per figure, written as CSV. Work that cells share (the ``phong`` kind's exact render
+of a material and view, the ``impastor`` kind's brute force of a painting, light and α, the
+``shrm`` kind's brute-force render of a sphere) is a task of its own that those cells depend on
+(:class:`reference.tasks.Shared`): built once, where the cells run.
 
 The ``phong`` kind (Wang, Chern & Lee): the table error of every placement × interpolation ×
 entry count on every material × view, against the exact render::
@@ -34,7 +37,7 @@ from reference.errors import format_allowed, require, require_positive_int
 from reference.files import write_text_atomic
 from reference.registry import Registry
 from reference.scene.loader import read_toml_file
-from reference.tasks import run_tasks
+from reference.tasks import Shared, run_tasks
 
 __all__ = ["SWEEP_KINDS", "SweepKind", "load_sweep", "run_sweep", "sweep_csv"]
 
@@ -44,7 +47,9 @@ class SweepKind:
     """A kind of sweep: its grid keys and their allowed values, and the function of one cell.
 
     ``lists`` are the keys that take a list (the grid's axes); ``scalars`` take one value and
-    are passed to every cell; ``run_cell(cell: dict) -> dict`` returns the cell's figures.
+    are passed to every cell; ``run_cell(cell: dict) -> dict`` returns the cell's figures, or
+    ``run_cell(cell, built)`` when the kind names the work its cells share (``shared``:
+    ``shared.build(shared.key(cell))``, built once per key).
     """
 
     name: str
@@ -52,6 +57,7 @@ class SweepKind:
     scalars: dict
     run_cell: object
     about: str = ""
+    shared: Shared | None = None
 
 
 def _phong_materials():
@@ -60,20 +66,42 @@ def _phong_materials():
     return SCENES.names()
 
 
-@functools.lru_cache(maxsize=8)
-def _phong_state(material: str, view: str, resolution: int):
-    # One exact render per (material, view, resolution) per worker process, shared by its cells.
+def phong_state_key(cell: dict) -> tuple:
+    """What a ``phong`` cell shares with others: its (material, view, resolution).
+
+    Examples
+    --------
+    >>> phong_state_key({"materials": "R1", "views": "near", "entries": 64, "resolution": 16})
+    ('R1', 'near', 16)
+    """
+    return (cell["materials"], cell["views"], cell["resolution"])
+
+
+def phong_state(key: tuple):
+    """The exact render of a material and view that the cells of a ``phong`` sweep share.
+
+    ``key`` is :func:`phong_state_key`'s; the result is
+    ``validation.studies.phong.view_state``'s (the exact spectral render and what the tables
+    are measured on).
+    """
     from phong_table.materialfile import load_material_file
     from phong_table.scenes import SCENES
     from validation.studies.phong import view_state
 
+    material, view, resolution = key
     known = material in SCENES
     model = SCENES.lookup(material).build() if known else load_material_file(material)
     return view_state(model, view, resolution)
 
 
-def phong_cell(cell: dict) -> dict:
+#: A cell called alone remembers the last exact renders of its process.
+_phong_state = functools.lru_cache(maxsize=8)(phong_state)
+
+
+def phong_cell(cell: dict, state=None) -> dict:
     """One cell of a ``phong`` sweep: the table error of one method on one material and view.
+
+    ``state`` is the cell's :func:`phong_state` (built here when not given).
 
     Examples
     --------
@@ -84,7 +112,8 @@ def phong_cell(cell: dict) -> dict:
     """
     from validation.studies.phong import table_error_row
 
-    state = _phong_state(cell["materials"], cell["views"], cell["resolution"])
+    if state is None:
+        state = _phong_state(phong_state_key(cell))
     row = table_error_row(state, cell["placements"], cell["interpolations"], cell["entries"])
     return {k: row[k] for k in ("segments", "rms_display", "rms_linear", "rms", "overshoot")}
 
@@ -106,15 +135,41 @@ def _phong_kind() -> SweepKind:
         scalars={"resolution": int},
         run_cell=phong_cell,
         about="table error of placements × interpolations × entries on materials × views",
+        shared=Shared(phong_state_key, phong_state),
     )
 
 
-def impastor_cell(cell: dict) -> dict:
+def impastor_reference_key(cell: dict) -> tuple:
+    """What an ``impastor`` cell shares with others: (seed, light, α, points, painting size).
+
+    Examples
+    --------
+    >>> impastor_reference_key({"seeds": 3, "lights": "fluorescent", "n_lights": 8,
+    ...                         "n_samples": 8, "alphas": 0.1, "points": 2, "painting_size": 16})
+    (3, 'fluorescent', 0.1, 2, 16)
+    """
+    return tuple(cell[k] for k in ("seeds", "lights", "alphas", "points", "painting_size"))
+
+
+def impastor_reference(key: tuple) -> dict:
+    """The brute-force renders that the ``impastor`` cells of every N and K share.
+
+    ``key`` is :func:`impastor_reference_key`'s; the result maps α to
+    ``validation.studies.impastor_hybrid.hybrid_brute_force``'s (reference, check) pair.
+    """
+    from validation.studies.impastor_hybrid import hybrid_brute_force
+
+    seed, light, alpha, points, painting_size = key
+    return {alpha: hybrid_brute_force(seed, light, alpha, points, painting_size)}
+
+
+def impastor_cell(cell: dict, brute_force=None) -> dict:
     """One cell of an ``impastor`` sweep: median cut, FIS and the hybrid against brute force.
 
     Relative RMS errors of the three specular lighting methods of the painting (§3.5, Ferwerda)
     at one α, and the hybrid's ratio to the better of the other two
-    (``validation.studies.impastor_hybrid.hybrid_case_ratios``).
+    (``validation.studies.impastor_hybrid.hybrid_case_ratios``). ``brute_force`` is the cell's
+    :func:`impastor_reference` (rendered here when not given).
 
     Examples
     --------
@@ -126,7 +181,9 @@ def impastor_cell(cell: dict) -> dict:
     from validation.studies.impastor_hybrid import HybridCase, hybrid_case_ratios
 
     case = HybridCase(cell["seeds"], cell["lights"], cell["n_lights"], cell["n_samples"])
-    found = hybrid_case_ratios(case, (cell["alphas"],), cell["points"], cell["painting_size"])
+    found = hybrid_case_ratios(
+        case, (cell["alphas"],), cell["points"], cell["painting_size"], brute_force=brute_force
+    )
     return {k: found[k][0] for k in ("median_cut", "fis", "hybrid", "reference_error", "ratio")}
 
 
@@ -167,17 +224,51 @@ def _impastor_kind() -> SweepKind:
         scalars={"points": int, "painting_size": int},
         run_cell=impastor_cell,
         about="median cut, FIS and the hybrid against brute force: paintings × lights × N × K × α",
+        shared=Shared(impastor_reference_key, impastor_reference),
     )
 
 
-def shrm_cell(cell: dict) -> dict:
+def shrm_oracle_key(cell: dict) -> tuple:
+    r"""What an ``shrm`` cell shares with others: its (environment, material lines, size).
+
+    Examples
+    --------
+    >>> shrm_oracle_key({"environments": "sky.exr", "materials": {"brdf": "ggx", "alpha": 0.3},
+    ...                  "tolerances": 0.01, "size": 4})
+    ('sky.exr', 'type = "isotropic_brdf"\nbrdf = "ggx"\nalpha = 0.3', 4)
+    """
+    return (cell["environments"], _material_lines(cell["materials"]), cell["size"])
+
+
+def _sphere_scene(key: tuple):
+    from reference.scene.loader import loads_scene
+    from validation.studies.env_accuracy import sphere_scene_toml
+
+    environment, material, size = key
+    return loads_scene(sphere_scene_toml(environment, material, size))
+
+
+def shrm_oracle(key: tuple):
+    """The brute-force render (``--oracle``) that the cells of an ``shrm`` sweep share.
+
+    ``key`` is :func:`shrm_oracle_key`'s; the result is the ``RenderResult`` of the sphere with
+    ``environment = "bruteforce"``, which does not depend on the cell's tolerance.
+    """
+    import shrm  # noqa: F401  (registers the environment shaders)
+    from reference.scene.render import render_scene
+
+    return render_scene(_sphere_scene(key), options={"environment": "bruteforce"})
+
+
+def shrm_cell(cell: dict, oracle=None) -> dict:
     """One cell of an ``shrm`` sweep: a sphere's default render against ``--oracle``, in Y.
 
     The sphere (``validation.studies.env_accuracy.sphere_scene_toml``) of one ``isotropic_brdf``
     material under one environment map, rendered with ``shrm_tol`` = the cell's tolerance and
     by brute force; mean and largest relative error of Y over the lit pixels, and what the
     shader chose and promised (``RenderResult.records["shrm"]``: the settings, and the bound
-    relative to a lower bound of the peak).
+    relative to a lower bound of the peak). ``oracle`` is the cell's :func:`shrm_oracle` (rendered
+    here when not given).
 
     Examples
     --------
@@ -191,12 +282,11 @@ def shrm_cell(cell: dict) -> dict:
     >>> row["promised_of_peak"] <= 0.01 and row["check_of_peak"] <= 0.01   # bound, spot check
     True
     """
-    from reference.scene.loader import loads_scene
-    from validation.studies.env_accuracy import render_against_oracle, sphere_scene_toml
+    from validation.studies.env_accuracy import render_against_oracle
 
-    material = _material_lines(cell["materials"])
-    scene = loads_scene(sphere_scene_toml(cell["environments"], material, cell["size"]))
-    found = render_against_oracle(scene, {"shrm_tol": cell["tolerances"]})
+    key = shrm_oracle_key(cell)
+    oracle = shrm_oracle(key) if oracle is None else oracle
+    found = render_against_oracle(_sphere_scene(key), {"shrm_tol": cell["tolerances"]}, oracle)
     chose = found["records"].get("shrm", {})
     promised = (
         chose["bound_Y"] / chose["peak_lower_bound"] if chose.get("peak_lower_bound") else None
@@ -258,6 +348,7 @@ def _shrm_kind() -> SweepKind:
         scalars={"size": int},
         run_cell=shrm_cell,
         about="isotropic BRDF spheres under environment maps, default render against --oracle",
+        shared=Shared(shrm_oracle_key, shrm_oracle),
     )
 
 
@@ -363,7 +454,13 @@ def run_sweep(path, scheduler: str | None = None, progress: bool = True, client=
     """
     kind, cells = load_sweep(path)
     figures = run_tasks(
-        kind.run_cell, cells, scheduler=scheduler, client=client, progress=progress, desc="sweep"
+        kind.run_cell,
+        cells,
+        scheduler=scheduler,
+        client=client,
+        progress=progress,
+        desc="sweep",
+        shared=kind.shared,
     )
     return [{**cell, **found} for cell, found in zip(cells, figures, strict=True)]
 

@@ -117,17 +117,30 @@ painting_size = 16
 """
 
 
-def test_impastor_sweep_matches_the_direct_computation(tmp_path):
-    from validation.studies.impastor_hybrid import HybridCase, hybrid_case_ratios
+def test_impastor_sweep_matches_the_direct_computation(tmp_path, monkeypatch):
+    # the brute force of a painting, light and α does not depend on N and K: cells of every N
+    # share it (reference.tasks.Shared), rendered once per (light, α)
+    import validation.studies.impastor_hybrid as hybrid
 
     path = tmp_path / "p.toml"
-    path.write_text(PAINTING_GRID)
+    path.write_text(PAINTING_GRID.replace("n_lights = [8]", "n_lights = [8, 4]"))
+    calls, brute_force = [], hybrid.specular_brute_force
+
+    def counted(*args):
+        calls.append(args[5])  # the supersampling
+        return brute_force(*args)
+
+    monkeypatch.setattr(hybrid, "specular_brute_force", counted)
     rows = run_sweep(path, scheduler="serial", progress=False)
-    assert len(rows) == 1 * 2 * 1 * 1 * 2
-    direct = hybrid_case_ratios(HybridCase(301, "lamp_panel:4", 8, 8), (0.05, 0.2), 2, 16)
-    got = [r for r in rows if r["lights"] == "lamp_panel:4"]
-    assert [r["ratio"] for r in got] == direct["ratio"]
-    assert [r["fis"] for r in got] == direct["fis"]
+    assert len(rows) == 1 * 2 * 2 * 1 * 2
+    assert sorted(calls) == [8] * 4 + [16] * 4  # 2 lights × 2 α, the reference and its check
+    monkeypatch.setattr(hybrid, "specular_brute_force", brute_force)
+    for n_lights in (8, 4):
+        case = hybrid.HybridCase(301, "lamp_panel:4", n_lights, 8)
+        direct = hybrid.hybrid_case_ratios(case, (0.05, 0.2), 2, 16)
+        got = [r for r in rows if (r["lights"], r["n_lights"]) == ("lamp_panel:4", n_lights)]
+        assert [r["ratio"] for r in got] == direct["ratio"]
+        assert [r["fis"] for r in got] == direct["fis"]
 
 
 @pytest.mark.parametrize(
@@ -165,14 +178,27 @@ def _sky(tmp_path):
     return write_exr(tmp_path / "sky.exr", np.ascontiguousarray(sky))
 
 
-def test_shrm_sweep_matches_the_direct_computation(tmp_path):
+def test_shrm_sweep_matches_the_direct_computation(tmp_path, monkeypatch):
+    # the brute-force render does not depend on the tolerance: the cells of one environment,
+    # material and size share it (reference.tasks.Shared), rendered once
+    import reference.scene.render as render
     from reference.scene.loader import loads_scene
     from validation.studies.env_accuracy import render_against_oracle, sphere_scene_toml
 
     sky = _sky(tmp_path)
     path = tmp_path / "s.toml"
-    path.write_text(SHRM_GRID)  # the map relative to the sweep file's folder
-    (row,) = run_sweep(path, scheduler="serial", progress=False)
+    path.write_text(SHRM_GRID.replace("[0.01]", "[0.05, 0.01]"))  # the map beside the file
+    calls, render_scene = [], render.render_scene
+
+    def counted(scene, options=None, **kwargs):
+        calls.append((options or {}).get("environment"))
+        return render_scene(scene, options=options, **kwargs)
+
+    monkeypatch.setattr(render, "render_scene", counted)
+    coarse, row = run_sweep(path, scheduler="serial", progress=False)
+    assert calls == ["bruteforce", None, None]
+    assert (coarse["tolerances"], row["tolerances"]) == (0.05, 0.01)
+    monkeypatch.setattr(render, "render_scene", render_scene)
     material = 'type = "isotropic_brdf"\nbrdf = "ggx"\nalpha = 0.3\nF_0 = 1.0\nrho_d = 0.0'
     direct = render_against_oracle(
         loads_scene(sphere_scene_toml(sky, material, 6)), {"shrm_tol": 0.01}
