@@ -41,6 +41,7 @@ __all__ = [
     "chunk_size",
     "connect_timeout",
     "dask_client",
+    "local_workers",
     "run_chunk",
     "run_shared_chunk",
     "run_tasks",
@@ -88,6 +89,33 @@ def scheduler_address(scheduler: str | None = None, default: str | None = None) 
     if not address or str(address) == LOCAL:
         return None
     return str(address)
+
+
+def local_workers(address: str | None) -> int | None:
+    """The worker count of ``local:N`` (a local cluster of N workers); None for other addresses.
+
+    Raises
+    ------
+    SpecrefError
+        ``local:`` followed by anything but a positive integer (one line).
+
+    Examples
+    --------
+    >>> local_workers("local:3"), local_workers("tcp://127.0.0.1:8786"), local_workers(None)
+    (3, None, None)
+    >>> local_workers("local:none")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: --scheduler local:none: allowed: local:N, N workers >= 1
+    """
+    if not address or not str(address).startswith(LOCAL + ":"):
+        return None
+    count = str(address)[len(LOCAL) + 1 :]
+    require(
+        count.isdigit() and int(count) >= 1,
+        f"--scheduler {address}: allowed: local:N, N workers >= 1",
+    )
+    return int(count)
 
 
 def connect_timeout(environ=None) -> float:
@@ -148,8 +176,8 @@ def add_scheduler_option(parser, default: str | None = None) -> None:
         "--scheduler",
         metavar="ADDRESS",
         help="where the tasks run: a running Dask scheduler (tcp://host:8786), 'local' (a local "
-        f"cluster of one worker process per core) or 'serial'; default $SPECREF_SCHEDULER, "
-        f"else {fallback}",
+        "cluster of one worker process per core), 'local:N' (of N workers) or 'serial'; default "
+        f"$SPECREF_SCHEDULER, else {fallback}",
     )
 
 
@@ -162,8 +190,9 @@ def dask_client(
     Parameters
     ----------
     scheduler : str, optional
-        Address of a running scheduler (``tcp://host:port``); default ``$SPECREF_SCHEDULER``,
-        else a ``LocalCluster`` of ``n_workers`` single-threaded processes on 127.0.0.1.
+        Address of a running scheduler (``tcp://host:port``), or ``local:N`` (a local cluster of
+        N workers); default ``$SPECREF_SCHEDULER``, else a ``LocalCluster`` of ``n_workers``
+        single-threaded processes on 127.0.0.1.
     n_workers : int, optional
         Local workers (default: the machine's cores).
     timeout : float, optional
@@ -188,6 +217,8 @@ def dask_client(
     address = scheduler_address(scheduler)
     timeout = connect_timeout() if timeout is None else timeout
     require(address != SERIAL, "dask_client: 'serial' runs without a client")
+    if local_workers(address):
+        address, n_workers = None, local_workers(address)
     if address:
         try:
             client = Client(address, timeout=timeout)

@@ -1,19 +1,22 @@
 """Scale-out as a user pays it: commands from the command line, in fresh processes.
 
 Group ``scaleout-cli`` (docs/scale-out.md, "How it scales, and what does not"; the report's
-Scale-out section):
+Scale-out section fits its model to these figures):
 
-- ``cli-serial``: ``specref sweep GRID --scheduler serial``, a 2,400-cell Phong sweep (4 materials ×
-  2 views × 3 placements × 4 interpolations × 25 table sizes, resolution 320), in a new process;
-- ``cli-local``: the same sweep with ``--scheduler local``: a new local cluster of one worker per
-  core, its start, the workers' imports and exact renders included (target ≥ 1.7× on two cores);
-  its CSV must equal the serial one byte for byte;
+- ``cli-serial``: ``specref sweep GRID --scheduler serial``, a 3,840-cell Phong sweep (4 materials
+  × 2 views × 3 placements × 4 interpolations × 40 table sizes, resolution 320; over a minute
+  serially), in a new process;
+- ``cli-workers``: the same sweep with ``--scheduler local:N`` for N = 1 … the cores present: a new
+  local cluster of N workers, its start, the workers' imports and the shared exact renders
+  included (target ≥ 1.7× on two cores); every CSV must equal the serial one byte for byte;
+- ``cli-startup``: a one-cell sweep, serially and on ``local:N``: what a run pays whatever its
+  size (process start, imports, the cluster's start, the kernels' loading, one exact render);
 - ``convert-memory``: ``specref env convert`` of a 4096 × 8192 RGB EXR in a new process, its peak
   resident set (``VmHWM``), beside the same command's on a 16 × 32 map (what the process holds
   without the map) and the size of one float32 chunk (target: at most four chunks above it, three
   in flight and the output's chunk buffer).
 
-One round each: the serial sweep takes most of a minute.
+One round each: the serial sweep takes more than a minute.
 """
 
 from __future__ import annotations
@@ -27,7 +30,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-ENTRIES = ", ".join(str(e) for e in range(40, 440, 16))
+ENTRIES = ", ".join(str(e) for e in range(40, 680, 16))
 GRID = f"""kind = "phong"
 [grid]
 materials = ["R1", "R2", "R3", "bimodal"]
@@ -37,7 +40,18 @@ interpolations = ["parabolic", "parabolic_w", "linear", "monotone"]
 entries = [{ENTRIES}]
 resolution = 320
 """
-CELLS = 4 * 2 * 3 * 4 * 25
+CELLS, SHARED = 4 * 2 * 3 * 4 * 40, 4 * 2
+#: One cell of the same sweep: the cost of a run that does not depend on its size.
+ONE_CELL = """kind = "phong"
+[grid]
+materials = ["R1"]
+views = ["near"]
+placements = ["importance"]
+interpolations = ["parabolic"]
+entries = [40]
+resolution = 320
+"""
+CORES = os.cpu_count() or 1
 SPECREF = os.path.join(os.path.dirname(sys.executable), "specref")
 #: A child that runs one specref command and prints its peak resident set size (bytes) last.
 PEAK_CHILD = (
@@ -53,31 +67,55 @@ PEAK_CHILD = (
 def grid(tmp_path_factory):
     folder = tmp_path_factory.mktemp("sweep")
     (folder / "grid.toml").write_text(GRID)
+    (folder / "one.toml").write_text(ONE_CELL)
     return folder
 
 
-def _sweep(folder: Path, scheduler: str) -> Path:
-    out = folder / f"{scheduler}.csv"
-    argv = [SPECREF, "sweep", str(folder / "grid.toml"), "--scheduler", scheduler, "-o", str(out)]
+def _sweep(folder: Path, scheduler: str, name: str = "grid") -> Path:
+    out = folder / f"{name}-{scheduler.replace(':', '-')}.csv"
+    argv = [
+        SPECREF,
+        "sweep",
+        str(folder / f"{name}.toml"),
+        "--scheduler",
+        scheduler,
+        "-o",
+        str(out),
+    ]
     subprocess.run(argv, check=True, capture_output=True)
     return out
 
 
+def _serial_csv(folder: Path) -> bytes:
+    serial = folder / "grid-serial.csv"
+    if not serial.is_file():  # a worker-count test alone
+        _sweep(folder, "serial")
+    return serial.read_bytes()
+
+
 @pytest.mark.benchmark(group="scaleout-cli")
 def test_cli_sweep_serial(benchmark, grid):
-    benchmark.extra_info.update({"role": "cli-serial", "cells": CELLS})
+    benchmark.extra_info.update({"role": "cli-serial", "cells": CELLS, "shared": SHARED})
     benchmark.pedantic(_sweep, args=(grid, "serial"), rounds=1, iterations=1)
 
 
+@pytest.mark.parametrize("workers", range(1, CORES + 1))
 @pytest.mark.benchmark(group="scaleout-cli")
-def test_cli_sweep_local_cluster(benchmark, grid):
-    workers = os.cpu_count() or 1
-    benchmark.extra_info.update({"role": "cli-local", "cells": CELLS, "workers": workers})
-    out = benchmark.pedantic(_sweep, args=(grid, "local"), rounds=1, iterations=1)
-    serial = grid / "serial.csv"
-    if not serial.is_file():  # this test alone
-        _sweep(grid, "serial")
-    assert out.read_bytes() == serial.read_bytes()
+def test_cli_sweep_workers(benchmark, grid, workers):
+    benchmark.extra_info.update(
+        {"role": "cli-workers", "cells": CELLS, "shared": SHARED, "workers": workers}
+    )
+    out = benchmark.pedantic(_sweep, args=(grid, f"local:{workers}"), rounds=1, iterations=1)
+    assert out.read_bytes() == _serial_csv(grid)
+
+
+@pytest.mark.parametrize("workers", range(CORES + 1))
+@pytest.mark.benchmark(group="scaleout-cli")
+def test_cli_startup(benchmark, grid, workers):
+    # workers = 0: serially, in the command's own process
+    scheduler = f"local:{workers}" if workers else "serial"
+    benchmark.extra_info.update({"role": "cli-startup", "workers": workers})
+    benchmark.pedantic(_sweep, args=(grid, scheduler, "one"), rounds=1, iterations=1)
 
 
 def _convert_peak(source: Path, out: Path) -> int:

@@ -405,3 +405,15 @@ def test_shared_work_survives_a_killed_worker(client, tmp_path):
     killer.join()
     assert found == _direct(tasks)
     client.wait_for_workers(2, timeout=60)
+
+
+def process_id(_task):
+    return os.getpid()
+
+
+def test_local_n_starts_a_cluster_of_n_workers():
+    pids = run_tasks(process_id, range(6), scheduler="local:1", progress=False, grain=1)
+    assert len(set(pids)) == 1
+    assert pids[0] != os.getpid()
+    with pytest.raises(SpecrefError, match=r"^--scheduler local:0: allowed: local:N, N workers"):
+        run_tasks(process_id, [1], scheduler="local:0", progress=False)

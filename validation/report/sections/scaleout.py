@@ -35,44 +35,151 @@ PEAK_RSS_TARGET = 2e9
 CLI_SWEEP_TARGET, CONVERT_CHUNKS_TARGET = 1.7, 4.0
 
 
+#: Workers the fitted model predicts for (the cores of machines this one stands for).
+PREDICT_WORKERS = (4, 8, 16, 64)
+#: The model's target at 16 workers (checked on a 16-core machine by whoever has one).
+PREDICTED_16_TARGET = 8.0
+
+
+def _chunks(cells: int, shared: int, workers: int) -> int:
+    # Dask tasks of a sweep on ``workers``: chunks of one shared key (reference.tasks), and builds
+    from reference.tasks import chunk_size
+
+    grain = chunk_size(cells, workers)
+    return shared * -(-(cells // shared) // grain) + shared
+
+
+def sweep_scaling_model(
+    serial_s: float, startup: dict, runs: dict, cells: int, shared: int
+) -> dict:
+    """The sweep's time on N workers: start-up, the work divided, and a per-task overhead.
+
+    ``T(N) = s(N) + W/N + o·m(N)/N``, fitted to cold command-line runs (docs/scale-out.md):
+
+    - ``s(N) = s_0 + s_1·N``, the start-up, least squares through the one-cell sweeps on
+      ``local:N`` (``startup[N]``; the process, the imports, the cluster, the kernels' loading);
+    - ``W = T_serial − s_serial``, the cells' work: the serial sweep less the serial one-cell run;
+    - ``m(N)``, the Dask tasks (chunks of one shared key, and the shared builds), and ``o``, the
+      overhead per task (scheduling, the last chunk's wait, data moved), least squares through
+      what the measured ``T(N)`` leaves over, never below 0.
+
+    The serial fraction is Amdahl's ``f = s(1)/T(1)``. Predictions assume one core per worker.
+
+    Examples
+    --------
+    >>> m = sweep_scaling_model(70.0, {0: 5.0, 1: 8.0, 2: 8.4}, {1: 74.0, 2: 41.5}, 3840, 8)
+    >>> round(m["work_s"], 1), round(m["startup_s"][0], 1), round(m["startup_s"][1], 1)
+    (65.0, 7.6, 0.4)
+    >>> round(m["speedup"][2], 2), m["predicted_speedup"][16] > m["predicted_speedup"][8]
+    (1.69, True)
+    """
+    import numpy as np
+
+    counts = sorted(n for n in startup if n >= 1)
+    A = np.vstack([np.ones(len(counts)), counts]).T
+    s01 = (
+        np.linalg.lstsq(A, [startup[n] for n in counts], rcond=None)[0]
+        if len(counts) > 1
+        else (np.array([startup[counts[0]], 0.0]))
+    )
+    s0, s1 = float(s01[0]), max(float(s01[1]), 0.0)
+    W = serial_s - startup[0]
+    # what the start-up and the work divided leave over, per Dask task per worker
+    x = np.array([_chunks(cells, shared, n) / n for n in sorted(runs)])
+    r = np.array([runs[n] - (s0 + s1 * n) - W / n for n in sorted(runs)])
+    o = max(float(x @ r / (x @ x)), 0.0)
+
+    def T(n):
+        return s0 + s1 * n + W / n + o * _chunks(cells, shared, n) / n
+
+    return {
+        "startup_s": (s0, s1),
+        "work_s": W,
+        "overhead_s": o,
+        "serial_fraction": (s0 + s1) / T(1),
+        "speedup": {n: serial_s / t for n, t in sorted(runs.items())},
+        "fitted_speedup": {n: serial_s / T(n) for n in sorted(runs)},
+        "predicted_speedup": {n: serial_s / T(n) for n in PREDICT_WORKERS},
+    }
+
+
+def _cli_sweep(cli: dict) -> dict | None:
+    # the serial sweep, the runs on local:N and the one-cell start-ups, and the model through them
+    serial = cli.get("cli-serial", [])
+    runs = {r["extra_info"]["workers"]: r["stats"]["min"] for r in cli.get("cli-workers", [])}
+    startup = {r["extra_info"]["workers"]: r["stats"]["min"] for r in cli.get("cli-startup", [])}
+    if not (serial and runs and 0 in startup and len(startup) > 1):
+        return None
+    e = serial[0]["extra_info"]
+    serial_s = serial[0]["stats"]["min"]
+    model = sweep_scaling_model(serial_s, startup, runs, e["cells"], e["shared"])
+    best = max(runs)
+    return {
+        "cells": e["cells"],
+        "shared": e["shared"],
+        "serial_s": serial_s,
+        "runs_s": dict(sorted(runs.items())),
+        "startup_serial_s": startup[0],
+        "workers": best,
+        "local_s": runs[best],
+        **model,
+    }
+
+
 def _cli_figures(groups: dict) -> dict | None:
-    """The command-line sweep's speed-up and env convert's memory, from group scaleout-cli."""
-    cli = _by_role(groups.get("scaleout-cli", []))
+    """The command-line sweep's speed-ups and model, and env convert's memory (scaleout-cli)."""
+    cli: dict = {}
+    for record in groups.get("scaleout-cli", []):
+        cli.setdefault(record.get("extra_info", {}).get("role"), []).append(record)
     found = {}
-    if {"cli-serial", "cli-local"} <= set(cli):
-        serial, local = cli["cli-serial"], cli["cli-local"]
-        found["sweep"] = {
-            "cells": serial["extra_info"]["cells"],
-            "workers": local["extra_info"]["workers"],
-            "serial_s": serial["stats"]["min"],
-            "local_s": local["stats"]["min"],
-            "speedup": serial["stats"]["min"] / local["stats"]["min"],
-        }
+    sweep = _cli_sweep(cli)
+    if sweep is not None:
+        found["sweep"] = sweep
     if "convert-memory" in cli:
-        e = cli["convert-memory"]["extra_info"]
+        record = cli["convert-memory"][0]
+        e = record["extra_info"]
         found["convert"] = {
             **{k: e[k] for k in ("height", "width", "channels", "chunk_bytes", "float32_bytes")},
             "peak_rss_bytes": e["peak_rss_bytes"],
             "baseline_rss_bytes": e["baseline_rss_bytes"],
             "above_chunks": (e["peak_rss_bytes"] - e["baseline_rss_bytes"]) / e["chunk_bytes"],
-            "seconds": cli["convert-memory"]["stats"]["min"],
+            "seconds": record["stats"]["min"],
         }
     return found or None
 
 
 def _present_cli(cli: dict | None) -> list:
-    """The command-line figures as a paragraph, when ``make bench`` measured them."""
+    """The command-line figures, when ``make bench`` measured them: a paragraph and the model."""
     if not cli:
         return []
-    text = []
+    text, tables = [], []
     if "sweep" in cli:
         s = cli["sweep"]
+        s0, s1 = s["startup_s"]
         text.append(
             f"From the command line, cold (new processes; the cluster's start, the workers' "
-            f"imports and exact renders included), a {s['cells']}-cell Phong sweep took "
-            f"{s['serial_s']:.1f} s serially and {s['local_s']:.1f} s on a local cluster of "
-            f"{s['workers']} workers: {s['speedup']:.2f}× (target ≥ {CLI_SWEEP_TARGET}×), the CSVs "
-            "byte-identical."
+            f"imports and the shared exact renders included), a {s['cells']:,}-cell Phong sweep "
+            f"took {s['serial_s']:.1f} s serially and {s['local_s']:.1f} s on a local cluster of "
+            f"{s['workers']} workers: {s['speedup'][s['workers']]:.2f}× (target ≥ "
+            f"{CLI_SWEEP_TARGET}×), the CSVs byte-identical. The model fitted to these runs: a "
+            f"start-up of {s0:.1f} s + {s1:.2f} s per worker (one-cell sweeps; "
+            f"{s['startup_serial_s']:.1f} s serially), {s['work_s']:.1f} s of cells' work divided "
+            f"among the workers, {1e3 * s['overhead_s']:.0f} ms per Dask task; serial fraction "
+            f"{100 * s['serial_fraction']:.0f} %."
+        )
+        measured = [
+            [n, s["runs_s"][n], s["speedup"][n], s["fitted_speedup"][n]] for n in s["runs_s"]
+        ]
+        predicted = [[n, None, None, v] for n, v in s["predicted_speedup"].items()]
+        tables.append(
+            Table(
+                ["workers", "measured (s)", "speed-up", "model's speed-up"],
+                measured + predicted,
+                f"The {s['cells']:,}-cell sweep on local:N, cold, against {s['serial_s']:.1f} s "
+                "serially; beyond the cores present, the model's prediction (one core per "
+                f"worker; target ≥ {PREDICTED_16_TARGET:g}× at 16)",
+                "{:.3g}",
+            )
         )
     if "convert" in cli:
         c = cli["convert"]
@@ -84,20 +191,30 @@ def _present_cli(cli: dict | None) -> list:
             f"{c['above_chunks']:.1f} chunks of {c['chunk_bytes'] / 1e6:.1f} MB above it "
             f"(target ≤ {CONVERT_CHUNKS_TARGET:g}), in {c['seconds']:.1f} s."
         )
-    return [Text(" ".join(text))]
+    return [Text(" ".join(text)), *tables]
 
 
 def _cli_checks(cli: dict | None) -> list[Check]:
     found = []
     if cli and "sweep" in cli:
         s = cli["sweep"]
+        speedup = s["speedup"][s["workers"]]
         found.append(
             Check(
-                f"{s['cells']}-cell sweep from the command line, cold: {s['workers']}-worker "
+                f"{s['cells']:,}-cell sweep from the command line, cold: {s['workers']}-worker "
                 "local cluster / serial",
                 f">= {CLI_SWEEP_TARGET}×",
-                s["speedup"],
-                s["speedup"] >= CLI_SWEEP_TARGET,
+                speedup,
+                speedup >= CLI_SWEEP_TARGET,
+            )
+        )
+        at_16 = s["predicted_speedup"][16]
+        found.append(
+            Check(
+                f"{s['cells']:,}-cell sweep: the fitted model's speed-up at 16 workers",
+                f">= {PREDICTED_16_TARGET:g}×",
+                at_16,
+                at_16 >= PREDICTED_16_TARGET,
             )
         )
     if cli and "convert" in cli:
