@@ -19,13 +19,17 @@ import pytest
 # test run names its file directly, which would register its methods twice.
 import impastor  # noqa: F401
 import phong_table  # noqa: F401
-import reference  # noqa: F401
+import reference
+import reference.tasks
 import shrm  # noqa: F401
 import validation.cli
 import validation.report.runner  # noqa: F401  (imports every section)
 
 matplotlib.use("Agg")
 np.set_printoptions(legacy=False)
+# The allocator thresholds every specref command sets (docs/scale-out.md): the suite's processes
+# run the same NumPy temporaries, and glibc's default spends seconds on mmap and munmap.
+reference.tasks.set_malloc_trim()
 
 ROOT = Path(__file__).resolve().parent
 

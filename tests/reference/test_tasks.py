@@ -257,6 +257,13 @@ def test_a_mixed_cluster_runs_on_the_workers_that_have_specref(tmp_path, capsys)
     assert "cannot import specref" in refused[-1]
 
 
+def _set_impastor_quick(settings):
+    # the ImpastoR section's quick settings in this process (a worker's, through client.run)
+    from validation.report.sections import impastor
+
+    impastor.QUICK = settings
+
+
 def test_report_sections_on_a_cluster_equal_serial(client, tmp_path, monkeypatch):
     # specref report --scheduler: a section's tasks (here the hybrid's held-out cases, on the
     # section's tiny sizes with two paintings) run on the cluster and give the serial figures
@@ -267,7 +274,7 @@ def test_report_sections_on_a_cluster_equal_serial(client, tmp_path, monkeypatch
     from validation.report.runner import run_report
     from validation.report.sections import impastor
 
-    tiny = impastor.TINY
+    tiny, original = impastor.TINY, impastor.QUICK
     two = dataclasses.replace(tiny, held_out={**tiny.held_out, "n_paintings": 2})
     monkeypatch.setattr(impastor, "QUICK", two)
 
@@ -282,8 +289,17 @@ def test_report_sections_on_a_cluster_equal_serial(client, tmp_path, monkeypatch
         return results["sections"]["impastor"]["held_out_hybrid"], results["meta"]["scheduler"]
 
     serial, where = held_out("serial", "a")
-    distributed, where_distributed = held_out(client.scheduler.address, "b")
+    # the section runs as a task on a worker: the workers get the same settings
+    client.run(_set_impastor_quick, two)
+    try:
+        distributed, where_distributed = held_out(client.scheduler.address, "b")
+    finally:
+        client.run(_set_impastor_quick, original)
     assert (where, where_distributed) == ("serial", client.scheduler.address)
+    # the section ran as a task on a worker, in a folder of its own: its files came back
+    files = sorted(p.relative_to(tmp_path / "a") for p in (tmp_path / "a").rglob("*.png"))
+    assert files
+    assert files == sorted(p.relative_to(tmp_path / "b") for p in (tmp_path / "b").rglob("*.png"))
     assert distributed["cases"] == serial["cases"]
     assert len(serial["per_case"]) >= 2
     for got, want in zip(distributed["per_case"], serial["per_case"], strict=True):

@@ -84,7 +84,7 @@ def add_parser(sub) -> None:
         type=int,
         default=None,
         help="sections side by side in this many processes (default: the cores, at most 2; "
-        "1 with --scheduler, whose cluster runs the sections' tasks)",
+        "ignored with --scheduler, whose cluster runs each section as a task, side by side)",
     )
     add_scheduler_option(p, default=SERIAL)
     p.set_defaults(func=_cmd_report)

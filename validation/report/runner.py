@@ -31,7 +31,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from reference.errors import require, require_choice
-from reference.files import read_json, write_text_atomic
+from reference.files import read_json, write_bytes_atomic, write_text_atomic
 from reference.registry import Registry
 from reference.tasks import LOCAL, SERIAL, dask_client, scheduler_address
 from validation.report.render import render_html, render_markdown
@@ -320,11 +320,12 @@ class _Run:
 def _run_sections(run: _Run, progress: bool) -> list:
     """Run each section; returns ``[(section, result), ...]`` in reading order.
 
-    The sections draw in :data:`CHART_STYLE` and run their tasks on one Dask client at
-    ``run.address`` (a local cluster for None), or serially for ``reference.tasks.SERIAL``; with
-    ``run.jobs`` > 1 they run side by side in as many forked processes. After each section the page
-    is rewritten with the sections still to come, and stderr gets a line with the section's time
-    (or a bar, on a terminal).
+    The sections draw in :data:`CHART_STYLE`. For ``reference.tasks.SERIAL`` they run in this
+    process, or side by side in ``run.jobs`` forked processes; otherwise each section is a task
+    on the Dask cluster at ``run.address`` (a local cluster for None) and sends its own tasks to
+    the same cluster (:func:`run_section_task`), so independent sections run side by side. After
+    each section the page is rewritten with the sections still to come, and stderr gets a line
+    with the section's time (or a bar, on a terminal).
     """
     import matplotlib
 
@@ -334,12 +335,12 @@ def _run_sections(run: _Run, progress: bool) -> list:
         if run.jobs > 1:
             finished = _side_by_side(run, stack)
         else:
-            client = (
-                None
-                if run.address == SERIAL
-                else stack.enter_context(dask_client(run.address or LOCAL))
-            )
-            finished = ((s, _run_section(run, s, client)) for s in run.sections)
+            if run.address == SERIAL:
+                finished = ((s, _run_section(run, s, None)) for s in run.sections)
+            else:
+                finished = _on_scheduler(
+                    run, stack.enter_context(dask_client(run.address or LOCAL))
+                )
         for section, result in finished:
             done[section.name] = (section, result)
             tracker.finished(
@@ -410,6 +411,48 @@ def _side_by_side(run: _Run, stack: contextlib.ExitStack):
     for future in concurrent.futures.as_completed(futures):
         index, result = future.result()
         yield run.sections[index], result
+
+
+def run_section_task(section: ReportSection, effort: str, bench: dict | None) -> tuple:
+    """One report section as a Dask task: its result and the files it wrote, by relative path.
+
+    The section runs in a temporary folder of the worker (the client writes the files into the
+    report's folder, so workers need no shared file system), in the chart style, and sends its
+    own independent tasks to the same cluster (``distributed.worker_client``).
+    """
+    import tempfile
+
+    import matplotlib
+    from distributed import worker_client
+
+    with (
+        tempfile.TemporaryDirectory() as folder,
+        matplotlib.rc_context(CHART_STYLE),
+        worker_client() as client,
+    ):
+        run = _Run(Path(folder), effort, bench, None, {}, [section])
+        result = _run_section(run, section, client)
+        files = {
+            path.relative_to(folder).as_posix(): path.read_bytes()
+            for path in sorted(Path(folder).rglob("*"))
+            if path.is_file()
+        }
+    return result, files
+
+
+def _on_scheduler(run: _Run, client):
+    """Yield ``(section, result)`` as the sections finish, each a task on ``client``'s cluster."""
+    from distributed import as_completed
+
+    futures = {
+        client.submit(run_section_task, section, run.effort, run.bench, pure=False): section
+        for section in run.sections
+    }
+    for future in as_completed(futures):
+        result, files = future.result()
+        for name, data in files.items():
+            write_bytes_atomic(run.out_dir / name, data)
+        yield futures[future], result
 
 
 def _run_section(run: _Run, section: ReportSection, client) -> SectionResult:
