@@ -30,6 +30,7 @@ __all__ = [
     "CHUNKS_PER_WORKER",
     "LOCAL",
     "MMAP_SETTING",
+    "PROFILE_SETTING",
     "SCHEDULER_ENV",
     "SERIAL",
     "TIMEOUT_ENV",
@@ -239,7 +240,13 @@ def dask_client(
 
     workers = n_workers or os.cpu_count() or 1
     with (
-        dask.config.set({TRIM_SETTING: WORKER_TRIM_BYTES, MMAP_SETTING: WORKER_MMAP_BYTES}),
+        dask.config.set(
+            {
+                TRIM_SETTING: WORKER_TRIM_BYTES,
+                MMAP_SETTING: WORKER_MMAP_BYTES,
+                PROFILE_SETTING: False,
+            }
+        ),
         LocalCluster(
             n_workers=workers,
             threads_per_worker=1,
@@ -477,6 +484,12 @@ TRIM_SETTING = "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_"
 #: reaches (32 MiB on 64-bit), so temporaries below it reuse the heap as in a plain process.
 WORKER_MMAP_BYTES = 32 << 20
 MMAP_SETTING = "distributed.nanny.pre-spawn-environ.MALLOC_MMAP_THRESHOLD_"
+
+
+#: Dask's statistical profiler, which samples every worker's task thread every 10 ms: off in
+#: local clusters, where it cost about 5 % of a long sweep's time (docs/scale-out.md); for workers
+#: started by hand, ``DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED=False``.
+PROFILE_SETTING = "distributed.worker.profile.enabled"
 
 
 def set_malloc_trim(threshold: int = WORKER_TRIM_BYTES) -> bool:
