@@ -576,6 +576,11 @@ def spectralize_file(panorama, model, out, rows_per_block: int | None = None) ->
     }
 
 
+#: Reads per chunk of rows in :func:`convert_to_zarr`: the reader's own buffers are this much
+#: smaller than a chunk.
+READ_WINDOWS_PER_CHUNK = 4
+
+
 def convert_to_zarr(
     source, out, rows_per_chunk: int | None = None, compression: str = "blosc-lz4"
 ) -> dict:
@@ -584,11 +589,11 @@ def convert_to_zarr(
     The source is read a chunk of rows at a time (:func:`open_panorama_rows`: OpenEXR scanline
     windows, Radiance scanlines, a memory-mapped TIFF) and each chunk is written as it is read
     (``write_zarr_blocks``), so the resident memory is a few chunks whatever the panorama's size:
-    one chunk of rows as float64 as read, its float32 copy and the compressor's output (about
-    3.5 × one float32 chunk, :data:`~reference.images.zarr_store.CHUNK_BYTES` by default;
-    docs/scale-out.md states the measured peak). Files that cannot be read by rows (compressed
-    TIFF, rotated Radiance; ``streamed`` False in the summary) are read whole. Nothing is left at
-    ``out`` when a chunk holds NaN or infinity.
+    one float32 chunk buffer, reused, filled :data:`READ_WINDOWS_PER_CHUNK` windows at a time, and
+    the compressor's output and working copy (about four chunks,
+    :data:`~reference.images.zarr_store.CHUNK_BYTES` each by default; docs/scale-out.md). Files
+    that cannot be read by rows (compressed TIFF, rotated Radiance; ``streamed`` False in the
+    summary) are read whole. Nothing is left at ``out`` when a chunk holds NaN or infinity.
 
     Returns a summary: the shape, ``rows_per_chunk``, ``chunks``, the compression and its ratio,
     and ``streamed``.
@@ -617,14 +622,21 @@ def convert_to_zarr(
         )
 
         def chunks():
+            # one chunk buffer, reused, filled a quarter chunk at a time (the store's float32):
+            # the reader's temporaries stay a fraction of a chunk
+            buffer = np.empty((rows_per_chunk, width, n), np.float32)
+            step = max(1, rows_per_chunk // READ_WINDOWS_PER_CHUNK)
             for row0 in range(0, height, rows_per_chunk):
                 row1 = min(row0 + rows_per_chunk, height)
-                block = rows.read(row0, row1, np.float32)  # the store's type: no float64 copy
-                require(
-                    np.isfinite(block).all(),
-                    f"{source}: radiance must be finite, found NaN or inf (rows {row0}-{row1 - 1})",
-                )
-                yield block
+                for a in range(row0, row1, step):
+                    b = min(a + step, row1)
+                    window = buffer[a - row0 : b - row0]
+                    window[...] = rows.read(a, b, np.float32)
+                    require(
+                        np.isfinite(window).all(),
+                        f"{source}: radiance must be finite, found NaN or inf (rows {a}-{b - 1})",
+                    )
+                yield buffer[: row1 - row0]
 
         write_zarr_blocks(
             out, height, width, rows.names, chunks(), rows_per_chunk, compression=compression

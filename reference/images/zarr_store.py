@@ -327,6 +327,9 @@ def _write_row_blocks(array, blocks: Iterable[np.ndarray], rows_per_chunk: int, 
             array[row : row + full] = pending[:full]
             row += full
             pending = pending[full:]
+        if len(pending) and row + len(pending) == height:  # the last rows: no need to wait
+            array[row:height] = pending
+            row, pending = height, pending[:0]
         if len(pending) and np.may_share_memory(pending, block):
             pending = pending.copy()  # the rest waits; the caller may reuse its block's buffer
     if len(pending):

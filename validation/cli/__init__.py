@@ -79,11 +79,13 @@ def main(argv: list[str] | None = None) -> int:
     import shrm  # noqa: F401  (registers the environment-light shaders before any rendering)
     from reference.tasks import set_malloc_trim
 
-    # glibc's default mmap threshold makes NumPy's large temporaries an mmap and a munmap each: a
-    # fifth of a long sweep's time in system calls (docs/scale-out.md); the workers set the same
-    set_malloc_trim()
     parser = build_parser()
     args = parser.parse_args(argv)
+    # glibc's default mmap threshold makes NumPy's large temporaries an mmap and a munmap each: a
+    # fifth of a long sweep's time in system calls (docs/scale-out.md); the workers set the same.
+    # Streamed commands keep the default, which returns each chunk's memory to the system.
+    if not getattr(args, "streamed", False):
+        set_malloc_trim()
     try:
         return int(args.func(args) or 0)
     except SpecrefError as error:

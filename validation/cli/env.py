@@ -103,7 +103,7 @@ def add_parser(sub) -> None:
     s.add_argument("--model", required=True, help="model .json from `env fit`, or 'default'")
     s.add_argument("--rows", type=int, default=None, help="rows per block (default: 2^17 pixels)")
     s.add_argument("-o", "--out", required=True, help="output .exr, .tif or .zarr")
-    s.set_defaults(func=_cmd_env_spectralize)
+    s.set_defaults(func=_cmd_env_spectralize, streamed=True)
     from reference.images.zarr_store import ZARR_COMPRESSIONS
 
     c = env.add_parser(
@@ -118,4 +118,4 @@ def add_parser(sub) -> None:
         help="rows per chunk (default: about 21.5 MB of float32 per chunk)",
     )
     registry_option(c, "--compression", ZARR_COMPRESSIONS, "chunk compression", default="blosc-lz4")
-    c.set_defaults(func=_cmd_env_convert)
+    c.set_defaults(func=_cmd_env_convert, streamed=True)

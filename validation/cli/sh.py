@@ -40,7 +40,7 @@ def add_parser(sub) -> None:
     q.add_argument("--bands", choices=("spectral", "rgb"), default=None, help="convert first")
     registry_option(q, "--backend", SH_BACKENDS, "SH transform engine", default="ducc0")
     q.add_argument("-o", "--out", required=True, help="output .npz")
-    q.set_defaults(func=_cmd_sh_project)
+    q.set_defaults(func=_cmd_sh_project, streamed=True)
     r = sh.add_parser("prefilter", help="frequency-space prefiltered cube or lat-long map (.exr)")
     r.add_argument("env", type=input_file, help="lat-long map, .hdr or .exr")
     registry_option(r, "--kernel", PREFILTER_KERNELS, "prefilter kernel", required=True)

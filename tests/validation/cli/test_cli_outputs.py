@@ -277,3 +277,21 @@ def test_sprague_with_too_few_samples_is_refused():
     uneven = make_spectrum([380, 400, 450, 500, 600, 700, 780], [0.1] * 7, "uneven")
     with pytest.raises(SpecrefError, match="unevenly spaced"):
         resample_spectrum(uneven, GRID_41, interpolation="sprague")
+
+
+def test_commands_set_the_allocator_thresholds_but_streamed_ones(tmp_path, monkeypatch):
+    # docs/scale-out.md: every command keeps NumPy's temporaries on the heap, except the streamed
+    # ones (env convert, env spectralize, sh project), which return each chunk's memory
+    import numpy as np
+
+    import reference.tasks
+    from reference.images.formats import write_exr
+    from validation.cli import main
+
+    calls = []
+    monkeypatch.setattr(reference.tasks, "set_malloc_trim", lambda: calls.append(1) or True)
+    sky = write_exr(tmp_path / "sky.exr", np.ones((8, 16, 3), np.float32))
+    assert main(["env", "convert", str(sky), str(tmp_path / "sky.zarr")]) == 0
+    assert calls == []
+    assert main(["sweep", str(tmp_path / "missing.toml"), "--scheduler", "serial"]) == 2
+    assert calls == [1]
