@@ -178,27 +178,21 @@ def _sky(tmp_path):
     return write_exr(tmp_path / "sky.exr", np.ascontiguousarray(sky))
 
 
-def test_shrm_sweep_matches_the_direct_computation(tmp_path, monkeypatch):
-    # the brute-force render does not depend on the tolerance: the cells of one environment,
-    # material and size share it (reference.tasks.Shared), rendered once
-    import reference.scene.render as render
+def test_shrm_sweep_matches_the_direct_computation(tmp_path):
     from reference.scene.loader import loads_scene
     from validation.studies.env_accuracy import render_against_oracle, sphere_scene_toml
+    from validation.studies.sweep import SWEEP_KINDS
 
     sky = _sky(tmp_path)
     path = tmp_path / "s.toml"
-    path.write_text(SHRM_GRID.replace("[0.01]", "[0.05, 0.01]"))  # the map beside the file
-    calls, render_scene = [], render.render_scene
-
-    def counted(scene, options=None, **kwargs):
-        calls.append((options or {}).get("environment"))
-        return render_scene(scene, options=options, **kwargs)
-
-    monkeypatch.setattr(render, "render_scene", counted)
-    coarse, row = run_sweep(path, scheduler="serial", progress=False)
-    assert calls == ["bruteforce", None, None]
-    assert (coarse["tolerances"], row["tolerances"]) == (0.05, 0.01)
-    monkeypatch.setattr(render, "render_scene", render_scene)
+    path.write_text(SHRM_GRID)  # the map relative to the sweep file's folder
+    (row,) = run_sweep(path, scheduler="serial", progress=False)
+    # the brute-force render does not depend on the tolerance: cells of other tolerances share
+    # it (reference.tasks.Shared builds a key once; tests/reference/test_tasks.py)
+    _, cells = load_sweep(path)
+    key = SWEEP_KINDS.lookup("shrm").shared.key
+    assert key(cells[0]) == key({**cells[0], "tolerances": 0.5})
+    assert key(cells[0]) != key({**cells[0], "size": 7})
     material = 'type = "isotropic_brdf"\nbrdf = "ggx"\nalpha = 0.3\nF_0 = 1.0\nrho_d = 0.0'
     direct = render_against_oracle(
         loads_scene(sphere_scene_toml(sky, material, 6)), {"shrm_tol": 0.01}
