@@ -217,3 +217,20 @@ __all__ = [
     "prefilter_bruteforce_table_kernel",
     "sh_evaluate_kernel",
 ]
+
+
+@njit
+def polar_rotate_each_kernel(x, cos_ma, sin_ma, partner, out):
+    """Twin of ``shrm.shrm._polar_rotate_each``: x, out (outer, angle, inner, (P+1)²).
+
+    ``cos_ma[j, i] = cos(|m_i| a_j)`` and ``sin_ma[j, i] = sgn(m_i) sin(|m_i| a_j)``.
+    """
+    n_outer, n_angle, n_inner, n = x.shape
+    for o in range(n_outer):
+        for j in range(n_angle):
+            for k in range(n_inner):
+                for i in range(n):
+                    # c'_m = cos(|m| a) c_m + sgn(m) sin(|m| a) c_{-m}
+                    out[o, j, k, i] = (
+                        cos_ma[j, i] * x[o, j, k, i] + sin_ma[j, i] * x[o, j, k, partner[i]]
+                    )

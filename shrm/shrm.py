@@ -151,17 +151,38 @@ def _block_apply(blocks, c, transpose=False):
     return out
 
 
-def _polar_rotate_each(x, a, P):
-    """``Y(a) x`` with one angle per row or column (``a`` broadcast against ``x[..., :1]``)."""
+def _polar_rotate_each(x, a, P, backend: str = "numpy"):
+    """``Y(a) x`` with one angle per row or column (``a`` broadcast against ``x[..., :1]``).
+
+    ``backend="numba"`` (or ``"ducc0"``) runs ``shrm._kernels.polar_rotate_each_kernel`` in one
+    pass over ``x`` (rows × columns × channels × (P+1)², hundreds of MB for an SHRM).
+    """
     l, m = sh_degrees_orders(P)
     partner = l * l + l - m
-    # cos(|m| a) x_m + sgn(m) sin(|m| a) x_-m, in place on two full-size arrays (x is large:
-    # rows × columns × channels × (P+1)²)
+    a = np.asarray(a, dtype=np.float64)
+    varying = [axis for axis, n in enumerate(a.shape) if n > 1]
+    if backend != "numpy" and len(varying) == 1:
+        return _polar_rotate_each_kernel(x, a.reshape(-1), varying[0], m, partner)
+    # cos(|m| a) x_m + sgn(m) sin(|m| a) x_-m, in place on two full-size arrays
     out = np.multiply(np.cos(np.abs(m) * a), x)
     swapped = x[..., partner]
     swapped *= np.sign(m) * np.sin(np.abs(m) * a)
     out += swapped
     return out
+
+
+def _polar_rotate_each_kernel(x, angles, axis, m, partner):
+    # x as (outer, angle, inner, (P+1)²) around the axis the angles run along
+    from shrm._kernels import polar_rotate_each_kernel
+
+    shape = x.shape
+    outer = int(np.prod(shape[:axis], dtype=np.int64))
+    x4 = np.ascontiguousarray(x).reshape(outer, shape[axis], -1, shape[-1])
+    cos_ma = np.cos(np.abs(m)[None, :] * angles[:, None])
+    sin_ma = np.sign(m)[None, :] * np.sin(np.abs(m)[None, :] * angles[:, None])
+    out = np.empty_like(x4)
+    polar_rotate_each_kernel(x4, cos_ma, sin_ma, partner, out)
+    return out.reshape(shape)
 
 
 @dataclass(frozen=True, eq=False)
@@ -265,20 +286,53 @@ def shrm_create(
     phi = 2.0 * np.pi * (np.arange(W) + 0.5) / W
     # B_pq(n) on a Fejér-1 grid of 2(F+P)+2 rows: each texel's frame, then world axes
     A_cos, A_sin = _local_row_terms(L, rho, theta)
-    B_world = _rotate_to_world(A_cos, A_sin, theta, phi)  # (H, W, C, (P+1)²)
+    B_world = _rotate_to_world(A_cos, A_sin, theta, phi, backend)  # (H, W, C, (P+1)²)
     # B_pq(n) is band-limited to F + P: project exactly (Fejér-1), synthesize at the texels
     from reference.geometry.cubemap import cubemap_texel_directions
 
     grid = B_world.reshape(H, W, C * P1 * P1)
     coeffs_n = project_latlong(grid, K, backend=backend, where="SHRM")
     texels = cubemap_texel_directions(size)
-    values = sh_evaluate(coeffs_n, texels, backend=backend)
+    values = _synthesize_many(coeffs_n, K, texels, backend)
     coeffs = values.reshape(6, size, size, C, P1 * P1)
     irradiance = None
     if lambert is not None:
         lambert = np.broadcast_to(np.asarray(lambert, dtype=np.float64), (C,)).copy()
         irradiance = _irradiance_cube(env_coeffs, texels, backend)
     return SHRM(coeffs, frame, F, P, float(view_power), lambert, irradiance)
+
+
+#: Up to this degree, :func:`_synthesize_many` evaluates the basis once and multiplies.
+BASIS_PRODUCT_MAX_ORDER = 64
+#: Texels per block of the basis matrix in :func:`_synthesize_many` (bytes of float64).
+BASIS_BLOCK_BYTES = 64 << 20
+
+
+def _synthesize_many(coeffs, K: int, texels, backend: str) -> np.ndarray:
+    """``f_c(ω) = Σ_lm c_lm Y_lm(ω)`` for thousands of functions c at the texels, (..., C).
+
+    Eq. (2), Ramamoorthi & Hanrahan 2001, as a matrix product: the basis ``Y`` (texels ×
+    (K+1)²) once per block of texels, times the coefficients of every function. An SHRM has
+    C·(P+1)² functions (thousands); one synthesis call per function (``sh_evaluate``) spends its
+    time in per-call work, while the product costs (K+1)² per texel and function, less up to
+    :data:`BASIS_PRODUCT_MAX_ORDER` (docs/errata.md, SHRM creation).
+
+    Examples
+    --------
+    >>> c = np.zeros((2, 4)); c[0, 0] = np.sqrt(4 * np.pi); c[1, 2] = 1.0
+    >>> d = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])
+    >>> np.allclose(_synthesize_many(c, 1, d, "ducc0"), sh_evaluate(c, d, backend="numpy"))
+    True
+    """
+    if K > BASIS_PRODUCT_MAX_ORDER:
+        return sh_evaluate(coeffs, texels, backend=backend)
+    flat = texels.reshape(-1, 3)
+    out = np.empty((flat.shape[0], coeffs.shape[0]))
+    step = max(1, BASIS_BLOCK_BYTES // (8 * (K + 1) ** 2))
+    for start in range(0, flat.shape[0], step):
+        Y = sh_basis(K, flat[start : start + step])  # (texels, (K+1)²)
+        out[start : start + step] = Y @ coeffs.T
+    return out.reshape(*texels.shape[:-1], coeffs.shape[0])
 
 
 def _local_row_terms(L, rho, theta) -> tuple[np.ndarray, np.ndarray]:
@@ -328,7 +382,7 @@ def _local_row_terms(L, rho, theta) -> tuple[np.ndarray, np.ndarray]:
     return A_cos, A_sin
 
 
-def _rotate_to_world(A_cos, A_sin, theta, phi) -> np.ndarray:
+def _rotate_to_world(A_cos, A_sin, theta, phi, backend: str = "numpy") -> np.ndarray:
     """``B_pq(n) = [D(R_n) B^loc(n)]_pq`` in world axes on the Fejér-1 grid, (H, W, C, (P+1)²)."""
     F1 = A_cos.shape[-1]
     P = qmax = A_cos.shape[2] - 1
@@ -341,11 +395,11 @@ def _rotate_to_world(A_cos, A_sin, theta, phi) -> np.ndarray:
     # R_n = R_y(−φ) R_x(−θ) = R_y(−φ) Qᵀ R_y(−θ) Q: the row part D(Qᵀ) Y(−θ_j) D(Q) acts on the
     # Fourier terms of each row, before the sum over m' for every column k
     DQ = _quarter_turn_blocks(P)
-    A = _polar_rotate_each(_block_apply(DQ, A), -theta[None, :, None, None, None], P)
+    A = _polar_rotate_each(_block_apply(DQ, A), -theta[None, :, None, None, None], P, backend)
     A = np.moveaxis(_block_apply(DQ, A, transpose=True), -1, -2)  # (2, H, C, (P+1)², F+1)
     # Σ_m' cos(m'φ_k) A_cos + sin(m'φ_k) A_sin, then Y(−φ_k) per column k
     B_world = np.moveaxis(A[0] @ cos_phi.T + A[1] @ sin_phi.T, -1, 1)  # (H, W, C, (P+1)²)
-    B_world = _polar_rotate_each(B_world, -phi[None, :, None, None], P)
+    B_world = _polar_rotate_each(B_world, -phi[None, :, None, None], P, backend)
     return B_world
 
 

@@ -158,3 +158,49 @@ def test_shrm_extract_is_linear_in_the_view_basis():
     np.testing.assert_allclose(
         shrm_extract(s, v)[..., 0], s.coeffs[..., 0, :] @ sh_basis(2, v[None])[0]
     )
+
+
+@pytest.mark.parametrize("K", [0, 7, 25])
+def test_the_basis_product_equals_one_synthesis_per_function(rng, K, monkeypatch):
+    # erratum E97: the texels' values of many functions as one matrix product, in blocks of
+    # texels (a small block here, so several), agree with ducc0's synthesis of each function
+    import shrm.shrm as shrm_module
+
+    monkeypatch.setattr(shrm_module, "BASIS_BLOCK_BYTES", 8 * (K + 1) ** 2 * 100)
+    coeffs = rng.standard_normal((37, (K + 1) ** 2))
+    texels = cubemap_texel_directions(8)
+    got = shrm_module._synthesize_many(coeffs, K, texels, "ducc0")
+    want = sh_evaluate(coeffs, texels, backend="ducc0")
+    assert got.shape == want.shape == (6, 8, 8, 37)
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-11 * np.abs(want).max())
+    # above the product's order, the per-function synthesis itself
+    monkeypatch.setattr(shrm_module, "BASIS_PRODUCT_MAX_ORDER", K - 1)
+    if K > 0:
+        assert np.array_equal(shrm_module._synthesize_many(coeffs, K, texels, "ducc0"), want)
+
+
+@pytest.mark.parametrize("axis", [0, 1, 2])
+def test_polar_rotation_kernel_equals_the_numpy_reference(rng, axis):
+    # shrm._kernels.polar_rotate_each_kernel against shrm.shrm._polar_rotate_each's NumPy path,
+    # with the angles along each axis, on a non-contiguous array as shrm_create passes it
+    from shrm.shrm import _polar_rotate_each
+
+    P = 4
+    x = np.moveaxis(rng.standard_normal((3, 5, 7, 2, (P + 1) ** 2)), 0, 2)  # (5, 7, 3, 2, 25)
+    shape = [1] * 5
+    shape[axis] = x.shape[axis]
+    a = rng.uniform(-np.pi, np.pi, x.shape[axis]).reshape(shape)
+    want = _polar_rotate_each(x, a, P, "numpy")
+    got = _polar_rotate_each(x, a, P, "numba")
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(want, polar_rotate_reference(x, a, P), rtol=0, atol=1e-12)
+
+
+def polar_rotate_reference(x, a, P):
+    # the public polar_rotate, one angle at a time along the axis
+    axis = int(np.flatnonzero(np.array(a.shape) > 1)[0])
+    out = np.empty_like(x)
+    for j, angle in enumerate(a.reshape(-1)):
+        index = (slice(None),) * axis + (j,)
+        out[index] = polar_rotate(x[index], np.array([angle]))[0]
+    return out
