@@ -220,7 +220,7 @@ __all__ = [
 
 
 @njit
-def polar_rotate_each_kernel(x, cos_ma, sin_ma, partner, out):
+def _polar_rotate_each_kernel(x, cos_ma, sin_ma, partner, out):
     """Twin of ``shrm.shrm._polar_rotate_each``: x, out (outer, angle, inner, (P+1)²).
 
     ``cos_ma[j, i] = cos(|m_i| a_j)`` and ``sin_ma[j, i] = sgn(m_i) sin(|m_i| a_j)``.

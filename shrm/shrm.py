@@ -154,7 +154,7 @@ def _block_apply(blocks, c, transpose=False):
 def _polar_rotate_each(x, a, P, backend: str = "numpy"):
     """``Y(a) x`` with one angle per row or column (``a`` broadcast against ``x[..., :1]``).
 
-    ``backend="numba"`` (or ``"ducc0"``) runs ``shrm._kernels.polar_rotate_each_kernel`` in one
+    ``backend="numba"`` (or ``"ducc0"``) runs ``shrm._kernels._polar_rotate_each_kernel`` in one
     pass over ``x`` (rows × columns × channels × (P+1)², hundreds of MB for an SHRM).
     """
     l, m = sh_degrees_orders(P)
@@ -162,7 +162,7 @@ def _polar_rotate_each(x, a, P, backend: str = "numpy"):
     a = np.asarray(a, dtype=np.float64)
     varying = [axis for axis, n in enumerate(a.shape) if n > 1]
     if backend != "numpy" and len(varying) == 1:
-        return _polar_rotate_each_kernel(x, a.reshape(-1), varying[0], m, partner)
+        return _polar_rotate_each_numba(x, a.reshape(-1), varying[0], m, partner)
     # cos(|m| a) x_m + sgn(m) sin(|m| a) x_-m, in place on two full-size arrays
     out = np.multiply(np.cos(np.abs(m) * a), x)
     swapped = x[..., partner]
@@ -171,9 +171,9 @@ def _polar_rotate_each(x, a, P, backend: str = "numpy"):
     return out
 
 
-def _polar_rotate_each_kernel(x, angles, axis, m, partner):
+def _polar_rotate_each_numba(x, angles, axis, m, partner):
     # x as (outer, angle, inner, (P+1)²) around the axis the angles run along
-    from shrm._kernels import polar_rotate_each_kernel
+    from shrm._kernels import _polar_rotate_each_kernel as kernel
 
     shape = x.shape
     outer = int(np.prod(shape[:axis], dtype=np.int64))
@@ -181,7 +181,7 @@ def _polar_rotate_each_kernel(x, angles, axis, m, partner):
     cos_ma = np.cos(np.abs(m)[None, :] * angles[:, None])
     sin_ma = np.sign(m)[None, :] * np.sin(np.abs(m)[None, :] * angles[:, None])
     out = np.empty_like(x4)
-    polar_rotate_each_kernel(x4, cos_ma, sin_ma, partner, out)
+    kernel(x4, cos_ma, sin_ma, partner, out)
     return out.reshape(shape)
 
 

@@ -181,7 +181,7 @@ def test_the_basis_product_equals_one_synthesis_per_function(rng, K, monkeypatch
 
 @pytest.mark.parametrize("axis", [0, 1, 2])
 def test_polar_rotation_kernel_equals_the_numpy_reference(rng, axis):
-    # shrm._kernels.polar_rotate_each_kernel against shrm.shrm._polar_rotate_each's NumPy path,
+    # shrm._kernels._polar_rotate_each_kernel against shrm.shrm._polar_rotate_each's NumPy path,
     # with the angles along each axis, on a non-contiguous array as shrm_create passes it
     from shrm.shrm import _polar_rotate_each
 
