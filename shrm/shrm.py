@@ -377,8 +377,9 @@ def _local_row_terms(L, rho, theta) -> tuple[np.ndarray, np.ndarray]:
             )
         # R&H 2002, the SHRM coefficients: Σ_l ρ_{lp|q|} (D(R_nᵀ) L)_lq
         r = rho[:, l][:, :, np.abs(qs)]  # (C, P+1, nq)
-        A_cos[:, :, :, qs + qmax, : l + 1] += r[None, ..., None] * u[:, :, None]
-        A_sin[:, :, :, qs + qmax, : l + 1] += r[None, ..., None] * v[:, :, None]
+        q = slice(qs[0] + qmax, qs[-1] + qmax + 1)  # the q of this l, a view (no gather/scatter)
+        A_cos[:, :, :, q, : l + 1] += r[None, ..., None] * u[:, :, None]
+        A_sin[:, :, :, q, : l + 1] += r[None, ..., None] * v[:, :, None]
     return A_cos, A_sin
 
 
