@@ -29,6 +29,7 @@ from reference.errors import SpecrefError, require, require_positive_int
 __all__ = [
     "CHUNKS_PER_WORKER",
     "LOCAL",
+    "MAX_LOCAL_WORKERS",
     "MMAP_SETTING",
     "PROFILE_SETTING",
     "SCHEDULER_ENV",
@@ -92,6 +93,10 @@ def scheduler_address(scheduler: str | None = None, default: str | None = None) 
     return str(address)
 
 
+#: The most workers ``local:N`` starts on one machine (each is a process of a few hundred MB).
+MAX_LOCAL_WORKERS = 256
+
+
 def local_workers(address: str | None) -> int | None:
     """The worker count of ``local:N`` (a local cluster of N workers); None for other addresses.
 
@@ -107,14 +112,14 @@ def local_workers(address: str | None) -> int | None:
     >>> local_workers("local:none")
     Traceback (most recent call last):
     ...
-    reference.errors.SpecrefError: --scheduler local:none: allowed: local:N, N workers >= 1
+    reference.errors.SpecrefError: --scheduler local:none: allowed: local:N, N workers from 1 to 256
     """
     if not address or not str(address).startswith(LOCAL + ":"):
         return None
     count = str(address)[len(LOCAL) + 1 :]
     require(
-        count.isdigit() and int(count) >= 1,
-        f"--scheduler {address}: allowed: local:N, N workers >= 1",
+        count.isdigit() and 1 <= int(count) <= MAX_LOCAL_WORKERS,
+        f"--scheduler {address}: allowed: local:N, N workers from 1 to {MAX_LOCAL_WORKERS}",
     )
     return int(count)
 
@@ -487,8 +492,8 @@ MMAP_SETTING = "distributed.nanny.pre-spawn-environ.MALLOC_MMAP_THRESHOLD_"
 
 
 #: Dask's statistical profiler, which samples every worker's task thread every 10 ms: off in
-#: local clusters, where it cost about 5 % of a long sweep's time (docs/scale-out.md); for workers
-#: started by hand, ``DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED=False``.
+#: local clusters, where it slowed long sweeps (docs/scale-out.md); for workers started by hand,
+#: ``DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED=False``.
 PROFILE_SETTING = "distributed.worker.profile.enabled"
 
 

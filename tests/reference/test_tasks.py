@@ -433,3 +433,24 @@ def test_local_n_starts_a_cluster_of_n_workers():
     assert pids[0] != os.getpid()
     with pytest.raises(SpecrefError, match=r"^--scheduler local:0: allowed: local:N, N workers"):
         run_tasks(process_id, [1], scheduler="local:0", progress=False)
+
+
+@pytest.mark.parametrize("count", ["0", "-2", "nan", "2.5", "", "100000"])
+def test_a_bad_local_worker_count_is_one_line(tmp_path, capsys, count):
+    # specref sweep --scheduler local:N with N not a worker count: one line, exit 2, before any
+    # cluster starts, and the earlier output left as it was
+    from validation.cli import main
+
+    grid = tmp_path / "s.toml"
+    grid.write_text(
+        'kind = "phong"\n[grid]\nmaterials = ["R1"]\nviews = ["near"]\nplacements = ["error"]\n'
+        'interpolations = ["linear"]\nentries = [8]\nresolution = 4\n'
+    )
+    out = tmp_path / "out.csv"
+    out.write_text("earlier")
+    argv = ["sweep", str(grid), "--scheduler", f"local:{count}", "-o", str(out)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert f"--scheduler local:{count}: allowed: local:N, N workers from 1 to 256" in err
+    assert out.read_text() == "earlier"

@@ -81,8 +81,8 @@ def main(argv: list[str] | None = None) -> int:
 
     parser = build_parser()
     args = parser.parse_args(argv)
-    # glibc's default mmap threshold makes NumPy's large temporaries an mmap and a munmap each: a
-    # fifth of a long sweep's time in system calls (docs/scale-out.md); the workers set the same.
+    # glibc's default mmap threshold makes NumPy's large temporaries an mmap and a munmap each, in
+    # system calls that slowed long sweeps (docs/scale-out.md); the workers set the same.
     # Streamed commands keep the default, which returns each chunk's memory to the system.
     if not getattr(args, "streamed", False):
         set_malloc_trim()

@@ -83,6 +83,14 @@ def phong_state(key: tuple):
     ``key`` is :func:`phong_state_key`'s; the result is
     ``validation.studies.phong.view_state``'s (the exact spectral render and what the tables
     are measured on).
+
+    Examples
+    --------
+    >>> state = phong_state(("R1", "near", 8))
+    >>> cell = {"materials": "R1", "views": "near", "placements": "error",
+    ...         "interpolations": "linear", "entries": 32, "resolution": 8}
+    >>> phong_cell(cell, state)["rms"] < 0.05
+    True
     """
     from phong_table.materialfile import load_material_file
     from phong_table.scenes import SCENES
@@ -156,6 +164,12 @@ def impastor_reference(key: tuple) -> dict:
 
     ``key`` is :func:`impastor_reference_key`'s; the result maps α to
     ``validation.studies.impastor_hybrid.hybrid_brute_force``'s (reference, check) pair.
+
+    Examples
+    --------
+    >>> built = impastor_reference((3, "fluorescent", 0.1, 2, 16))
+    >>> list(built), [a.shape for a in built[0.1]]
+    ([0.1], [(4,), (4,)])
     """
     from validation.studies.impastor_hybrid import hybrid_brute_force
 
@@ -253,6 +267,15 @@ def shrm_oracle(key: tuple):
 
     ``key`` is :func:`shrm_oracle_key`'s; the result is the ``RenderResult`` of the sphere with
     ``environment = "bruteforce"``, which does not depend on the cell's tolerance.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from reference.images.formats import write_exr
+    >>> sky = write_exr(pathlib.Path(tempfile.mkdtemp()) / "sky.exr", np.ones((16, 32, 3)))
+    >>> lines = _material_lines({"brdf": "ggx", "alpha": 0.3, "F_0": 1.0, "rho_d": 0.0})
+    >>> shrm_oracle((str(sky), lines, 2)).XYZ.shape[:2]
+    (2, 2)
     """
     import shrm  # noqa: F401  (registers the environment shaders)
     from reference.scene.render import render_scene
