@@ -99,3 +99,25 @@ def test_the_wheel_ships_every_data_file(installed):
     }
     assert wanted, folders
     assert not wanted - shipped, sorted(wanted - shipped)
+
+
+def test_the_conformance_suite_runs_from_an_installed_wheel(installed):
+    # the scenes, maps and manifest ship in the wheel: references, export and a check from any
+    # folder (the check of a reference against itself passes; exit 0)
+    bin_, run, env, _ = installed
+    refs, scenes = run / "conformance-refs", run / "conformance-scenes"
+    specref = bin_ / "specref"
+    _run([specref, "conformance", "references", "--out", refs, "--scene", "colorchecker-a"], run,
+         env=env)  # fmt: skip
+    _run([specref, "conformance", "export", scenes, "--format", "specref"], run, env=env)
+    renders = run / "conformance-renders"
+    renders.mkdir()
+    code = (
+        "import sys; from validation.conformance.references import load_reference; "
+        "from reference.images.formats import write_exr; "
+        f"r = load_reference('colorchecker-a', {str(refs)!r}); "
+        f"write_exr({str(renders / 'colorchecker-a.exr')!r}, r.XYZ.astype('float32'), list('XYZ'))"
+    )
+    _run([bin_ / "python", "-c", code], run, env=env)
+    _run([specref, "conformance", "check", renders, "--references", refs], run, env=env)
+    assert (scenes / "lambert-env-venice.toml").is_file()

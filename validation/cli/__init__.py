@@ -16,6 +16,7 @@ from validation.cli import (
     brdf,
     cache,
     compare,
+    conformance,
     crosscheck,
     display,
     env,
@@ -49,6 +50,7 @@ COMMANDS = (
     sweep,
     equations,
     crosscheck,
+    conformance,
     compare,
 )
 

@@ -36,6 +36,7 @@ from reference.registry import Registry
 from reference.tasks import LOCAL, SERIAL, dask_client, scheduler_address
 from validation.report.render import render_html, render_markdown
 from validation.report.sections import (
+    conformance,
     crosscheck,
     display,
     examples,
@@ -76,6 +77,7 @@ PARTS: tuple[ReportPart, ...] = (
             raster.SECTION,
             examples.SECTION,
             crosscheck.SECTION,
+            conformance.SECTION,
             scaleout.SECTION,
         ),
     ),

@@ -1,0 +1,283 @@
+"""Tests of the conformance suite: scenes, references, the check and its diagnoses, the export.
+
+The references of every scene are rendered once for the module (about half a minute) into a
+temporary folder; the Mitsuba 3 proof (tests/validation/conformance/test_mitsuba_proof.py) has
+its own.
+"""
+
+from __future__ import annotations
+
+import json
+import tomllib
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+
+from reference.data import data_path
+from reference.errors import SpecrefError
+from reference.images.formats import read_exr, write_exr
+from reference.scene.loader import load_scene
+from reference.scene.render import render_scene
+from validation.cli import main
+from validation.conformance.check import check_folder, check_render
+from validation.conformance.diagnose import DIAGNOSES, DiagnosisContext, diagnosis_variants
+from validation.conformance.export import export_scenes, mitsuba_xml
+from validation.conformance.references import (
+    REFERENCE_OPTIONS,
+    ensure_references,
+    load_reference,
+    render_reference,
+    shipped_manifest,
+)
+from validation.conformance.scenes import (
+    CONFORMANCE_SCENES,
+    ENVIRONMENT_MAPS,
+    scene_path,
+    scene_text,
+)
+from validation.precompute.conformance import small_map
+
+NAMES = CONFORMANCE_SCENES.names()
+
+
+@pytest.fixture(scope="module")
+def references(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("references")
+    ensure_references(folder=folder)
+    return folder
+
+
+def _write(path, XYZ):
+    return write_exr(path, np.asarray(XYZ, dtype=np.float32), ["X", "Y", "Z"])
+
+
+def test_the_shipped_scene_files_are_what_the_registry_writes():
+    for name in NAMES:
+        assert scene_path(name).read_text(encoding="utf-8") == scene_text(name), name
+    assert len(NAMES) >= 18
+
+
+def test_every_scene_is_small_loads_and_lists_known_mistakes():
+    for name in NAMES:
+        scene = load_scene(scene_path(name))
+        r = scene.render
+        assert r.width * r.height <= 256 * 256, name
+        assert set(CONFORMANCE_SCENES.lookup(name).catches) <= set(DIAGNOSES.names()), name
+        assert scene.title == name
+        assert scene_text(name).count("Tests ") == 1
+
+
+def test_the_shipped_maps_are_box_averages_of_the_shipped_environments():
+    for key, file in ENVIRONMENT_MAPS.items():
+        shipped = read_exr(data_path(f"conformance/maps/{key}.exr"))[0][..., :3]
+        np.testing.assert_allclose(shipped, small_map(file), rtol=1e-6, atol=1e-30)
+
+
+@pytest.mark.parametrize("name", ["colorchecker-fl2", "lambert-point-orange-a"])
+def test_a_reference_is_the_box_filtered_render_with_its_standard_error(name):
+    # Source: render_scene's own box resolve at the scene's supersampling (an independent path
+    # through specref: XYZ shading instead of spectral output integrated here).
+    ref = render_reference(name)
+    scene = load_scene(scene_path(name))
+    np.testing.assert_allclose(ref.XYZ, render_scene(scene, options=REFERENCE_OPTIONS).XYZ,
+                               rtol=1e-12, atol=1e-14)  # fmt: skip
+    # the spectral image integrates to XYZ up to the light's folding into the band weights (E7)
+    from validation.conformance.references import _equal_energy_weights
+
+    np.testing.assert_allclose(ref.spectral @ _equal_energy_weights(ref), ref.XYZ, rtol=1e-4,
+                               atol=1e-9)  # fmt: skip
+    assert (ref.stderr >= 0).all()
+    full = ref.coverage == 1.0
+    # inside a flat patch or on a smooth sphere the sub-samples barely differ; at edges they do
+    assert np.median(ref.stderr[full][:, 1] / np.maximum(ref.XYZ[full][:, 1], 1e-12)) < 0.01
+    assert ref.stderr[..., 1].max() > 10 * np.median(ref.stderr[full][:, 1])
+
+
+def test_references_agree_with_the_shipped_manifest_within_their_uncertainty(references):
+    shipped = shipped_manifest()["scenes"]
+    made = json.loads((references / "manifest.json").read_text())["scenes"]
+    assert set(shipped) == set(made) == set(NAMES)
+    for name in NAMES:
+        a, b = np.array(made[name]["mean_XYZ"]), np.array(shipped[name]["mean_XYZ"])
+        se = np.array(shipped[name]["stderr_mean_XYZ"])
+        assert (np.abs(a - b) <= 4 * se + 1e-6 * np.abs(b)).all(), name
+
+
+def test_a_changed_reference_file_is_refused_in_one_line(references, tmp_path):
+    import shutil
+
+    folder = tmp_path / "refs"
+    shutil.copytree(references, folder)
+    path = folder / "colorchecker-a.xyz.exr"
+    data = bytearray(path.read_bytes())
+    data[-5] ^= 0xFF
+    path.write_bytes(bytes(data))
+    with pytest.raises(SpecrefError, match="SHA-256 differs") as error:
+        load_reference("colorchecker-a", folder)
+    assert "\n" not in str(error.value)
+    manifest = json.loads((folder / "manifest.json").read_text())
+    manifest["version"] = 0
+    (folder / "manifest.json").write_text(json.dumps(manifest))
+    with pytest.raises(SpecrefError, match="version"):
+        load_reference("colorchecker-a", folder)
+
+
+def test_every_reference_passes_its_own_check_from_the_command_line(references, tmp_path, capsys):
+    renders = tmp_path / "renders"
+    renders.mkdir()
+    for name in NAMES:
+        _write(renders / f"{name}.exr", load_reference(name, references).XYZ)
+    out = tmp_path / "check.json"
+    code = main(["conformance", "check", str(renders), "--references", str(references),
+                 "--json", str(out), "--html", str(tmp_path / "check.html")])  # fmt: skip
+    assert code == 0, capsys.readouterr().out
+    result = json.loads(out.read_text())
+    assert result["passed"] == len(NAMES)
+    assert result["missing"] == []
+    assert "<img" in (tmp_path / "check.html").read_text()
+
+
+def _catches(name):
+    return [(name, key) for key in CONFORMANCE_SCENES.lookup(name).catches]
+
+
+# The glossy environment scenes' diagnoses render four brute-force variants each (half a minute);
+# their list is the Lambertian spheres', which are tested.
+CHEAP = [n for n in NAMES if not n.startswith(("ggx", "ward"))]
+CASES = [c for n in CHEAP for c in _catches(n)]
+
+
+@pytest.mark.parametrize(("name", "key"), CASES)
+def test_each_mistake_a_scene_lists_fails_and_is_named(references, tmp_path, name, key):
+    # Every scene is held to its list: each mistake it lists, made on purpose, fails the check
+    # and is the diagnosis among all the scene's mistakes (the variants are cached beside the
+    # references, so each is rendered once for the module).
+    ref = load_reference(name, references)
+    if key == "Y_scaled":
+        broken, label = ref.XYZ * 1.2, "by 1.2"
+    else:
+        ctx = DiagnosisContext(name, ref, ref.XYZ)
+        label, broken = diagnosis_variants(DIAGNOSES.lookup(key), ctx, references)[-1]
+    found = check_render(name, _write(tmp_path / f"{name}.exr", broken), references)
+    assert not found["passed"], (name, label)
+    diagnosis = found["diagnosis"]
+    assert diagnosis["mistake"] == key, diagnosis
+    assert diagnosis["certain"], diagnosis
+    assert diagnosis["detail"].startswith(label)
+
+
+def test_a_render_no_mistake_explains_is_said_to_be_so(references, tmp_path):
+    ref = load_reference("lambert-point-d65", references)
+    rng = np.random.default_rng(7)
+    noisy = ref.XYZ * rng.uniform(0.5, 1.5, ref.XYZ.shape[:2])[..., None]
+    found = check_render("lambert-point-d65", _write(tmp_path / "x.exr", noisy), references)
+    assert not found["passed"]
+    assert found["diagnosis"]["mistake"] is None
+
+
+def test_monte_carlo_noise_passes_and_bias_fails(references, tmp_path):
+    # a renderer's per-pixel noise (5 % per pixel) averages out over the blocks; 3 % bias does not
+    ref = load_reference("lambert-env-studio", references)
+    rng = np.random.default_rng(11)
+    noisy = ref.XYZ * (1 + 0.05 * rng.standard_normal(ref.XYZ.shape[:2]))[..., None]
+    assert check_render("lambert-env-studio", _write(tmp_path / "a.exr", noisy), references)[
+        "passed"
+    ]
+    biased = _write(tmp_path / "b.exr", ref.XYZ * 1.03)
+    assert not check_render("lambert-env-studio", biased, references, diagnose=False)["passed"]
+
+
+@pytest.mark.parametrize(
+    ("make", "message"),
+    [
+        (lambda d, ref: _write(d / "colorchecker-a.exr", ref.XYZ[:-1]), "width × height"),
+        (lambda d, ref: _write(d / "colorchecker-a.exr", np.where(ref.XYZ > 0.5, np.nan, ref.XYZ)),
+         "NaN or infinite"),
+        (lambda d, ref: (d / "colorchecker-a.exr").write_bytes(b"not an exr"),
+         "colorchecker-a.exr"),
+        (lambda d, ref: _write(d / "colourchecker-a.exr", ref.XYZ), "no conformance scene named"),
+        (lambda d, ref: None, "no renders"),
+        (lambda d, ref: write_exr(d / "colorchecker-a.exr", ref.XYZ[..., :2].astype(np.float32),
+                                  ["U", "V"]), "no X, Y, Z"),
+    ],
+)  # fmt: skip
+def test_bad_renders_are_refused_in_one_line_and_nothing_is_written(
+    references, tmp_path, capsys, make, message
+):
+    renders = tmp_path / "renders"
+    renders.mkdir()
+    make(renders, load_reference("colorchecker-a", references))
+    out = tmp_path / "out.json"
+    code = main(["conformance", "check", str(renders), "--references", str(references),
+                 "--json", str(out)])  # fmt: skip
+    err = capsys.readouterr().err.strip()
+    assert code == 2, err
+    assert message in err, err
+    assert len(err.splitlines()) == 1, err
+    assert not out.exists()
+
+
+def test_the_mitsuba_export_is_well_formed_and_lists_what_it_cannot_express(tmp_path):
+    index = export_scenes(tmp_path, "mitsuba", spp=16)
+    assert set(index["scenes"]) | set(index["cannot_express"]) == set(NAMES)
+    assert {"phong-point-r1", "ward-env-stage"} <= set(index["cannot_express"])
+    for name in index["scenes"]:
+        root = ET.fromstring((tmp_path / f"{name}.xml").read_text())
+        assert root.tag == "scene"
+        assert root.find("sensor/film/integer[@name='width']") is not None
+    # the maps' texels are repeated 8 × 8 (docs/conformance.md)
+    big = read_exr(tmp_path / "maps" / "venice.exr")[0]
+    small = read_exr(data_path("conformance/maps/venice.exr"))[0]
+    assert big.shape[:2] == (8 * small.shape[0], 8 * small.shape[1])
+    np.testing.assert_array_equal(big[::8, ::8, :3], small[..., :3])
+    with pytest.raises(SpecrefError, match="no Phong BSDF"):
+        mitsuba_xml("phong-point-r2")
+
+
+def test_the_mitsuba_units_are_specrefs(tmp_path):
+    # Source: closed form. A point light of specref intensity I at distance d facing a white
+    # diffuser gives Y = I/d²; in Mitsuba radiance = (1/π) · Φ/d² with Φ = π I S/Y_S.
+    xml = mitsuba_xml("lambert-point-d65")
+    light = ET.fromstring(xml).find("emitter[@type='point']/spectrum")
+    pairs = [tuple(map(float, p.split(":"))) for p in light.get("value").split(",")]
+    wl, values = np.array(pairs).T
+    import colour
+
+    ybar = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(
+        colour.SpectralShape(wl[0], wl[-1], 1)).values[:, 1]  # fmt: skip
+    Y = (values * ybar).sum() / ybar.sum()
+    assert pytest.approx(np.pi * 25, rel=1e-6) == Y
+
+
+def test_the_specref_export_is_self_contained_and_renders_the_same(tmp_path):
+    index = export_scenes(tmp_path / "out", "specref")
+    assert set(index["scenes"]) == set(NAMES)
+    assert not index["cannot_express"]
+    text = (tmp_path / "out" / "lambert-point-orange-a.toml").read_text()
+    assert "data:" not in tomllib.loads(text)["materials"]["m"]["k_d"]["csv"]
+    for name in ("lambert-point-orange-a", "lambert-env-venice"):
+        exported = render_scene(load_scene(tmp_path / "out" / f"{name}.toml"), width=16,
+                                options=REFERENCE_OPTIONS)  # fmt: skip
+        shipped = render_scene(load_scene(scene_path(name)), width=16, options=REFERENCE_OPTIONS)
+        np.testing.assert_array_equal(exported.XYZ, shipped.XYZ)
+
+
+def test_list_and_export_from_the_command_line(tmp_path, capsys):
+    assert main(["conformance", "list"]) == 0
+    out = capsys.readouterr().out
+    assert all(name in out for name in NAMES)
+    assert "catches:" in out
+    assert main(["conformance", "export", str(tmp_path), "--format", "mitsuba"]) == 0
+    assert "not exported: phong-point-r1" in capsys.readouterr().out
+    with pytest.raises(SystemExit) as error:  # argparse's usage error: one line, exit 2
+        main(["conformance", "export", str(tmp_path), "--format", "pbrt"])
+    assert error.value.code == 2
+    assert "invalid choice: 'pbrt'" in capsys.readouterr().err
+
+
+def test_check_folder_reports_missing_scenes(references, tmp_path):
+    _write(tmp_path / "colorchecker-d65.exr", load_reference("colorchecker-d65", references).XYZ)
+    result = check_folder(tmp_path, references)
+    assert result["passed"] == 1
+    assert len(result["missing"]) == len(NAMES) - 1

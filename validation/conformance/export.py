@@ -1,0 +1,288 @@
+"""The conformance scenes in other renderers' formats: specref's own files and Mitsuba 3 XML.
+
+``specref conformance export DIR --format specref|mitsuba`` writes every scene the format can
+express, with what they need beside them (maps, spectra), and ``scenes.json``: per scene its size,
+what it tests, the mistakes it catches, and the scenes the format cannot express, with why.
+
+**Mitsuba 3** (scene format version 3.0.0, a spectral variant): the camera as a ``perspective`` or
+``orthographic`` sensor with ``fov_axis = "y"`` and a ``lookat`` transform; an ``hdrfilm`` of the
+scene's size with ``pixel_format = "xyz"`` and a ``box`` filter; the ``path`` integrator with
+``max_depth = 2`` (direct light only: the scenes have one convex object, or a flat chart);
+Lambertian materials as ``diffuse``; the GGX conductor as ``roughconductor`` with
+``distribution = "ggx"`` and ``material = "none"`` (F = 1). specref's units become Mitsuba's
+(docs/conformance.md): a light spectrum ``S`` normalized to Y = 1 (``Y_S = Σ S ȳ / Σ ȳ``); a
+point light of ``intensity`` I is ``π I S / Y_S`` in W/sr (a white diffuser facing it at unit
+distance then reflects radiance ``I S / Y_S``, specref's Y = I), an ambient light is a
+``constant`` emitter of radiance ``I S / Y_S``. The ColorChecker is 24 ``rectangle`` shapes (the
+chart's black gaps are the background). Spectra are written as ``wavelength:value`` pairs at 5 nm.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+import tomllib
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+from reference.errors import require
+from validation.conformance.scenes import CONFORMANCE_SCENES, scene_text
+
+__all__ = ["EXPORT_FORMATS", "export_scenes", "mitsuba_xml"]
+
+#: Formats of ``specref conformance export``.
+EXPORT_FORMATS = ("specref", "mitsuba")
+_DATA = re.compile(r'"data:([^"]+)"')
+#: Wavelengths of the spectra written for Mitsuba, nm.
+MITSUBA_WAVELENGTHS = np.arange(360.0, 831.0, 5.0)
+
+
+def _spectrum_values(table, where: str) -> np.ndarray:
+    """A scene file's spectrum (a number or a spectrum table) at MITSUBA_WAVELENGTHS."""
+    from reference.colour.spectra import SpectralGrid
+    from reference.scene.values import SceneReader
+
+    if isinstance(table, int | float):
+        return np.full(MITSUBA_WAVELENGTHS.size, float(table))
+    from reference.data import data_root
+
+    reader = SceneReader(where, data_root() / "conformance", SpectralGrid(360.0, 830.0, 5.0))
+    return reader.spectrum_on_grid({**table, "extrapolation": "constant"}, where)
+
+
+def _pairs(values: np.ndarray, wavelengths=MITSUBA_WAVELENGTHS) -> str:
+    return ", ".join(f"{w:g}:{v:.6g}" for w, v in zip(wavelengths, values, strict=True))
+
+
+def _normalized(illuminant: str) -> tuple[np.ndarray, np.ndarray]:
+    """An illuminant at 1 nm, scaled to Y = 1, as Mitsuba ``wavelength:value`` pairs.
+
+    At 1 nm as the band weights fold it in (colour-science's ``align``: Sprague interpolation,
+    constant beyond the table), so that Mitsuba's linear interpolation sees the same lines; Y as
+    Mitsuba's XYZ film computes it, ``Σ S ȳ / Σ ȳ``.
+    """
+    import colour
+
+    shape = colour.SpectralShape(360, 830, 1)
+    S = colour.SDS_ILLUMINANTS[illuminant].copy().align(shape)
+    ybar = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(shape)
+    Y_S = float((S.values * ybar.values[:, 1]).sum() / ybar.values[:, 1].sum())
+    return S.values / Y_S, S.wavelengths
+
+
+def _sensor(data: dict) -> list[str]:
+    cam, r = data["camera"], data["render"]
+    eye, target = cam.get("eye", [0, 0, 5]), cam.get("target", [0, 0, 0])
+    look = (
+        f'<lookat origin="{",".join(map(str, eye))}" target="{",".join(map(str, target))}" '
+        'up="0,1,0"/>'
+    )
+    film = [
+        '    <film type="hdrfilm">',
+        f'      <integer name="width" value="{r["width"]}"/>',
+        f'      <integer name="height" value="{r["height"]}"/>',
+        '      <string name="pixel_format" value="xyz"/>',
+        '      <rfilter type="box"/>',
+        "    </film>",
+        '    <sampler type="independent"><integer name="sample_count" value="$spp"/></sampler>',
+    ]
+    if cam.get("projection") == "orthographic":
+        # Mitsuba's orthographic film spans ±1 across its width: the scale is half the width
+        half = cam.get("extent", 2.0) / 2.0 * r["width"] / r["height"]
+        return [
+            '  <sensor type="orthographic">',
+            f'    <transform name="to_world">{look}<scale x="{half}" y="{half}" z="1"/>'
+            "</transform>",
+            *film,
+            "  </sensor>",
+        ]
+    return [
+        '  <sensor type="perspective">',
+        f'    <float name="fov" value="{cam["fov_deg"]}"/>',
+        '    <string name="fov_axis" value="y"/>',
+        f'    <transform name="to_world">{look}</transform>',
+        *film,
+        "  </sensor>",
+    ]
+
+
+def _bsdf(material: dict, where: str) -> list[str]:
+    if material["type"] == "lambert":
+        k_d = _spectrum_values(material["k_d"], f"{where}.k_d")
+        return [
+            '    <bsdf type="diffuse">',
+            f'      <spectrum name="reflectance" value="{_pairs(k_d)}"/>',
+            "    </bsdf>",
+        ]
+    # the GGX conductor of F = 1 (ConformanceScene.cannot_export lists the other BRDFs)
+    return ['    <bsdf type="roughconductor">', '      <string name="distribution" value="ggx"/>',
+            f'      <float name="alpha" value="{material["alpha"]}"/>',
+            '      <string name="material" value="none"/>', "    </bsdf>"]  # fmt: skip
+
+
+def _chart_shapes() -> list[str]:
+    import colour
+
+    from reference.scene.colorchecker import colorchecker_patch_centres_uv
+
+    uv = colorchecker_patch_centres_uv()
+    chart = colour.SDS_COLOURCHECKERS["ColorChecker N Ohta"]
+    out = []
+    for (u, v), sd in zip(uv, chart.values(), strict=True):
+        x, y = -0.3 + 0.6 * u, 0.2 - 0.4 * v
+        values = np.interp(MITSUBA_WAVELENGTHS, sd.wavelengths, sd.values)
+        out += [
+            '  <shape type="rectangle">',
+            f'    <transform name="to_world"><scale value="0.044"/><translate x="{x:.6g}" '
+            f'y="{y:.6g}" z="0"/></transform>',
+            f'    <bsdf type="diffuse"><spectrum name="reflectance" value="{_pairs(values)}"/>'
+            "</bsdf>",
+            "  </shape>",
+        ]
+    return out
+
+
+def _emitters(data: dict) -> list[str]:
+    out = []
+    for light in data["lights"]:
+        kind, intensity = light["type"], float(light.get("intensity", 1.0))
+        if kind == "environment":
+            out.append(f'  <emitter type="envmap"><string name="filename" '
+                       f'value={quoteattr(light["file"])}/></emitter>')  # fmt: skip
+            continue
+        S, wl = _normalized(light.get("spectrum", {}).get("illuminant", "D65"))
+        if kind == "point":
+            p = ",".join(map(str, light["position"]))
+            out.append(f'  <emitter type="point"><point name="position" value="{p}"/>'
+                       f'<spectrum name="intensity" value="{_pairs(np.pi * intensity * S, wl)}"/>'
+                       "</emitter>")  # fmt: skip
+        else:  # ambient: a uniform sky of radiance I S / Y_S
+            out.append(f'  <emitter type="constant"><spectrum name="radiance" '
+                       f'value="{_pairs(intensity * S, wl)}"/></emitter>')  # fmt: skip
+    return out
+
+
+def mitsuba_xml(name: str, spp: int = 64) -> str:
+    """A conformance scene as a Mitsuba 3 scene file (module docstring).
+
+    Examples
+    --------
+    >>> xml = mitsuba_xml("lambert-point-d65", spp=16)
+    >>> xml.splitlines()[1]
+    '<scene version="3.0.0">'
+    >>> '<emitter type="point">' in xml, 'value="16"' in xml
+    (True, True)
+    >>> mitsuba_xml("phong-point-r1")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: phong-point-r1: Mitsuba 3 has no Phong BSDF ...
+    """
+    scene = CONFORMANCE_SCENES.lookup(name)
+    why = scene.cannot_export.get("mitsuba")
+    require(why is None, f"{name}: {why}")
+    data = tomllib.loads(scene_text(scene))
+    lines = ['<?xml version="1.0" encoding="utf-8"?>', '<scene version="3.0.0">',
+             f"  <!-- specref conformance scene {name}: {data['description']} -->",
+             '  <integrator type="path"><integer name="max_depth" value="2"/></integrator>',
+             *_sensor(data)]  # fmt: skip
+    for obj in data["objects"]:
+        material = data["materials"][obj["material"]]
+        if material["type"] == "colorchecker":
+            lines += _chart_shapes()
+        else:
+            lines += ['  <shape type="sphere">', *_bsdf(material, f"materials.{obj['material']}"),
+                      "  </shape>"]  # fmt: skip
+    lines += [*_emitters(data), "</scene>"]
+    return "\n".join(lines).replace("$spp", str(int(spp))) + "\n"
+
+
+#: Each texel of a map becomes this many × this many in the Mitsuba export.
+TEXEL_REPEAT = 8
+
+
+def texels_repeated(image: np.ndarray, k: int = TEXEL_REPEAT) -> np.ndarray:
+    """A lat-long map with each texel repeated ``k × k`` times (float32), for Mitsuba 3.
+
+    The scenes' maps are constant over each texel (``texel_placement = "centred"``); Mitsuba 3
+    interpolates bilinearly between texels, and between texels of different colour and brightness
+    it interpolates the upsampled spectrum's shape and scale apart (erratum E81). Repeated texels
+    confine both to a border of half a repeated texel, 1/k of the original's width.
+
+    Examples
+    --------
+    >>> texels_repeated(np.arange(2.0).reshape(1, 2, 1), 2)[..., 0]
+    array([[0., 0., 1., 1.],
+           [0., 0., 1., 1.]], dtype=float32)
+    """
+    return np.repeat(np.repeat(np.asarray(image), k, axis=0), k, axis=1).astype(np.float32)
+
+
+def _copy_data(text: str, out: Path) -> str:
+    """``"data:X"`` values copied beside the scene (``data/X``) and named relative to it."""
+    from reference.data import data_path
+
+    def copy(match) -> str:
+        target = out / "data" / match.group(1)
+        target.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(data_path(match.group(1)), target)
+        return json.dumps(f"data/{match.group(1)}")
+
+    return _DATA.sub(copy, text)
+
+
+def export_scenes(folder, fmt: str = "specref", spp: int = 64) -> dict:
+    """Write every scene ``fmt`` can express into ``folder``; return the index (``scenes.json``).
+
+    Parameters
+    ----------
+    folder : str or Path
+        Created if missing; the scenes' maps go to ``maps/``, other shipped files to ``data/``.
+    fmt : {"specref", "mitsuba"}
+    spp : int
+        Samples per pixel written into Mitsuba scenes.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> index = export_scenes(tempfile.mkdtemp(), "mitsuba")
+    >>> len(index["scenes"]) + len(index["cannot_express"]) == len(CONFORMANCE_SCENES.names())
+    True
+    >>> index["cannot_express"]["ward-env-stage"]
+    'Mitsuba 3 has no Ward BSDF'
+    """
+    from reference.data import data_path
+    from reference.files import write_text_atomic
+    from reference.images.formats import read_exr, write_exr
+
+    require(fmt in EXPORT_FORMATS, f"--format: {fmt!r}; allowed: {', '.join(EXPORT_FORMATS)}")
+    out = Path(folder)
+    (out / "maps").mkdir(parents=True, exist_ok=True)
+    for path in sorted(data_path("conformance/maps").iterdir()):
+        if path.suffix == ".exr" and fmt == "mitsuba":
+            write_exr(out / "maps" / path.name, texels_repeated(read_exr(path)[0][..., :3]))
+        elif path.suffix == ".exr":
+            shutil.copyfile(path, out / "maps" / path.name)
+    index = {"format": fmt, "scenes": {}, "cannot_express": {}}
+    for scene in CONFORMANCE_SCENES.values():
+        why = scene.cannot_export.get(fmt)
+        if why is not None:
+            index["cannot_express"][scene.name] = why
+            continue
+        text = scene_text(scene)
+        data = tomllib.loads(text)
+        if fmt == "specref":
+            file = write_text_atomic(out / f"{scene.name}.toml", _copy_data(text, out))
+        else:
+            file = write_text_atomic(out / f"{scene.name}.xml", mitsuba_xml(scene.name, spp))
+        index["scenes"][scene.name] = {
+            "file": file.name,
+            "width": data["render"]["width"],
+            "height": data["render"]["height"],
+            "tests": scene.tests,
+            "catches": list(scene.catches),
+        }
+    write_text_atomic(out / "scenes.json", json.dumps(index, indent=1) + "\n")
+    return index

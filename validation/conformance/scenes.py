@@ -1,0 +1,314 @@
+"""The conformance scenes: small canonical scenes, each testing one thing, shipped as scene files.
+
+Each scene is a specref scene file in ``data:conformance/<name>.toml`` (docs/scene-format.md),
+at most 64 × 64 pixels, with what it tests and the mistakes it catches (keys of
+:data:`validation.conformance.diagnose.DIAGNOSES`). The files are written from this registry by
+``python -m validation.precompute.conformance`` (with the 32 × 64 maps of
+``data:conformance/maps/``, box averages of the shipped environment maps), and a test checks that
+the shipped files are what the registry writes.
+
+Conventions every scene spells out (docs/conformance.md): Y = 1 for a white diffuser facing a
+unit light (``intensity`` of a point light at ``f_att = 1``; an illuminant normalized to Y = 1);
+point lights fall off as ``1/d²`` (``attenuation = [0, 0, 1]``, the physical law) except in the
+Phong scenes, which keep the attenuation of Eq. (1), Wang et al.; environment maps are lat-long in
+Mitsuba 3's orientation, constant over each texel (``texel_placement = "centred"``: texel ``j``
+spans rows ``j/H`` to ``(j + 1)/H``), each texel's RGB upsampled by Jakob and Hanika 2019 as
+Mitsuba 3 and pbrt-v4 do (``upsampling = "jakob2019"``, erratum E80); the scenes lit by point
+and ambient lights are on a 1 nm grid (:data:`FINE_GRID`), so that lamps with lines (FL2, FL11)
+meet the materials as in a renderer that samples wavelengths; pixels are box-filtered over their
+area.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from reference.registry import Registry
+
+__all__ = [
+    "CONFORMANCE_SCENES",
+    "ENVIRONMENT_MAPS",
+    "ConformanceScene",
+    "scene_path",
+    "scene_text",
+]
+
+#: Shipped maps (``data:environments``) averaged to 32 × 64 for the environment scenes:
+#: short name -> file name.
+ENVIRONMENT_MAPS = {
+    "venice": "venice_sunset_1k.hdr",
+    "fagans": "st_fagans_interior_1k.hdr",
+    "studio": "studio_small_03_1k.hdr",
+    "stage": "StageEnvLatLong.exr",
+}
+#: Rows of those maps.
+MAP_ROWS = 32
+
+
+@dataclass(frozen=True)
+class ConformanceScene:
+    """One conformance scene.
+
+    Attributes
+    ----------
+    name : str
+        Key and file stem (``data:conformance/<name>.toml``).
+    tests : str
+        What a renderer must get right to pass.
+    catches : tuple of str
+        Keys of ``DIAGNOSES`` that this scene can tell apart (the mistakes it catches).
+    body : callable
+        ``body() -> str``: the scene file after its title and description.
+    cannot_export : dict
+        Export format -> why that renderer cannot express the scene.
+    tolerance_Y, tolerance_dE : float
+        Floors of the pass thresholds: mean relative ΔY of 4 × 4-pixel blocks and their mean
+        ΔE00 (what two correct renderers may differ by: spectral sampling, pixel filters). The
+        reference's own uncertainty is added (:mod:`validation.conformance.check`).
+    """
+
+    name: str
+    tests: str
+    catches: tuple
+    body: Callable[[], str]
+    cannot_export: dict = field(default_factory=dict)
+    tolerance_Y: float = 0.01
+    tolerance_dE: float = 1.0
+
+
+#: The conformance scenes by name.
+CONFORMANCE_SCENES = Registry("conformance scene", ConformanceScene)
+
+_NO_PHONG = "Mitsuba 3 has no Phong BSDF (Wang et al.'s un-normalized cos^n(λ) lobe)"
+_NO_WARD = "Mitsuba 3 has no Ward BSDF"
+_NO_SCHLICK = (
+    "Mitsuba 3's rough BSDFs use a dielectric or conductor Fresnel term, not Schlick's F_0 "
+    "with a Lambertian base"
+)
+
+
+def _spectrum(wavelengths, values) -> str:
+    wl = ", ".join(f"{w:g}" for w in wavelengths)
+    v = ", ".join(f"{float(x):.6g}" for x in values)
+    return f"{{ wavelengths = [{wl}], values = [{v}] }}"
+
+
+#: The grid of the scenes lit by point and ambient lights: 1 nm, so that a lamp's lines meet the
+#: materials' spectra as in a renderer that samples wavelengths (the band weights fold a light in
+#: at its own sampling, but a material only at the grid's nodes, errata E7).
+FINE_GRID = "\n".join(["[spectral]", "start_nm = 380", "end_nm = 780", "step_nm = 1"])
+
+
+def _sphere_camera(width: int, supersample: int = 4) -> str:
+    return "\n".join([
+        "[camera]", "eye = [0, 0, 4]", "target = [0, 0, 0]", "fov_deg = 32",
+        "[render]", f"width = {width}", f"height = {width}", f"supersample = {supersample}",
+    ])  # fmt: skip
+
+
+def _lambert_point(k_d: str, illuminant: str) -> Callable[[], str]:
+    def body() -> str:
+        return "\n".join([
+            FINE_GRID, _sphere_camera(64),
+            "[materials.m]", 'type = "lambert"', f"k_d = {k_d}",
+            "[[objects]]", 'type = "sphere"', 'material = "m"',
+            "[[lights]]", 'type = "point"', "position = [3, 2, 4]",
+            f'spectrum = {{ illuminant = "{illuminant}" }}', "intensity = 25",
+            "attenuation = [0, 0, 1]",
+        ])  # fmt: skip
+
+    return body
+
+
+def _phong(key: str) -> Callable[[], str]:
+    def body() -> str:
+        from phong_table.scenes import EYE, SCENES, VIEWS
+        from reference.colour.spectra import DEFAULT_GRID
+
+        model = SCENES.lookup(key).build()
+        m, light = model.material, model.light
+        wl = DEFAULT_GRID.wavelengths_nm
+        return "\n".join([
+            FINE_GRID,
+            "[camera]", f"eye = {list(EYE)}", "target = [0, 0, 0]", f"fov_deg = {VIEWS['far']:g}",
+            "[render]", "width = 64", "height = 64", "supersample = 4",
+            "[materials.m]", 'type = "phong"', f"k_d = {_spectrum(wl, m.k_d)}",
+            f"k_s = {_spectrum(wl, m.k_s)}", f"n = {_spectrum(wl, m.n)}",
+            "[[objects]]", 'type = "sphere"', 'material = "m"',
+            "[[lights]]", 'type = "point"', f"position = {list(light.position)}",
+            f'spectrum = {{ illuminant = "{_illuminant_of(key)}" }}',
+            f"intensity = {light.intensity:.9g}", f"attenuation = {list(light.attenuation)}",
+        ])  # fmt: skip
+
+    return body
+
+
+def _illuminant_of(key: str) -> str:
+    return {"R1": "D65", "R2": "A", "R3": "FL11", "bimodal": "D65"}[key]
+
+
+def _chart(illuminant: str) -> Callable[[], str]:
+    def body() -> str:
+        return "\n".join([
+            FINE_GRID,
+            "[camera]", 'projection = "orthographic"', "eye = [0, 0, 5]", "target = [0, 0, 0]",
+            "extent = 0.4",
+            "[render]", "width = 60", "height = 40", "supersample = 4",
+            "[materials.chart]", 'type = "colorchecker"', "gap_width = 0.12", "gap = 0",
+            "[[objects]]", 'type = "rectangle"', "point = [0, 0, 0]", "normal = [0, 0, 1]",
+            "u_axis = [1, 0, 0]", "size = [0.6, 0.4]", 'material = "chart"',
+            "[[lights]]", 'type = "ambient"', f'spectrum = {{ illuminant = "{illuminant}" }}',
+        ])  # fmt: skip
+
+    return body
+
+
+def _environment(material: list[str], map_key: str) -> Callable[[], str]:
+    # the brute force of a glossy BRDF costs 16 times a Lambertian's per pixel: 2 × 2 samples
+    supersample = 2 if "isotropic_brdf" in material[0] else 4
+
+    def body() -> str:
+        return "\n".join([
+            _sphere_camera(48, supersample), "[render.options]", 'upsampling = "jakob2019"',
+            "[materials.m]", *material,
+            "[[objects]]", 'type = "sphere"', 'material = "m"',
+            "[[lights]]", 'type = "environment"', f'file = "maps/{map_key}.exr"',
+            'texel_placement = "centred"',
+        ])  # fmt: skip
+
+    return body
+
+
+_LAMBERT_HALF = ['type = "lambert"', "k_d = 0.5"]
+_ORANGE_K_D = (
+    '{ csv = "data:spectra/physicallybased/orange__nix_export.csv", extrapolation = "constant" }'
+)
+_ORANGE = ['type = "lambert"', f"k_d = {_ORANGE_K_D}"]
+_SCALE_MISTAKES = ("Y_scaled", "srgb_encoded")
+
+CONFORMANCE_SCENES.register(ConformanceScene(
+    "lambert-point-d65",
+    "the cosine law, the 1/d² fall-off and the normalization of a D65 point light "
+    "(a grey Lambertian sphere, ρ = 0.5)",
+    ("missing_cosine", "illuminant_not_normalized", *_SCALE_MISTAKES),
+    _lambert_point("0.5", "D65"),
+))  # fmt: skip
+CONFORMANCE_SCENES.register(ConformanceScene(
+    "lambert-point-orange-a",
+    "a measured reflectance (an orange, Nix Spectro 2, held constant beyond 400-700 nm) times "
+    "illuminant A, integrated per wavelength",
+    ("missing_cosine", "illuminant_not_normalized", "rgb_rendering", *_SCALE_MISTAKES),
+    _lambert_point(_ORANGE_K_D, "A"),
+))  # fmt: skip
+for _key, _what in (
+    ("R1", "smooth spectra, n(λ) = 20-80, D65"),
+    ("R2", "an exponent from 10 to 1000 across wavelengths, illuminant A"),
+    ("R3", "a narrow-band k_s at 530 nm with n(λ) = 2000-3000 under FL11's lines"),
+    ("bimodal", "n = 5 below 580 nm and 500 above: two highlights of different colour"),
+):
+    CONFORMANCE_SCENES.register(ConformanceScene(
+        f"phong-point-{_key.lower()}",
+        f"the spectral Phong model (Eq. (2), Wang et al.) with a per-wavelength exponent ({_what}; "
+        "phong_table.scenes); the reference is the exact per-band evaluation",
+        # under D65 the RGB product of a white light changes nothing
+        (*(("rgb_rendering",) if _illuminant_of(_key) != "D65" else ()), *_SCALE_MISTAKES),
+        _phong(_key),
+        {"mitsuba": _NO_PHONG},
+    ))  # fmt: skip
+for _illuminant, _what in (
+    ("D65", "daylight: the chart's colours as measured"),
+    ("A", "incandescent light: every patch shifts towards orange"),
+    (
+        "FL2",
+        "a cool-white fluorescent lamp with mercury lines that point sampling of the grid misses",
+    ),
+    ("FL11", "a narrow tri-band lamp: the largest metameric shifts of RGB rendering"),
+):
+    CONFORMANCE_SCENES.register(ConformanceScene(
+        f"colorchecker-{_illuminant.lower()}",
+        f"the 24 ColorChecker N Ohta patches under a uniform sky of {_illuminant} ({_what}); "
+        "each patch is a Lambertian square, black gaps between them",
+        (*(("rgb_rendering",) if _illuminant != "D65" else ()), "illuminant_not_normalized",
+         *_SCALE_MISTAKES),
+        _chart(_illuminant),
+    ))  # fmt: skip
+# The tests hold each scene to the mistakes it lists (each, made on purpose, fails and is named).
+_ENV_MISTAKES = (
+    "environment_mirrored", "environment_rotated_90", "environment_rotated_180",
+    *_SCALE_MISTAKES,
+)  # fmt: skip
+for _map in ENVIRONMENT_MAPS:
+    CONFORMANCE_SCENES.register(ConformanceScene(
+        f"lambert-env-{_map}",
+        f"a grey Lambertian sphere under the {_map} map: the map's orientation, its texel rows "
+        "and its RGB-to-spectrum upsampling",
+        _ENV_MISTAKES,
+        _environment(_LAMBERT_HALF, _map),
+    ))  # fmt: skip
+CONFORMANCE_SCENES.register(ConformanceScene(
+    "orange-env-venice",
+    "a measured reflectance under an upsampled RGB environment (the product per wavelength)",
+    _ENV_MISTAKES,
+    _environment(_ORANGE, "venice"),
+))  # fmt: skip
+CONFORMANCE_SCENES.register(ConformanceScene(
+    "ggx-env-venice",
+    "a GGX conductor (α = 0.4, F = 1, Smith G1·G1, Walter et al. 2007) under venice: the "
+    "reflection's orientation and the lobe's width",
+    _ENV_MISTAKES,
+    _environment(['type = "isotropic_brdf"', 'brdf = "ggx"', "rho_d = 0", "F_0 = 1",
+                  "alpha = 0.4"], "venice"),
+))  # fmt: skip
+CONFORMANCE_SCENES.register(ConformanceScene(
+    "ggx-plastic-env-fagans",
+    "GGX with Schlick's Fresnel (F_0 = 0.04) over a Lambertian base (ρ_d = 0.4) under fagans",
+    _ENV_MISTAKES,
+    _environment(['type = "isotropic_brdf"', 'brdf = "ggx"', "rho_d = 0.4", "F_0 = 0.04",
+                  "alpha = 0.3"], "fagans"),
+    {"mitsuba": _NO_SCHLICK},
+))  # fmt: skip
+CONFORMANCE_SCENES.register(ConformanceScene(
+    "ward-env-stage",
+    "Ward's isotropic BRDF (ρ_d = 0.1, ρ_s = 0.3, α = 0.3) under the stage map",
+    _ENV_MISTAKES,
+    _environment(['type = "isotropic_brdf"', 'brdf = "ward_isotropic"', "rho_d = 0.1",
+                  "rho_s = 0.3", "alpha = 0.3"], "stage"),
+    {"mitsuba": _NO_WARD},
+))  # fmt: skip
+
+
+def scene_text(scene: ConformanceScene | str) -> str:
+    """The scene file of a conformance scene: a comment header, title, description, the body.
+
+    Examples
+    --------
+    >>> text = scene_text("lambert-point-d65")
+    >>> text.splitlines()[0]
+    '# specref conformance scene: lambert-point-d65 (docs/conformance.md)'
+    >>> import tomllib; tomllib.loads(text)["lights"][0]["attenuation"]
+    [0, 0, 1]
+    """
+    s = CONFORMANCE_SCENES.lookup(scene) if isinstance(scene, str) else scene
+    head = [
+        f"# specref conformance scene: {s.name} (docs/conformance.md)",
+        "# Written by python -m validation.precompute.conformance; do not edit.",
+        f"title = {json.dumps(s.name)}",
+        f"description = {json.dumps('Tests ' + s.tests + '.')}",
+    ]
+    return "\n".join([*head, s.body()]) + "\n"
+
+
+def scene_path(name: str):
+    """The shipped file of a conformance scene (``data:conformance/<name>.toml``).
+
+    Examples
+    --------
+    >>> scene_path("colorchecker-fl2").name
+    'colorchecker-fl2.toml'
+    """
+    from reference.data import data_path
+
+    CONFORMANCE_SCENES.lookup(name)
+    return data_path(f"conformance/{name}.toml")
