@@ -24,7 +24,7 @@ import numpy as np
 from reference.errors import require
 from reference.materials.types import MATERIAL_TYPES, MaterialType
 from reference.registry import Method
-from reference.scene.lights import EnvironmentLight
+from reference.scene.lights import EnvironmentLight, PointLight
 from reference.scene.shading import SHADERS, Surface
 
 __all__ = [
@@ -36,6 +36,7 @@ __all__ = [
     "render_orbit",
     "scene_state",
     "shade_isotropic_brdf_environment",
+    "shade_isotropic_brdf_point",
 ]
 
 
@@ -262,6 +263,49 @@ def _full_brdf(material: IsotropicBRDFMaterial):
     return BRDF_METHODS.lookup(material.brdf).reference, material.params
 
 
+def shade_isotropic_brdf_point(
+    surface: Surface, material: IsotropicBRDFMaterial, light: PointLight, ctx
+) -> np.ndarray:
+    """XYZ of an isotropic 3-D BRDF under a point light: ``π f(ω_i, ω_o) cos θ_i f_att I``.
+
+    The rendering equation for a point light (Pharr et al., pbrt-v4 §12.1: ``L_o = f I cos θ_i /
+    d²``) in the scene format's units: a white diffuser (``f = 1/π``) facing the light at
+    ``f_att = 1`` has Y = ``intensity`` (docs/scene-format.md), so the reflected fraction per band
+    is ``π f cos θ_i f_att``, with the attenuation of Eq. (1), Wang et al. (``[0, 0, 1]`` is
+    ``1/d²``). The light's spectrum is folded into the band weights (errata E7).
+
+    Examples
+    --------
+    >>> from reference.scene.shading import ShadingContext
+    >>> from reference.colour.spectra import SpectralGrid
+    >>> ctx = ShadingContext(SpectralGrid(400.0, 700.0, 20.0))
+    >>> white = IsotropicBRDFMaterial("lambert", {"rho_d": np.ones(16)})
+    >>> n = np.array([[0.0, 0.0, 1.0]])
+    >>> XYZ = shade_isotropic_brdf_point(Surface(n * 0, n, n, np.zeros((1, 2))), white,
+    ...                                  PointLight((0.0, 0.0, 2.0), intensity=0.5), ctx)
+    >>> round(float(XYZ[0, 1]), 12)                       # a white diffuser: Y = intensity
+    0.5
+    """
+    from reference.scene.lights import attenuation_Wang, point_light_vectors
+
+    L, d = point_light_vectors(light.position, surface.position)
+    f_att = attenuation_Wang(d, *light.attenuation)
+    cos_i = np.maximum(np.einsum("ij,ij->i", surface.normal, L), 0.0)
+    brdf, params = _full_brdf(material)
+    f = brdf(L, surface.view, surface.normal, **params)
+    # L_o / I = f cos θ_i f_att, times π for the scene format's unit (a white diffuser: Y = I)
+    spectra = (np.pi * cos_i * f_att)[:, None] * f
+    return light.intensity * (spectra @ ctx.weights(light.spectrum))
+
+
+SHADERS.register(
+    Method(
+        "IsotropicBRDFMaterial/PointLight",
+        shade_isotropic_brdf_point,
+        None,
+        "§12.1, Pharr et al. (pbrt-v4); Eq. (1), Wang et al. (attenuation)",
+    )
+)
 SHADERS.register(
     Method(
         "IsotropicBRDFMaterial/EnvironmentLight",

@@ -256,3 +256,29 @@ material = "glossy"
 """
     with pytest.raises(SpecrefError, match=r"^scene.toml: materials.glossy: alpha: must be >= 0"):
         loads_scene(text, "scene.toml")
+
+
+def test_an_isotropic_brdf_under_a_point_light_is_the_lambert_shader_for_lambert():
+    # Source: the Lambert point-light shader of reference.scene.shading (an independent path):
+    # brdf = "lambert" with rho_d must give the same XYZ at random points, lights and views.
+    from reference.colour.spectra import SpectralGrid
+    from reference.materials.types import LambertMaterial
+    from reference.scene.lights import PointLight
+    from reference.scene.shading import ShadingContext, Surface, shade_lambert_point
+    from shrm.orbit import IsotropicBRDFMaterial, shade_isotropic_brdf_point
+
+    rng = np.random.default_rng(3)
+    n = rng.normal(size=(50, 3))
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    v = rng.normal(size=(50, 3)) + 2 * n
+    v /= np.linalg.norm(v, axis=1, keepdims=True)
+    surface = Surface(rng.normal(size=(50, 3)) * 0.3, n, v, np.zeros((50, 2)))
+    ctx = ShadingContext(SpectralGrid(400.0, 700.0, 10.0))
+    rho = np.linspace(0.2, 0.8, ctx.grid.n_bands)
+    light = PointLight((1.0, 2.0, 3.0), intensity=2.0, attenuation=(0.0, 0.0, 1.0))
+    ours = shade_isotropic_brdf_point(
+        surface, IsotropicBRDFMaterial("lambert", {"rho_d": rho}), light, ctx
+    )
+    np.testing.assert_allclose(
+        ours, shade_lambert_point(surface, LambertMaterial(rho), light, ctx), rtol=1e-12, atol=1e-15
+    )

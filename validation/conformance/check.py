@@ -302,6 +302,13 @@ def check_folder(folder, references=None, colourspace=None, progress=None) -> di
     from validation.conformance.scenes import CONFORMANCE_SCENES
 
     files = _render_files(Path(folder))
+    if colourspace is not None:
+        from reference.colour.colorimetry import XYZ_to_RGB_matrix
+
+        try:
+            XYZ_to_RGB_matrix(colourspace)
+        except SpecrefError as error:
+            raise SpecrefError(f"colourspace: {error}") from None
     for name, path in files.items():  # bad input is refused before the references are rendered
         _check_size(name, path, read_render(path, colourspace))
     results = []

@@ -142,7 +142,9 @@ def _broken_renders(scenes: Path, renders: Path, out: Path) -> dict[str, tuple[s
     }
 
 
-def run_mitsuba_proof(folder, names=None, broken: bool = True, progress=None) -> dict:
+def run_mitsuba_proof(
+    folder, names=None, broken: bool = True, references=None, progress=None
+) -> dict:
     """Export the scenes, render them in Mitsuba 3, check them; then check three broken renders.
 
     docs/conformance.md ("Proof on Mitsuba 3"): every scene Mitsuba 3 can express (or those of
@@ -150,13 +152,14 @@ def run_mitsuba_proof(folder, names=None, broken: bool = True, progress=None) ->
     :data:`PROOF_SPP` and checked against its reference; with ``broken``, the venice map mirrored,
     the point-lit sphere's values sRGB-encoded and the FL2 chart rendered by Mitsuba's
     ``scalar_rgb`` variant are checked too, each expected to fail with the mistake made (those
-    three scenes are then rendered whatever ``names`` says).
+    three scenes are then rendered whatever ``names`` says). ``references`` is the references'
+    folder (default ``folder/references``; rendered there where missing).
 
     Returns
     -------
     dict
-        ``check`` (:func:`validation.conformance.check.check_folder`'s result) and ``broken``:
-        per scene the mistake made and the check's result.
+        ``check`` (:func:`validation.conformance.check.check_folder`'s result), ``broken``: per
+        scene the mistake made and the check's result, and ``references`` (the folder).
 
     Raises
     ------
@@ -186,14 +189,15 @@ def run_mitsuba_proof(folder, names=None, broken: bool = True, progress=None) ->
     index = export_scenes(folder / "scenes", "mitsuba", spp=PROOF_SPP)
     wanted = set(index["scenes"] if names is None else names) | set(QUICK_PROOF if broken else ())
     names = [n for n in index["scenes"] if n in wanted]
-    ensure_references(names, folder / "references", progress)
+    references = Path(references) if references is not None else folder / "references"
+    ensure_references(names, references, progress)
     render_mitsuba_folder(
         folder / "scenes", folder / "renders", names, spp=PROOF_SPP_OVERRIDE, progress=progress
     )
-    result = check_folder(folder / "renders", folder / "references", progress=progress)
+    result = check_folder(folder / "renders", references, progress=progress)
     made = {}
     if broken:
         renders = _broken_renders(folder / "scenes", folder / "renders", folder / "broken")
         for name, (mistake, path) in renders.items():
-            made[name] = {"made": mistake, **check_render(name, path, folder / "references")}
-    return {"check": result, "broken": made}
+            made[name] = {"made": mistake, **check_render(name, path, references)}
+    return {"check": result, "broken": made, "references": str(references)}

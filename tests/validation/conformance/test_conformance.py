@@ -1,8 +1,8 @@
 """Tests of the conformance suite: scenes, references, the check and its diagnoses, the export.
 
-The references of every scene are rendered once for the module (about half a minute) into a
-temporary folder; the Mitsuba 3 proof (tests/validation/conformance/test_mitsuba_proof.py) has
-its own.
+The references of every scene are rendered once (about a minute) into the session's folder
+(conftest.py), which the Mitsuba 3 proof (test_mitsuba_proof.py) shares when it runs in the same
+process.
 """
 
 from __future__ import annotations
@@ -42,10 +42,9 @@ NAMES = CONFORMANCE_SCENES.names()
 
 
 @pytest.fixture(scope="module")
-def references(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("references")
-    ensure_references(folder=folder)
-    return folder
+def references(conformance_references):
+    ensure_references(folder=conformance_references)
+    return conformance_references
 
 
 def _write(path, XYZ):

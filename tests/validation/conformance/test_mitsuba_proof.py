@@ -23,9 +23,9 @@ pytestmark = pytest.mark.skipif(
 
 
 @pytest.fixture(scope="module")
-def proof(tmp_path_factory):
+def proof(tmp_path_factory, conformance_references):
     root = tmp_path_factory.mktemp("proof")
-    return root, run_mitsuba_proof(root)
+    return root, run_mitsuba_proof(root, references=conformance_references)
 
 
 def test_mitsuba_passes_every_scene_it_can_express(proof, capsys):
@@ -33,7 +33,7 @@ def test_mitsuba_passes_every_scene_it_can_express(proof, capsys):
     assert len(found["check"]["scenes"]) >= 12
     out = root / "check.json"
     code = main(["conformance", "check", str(root / "renders"), "--references",
-                 str(root / "references"), "--json", str(out)])  # fmt: skip
+                 found["references"], "--json", str(out)])  # fmt: skip
     table = capsys.readouterr().out
     assert code == 0, table
     result = json.loads(out.read_text())
