@@ -53,7 +53,7 @@ def _cmd_check(args) -> int:
     if args.html:
         from validation.conformance.html import write_html
 
-        write_html(result, args.html, args.references)
+        write_html(result, args.html, args.references, args.colourspace)
     return 0 if result["failed"] == 0 else 1
 
 

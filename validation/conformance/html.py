@@ -35,12 +35,12 @@ def _shown(XYZ: np.ndarray, scale: float) -> str:
     return _png(np.repeat(np.repeat(encode_srgb(RGB), 4, axis=0), 4, axis=1))
 
 
-def _scene_block(row: dict, references) -> str:
+def _scene_block(row: dict, references, colourspace=None) -> str:
     from validation.conformance.check import _compared, read_render
     from validation.conformance.references import load_reference
 
     ref = load_reference(row["scene"], references)
-    XYZ = read_render(row["file"])
+    XYZ = read_render(row["file"], colourspace)
     scale = max(float(np.percentile(ref.XYZ[..., 1], 99)), 1e-12)
     mask = _compared(ref)
     rel = np.where(
@@ -62,7 +62,7 @@ def _scene_block(row: dict, references) -> str:
     )
 
 
-def write_html(result: dict, path, references=None) -> Path:
+def write_html(result: dict, path, references=None, colourspace=None) -> Path:
     """Write the page for a :func:`validation.conformance.check.check_folder` result, atomically.
 
     Examples
@@ -75,7 +75,7 @@ def write_html(result: dict, path, references=None) -> Path:
     from reference.files import write_text_atomic
     from validation.conformance.check import summary_table
 
-    blocks = "".join(_scene_block(row, references) for row in result["scenes"])
+    blocks = "".join(_scene_block(row, references, colourspace) for row in result["scenes"])
     page = (
         "<!doctype html><meta charset='utf-8'><title>specref conformance check</title>"
         "<style>body{font-family:sans-serif;max-width:60em;margin:auto}figure{display:inline-"

@@ -108,11 +108,13 @@ def _sphere_camera(width: int, supersample: int = 4) -> str:
     ])  # fmt: skip
 
 
-def _lambert_point(k_d: str, illuminant: str) -> Callable[[], str]:
+def _point_lit(material: list[str], illuminant: str) -> Callable[[], str]:
+    """A sphere of ``material`` (its TOML lines) under a point light of ``illuminant``, 1/d²."""
+
     def body() -> str:
         return "\n".join([
             FINE_GRID, _sphere_camera(64),
-            "[materials.m]", 'type = "lambert"', f"k_d = {k_d}",
+            "[materials.m]", *material,
             "[[objects]]", 'type = "sphere"', 'material = "m"',
             "[[lights]]", 'type = "point"', "position = [3, 2, 4]",
             f'spectrum = {{ illuminant = "{illuminant}" }}', "intensity = 25",
@@ -193,29 +195,15 @@ CONFORMANCE_SCENES.register(ConformanceScene(
     "the cosine law, the 1/d² fall-off and the normalization of a D65 point light "
     "(a grey Lambertian sphere, ρ = 0.5)",
     ("missing_cosine", "illuminant_not_normalized", *_SCALE_MISTAKES),
-    _lambert_point("0.5", "D65"),
+    _point_lit(_LAMBERT_HALF, "D65"),
 ))  # fmt: skip
 CONFORMANCE_SCENES.register(ConformanceScene(
     "lambert-point-orange-a",
     "a measured reflectance (an orange, Nix Spectro 2, held constant beyond 400-700 nm) times "
     "illuminant A, integrated per wavelength",
     ("missing_cosine", "illuminant_not_normalized", "rgb_rendering", *_SCALE_MISTAKES),
-    _lambert_point(_ORANGE_K_D, "A"),
+    _point_lit(_ORANGE, "A"),
 ))  # fmt: skip
-
-
-def _brdf_point(material: list[str], illuminant: str) -> Callable[[], str]:
-    def body() -> str:
-        return "\n".join([
-            FINE_GRID, _sphere_camera(64),
-            "[materials.m]", *material,
-            "[[objects]]", 'type = "sphere"', 'material = "m"',
-            "[[lights]]", 'type = "point"', "position = [3, 2, 4]",
-            f'spectrum = {{ illuminant = "{illuminant}" }}', "intensity = 25",
-            "attenuation = [0, 0, 1]",
-        ])  # fmt: skip
-
-    return body
 
 
 CONFORMANCE_SCENES.register(ConformanceScene(
@@ -223,7 +211,7 @@ CONFORMANCE_SCENES.register(ConformanceScene(
     "a GGX conductor (α = 0.3, F = 1, Smith G1·G1, Walter et al. 2007) under a D65 point light: "
     "the microfacet lobe's shape, height and place, and π f cos θ in the scene's units",
     ("missing_cosine", "illuminant_not_normalized", *_SCALE_MISTAKES),
-    _brdf_point(['type = "isotropic_brdf"', 'brdf = "ggx"', "rho_d = 0", "F_0 = 1",
+    _point_lit(['type = "isotropic_brdf"', 'brdf = "ggx"', "rho_d = 0", "F_0 = 1",
                  "alpha = 0.3"], "D65"),
 ))  # fmt: skip
 CONFORMANCE_SCENES.register(ConformanceScene(
@@ -231,7 +219,7 @@ CONFORMANCE_SCENES.register(ConformanceScene(
     "GGX with Schlick's Fresnel (F_0 = 0.04) over a measured reflectance (an orange) under an "
     "FL2 point light: a white highlight on a coloured base, per wavelength",
     ("missing_cosine", "illuminant_not_normalized", "rgb_rendering", *_SCALE_MISTAKES),
-    _brdf_point(['type = "isotropic_brdf"', 'brdf = "ggx"', f"rho_d = {_ORANGE_K_D}",
+    _point_lit(['type = "isotropic_brdf"', 'brdf = "ggx"', f"rho_d = {_ORANGE_K_D}",
                  "F_0 = 0.04", "alpha = 0.2"], "FL2"),
     {"mitsuba": _NO_SCHLICK},
 ))  # fmt: skip
@@ -240,7 +228,7 @@ CONFORMANCE_SCENES.register(ConformanceScene(
     "Ward's isotropic BRDF (ρ_d = 0.2, ρ_s = 0.2, α = 0.15) under an illuminant A point light "
     "(flat spectra: an RGB renderer gets it right, so it does not list rgb_rendering)",
     ("missing_cosine", "illuminant_not_normalized", *_SCALE_MISTAKES),
-    _brdf_point(['type = "isotropic_brdf"', 'brdf = "ward_isotropic"', "rho_d = 0.2",
+    _point_lit(['type = "isotropic_brdf"', 'brdf = "ward_isotropic"', "rho_d = 0.2",
                  "rho_s = 0.2", "alpha = 0.15"], "A"),
     {"mitsuba": _NO_WARD},
 ))  # fmt: skip
