@@ -27,6 +27,7 @@ error most (at least twice) as a "likely" cause.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
 
@@ -160,7 +161,7 @@ def _diagnose(name: str, XYZ: np.ndarray, ref, scene, found: dict, folder=None) 
     for key in scene.catches:
         diagnosis = DIAGNOSES.lookup(key)
         for label, variant in diagnosis_variants(diagnosis, ctx, folder):
-            alt = dataclass_replace(ref, XYZ=variant)
+            alt = dataclasses.replace(ref, XYZ=variant)
             m = block_metrics(XYZ, alt, scene.tolerance_Y, scene.tolerance_dE)
             tried.append((key, label, m))
     if not tried:
@@ -179,12 +180,6 @@ def _diagnose(name: str, XYZ: np.ndarray, ref, scene, found: dict, folder=None) 
         "block_rel_Y": m["block_rel_Y"],
         "block_dE00": m["block_dE00"],
     }
-
-
-def dataclass_replace(obj, **changes):
-    import dataclasses
-
-    return dataclasses.replace(obj, **changes)
 
 
 def check_render(
