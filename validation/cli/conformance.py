@@ -40,12 +40,10 @@ def _cmd_export(args) -> int:
 
 
 def _cmd_check(args) -> int:
-    from reference.files import check_output_file
-    from validation.conformance.check import check_folder, summary_table, write_json
+    from validation.conformance.check import check_folder, check_outputs, summary_table, write_json
 
-    for out in (args.json, args.html):  # refuse an unusable output before any rendering
-        if out:
-            check_output_file(out)
+    # refuse an unusable output, or one that would overwrite an input, before any rendering
+    check_outputs(args.renders, args.references, [args.json, args.html])
     result = check_folder(args.renders, args.references, args.colourspace, _say)
     print(summary_table(result))
     if args.json:

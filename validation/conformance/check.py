@@ -39,6 +39,7 @@ __all__ = [
     "BLOCK",
     "block_metrics",
     "check_folder",
+    "check_outputs",
     "check_render",
     "read_render",
     "summary_table",
@@ -318,6 +319,32 @@ def check_folder(folder, references=None, colourspace=None, progress=None) -> di
         "failed": len(results) - passed,
         "missing": [n for n in CONFORMANCE_SCENES.names() if n not in files],
     }
+
+
+def check_outputs(renders, references, outputs) -> None:
+    """Refuse, before any work, outputs that cannot be written or that are one of the inputs.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp()); (d / "colorchecker-a.exr").write_bytes(b"")
+    0
+    >>> check_outputs(d, None, [d / "colorchecker-a.exr"])
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: .../colorchecker-a.exr: is an input of the check; ...
+    """
+    from reference.files import check_output_file
+
+    folders = [Path(renders), Path(references) if references is not None else None]
+    for out in (Path(o) for o in outputs if o):
+        for folder in filter(None, folders):
+            inside = folder.is_dir() and out.resolve().parent == folder.resolve()
+            require(
+                not (inside and out.exists()),
+                f"{out}: is an input of the check; give another file",
+            )
+        check_output_file(out)
 
 
 def summary_table(result: dict) -> str:

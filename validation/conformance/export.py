@@ -36,6 +36,8 @@ __all__ = ["EXPORT_FORMATS", "export_scenes", "mitsuba_xml"]
 #: Formats of ``specref conformance export``.
 EXPORT_FORMATS = ("specref", "mitsuba")
 _DATA = re.compile(r'"data:([^"]+)"')
+#: Most samples per pixel written into a Mitsuba scene (2^20: hours per scene on a laptop).
+MAX_SPP = 1 << 20
 #: Wavelengths of the spectra written for Mitsuba, nm.
 MITSUBA_WAVELENGTHS = np.arange(360.0, 831.0, 5.0)
 
@@ -254,12 +256,16 @@ def export_scenes(folder, fmt: str = "specref", spp: int = 64) -> dict:
     'Mitsuba 3 has no Ward BSDF'
     """
     from reference.data import data_path
-    from reference.files import write_text_atomic
+    from reference.files import check_output_folder, write_text_atomic
     from reference.images.formats import read_exr, write_exr
 
     require(fmt in EXPORT_FORMATS, f"--format: {fmt!r}; allowed: {', '.join(EXPORT_FORMATS)}")
-    out = Path(folder)
-    (out / "maps").mkdir(parents=True, exist_ok=True)
+    require(
+        isinstance(spp, int) and 1 <= spp <= MAX_SPP,
+        f"spp: samples per pixel must be an integer in 1-{MAX_SPP}, got {spp!r}",
+    )
+    out = check_output_folder(folder)
+    check_output_folder(out / "maps")
     for path in sorted(data_path("conformance/maps").iterdir()):
         if path.suffix == ".exr" and fmt == "mitsuba":
             write_exr(out / "maps" / path.name, texels_repeated(read_exr(path)[0][..., :3]))

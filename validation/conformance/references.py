@@ -267,10 +267,10 @@ def ensure_references(names=None, folder=None, progress=None, force: bool = Fals
     """
     import time
 
-    from reference.files import write_text_atomic
+    from reference.files import check_output_folder, write_text_atomic
     from validation.conformance.scenes import CONFORMANCE_SCENES
 
-    folder = Path(folder) if folder is not None else reference_folder()
+    folder = check_output_folder(folder if folder is not None else reference_folder())
     names = list(CONFORMANCE_SCENES.names() if names is None else names)
     for name in names:
         CONFORMANCE_SCENES.lookup(name)

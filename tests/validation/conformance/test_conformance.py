@@ -280,3 +280,44 @@ def test_check_folder_reports_missing_scenes(references, tmp_path):
     result = check_folder(tmp_path, references)
     assert result["passed"] == 1
     assert len(result["missing"]) == len(NAMES) - 1
+
+
+@pytest.mark.parametrize(
+    ("command", "message"),
+    [
+        (["check", "{renders}", "--json", "{renders}/colorchecker-a.exr"], "is an input"),
+        (["check", "{renders}", "--html", "{refs}/manifest.json"], "is an input"),
+        (["check", "{renders}", "--json", "{tmp}"], "is a folder"),
+        (["check", "{renders}", "--json", "/dev/null"], "a device"),
+        (["check", "{renders}", "--json", "{tmp}/afile/out.json"], "a part of the path is a file"),
+        (["references", "--out", "{tmp}/afile", "--scene", "colorchecker-a"], "is a file"),
+        (["references", "--out", "/dev/null"], "cannot write"),
+        (["references", "--scene", "nope", "--out", "{tmp}/r"], "unknown conformance scene"),
+        (["export", "{tmp}/afile"], "cannot write"),
+        (["export", "{tmp}/afile/x"], "cannot write"),
+        (["export", "{tmp}/e", "--format", "mitsuba", "--spp", "-3"], "must be an integer in"),
+        (["export", "{tmp}/e", "--format", "mitsuba", "--spp", "0"], "must be an integer in"),
+        (["export", "{tmp}/e", "--format", "mitsuba", "--spp", "99999999999999"], "integer in"),
+    ],
+)
+def test_bad_outputs_and_settings_are_refused_and_the_inputs_stay_intact(
+    references, tmp_path, capsys, command, message
+):
+    renders = tmp_path / "renders"
+    renders.mkdir()
+    render = _write(
+        renders / "colorchecker-a.exr", load_reference("colorchecker-a", references).XYZ
+    )
+    (tmp_path / "afile").write_text("x")
+    before = render.read_bytes(), (references / "manifest.json").read_bytes()
+    fill = {"renders": renders, "refs": references, "tmp": tmp_path}
+    argv = [a.format(**fill) for a in command]
+    if argv[0] == "check":
+        argv += ["--references", str(references)]
+    code = main(["conformance", *argv])
+    err = capsys.readouterr().err.strip()
+    assert code == 2, err
+    assert message in err, err
+    assert len(err.splitlines()) == 1, err
+    assert (render.read_bytes(), (references / "manifest.json").read_bytes()) == before
+    assert (tmp_path / "afile").read_text() == "x"
