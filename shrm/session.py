@@ -409,6 +409,8 @@ def _stage_shrm_create(state, inputs):
     out = {"coeffs": s.coeffs, "orders": np.array([s.F, s.P]), "view_power": b["view_power"]}
     if lambert is not None:
         out.update(lambert=s.lambert, irradiance=s.irradiance)
+    if s.mixing is not None:
+        out["mixing"] = s.mixing
     return out
 
 
@@ -425,6 +427,7 @@ def _shrm_of(state, created):
         float(created["view_power"]),
         created.get("lambert"),
         created.get("irradiance"),
+        created.get("mixing"),
     )
 
 
@@ -486,7 +489,7 @@ HERBERT_STAGES = (
         ("config",),
         ("sh_project", "brdf_coeffs"),
         _stage_shrm_create,
-        "2",
+        "3",  # version 3: on a basis of the channels (E103)
         persistent=True,
     ),
     Stage("gbuffer", ("viewpoint", "config"), (), _stage_gbuffer),
@@ -642,7 +645,7 @@ POLYMER_STAGES = (
         ("config",),
         ("sh_project", "brdf_coeffs"),
         _effect_stage(_stage_shrm_create),
-        "2",
+        "3",
     ),
     Stage("gbuffer", ("viewpoint", "config"), (), _stage_gbuffer),
     Stage("extract", ("viewpoint", "config"), ("shrm_create",), _effect_stage(_stage_extract)),

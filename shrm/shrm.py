@@ -191,8 +191,9 @@ class SHRM:
 
     Attributes
     ----------
-    coeffs : ndarray, shape (6, S, S, C, (P+1)²)
-        ``B_pq(n)`` in world axes (module docstring), per band or channel.
+    coeffs : ndarray, shape (6, S, S, R, (P+1)²)
+        ``B_pq(n)`` in world axes (module docstring), per band (R = C) or, with ``mixing``, per
+        basis channel.
     frame : str
         ``"normal"`` or ``"reflection"``: what the texel direction indexes.
     F, P : int
@@ -206,6 +207,9 @@ class SHRM:
     irradiance : ndarray, shape (6, S, S, C), optional
         The irradiance cube map ``E(n) = ∫ L max(0, ω·n) dω`` (Eq. (7), Ramamoorthi & Hanrahan
         2001), when ``lambert`` is given.
+    mixing : ndarray, shape (C, R), optional
+        The bands as combinations of the R basis channels ``coeffs`` hold (:func:`shrm_create`'s
+        channel basis): band c is ``Σ_r mixing[c, r] coeffs[..., r, :]``. None: R = C.
     """
 
     coeffs: np.ndarray
@@ -215,6 +219,7 @@ class SHRM:
     view_power: float = 0.0
     lambert: np.ndarray | None = None
     irradiance: np.ndarray | None = None
+    mixing: np.ndarray | None = None
 
     @property
     def size(self) -> int:
@@ -274,11 +279,14 @@ def shrm_create(
     C, F1, P1, _ = rho.shape
     F, P = F1 - 1, P1 - 1
     L = np.atleast_2d(np.asarray(env_coeffs, dtype=np.float64))
-    if C == 1 and L.shape[0] > 1:  # a grey BRDF under a coloured environment
-        rho, C = np.broadcast_to(rho, (L.shape[0], *rho.shape[1:])), L.shape[0]
-    require(L.shape[0] == C, f"SHRM: lighting has {L.shape[0]} channels but the BRDF has {C}")
+    bands = L.shape[0]
+    # a grey BRDF (one channel) goes with any environment
+    require(C in (1, bands), f"SHRM: lighting has {bands} channels but the BRDF has {C}")
     require(L.shape[1] >= F1 * F1, f"SHRM: lighting order is below F = {F}")
     L = L[:, : F1 * F1]
+    # Create on a basis of the channels where the bands are few combinations of it (E103)
+    rho, L, mixing = channel_basis(rho, L)
+    C = L.shape[0]
     K = F + P
     H = 2 * K + 2
     W = 2 * H
@@ -297,9 +305,69 @@ def shrm_create(
     coeffs = values.reshape(6, size, size, C, P1 * P1)
     irradiance = None
     if lambert is not None:
-        lambert = np.broadcast_to(np.asarray(lambert, dtype=np.float64), (C,)).copy()
+        lambert = np.broadcast_to(np.asarray(lambert, dtype=np.float64), (bands,)).copy()
         irradiance = _irradiance_cube(env_coeffs, texels, backend)
-    return SHRM(coeffs, frame, F, P, float(view_power), lambert, irradiance)
+    return SHRM(coeffs, frame, F, P, float(view_power), lambert, irradiance, mixing)
+
+
+#: Singular values below this fraction of the largest are dropped by :func:`channel_basis`.
+CHANNEL_RANK_RTOL = 1e-12
+
+
+def _numerical_basis(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``x (C, n) ≈ mix (C, r) @ basis (r, n)`` with r the numerical rank (SVD)."""
+    U, s, Vt = np.linalg.svd(x, full_matrices=False)
+    r = max(1, int((s > CHANNEL_RANK_RTOL * s[0]).sum())) if s[0] > 0 else 1
+    return U[:, :r], s[:r, None] * Vt[:r]
+
+
+def channel_basis(rho, L) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """The BRDF's and the lighting's channels on a common basis, when it has fewer channels.
+
+    Ours (E103): a SHRM's coefficients are bilinear in the BRDF and lighting coefficients of each
+    band, ``B_c = B(ρ_c, L_c)``. When ``ρ_c = Σ_j A_cj ρ_j`` (s basis BRDFs: 1 for a grey BRDF)
+    and ``L_c = Σ_k U_ck L_k`` (r basis lightings: 3 for a map upsampled linearly from RGB),
+    ``B_c = Σ_jk A_cj U_ck B(ρ_j, L_k)``: the SHRM is created on the s·r pairs and the bands
+    are mixed back at extraction. Used when s·r < C; the ranks are numerical
+    (:data:`CHANNEL_RANK_RTOL`), so the bands agree with a per-band creation to rounding.
+
+    Parameters
+    ----------
+    rho : ndarray, shape (C, F+1, P+1, M+1) or (1, ...)
+        BRDF coefficients per band (one channel: grey).
+    L : ndarray, shape (C, (F+1)²)
+        Lighting coefficients per band.
+
+    Returns
+    -------
+    rho, L : ndarray
+        Per basis channel, shapes (R, F+1, P+1, M+1) and (R, (F+1)²); the inputs (``rho``
+        broadcast to C channels) when no basis is smaller.
+    mixing : ndarray, shape (C, R), or None
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(1)
+    >>> L = rng.normal(size=(3, 9)); rho = rng.normal(size=(1, 3, 2, 2))
+    >>> L16 = np.linspace(0, 1, 16)[:, None] * L[0] + np.linspace(1, 0, 16)[:, None] * L[1]
+    >>> rho_b, L_b, mix = channel_basis(rho, L16)
+    >>> L_b.shape, mix.shape, bool(np.allclose(mix @ L_b, L16))
+    ((2, 9), (16, 2), True)
+    >>> channel_basis(rho, L)[2] is None                     # three independent bands
+    True
+    """
+    C = L.shape[0]
+    A, rho_j = _numerical_basis(rho.reshape(rho.shape[0], -1))
+    U, L_k = _numerical_basis(L)
+    s, r = rho_j.shape[0], L_k.shape[0]
+    if s * r >= C:
+        return np.broadcast_to(rho, (C, *rho.shape[1:])), L, None
+    A = np.broadcast_to(A, (C, s))
+    # The pairs (j, k): ρ_j with L_k, and the bands' weights A_cj U_ck
+    rho_pairs = np.repeat(rho_j.reshape(s, *rho.shape[1:]), r, axis=0)
+    L_pairs = np.tile(L_k, (s, 1))
+    mixing = (A[:, :, None] * U[:, None, :]).reshape(C, s * r)
+    return rho_pairs, L_pairs, mixing
 
 
 #: Up to this degree, :func:`_synthesize_many` evaluates the basis once and multiplies.
@@ -443,7 +511,9 @@ def shrm_extract(shrm: SHRM, view) -> np.ndarray:
     v = v / np.linalg.norm(v)
     Y = sh_basis(shrm.P, v[None])[0]
     # §5.6, Herbert et al.: expand the series with Y_pq indexed by the viewpoint
-    return shrm.coeffs @ Y
+    E = shrm.coeffs @ Y
+    # E103: the bands from the basis channels
+    return E if shrm.mixing is None else E @ shrm.mixing.T
 
 
 def _index_directions(frame: str, normal, view) -> np.ndarray:

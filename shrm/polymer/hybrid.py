@@ -462,8 +462,9 @@ def effect_shrm(
 
     Examples
     --------
+    >>> from shrm.shrm import shrm_extract
     >>> s = effect_shrm(np.ones((8, 16, 41)), F=2, P=2, size=2)
-    >>> s.frame, s.coeffs.shape[:4]
+    >>> s.frame, shrm_extract(s, [0.0, 0.0, 1.0]).shape               # a map per band
     ('reflection', (6, 2, 2, 41))
     """
     from reference.colour.spectra import DEFAULT_GRID

@@ -10,7 +10,14 @@ from reference.materials.isotropic import brdf_lafortune
 from shrm.brdf_sh import brdf_sh_coefficients
 from shrm.rotation import rotation_matrix, sh_rotation_blocks
 from shrm.sh import sh_evaluate
-from shrm.shrm import SHRM, polar_rotate, render_shrm, shrm_create, shrm_extract
+from shrm.shrm import (
+    SHRM,
+    polar_rotate,
+    render_shrm,
+    shade_shrm,
+    shrm_create,
+    shrm_extract,
+)
 from shrm.shrm_oracles import (
     env_quadrature,
     reflected_bruteforce,
@@ -177,6 +184,38 @@ def test_the_basis_product_equals_one_synthesis_per_function(rng, K, monkeypatch
     monkeypatch.setattr(shrm_module, "BASIS_PRODUCT_MAX_ORDER", K - 1)
     if K > 0:
         assert np.array_equal(shrm_module._synthesize_many(coeffs, K, texels, "ducc0"), want)
+
+
+@pytest.mark.parametrize(("grey", "expected_channels"), [(True, 3), (False, 6)])
+def test_creation_on_a_channel_basis_equals_one_per_band(rng, grey, expected_channels, monkeypatch):
+    # erratum E103: 16 bands that are combinations of 3 lightings (a linearly upsampled map) and,
+    # when not grey, of 2 BRDFs: the SHRM is made on the 3 or 6 pairs and mixed back per band
+    import shrm.shrm as shrm_module
+
+    lightings = rng.standard_normal((3, 25))
+    weights = rng.uniform(0.0, 1.0, (16, 3))
+    L = weights @ lightings
+    brdf = brdf_sh_coefficients(brdf_lafortune, POLY, 4, 2, "reflection")[:1]  # (1, 5, 3, 3)
+    if grey:
+        rho = brdf
+    else:
+        t = np.linspace(0.0, 1.0, 16)[:, None, None, None]
+        rho = (1.0 - t) * brdf + t * brdf[..., ::-1] * 0.5
+    s = shrm_create(L, rho, "reflection", size=4, lambert=0.2)
+    assert s.mixing.shape == (16, expected_channels)
+    assert s.coeffs.shape == (6, 4, 4, expected_channels, 9)
+    monkeypatch.setattr(shrm_module, "CHANNEL_RANK_RTOL", 0.0)  # every band its own channel
+    per_band = shrm_create(L, rho, "reflection", size=4, lambert=0.2)
+    assert per_band.mixing is None
+    assert per_band.coeffs.shape[3] == 16
+    normals = cubemap_texel_directions(5).reshape(-1, 3)
+    for v in ([0.0, 0.0, 1.0], [0.6, 0.0, 0.8]):
+        E, E_band = shrm_extract(s, v), shrm_extract(per_band, v)
+        assert E.shape == E_band.shape == (6, 4, 4, 16)
+        np.testing.assert_allclose(E, E_band, rtol=0, atol=1e-12 * np.abs(E_band).max())
+        got = shade_shrm(s, E, normals, np.array(v))
+        want = shade_shrm(per_band, E_band, normals, np.array(v))
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * np.abs(want).max())
 
 
 @pytest.mark.parametrize("axis", [0, 1, 2])
