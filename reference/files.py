@@ -22,9 +22,12 @@ __all__ = [
     "atomic_write",
     "check_output_file",
     "check_output_folder",
+    "check_output_store",
+    "check_outputs",
     "default_cache_dir",
     "output_error",
     "read_json",
+    "same_file",
     "write_bytes_atomic",
     "write_text_atomic",
 ]
@@ -93,16 +96,167 @@ def _write_errors(path):
         raise translated from None
 
 
-def _require_file_target(path: Path) -> None:
-    """Refuse a destination that is a folder or an existing special file (a device, a FIFO).
+def _existing_ancestor(path: Path) -> Path:
+    """The nearest folder (or file) on ``path``'s way that exists."""
+    parent = path.absolute().parent
+    while not parent.exists() and parent != parent.parent:
+        parent = parent.parent
+    return parent
 
-    Writing is a rename onto ``path``: onto ``/dev/null`` it would replace the device node.
+
+def _require_file_target(path: Path) -> None:
+    """Refuse a folder, a special file, a path below a file and a name too long for the disk.
+
+    Special files: devices, FIFOs, sockets. Writing is a rename onto ``path``: onto ``/dev/null``
+    it would replace the device node.
     """
     require(not path.is_dir(), f"{path}: cannot write ({WRITE_ERRORS[errno.EISDIR]})")
     require(
         not path.exists() or path.is_file(),
         f"{path}: cannot write (a device or special file, not a regular file; give a file name)",
     )
+    ancestor = _existing_ancestor(path)
+    require(ancestor.is_dir(), f"{path}: cannot write ({WRITE_ERRORS[errno.ENOTDIR]}: {ancestor})")
+    try:
+        name_max = os.pathconf(ancestor, "PC_NAME_MAX")
+    except (AttributeError, OSError, ValueError):  # no pathconf (Windows): the common limit
+        name_max = 255
+    # the temporary file beside it adds a dot and a suffix of 8 random characters and ".tmp"
+    sizes = [len(part.encode("utf-8", "surrogateescape")) for part in path.parts]
+    require(
+        max(sizes[:-1], default=0) <= name_max and sizes[-1] + 14 <= name_max,
+        f"{path}: cannot write (a name in the path is longer than the file system's "
+        f"{name_max} bytes, {name_max - 14} for the file's own name)",
+    )
+
+
+def same_file(a, b) -> bool:
+    """Whether two paths name the same file: the same inode where both exist, else the same path.
+
+    Hard links, symbolic links and ``..`` count as the same file.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     a = os.path.join(d, "a.exr"); _ = open(a, "w").close()
+    ...     os.link(a, os.path.join(d, "b.exr"))
+    ...     same_file(a, os.path.join(d, "b.exr")), same_file(a, os.path.join(d, "c.exr"))
+    (True, False)
+    """
+    a, b = Path(a), Path(b)
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return os.path.realpath(a) == os.path.realpath(b)
+
+
+#: Files at the top of a Zarr store (version 2 or 3), the folders specref writes as a whole:
+#: a folder with one may be replaced by a new store.
+STORE_MARKERS = (".zgroup", ".zarray", "zarr.json")
+
+
+def check_output_store(path) -> Path:
+    """Refuse, before any work, a store path that would lose data or cannot be a store.
+
+    The write policy (docs/bad-input.md): a store replaces only an empty folder or an earlier
+    Zarr store, never a folder of other files, a file or a special file.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp()); _ = (d / "holiday.jpg").write_bytes(b"")
+    >>> check_output_store(d / "new.zarr").name
+    'new.zarr'
+    >>> check_output_store(d)
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: ...: cannot write a Zarr store: a folder that is not a Zarr ...
+    """
+    path = Path(path)
+    require(
+        not path.exists() or path.is_dir(),
+        f"{path}: cannot write a Zarr store: a file is in the way",
+    )
+    if path.is_dir() and any(path.iterdir()):
+        require(
+            any((path / marker).is_file() for marker in STORE_MARKERS),
+            f"{path}: cannot write a Zarr store: a folder that is not a Zarr store is there "
+            "(its files would be lost); give another name or remove it",
+        )
+    return path
+
+
+def check_outputs(outputs, inputs=(), stores=()) -> list[Path]:
+    """The write policy: refuse, before any work, outputs that cannot or must not be written.
+
+    Every command calls it with all the files it will write (sibling outputs derived from a name
+    included) and all the files it reads, before reading or computing anything
+    (``validation.cli.main`` does it from the arguments; docs/bad-input.md). An output is
+    refused, in one line naming it, when it is
+
+    - a folder, a device, a FIFO or a socket (a rename onto ``/dev/null`` would replace the
+      device node; specref never writes to special files: give a regular file name);
+    - below a file, or has a name longer than the file system holds;
+    - the same file as an input (inodes compared: hard and symbolic links count), or as another
+      output of the same command.
+
+    An output *store* (a Zarr folder) must not be an input either; whether an existing folder may
+    be replaced is its writer's decision (``reference.images.zarr_store``: only a Zarr store).
+
+    Parameters
+    ----------
+    outputs : iterable of str or Path
+        The files to be written (None entries are skipped).
+    inputs : iterable of str or Path
+        The files to be read (None entries and names that do not exist are skipped).
+    stores : iterable of str or Path
+        Folders to be written as a whole (Zarr stores).
+
+    Returns
+    -------
+    list of Path
+        The outputs.
+
+    Raises
+    ------
+    SpecrefError
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> d = tempfile.mkdtemp(); a = os.path.join(d, "a.exr"); _ = open(a, "w").close()
+    >>> check_outputs([os.path.join(d, "diff.exr")], [a])[0].name
+    'diff.exr'
+    >>> check_outputs([a], [a, os.path.join(d, "b.exr")])
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: .../a.exr: is also an input of this command (.../a.exr); ...
+    >>> check_outputs(["/dev/null"])
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: /dev/null: cannot write (a device or special file, ...
+    """
+    outputs = [Path(o) for o in outputs if o is not None]
+    inputs = [Path(i) for i in inputs if i is not None and os.path.lexists(i)]
+    for k, out in enumerate(outputs):
+        with _write_errors(out):
+            _require_file_target(out)
+        for source in inputs:
+            require(
+                not same_file(out, source),
+                f"{out}: is also an input of this command ({source}); give another output name",
+            )
+        for other in outputs[:k]:
+            require(not same_file(out, other), f"{out}: the command would write it twice ({other})")
+    for store in (Path(s) for s in stores):
+        check_output_store(store)
+        for source in inputs:
+            require(
+                not same_file(store, source),
+                f"{store}: is also an input of this command ({source}); give another output name",
+            )
+    return outputs
 
 
 @contextlib.contextmanager

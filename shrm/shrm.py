@@ -279,8 +279,7 @@ def shrm_create(
     C, F1, P1, _ = rho.shape
     F, P = F1 - 1, P1 - 1
     L = np.atleast_2d(np.asarray(env_coeffs, dtype=np.float64))
-    bands = L.shape[0]
-    # a grey BRDF (one channel) goes with any environment
+    bands = L.shape[0]  # a grey BRDF (one channel) goes with any environment
     require(C in (1, bands), f"SHRM: lighting has {bands} channels but the BRDF has {C}")
     require(L.shape[1] >= F1 * F1, f"SHRM: lighting order is below F = {F}")
     L = L[:, : F1 * F1]

@@ -26,7 +26,13 @@ import numpy as np
 from reference.display.cgats import read_ti3
 from reference.errors import SpecrefError, require
 
-__all__ = ["INSTALL_HINT", "build_icc_profile", "check_icc_profile", "icc_tools_missing"]
+__all__ = [
+    "INSTALL_HINT",
+    "build_icc_profile",
+    "check_icc_profile",
+    "icc_tools_missing",
+    "require_icc_tools",
+]
 
 #: How to get the tools (what CI's ``.ci/run`` does).
 INSTALL_HINT = "install them with: apt-get install -y argyll liblcms2-utils"
@@ -41,6 +47,17 @@ def icc_tools_missing() -> list[str]:
     True
     """
     return [tool for tool in ("colprof", "transicc") if shutil.which(tool) is None]
+
+
+def require_icc_tools() -> None:
+    """Refuse, in one line, to go on when an ICC tool is missing (before anything is written).
+
+    Examples
+    --------
+    >>> require_icc_tools() if not icc_tools_missing() else None
+    """
+    for tool in icc_tools_missing():
+        _require_tool(tool)
 
 
 def _require_tool(tool: str) -> str:

@@ -37,7 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from reference.errors import SpecrefError, format_allowed, require, require_positive_int
-from reference.files import output_error
+from reference.files import check_output_store, output_error
 from reference.geometry.cubemap import latlong_blocks_to_cubemap
 from reference.images.formats import channel_wavelengths_nm
 
@@ -204,8 +204,7 @@ def _check_channels(channels, n_channels: int, where: str) -> list[str]:
 @contextlib.contextmanager
 def _atomic_folder(path: Path):
     """A temporary folder beside ``path``, renamed to ``path`` on success (else removed)."""
-    path = Path(path)
-    require(not path.is_file(), f"{path}: cannot write a Zarr store: a file is in the way")
+    path = check_output_store(path)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.", dir=path.parent))

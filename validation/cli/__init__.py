@@ -30,7 +30,7 @@ from validation.cli import (
     shrm,
     sweep,
 )
-from validation.cli.parser import Parser
+from validation.cli.parser import Parser, command_paths
 
 __all__ = ["COMMANDS", "build_parser", "main"]
 
@@ -79,6 +79,7 @@ def main(argv: list[str] | None = None) -> int:
     2
     """
     import shrm  # noqa: F401  (registers the environment-light shaders before any rendering)
+    from reference.files import check_outputs
     from reference.tasks import set_malloc_trim
 
     parser = build_parser()
@@ -89,6 +90,8 @@ def main(argv: list[str] | None = None) -> int:
     if not getattr(args, "streamed", False):
         set_malloc_trim()
     try:
+        # The write policy (docs/bad-input.md): every output checked before any work
+        check_outputs(*command_paths(args))
         return int(args.func(args) or 0)
     except SpecrefError as error:
         print(f"specref: error: {error}", file=sys.stderr)

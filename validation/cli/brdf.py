@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from validation.cli.parser import Parser, registry_option
+from validation.cli.parser import Parser, input_file, output_file, registry_option
 
 
 def _cmd_brdf_tabulate(args) -> int:
@@ -36,10 +36,10 @@ def add_parser(sub) -> None:
     t = brdf.add_parser("tabulate", help="tabulate a registered BRDF (docs/brdf-format.md)")
     tabulable = tabulable_brdf_names()
     registry_option(t, "model", BRDF_METHODS, "the BRDF", where=lambda key, _: key in tabulable)
-    t.add_argument("-o", "--out", required=True, help="output text file")
+    t.add_argument("-o", "--out", type=output_file, required=True, help="output text file")
     t.add_argument("--theta-step", type=float, default=5.0, help="polar step, degrees")
     t.add_argument("--phi-step", type=float, default=15.0, help="azimuth step, degrees")
     t.set_defaults(func=_cmd_brdf_tabulate)
     c = brdf.add_parser("check", help="read a BRDF table file and summarize it")
-    c.add_argument("file")
+    c.add_argument("file", type=input_file)
     c.set_defaults(func=_cmd_brdf_check)

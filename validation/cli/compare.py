@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from validation.cli.parser import input_file, output_file
+
 
 def _cmd_compare(args) -> int:
     import json
@@ -23,9 +25,18 @@ def add_parser(sub) -> None:
         "a Y.stderr channel, z-scores. EXR with X/Y/Z, spectral (S0.<nm>nm) or R/G/B channels, "
         "or Radiance HDR. docs/render-outputs.md.",
     )
-    p.add_argument("a", metavar="A.exr", help="the image to check")
-    p.add_argument("b", metavar="B.exr", help="the reference")
-    p.add_argument("--mask", metavar="M", help="image of the same size: compare where > 0.5")
-    p.add_argument("--json", metavar="OUT.json", help="write the summary as JSON ('-' prints it)")
-    p.add_argument("--diff", metavar="OUT.exr", help="write the per-pixel differences as EXR")
+    p.add_argument("a", type=input_file, metavar="A.exr", help="the image to check")
+    p.add_argument("b", type=input_file, metavar="B.exr", help="the reference")
+    p.add_argument(
+        "--mask", type=input_file, metavar="M", help="image of the same size: compare where > 0.5"
+    )
+    p.add_argument(
+        "--json",
+        type=output_file,
+        metavar="OUT.json",
+        help="write the summary as JSON ('-' prints it)",
+    )
+    p.add_argument(
+        "--diff", type=output_file, metavar="OUT.exr", help="write the per-pixel differences as EXR"
+    )
     p.set_defaults(func=_cmd_compare)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import sys
 
+from validation.cli.parser import output_file
+
 
 def _say(line: str) -> None:
     print(line, file=sys.stderr, flush=True)
@@ -89,6 +91,13 @@ def add_parser(sub) -> None:
     q.add_argument("--references", metavar="DIR", help="the references' folder (default cache)")
     q.add_argument("--colourspace", help="of renders with R, G, B channels (default: the file's "
                    "specref metadata, else sRGB)")  # fmt: skip
-    q.add_argument("--json", metavar="OUT.json", help="also write the figures as JSON")
-    q.add_argument("--html", metavar="OUT.html", help="also write a page with difference images")
+    q.add_argument(
+        "--json", type=output_file, metavar="OUT.json", help="also write the figures as JSON"
+    )
+    q.add_argument(
+        "--html",
+        type=output_file,
+        metavar="OUT.html",
+        help="also write a page with difference images",
+    )
     q.set_defaults(func=_cmd_check)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import sys
 
+from validation.cli.parser import output_file
+
 
 def _cmd_crosscheck(args) -> int:
     from validation.studies.crosscheck import (
@@ -63,5 +65,10 @@ def add_parser(sub) -> None:
         "shipped with specref",
     )
     p.add_argument("--case", metavar="TEXT", help="run only the cases whose name contains TEXT")
-    p.add_argument("--json", metavar="OUT.json", help="also write the per-case summary as JSON")
+    p.add_argument(
+        "--json",
+        type=output_file,
+        metavar="OUT.json",
+        help="also write the per-case summary as JSON",
+    )
     p.set_defaults(func=_cmd_crosscheck)

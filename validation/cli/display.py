@@ -5,7 +5,7 @@ Herbert et al. §6; docs/display.md.
 
 from __future__ import annotations
 
-from validation.cli.parser import Parser, registry_option
+from validation.cli.parser import Parser, input_file, output_file, registry_option
 
 
 def _cmd_display_calibrate(args) -> int:
@@ -13,6 +13,10 @@ def _cmd_display_calibrate(args) -> int:
     from reference.display.calibration_files import write_calibration
     from reference.display.spectral import load_spectral_display, spectral_display
 
+    if args.profile:  # all files or none: the profile's tools are needed before any is written
+        from reference.display.icc import require_icc_tools
+
+        require_icc_tools()
     display = load_spectral_display(args.display) if args.display else spectral_display()
     calibration = calibrate_display(
         display, args.white, args.curve, args.points, args.instrument, seed=args.seed
@@ -54,6 +58,15 @@ def _cmd_display_calibrate(args) -> int:
     return 0
 
 
+def _calibration_files(args) -> list:
+    """The files ``display calibrate`` writes beside its .cal (the write policy checks them)."""
+    from pathlib import Path
+
+    suffixes = (".cal", ".cube", ".ti3", ".json") + ((".icc",) if args.profile else ())
+    out = Path(args.output)
+    return [out.with_suffix(k) for k in suffixes if out.with_suffix(k) != out]
+
+
 def add_parser(sub) -> None:
     """Add ``specref display`` and its options to the subcommand parsers ``sub``."""
     from reference.display.calibration import CALIBRATION_CURVES, WHITES
@@ -73,12 +86,21 @@ def add_parser(sub) -> None:
     registry_option(c, "--curve", CALIBRATION_CURVES, "tone curve", default="gamma2.2")
     c.add_argument("--points", type=int, default=15, help="control points, 2..64 (default 15)")
     registry_option(c, "--instrument", INSTRUMENTS, "measuring instrument", default="spectro")
-    c.add_argument("--display", metavar="FILE", help="display file (JSON, docs/display.md)")
+    c.add_argument(
+        "--display", type=input_file, metavar="FILE", help="display file (JSON, docs/display.md)"
+    )
     c.add_argument("--seed", type=int, default=0, help="seed of the instrument noise")
     c.add_argument(
         "--profile",
         action="store_true",
         help="also build an ICC profile with ArgyllCMS colprof and check it with littlecms",
     )
-    c.add_argument("-o", "--output", required=True, metavar="CAL.cal", help="the .cal to write")
-    c.set_defaults(func=_cmd_display_calibrate)
+    c.add_argument(
+        "-o",
+        "--output",
+        type=output_file,
+        required=True,
+        metavar="CAL.cal",
+        help="the .cal to write",
+    )
+    c.set_defaults(func=_cmd_display_calibrate, sibling_outputs=_calibration_files)

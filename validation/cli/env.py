@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from validation.cli.parser import Parser, input_file, registry_option
+from validation.cli.parser import Parser, input_file, output_file, registry_option
 
 
 def _cmd_env_fit(args) -> int:
@@ -67,8 +67,15 @@ def add_parser(sub) -> None:
     p = sub.add_parser("env", help="spectral environments: camera-target regression (Herbert §4)")
     env = p.add_subparsers(dest="env_command", required=True, parser_class=Parser)
     f = env.add_parser("fit", help="fit and save an RGB -> spectrum model; print its figures")
-    f.add_argument("--target", default=None, help="target CSV (R, G, B and wavelength columns)")
-    f.add_argument("--spectra", default=None, help="spectra CSV when --target holds only RGB")
+    f.add_argument(
+        "--target",
+        type=input_file,
+        default=None,
+        help="target CSV (R, G, B and wavelength columns)",
+    )
+    f.add_argument(
+        "--spectra", type=input_file, default=None, help="spectra CSV when --target holds only RGB"
+    )
     registry_option(f, "--camera", CAMERAS, "synthetic target camera", default="Nikon 5100 (NPL)")
     f.add_argument("--illuminant", default="D65", help="capture illuminant (colour-science key)")
     registry_option(
@@ -92,25 +99,41 @@ def add_parser(sub) -> None:
         default=None,
     )
     f.add_argument("--noise", action="store_true", help="add 0.5 %% + 0.1 %% camera noise")
-    f.add_argument("-o", "--out", required=True, help="output model .json")
+    f.add_argument("-o", "--out", type=output_file, required=True, help="output model .json")
     f.set_defaults(func=_cmd_env_fit)
     s = env.add_parser(
         "spectralize", help="expand an HDR panorama to a spectral .exr, .tif or .zarr"
     )
     s.add_argument(
-        "panorama", help="linear HDR panorama: .hdr, RGB .exr, float RGB .tif or RGB .zarr"
+        "panorama",
+        type=input_file,
+        help="linear HDR panorama: .hdr, RGB .exr, float RGB .tif or RGB .zarr",
     )
-    s.add_argument("--model", required=True, help="model .json from `env fit`, or 'default'")
+    s.add_argument(
+        "--model", type=input_file, required=True, help="model .json from `env fit`, or 'default'"
+    )
     s.add_argument("--rows", type=int, default=None, help="rows per block (default: 2^17 pixels)")
-    s.add_argument("-o", "--out", required=True, help="output .exr, .tif or .zarr")
+    s.add_argument(
+        "-o", "--out", type=output_file, required=True, help="output .exr, .tif or .zarr"
+    )
     s.set_defaults(func=_cmd_env_spectralize, streamed=True)
+    _add_convert(env)
+
+
+def _add_convert(env) -> None:
+    """Add ``specref env convert`` to the ``env`` subcommands."""
     from reference.images.zarr_store import ZARR_COMPRESSIONS
 
     c = env.add_parser(
         "convert", help="convert a panorama (.exr, .hdr, .tif) to a chunked Zarr store"
     )
     c.add_argument("input", type=input_file, help="lat-long panorama: .exr, .hdr or spectral .tif")
-    c.add_argument("out", metavar="OUT.zarr", help="the Zarr store to write (docs/scale-out.md)")
+    c.add_argument(
+        "out",
+        type=output_file,
+        metavar="OUT.zarr",
+        help="the Zarr store to write (docs/scale-out.md)",
+    )
     c.add_argument(
         "--rows",
         type=int,

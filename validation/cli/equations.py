@@ -5,6 +5,8 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from validation.cli.parser import output_file
+
 
 def _cmd_equations(args) -> int:
     from reference.files import check_output_file, write_text_atomic
@@ -42,7 +44,11 @@ def add_parser(sub) -> None:
         help="the equation index: each paper's equations, the code citing them, tests, errata",
     )
     p.add_argument(
-        "-o", "--out", metavar="FILE", help="write the Markdown to FILE (default: standard output)"
+        "-o",
+        "--out",
+        type=output_file,
+        metavar="FILE",
+        help="write the Markdown to FILE (default: standard output)",
     )
     p.add_argument(
         "--check",

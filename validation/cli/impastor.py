@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 
 from reference.tasks import SERIAL, add_scheduler_option
-from validation.cli.parser import Parser, registry_option
+from validation.cli.parser import Parser, input_file, output_file, registry_option
 
 
 def _cmd_impastor_table1(args) -> int:
@@ -68,22 +68,30 @@ def add_parser(sub) -> None:
     p = sub.add_parser("impastor", help="ImpastoR (Ferwerda 2015): Table 1 and the demo painting")
     isub = p.add_subparsers(dest="impastor_command", required=True, parser_class=Parser)
     t = isub.add_parser("table1", help="Table 1: ColorChecker simulation and screen output")
-    t.add_argument("--json", metavar="FILE", help="also write the table as JSON")
+    t.add_argument("--json", type=output_file, metavar="FILE", help="also write the table as JSON")
     registry_option(t, "--design", MULTISPECTRAL_DESIGNS, "channel design", default="optimized")
     t.add_argument("--channels", type=int, default=6, help="channel count (3-10)")
     t.add_argument(
         "--white-luminance", type=float, default=200.0, help="white diffuser luminance, cd/m²"
     )
-    t.add_argument("--display", metavar="JSON", help="display measurement file (default: virtual)")
+    t.add_argument(
+        "--display",
+        type=input_file,
+        metavar="JSON",
+        help="display measurement file (default: virtual)",
+    )
     add_scheduler_option(t, default=SERIAL)
     t.set_defaults(func=_cmd_impastor_table1)
     r = isub.add_parser("render", help="render the demo painting under a booth light to a PNG")
     r.add_argument("--light", default="D65", help="illuminant key (D65, D50, A, FL2, ...)")
     r.add_argument("--size", type=int, default=512, help="image side in pixels")
     registry_option(r, "--method", PAINTING_LIGHTING_METHODS, "specular lighting", default="hybrid")
-    r.add_argument("--out", default="impastor.png", help="output PNG")
+    r.add_argument("--out", type=output_file, default="impastor.png", help="output PNG")
     r.add_argument(
-        "--counts", metavar="PNG", help="also write the display's 11-bit counts (16-bit PNG)"
+        "--counts",
+        type=output_file,
+        metavar="PNG",
+        help="also write the display's 11-bit counts (16-bit PNG)",
     )
     r.add_argument(
         "--observer",

@@ -7,7 +7,16 @@ import json
 
 from reference.registry import ParametricMethod
 
-__all__ = ["Parser", "registry_option", "write_json"]
+__all__ = [
+    "InputPath",
+    "OutputPath",
+    "Parser",
+    "command_paths",
+    "input_file",
+    "output_file",
+    "registry_option",
+    "write_json",
+]
 
 
 class Parser(argparse.ArgumentParser):
@@ -18,10 +27,24 @@ class Parser(argparse.ArgumentParser):
         self.exit(2, f"specref: error: {message} (see {self.prog} --help)\n")
 
 
-def input_file(value: str) -> str:
+class InputPath(str):
+    """An argument that names a file the command reads (:func:`input_file`)."""
+
+
+class OutputPath(str):
+    """An argument that names a file the command writes (:func:`output_file`)."""
+
+
+class OutputStore(str):
+    """An argument that names a file, or a Zarr store (``*.zarr``), the command writes."""
+
+
+def input_file(value: str) -> InputPath:
     """An input file argument: ``data:<name>`` names a file shipped with specref, else the path.
 
     For argparse's ``type=``; an unknown ``data:`` name is a one-line usage error (exit code 2).
+    The value is marked as an input, so that no output of the command may be the same file
+    (:func:`command_paths`).
 
     Examples
     --------
@@ -34,11 +57,53 @@ def input_file(value: str) -> str:
     from reference.errors import SpecrefError
 
     if not value.startswith(DATA_SCHEME):
-        return value
+        return InputPath(value)
     try:
-        return str(data_path(value))
+        return InputPath(data_path(value))
     except SpecrefError as error:
         raise argparse.ArgumentTypeError(str(error)) from None
+
+
+def output_file(value: str) -> str:
+    """An output file argument, for argparse's ``type=``: marked for the write policy.
+
+    ``-`` (standard output, where a command offers it) is left as it is.
+
+    Examples
+    --------
+    >>> type(output_file("out.exr")).__name__, output_file("-")
+    ('OutputPath', '-')
+    """
+    if value == "-":
+        return value
+    return (OutputStore if value.rstrip("/\\").endswith(".zarr") else OutputPath)(value)
+
+
+def command_paths(args) -> tuple[list[str], list[str], list[str]]:
+    """The files a parsed command writes and the files it reads, from its arguments.
+
+    Its output files (with the sibling files the command derives from them,
+    ``args.sibling_outputs``), its inputs and its output stores.
+
+    ``validation.cli.main`` passes them to :func:`reference.files.check_outputs` before the
+    command runs (the write policy, docs/bad-input.md).
+
+    Examples
+    --------
+    >>> import argparse
+    >>> args = argparse.Namespace(a=input_file("A.exr"), diff=output_file("A.exr"), n=3)
+    >>> command_paths(args)
+    (['A.exr'], ['A.exr'], [])
+    """
+    values = []
+    for value in vars(args).values():
+        values.extend(value if isinstance(value, list | tuple) else [value])
+    outputs = [v for v in values if isinstance(v, OutputPath)]
+    siblings = getattr(args, "sibling_outputs", None)
+    if siblings is not None:
+        outputs += [str(s) for s in siblings(args)]
+    inputs = [v for v in values if isinstance(v, InputPath)]
+    return outputs, inputs, [v for v in values if isinstance(v, OutputStore)]
 
 
 def write_json(path, result) -> None:

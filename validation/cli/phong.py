@@ -5,7 +5,7 @@ from __future__ import annotations
 from functools import partial
 
 from reference.tasks import SERIAL, add_scheduler_option
-from validation.cli.parser import registry_option, write_json
+from validation.cli.parser import input_file, output_file, registry_option, write_json
 
 
 def _cmd_phong(args) -> int:
@@ -96,10 +96,14 @@ def add_parser(sub) -> None:
     p.add_argument("file", nargs="?", metavar="MATERIAL.toml", help="edit: the file to open")
     p.add_argument("--port", type=int, default=5006, help="edit: the local port (default 5006)")
     p.add_argument(
-        "--screenshot", metavar="PNG", help="edit: write a screenshot of the page and exit"
+        "--screenshot",
+        type=output_file,
+        metavar="PNG",
+        help="edit: write a screenshot of the page and exit",
     )
     p.add_argument(
         "--material",
+        type=input_file,
         metavar="FILE.toml",
         help="a material file (docs/scene-format.md, Phong material files)",
     )
@@ -113,7 +117,7 @@ def add_parser(sub) -> None:
     p.add_argument("--tolerance", type=float, help="pick the smallest table with RMS <= T")
     p.add_argument("--resolution", type=int, default=512, help="image size (default 512)")
     p.add_argument("--repeats", type=int, default=9, help="timing repetitions (minimum kept)")
-    p.add_argument("--json", metavar="FILE", help="write the records as JSON")
+    p.add_argument("--json", type=output_file, metavar="FILE", help="write the records as JSON")
     add_scheduler_option(p, default=SERIAL)
     p.add_argument(
         "--images",

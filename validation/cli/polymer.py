@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from validation.cli.parser import Parser
+from validation.cli.parser import Parser, input_file, output_file
 
 
 def _numbers(text: str, name: str) -> list[float]:
@@ -44,7 +44,9 @@ def add_parser(sub) -> None:
     q = polymer.add_parser(
         "characterize", help="write a characterization file from the Kubelka-Munk slab model"
     )
-    q.add_argument("-o", "--out", required=True, help="output .csv (docs/herbert-polymer.md)")
+    q.add_argument(
+        "-o", "--out", type=output_file, required=True, help="output .csv (docs/herbert-polymer.md)"
+    )
     q.add_argument(
         "--thickness",
         default=",".join(f"{d:g}" for d in DEFAULT_THICKNESS_MM),
@@ -56,7 +58,10 @@ def add_parser(sub) -> None:
         help="TiO2 grid, %% by weight, increasing (default: %(default)s)",
     )
     q.add_argument(
-        "--constituents", default=None, help="K/S constituents TOML (default: HDPE-like)"
+        "--constituents",
+        type=input_file,
+        default=None,
+        help="K/S constituents TOML (default: HDPE-like)",
     )
     q.add_argument("--backing-white", type=float, default=0.9, help="white backing reflectance")
     q.add_argument("--grid", choices=sorted(GRIDS), default="41", help="spectral grid")

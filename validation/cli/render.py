@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from reference.geometry.envmap import TEXEL_PLACEMENTS
-from validation.cli.parser import input_file, registry_option
+from validation.cli.parser import input_file, output_file, registry_option
 
 
 def _cmd_render(args) -> int:
@@ -64,10 +64,18 @@ def add_parser(sub) -> None:
         help="the scene file, or data:examples/<name>.toml",
     )
     p.add_argument(
-        "-o", "--output", required=True, metavar="OUT.png", help="display-encoded 8-bit PNG"
+        "-o",
+        "--output",
+        type=output_file,
+        required=True,
+        metavar="OUT.png",
+        help="display-encoded 8-bit PNG",
     )
     p.add_argument(
-        "--exr", metavar="OUT.exr", help="also write a linear EXR (what it holds: --exr-output)"
+        "--exr",
+        type=output_file,
+        metavar="OUT.exr",
+        help="also write a linear EXR (what it holds: --exr-output)",
     )
     registry_option(
         p,
@@ -84,6 +92,7 @@ def add_parser(sub) -> None:
     )
     p.add_argument(
         "--json",
+        type=output_file,
         metavar="OUT.json",
         help="write the render's metadata (orders chosen, bounds promised, units) as JSON; "
         "'-' prints it",

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from validation.cli.parser import registry_option
+from validation.cli.parser import input_file, output_file, registry_option
 
 
 def _cmd_report(args) -> int:
@@ -65,9 +65,14 @@ def add_parser(sub) -> None:
     registry_option(
         p, "--only", REPORT_SECTIONS, "run only these sections", nargs="+", metavar="SECTION"
     )
-    p.add_argument("--bench", metavar="JSON", help="pytest-benchmark JSON from make bench")
     p.add_argument(
-        "--markdown", metavar="MD", help="also write a Markdown rendering (docs/results.md)"
+        "--bench", type=input_file, metavar="JSON", help="pytest-benchmark JSON from make bench"
+    )
+    p.add_argument(
+        "--markdown",
+        type=output_file,
+        metavar="MD",
+        help="also write a Markdown rendering (docs/results.md)",
     )
     p.add_argument(
         "--markdown-image-prefix",

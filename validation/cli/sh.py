@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from validation.cli.parser import Parser, input_file, registry_option
+from validation.cli.parser import Parser, input_file, output_file, registry_option
 
 
 def _cmd_sh_project(args) -> int:
@@ -39,12 +39,12 @@ def add_parser(sub) -> None:
     registry_option(q, "--window", WINDOWS, "window against ringing")
     q.add_argument("--bands", choices=("spectral", "rgb"), default=None, help="convert first")
     registry_option(q, "--backend", SH_BACKENDS, "SH transform engine", default="ducc0")
-    q.add_argument("-o", "--out", required=True, help="output .npz")
+    q.add_argument("-o", "--out", type=output_file, required=True, help="output .npz")
     q.set_defaults(func=_cmd_sh_project, streamed=True)
     r = sh.add_parser("prefilter", help="frequency-space prefiltered cube or lat-long map (.exr)")
     r.add_argument("env", type=input_file, help="lat-long map, .hdr or .exr")
     registry_option(r, "--kernel", PREFILTER_KERNELS, "prefilter kernel", required=True)
-    r.add_argument("--out", required=True, help="output .exr")
+    r.add_argument("--out", type=output_file, required=True, help="output .exr")
     r.add_argument("--tol", type=float, default=1e-2, help="adaptive-order tolerance")
     r.add_argument("--format", choices=("cube", "latlong"), default="cube")
     r.add_argument("--size", type=int, default=64, help="cube face size")

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from validation.cli.parser import input_file, output_file
+
 
 def _cmd_sweep(args) -> int:
     from validation.studies.sweep import run_sweep, sweep_csv
@@ -26,10 +28,19 @@ def add_parser(sub) -> None:
     )
     kinds = ", ".join(SWEEP_KINDS.names())
     file = p.add_argument(
-        "file", metavar="SWEEP.toml", help=f"the sweep file (docs/scale-out.md); kind: {kinds}"
+        "file",
+        type=input_file,
+        metavar="SWEEP.toml",
+        help=f"the sweep file (docs/scale-out.md); kind: {kinds}",
     )
     # its help lists the kinds from the registry (as validation.cli.parser.registry_option does)
     file.registry, file.registry_keys = SWEEP_KINDS, SWEEP_KINDS.names()
-    p.add_argument("-o", "--out", metavar="CSV", help="write the table here (default: stdout)")
+    p.add_argument(
+        "-o",
+        "--out",
+        type=output_file,
+        metavar="CSV",
+        help="write the table here (default: stdout)",
+    )
     add_scheduler_option(p)
     p.set_defaults(func=_cmd_sweep)

@@ -1,0 +1,181 @@
+"""The write policy: no command loses data, whatever output path it is given.
+
+Each case is one a careless or hostile user tried (docs/bad-input.md, "The write policy"): an output
+that is a device, a FIFO or an input of the same command (by name, hard link or symbolic link), a
+sibling output that is an input, two outputs that are the same file, a name too long for the file
+system, and a Zarr store over a folder of other files. Every one is refused in one line with exit
+code 2 before any work, and the file that was there is unchanged.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import os
+import stat
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from reference.data import data_path
+from reference.images.formats import write_exr
+from validation.cli import build_parser, main
+from validation.cli.parser import OutputPath, OutputStore, input_file, output_file
+
+VENICE = str(data_path("environments/venice_sunset_1k.hdr"))
+SCENE = str(data_path("examples/phong-sphere.toml"))
+
+
+def _digest(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _refused(argv, capsys, *needles) -> str:
+    code = main([str(a) for a in argv])
+    err = capsys.readouterr().err.strip()
+    assert code == 2, err
+    assert len(err.splitlines()) == 1, err
+    assert "Traceback" not in err
+    for needle in needles:
+        assert needle in err, err
+    return err
+
+
+@pytest.fixture
+def files(tmp_path):
+    """Inputs a user might point an output at: an EXR, a TOML, a CSV and a display JSON."""
+    write_exr(tmp_path / "A.exr", np.full((4, 4, 3), 0.5))
+    (tmp_path / "c.toml").write_text('name = "x"\n')
+    (tmp_path / "t.csv").write_text("R,G,B\n0.1,0.2,0.3\n")
+    (tmp_path / "s.toml").write_text('kind = "phong"\n')
+    (tmp_path / "d.json").write_text("{}\n")
+    return tmp_path
+
+
+# (argv with {d} for the folder, the input that must survive)
+SAME_AS_INPUT = [
+    (["compare", "{d}/A.exr", "{d}/A.exr", "--diff", "{d}/A.exr"], "A.exr"),
+    (["polymer", "characterize", "--constituents", "{d}/c.toml", "-o", "{d}/c.toml"], "c.toml"),
+    (["env", "fit", "--target", "{d}/t.csv", "-o", "{d}/t.csv"], "t.csv"),
+    (["sweep", "{d}/s.toml", "-o", "{d}/s.toml"], "s.toml"),
+    # a sibling: calibrate -o d.cal also writes d.json, the display file here
+    (["display", "calibrate", "--display", "{d}/d.json", "-o", "{d}/d.cal"], "d.json"),
+    (["render", "{d}/c.toml", "-o", "{d}/c.toml"], "c.toml"),
+    (["phong", "table1", "--material", "{d}/c.toml", "--json", "{d}/c.toml"], "c.toml"),
+]
+
+
+@pytest.mark.parametrize(("argv", "kept"), SAME_AS_INPUT, ids=lambda x: " ".join(x[:2]))
+def test_an_output_that_is_an_input_is_refused(argv, kept, files, capsys):
+    before = _digest(files / kept)
+    _refused([a.format(d=files) for a in argv], capsys, "is also an input of this command")
+    assert _digest(files / kept) == before
+
+
+@pytest.mark.parametrize("link", ["hard", "symbolic", "dotdot"])
+def test_links_to_an_input_are_the_input(link, files, capsys):
+    out = files / "link.exr"
+    if link == "hard":
+        os.link(files / "A.exr", out)
+    elif link == "symbolic":
+        out.symlink_to(files / "A.exr")
+    else:
+        (files / "sub").mkdir()
+        out = files / "sub" / ".." / "A.exr"
+    before = _digest(files / "A.exr")
+    _refused(["compare", files / "A.exr", files / "A.exr", "--diff", out], capsys, "input")
+    assert _digest(files / "A.exr") == before
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["polymer", "characterize", "-o", "/dev/null"],
+        ["env", "fit", "-o", "/dev/null"],
+        ["sweep", "{d}/s.toml", "-o", "/dev/null"],
+        ["equations", "-o", "/dev/null"],
+        ["render", SCENE, "-o", "/dev/null"],
+        ["compare", "{d}/A.exr", "{d}/A.exr", "--json", "/dev/full"],
+    ],
+    ids=lambda a: " ".join(a[:2]),
+)
+def test_device_nodes_are_never_replaced(argv, files, capsys):
+    device = Path(argv[-1])
+    before = device.stat()
+    _refused([a.format(d=files) for a in argv], capsys, "a device or special file")
+    after = device.stat()
+    assert stat.S_ISCHR(after.st_mode)
+    assert (after.st_ino, after.st_rdev) == (before.st_ino, before.st_rdev)
+
+
+def test_a_fifo_is_refused(files, capsys):
+    fifo = files / "out.csv"
+    os.mkfifo(fifo)
+    _refused(["sweep", files / "s.toml", "-o", fifo], capsys, "a device or special file")
+    assert stat.S_ISFIFO(fifo.stat().st_mode)
+
+
+def test_two_outputs_that_are_one_file_are_refused(files, capsys):
+    _refused(
+        ["compare", files / "A.exr", files / "A.exr", "--diff", files / "o.exr", "--json",
+         files / "o.exr"], capsys, "would write it twice",
+    )  # fmt: skip
+    assert not (files / "o.exr").exists()
+
+
+def test_a_name_too_long_for_the_file_system_is_refused(files, capsys):
+    long = files / ("x" * 250 + ".exr")
+    _refused(["compare", files / "A.exr", files / "A.exr", "--diff", long], capsys, "longer than")
+    assert sorted(p.name for p in files.iterdir()) == ["A.exr", "c.toml", "d.json", "s.toml",
+                                                       "t.csv"]  # fmt: skip
+
+
+def test_a_zarr_store_never_replaces_a_folder_of_other_files(tmp_path, capsys):
+    photos = tmp_path / "photos.zarr"
+    photos.mkdir()
+    (photos / "holiday.jpg").write_bytes(b"\xff\xd8 a photo")
+    _refused(["env", "convert", VENICE, photos], capsys, "not a Zarr store")
+    assert (photos / "holiday.jpg").read_bytes() == b"\xff\xd8 a photo"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["photos.zarr"]  # no temporary left
+
+
+def test_a_zarr_store_replaces_an_earlier_store_and_not_its_own_input(tmp_path, capsys):
+    store = tmp_path / "v.zarr"
+    assert main(["env", "convert", VENICE, str(store), "--rows", "256"]) == 0
+    assert main(["env", "convert", VENICE, str(store), "--rows", "128"]) == 0  # replaced
+    capsys.readouterr()
+    _refused(["env", "spectralize", store, "--model", "default", "-o", store], capsys, "input")
+
+
+def test_profile_without_its_tools_writes_nothing(tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("PATH", str(tmp_path / "empty"))
+    _refused(["display", "calibrate", "--profile", "-o", tmp_path / "d.cal"], capsys, "colprof")
+    assert list(tmp_path.iterdir()) == []
+
+
+FOLDER_OUTPUTS = {("report", "out"), ("shrm orbit", "out"), ("conformance references", "out"),
+                  ("conformance export", "out"), ("phong", "images")}  # fmt: skip
+OUTPUT_DESTS = {"out", "output", "json", "html", "diff", "exr", "counts", "screenshot", "markdown"}
+
+
+def _actions(parser, prefix=""):
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for name, sub in action.choices.items():
+                yield from _actions(sub, f"{prefix} {name}".strip())
+        else:
+            yield prefix, action
+
+
+def test_every_output_argument_is_under_the_policy():
+    # a new command's output flag must be marked (type=output_file), so main() checks it
+    found = 0
+    for command, action in _actions(build_parser()):
+        if action.dest in OUTPUT_DESTS and (command, action.dest) not in FOLDER_OUTPUTS:
+            assert action.type is output_file, f"specref {command} {action.option_strings}"
+            found += 1
+    assert found >= 20
+    assert isinstance(output_file("x.exr"), OutputPath)
+    assert isinstance(output_file("x.zarr"), OutputStore)
+    assert type(input_file("x.exr")).__name__ == "InputPath"
