@@ -361,10 +361,15 @@ def read_json(path, kind: str = "JSON"):
     import json
 
     path = Path(path)
+    require(path.exists(), f"{path}: file not found")
+    # /dev/zero or a FIFO would be read for ever
+    require(path.is_file(), f"{path}: not a {kind} (not a regular file)")
     try:
         return json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise SpecrefError(f"{path}: file not found") from None
+    except RecursionError:
+        raise SpecrefError(f"{path}: not a {kind} (nested too deeply)") from None
     except (OSError, ValueError) as error:
         raise SpecrefError(f"{path}: not a {kind} ({error})") from None
 

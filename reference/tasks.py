@@ -19,6 +19,7 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
+import re
 import sys
 import weakref
 from collections.abc import Callable, Hashable, Sequence
@@ -86,11 +87,26 @@ def scheduler_address(scheduler: str | None = None, default: str | None = None) 
     'serial'
     >>> scheduler_address("local", default="serial") is None
     True
+    >>> scheduler_address("ucx://127.0.0.1:8786")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: --scheduler ucx://127.0.0.1:8786: allowed: tcp://HOST:PORT ...
     """
     address = scheduler or os.environ.get(SCHEDULER_ENV) or default
     if not address or str(address) == LOCAL:
         return None
-    return str(address)
+    address = str(address)
+    # Dask's other protocols (tls://, ucx://, inproc://) need settings specref does not pass
+    require(
+        address == SERIAL or address.startswith(LOCAL + ":") or _TCP_ADDRESS.match(address),
+        f"--scheduler {address}: allowed: tcp://HOST:PORT (a running `dask scheduler`), "
+        f"host:port, '{LOCAL}', '{LOCAL}:N' or '{SERIAL}'",
+    )
+    return address
+
+
+#: A scheduler address specref connects to: ``tcp://host:port`` or ``host:port`` (IPv6 in [ ]).
+_TCP_ADDRESS = re.compile(r"^(tcp://)?(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]+):[0-9]{1,5}$")
 
 
 #: The most workers ``local:N`` starts on one machine (each is a process of a few hundred MB).
@@ -178,8 +194,19 @@ def add_scheduler_option(parser, default: str | None = None) -> None:
         if default == SERIAL
         else ("a local cluster of one worker process per core")
     )
+    import argparse
+
+    def address(value: str) -> str:  # checked when parsed, before any input is read
+        try:
+            scheduler_address(value)
+            local_workers(value)
+        except SpecrefError as error:
+            raise argparse.ArgumentTypeError(str(error).removeprefix("--scheduler ")) from None
+        return value
+
     parser.add_argument(
         "--scheduler",
+        type=address,
         metavar="ADDRESS",
         help="where the tasks run: a running Dask scheduler (tcp://host:8786), 'local' (a local "
         "cluster of one worker process per core), 'local:N' (of N workers) or 'serial'; default "

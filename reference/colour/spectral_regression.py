@@ -965,7 +965,10 @@ def load_regression(path, wavelengths_nm=None) -> SpectralRegression:
     require(path.is_file(), f"{path}: file not found")
     try:
         document = json.loads(path.read_text(encoding="utf-8"))
-        require(document.get("format") == FORMAT, f"{path}: not a {FORMAT} file")
+        require(
+            isinstance(document, dict) and document.get("format") == FORMAT,
+            f"{path}: not a {FORMAT} file",
+        )
         version = document.get("version")
         require(
             version in _READABLE_VERSIONS,

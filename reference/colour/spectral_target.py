@@ -393,8 +393,11 @@ def _read_csv(path) -> tuple[list[str], list[list[str]]]:
 
     path = Path(path)
     require(path.is_file(), f"{path}: file not found")
-    with open(path, newline="", encoding="utf-8") as handle:
-        rows = [r for r in csv.reader(handle) if r and not r[0].lstrip().startswith("#")]
+    try:
+        with open(path, newline="", encoding="utf-8") as handle:
+            rows = [r for r in csv.reader(handle) if r and not r[0].lstrip().startswith("#")]
+    except (UnicodeDecodeError, csv.Error) as error:  # a binary or non-UTF-8 file
+        raise SpecrefError(f"{path}: not a UTF-8 CSV text file ({error})") from None
     require(len(rows) >= 2, f"{path}: expected a header row and at least one patch")
     return [h.strip() for h in rows[0]], rows[1:]
 

@@ -260,6 +260,10 @@ class PanoramaRows:
     """
 
     def __init__(self, path, height, width, names, read, close=None, streamed=True):
+        if not (height > 0 and width > 0):  # OpenEXR's writer aborts the process on 0 rows
+            if close is not None:
+                close()
+            raise SpecrefError(f"{path}: an image of {height} × {width} pixels; nothing to read")
         self.path, self.height, self.width, self.names = Path(path), height, width, names
         self.streamed = streamed
         self._read, self._close = read, close
@@ -396,7 +400,10 @@ def _open_hdr_rows(path: Path) -> PanoramaRows:
         for row in range(row0, row1):
             if len(buffer) - p < worst:  # keep at least one whole scanline ahead
                 buffer += handle.read(max(1 << 18, worst))
-            end = _hdr_scanline_end(buffer, p, width) if len(buffer) - p >= 4 else p + worst
+            try:
+                end = _hdr_scanline_end(buffer, p, width) if len(buffer) - p >= 4 else p + worst
+            except IndexError:  # a run that goes past the end of the file
+                end = len(buffer) + 1
             if end is None:
                 raise SpecrefError(f"{path}: old-style RLE scanlines; re-save it (e.g. pfstools)")
             require(end <= len(buffer), f"{path}: truncated Radiance HDR image (row {row})")

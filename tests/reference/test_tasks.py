@@ -449,8 +449,10 @@ def test_a_bad_local_worker_count_is_one_line(tmp_path, capsys, count):
     out = tmp_path / "out.csv"
     out.write_text("earlier")
     argv = ["sweep", str(grid), "--scheduler", f"local:{count}", "-o", str(out)]
-    assert main(argv) == 2
+    with pytest.raises(SystemExit) as refused:  # refused while the arguments are parsed
+        main(argv)
+    assert refused.value.code == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1
-    assert f"--scheduler local:{count}: allowed: local:N, N workers from 1 to 256" in err
+    assert f"--scheduler: local:{count}: allowed: local:N, N workers from 1 to 256" in err
     assert out.read_text() == "earlier"

@@ -5,7 +5,13 @@ Herbert et al. §6; docs/display.md.
 
 from __future__ import annotations
 
-from validation.cli.parser import Parser, input_file, output_file, registry_option
+from validation.cli.parser import (
+    Parser,
+    input_file,
+    nonnegative_int,
+    output_file,
+    registry_option,
+)
 
 
 def _cmd_display_calibrate(args) -> int:
@@ -89,7 +95,7 @@ def add_parser(sub) -> None:
     c.add_argument(
         "--display", type=input_file, metavar="FILE", help="display file (JSON, docs/display.md)"
     )
-    c.add_argument("--seed", type=int, default=0, help="seed of the instrument noise")
+    c.add_argument("--seed", type=nonnegative_int, default=0, help="seed of the instrument noise")
     c.add_argument(
         "--profile",
         action="store_true",

@@ -13,7 +13,9 @@ __all__ = [
     "Parser",
     "command_paths",
     "input_file",
+    "nonnegative_int",
     "output_file",
+    "port_number",
     "registry_option",
     "write_json",
 ]
@@ -62,6 +64,48 @@ def input_file(value: str) -> InputPath:
         return InputPath(data_path(value))
     except SpecrefError as error:
         raise argparse.ArgumentTypeError(str(error)) from None
+
+
+def nonnegative_int(value: str) -> int:
+    """An integer >= 0 (a seed, a count), for argparse's ``type=``.
+
+    Examples
+    --------
+    >>> nonnegative_int("7")
+    7
+    >>> nonnegative_int("-1")
+    Traceback (most recent call last):
+    ...
+    argparse.ArgumentTypeError: must be an integer >= 0, got '-1'
+    """
+    try:
+        number = int(value)
+    except ValueError:
+        number = -1
+    if number < 0:
+        raise argparse.ArgumentTypeError(f"must be an integer >= 0, got {value!r}")
+    return number
+
+
+def port_number(value: str) -> int:
+    """A TCP port, 0 (any free port) to 65535, for argparse's ``type=``.
+
+    Examples
+    --------
+    >>> port_number("5006")
+    5006
+    >>> port_number("70000")
+    Traceback (most recent call last):
+    ...
+    argparse.ArgumentTypeError: a TCP port is 0 to 65535, got '70000'
+    """
+    try:
+        number = int(value)
+    except ValueError:
+        number = -1
+    if not 0 <= number <= 65535:
+        raise argparse.ArgumentTypeError(f"a TCP port is 0 to 65535, got {value!r}")
+    return number
 
 
 def output_file(value: str) -> str:

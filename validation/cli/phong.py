@@ -5,7 +5,13 @@ from __future__ import annotations
 from functools import partial
 
 from reference.tasks import SERIAL, add_scheduler_option
-from validation.cli.parser import input_file, output_file, registry_option, write_json
+from validation.cli.parser import (
+    input_file,
+    output_file,
+    port_number,
+    registry_option,
+    write_json,
+)
 
 
 def _cmd_phong(args) -> int:
@@ -94,7 +100,9 @@ def add_parser(sub) -> None:
         help="table1: reproduce Table 1; edit: the material editor in the browser",
     )
     p.add_argument("file", nargs="?", metavar="MATERIAL.toml", help="edit: the file to open")
-    p.add_argument("--port", type=int, default=5006, help="edit: the local port (default 5006)")
+    p.add_argument(
+        "--port", type=port_number, default=5006, help="edit: the local port (default 5006)"
+    )
     p.add_argument(
         "--screenshot",
         type=output_file,

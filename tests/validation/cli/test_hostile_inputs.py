@@ -1,0 +1,81 @@
+"""Inputs that used to end in a traceback or a crash: each is now one line and exit code 2.
+
+A binary target file, a model file that is a JSON list, a truncated Radiance file, an image of zero
+rows (OpenEXR's writer aborted the process on it), a negative seed, a display file that is
+``/dev/zero`` or nested 100,000 deep, a port above 65535, scheduler protocols specref does not
+speak, and a sibling output that is a folder (docs/bad-input.md).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from reference.data import data_path
+from validation.cli import main
+
+VENICE = data_path("environments/venice_sunset_1k.hdr")
+
+
+def _make(tmp_path: Path, name: str) -> Path:
+    path = tmp_path / name
+    if name == "binary.csv":
+        path.write_bytes(b"\x00\xff\xfe not text")
+    elif name == "list.json":
+        path.write_text("[1, 2]")
+    elif name == "truncated.hdr":
+        path.write_bytes(Path(VENICE).read_bytes()[:300])
+    elif name == "zero.hdr":
+        path.write_bytes(b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 0 +X 16\n")
+    elif name == "deep.json":
+        path.write_text("[" * 100_000 + "]" * 100_000)
+    elif name == "sweep.toml":
+        path.write_text('kind = "phong"\n')
+    elif name == "d.cube":
+        path.mkdir()
+    return path
+
+
+CASES = [
+    (["env", "fit", "--target", "{binary.csv}", "-o", "{out.json}"], "not a UTF-8 CSV text file"),
+    (["env", "spectralize", VENICE, "--model", "{list.json}", "-o", "{out.exr}"],
+     "not a specref-spectral-regression file"),
+    (["env", "convert", "{truncated.hdr}", "{out.zarr}"], "truncated Radiance HDR image"),
+    (["env", "convert", "{zero.hdr}", "{out.zarr}"], "an image of 0 × 16 pixels"),
+    (["env", "spectralize", "{zero.hdr}", "--model", "default", "-o", "{out.exr}"],
+     "an image of 0 × 16 pixels"),
+    (["display", "calibrate", "--seed", "-1", "-o", "{d.cal}"], "--seed: must be an integer >= 0"),
+    (["display", "calibrate", "--display", "/dev/zero", "-o", "{d.cal}"], "not a regular file"),
+    (["display", "calibrate", "--display", "{deep.json}", "-o", "{d.cal}"], "nested too deeply"),
+    (["display", "calibrate", "-o", "{d.cal}", "{d.cube}"], None),  # d.cube made a folder below
+    (["phong", "edit", "--port", "70000"], "a TCP port is 0 to 65535"),
+    (["sweep", "{sweep.toml}", "--scheduler", "ucx://127.0.0.1:8786"], "allowed: tcp://HOST:PORT"),
+    (["sweep", "{sweep.toml}", "--scheduler", "tls://127.0.0.1:8786"], "allowed: tcp://HOST:PORT"),
+    (["report", "--scheduler", "tcp://host:1/path"], "allowed: tcp://HOST:PORT"),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"), CASES, ids=[" ".join(map(str, argv[:4])) for argv, _ in CASES]
+)
+def test_one_line_and_exit_2(argv, message, tmp_path, capsys):
+    args = []
+    for a in argv:
+        if isinstance(a, str) and a.startswith("{"):
+            args.append(str(_make(tmp_path, a.strip("{}"))))
+        else:
+            args.append(str(a))
+    if message is None:  # the .cal's sibling .cube is a folder
+        args, message = args[:-1], "d.cube: cannot write (is a folder"
+    try:
+        code = main(args)
+    except SystemExit as usage_error:  # argparse's: refused while parsing
+        code = usage_error.code
+    err = capsys.readouterr().err.strip()
+    assert code == 2, err
+    assert len(err.splitlines()) == 1, err
+    assert message in err, err
+    assert not (tmp_path / "out.zarr").exists()
+    assert not (tmp_path / "out.exr").exists()
+    assert not (tmp_path / "d.cal").exists()
