@@ -25,6 +25,7 @@ __all__ = [
     "check_output_store",
     "check_outputs",
     "default_cache_dir",
+    "folder_lock",
     "output_error",
     "read_json",
     "same_file",
@@ -443,6 +444,39 @@ def check_output_folder(folder) -> Path:
     probe = write_bytes_atomic(folder / ".specref-write-probe", b"specref")
     probe.unlink()
     return folder
+
+
+@contextlib.contextmanager
+def folder_lock(folder):
+    """Hold an exclusive lock on ``folder`` (its ``.lock`` file) while the block runs.
+
+    Processes that fill one cache folder at once (two commands, the workers of a test run) take
+    turns: the second finds what the first wrote instead of writing it again, and no manifest
+    update is lost. An advisory ``flock`` (released when the process ends, even killed); where
+    the platform has none (Windows), no lock.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     with folder_lock(d):
+    ...         sorted(os.listdir(d))
+    ['.lock']
+    """
+    folder = Path(folder)
+    try:
+        import fcntl
+    except ImportError:  # no flock: one process at a time is the user's business
+        yield folder
+        return
+    with _write_errors(folder):
+        folder.mkdir(parents=True, exist_ok=True)
+        handle = open(folder / ".lock", "a+b")  # noqa: SIM115 (closed below)
+    try:
+        fcntl.flock(handle.fileno(), fcntl.LOCK_EX)
+        yield folder
+    finally:
+        handle.close()  # releases the lock
 
 
 def write_bytes_atomic(path, data: bytes) -> Path:

@@ -190,10 +190,11 @@ def run_mitsuba_proof(
     wanted = set(index["scenes"] if names is None else names) | set(QUICK_PROOF if broken else ())
     names = [n for n in index["scenes"] if n in wanted]
     references = Path(references) if references is not None else folder / "references"
-    ensure_references(names, references, progress)
     render_mitsuba_folder(
         folder / "scenes", folder / "renders", names, spp=PROOF_SPP_OVERRIDE, progress=progress
     )
+    # after Mitsuba: another process filling the same folder has had the time to
+    ensure_references(names, references, progress)
     result = check_folder(folder / "renders", references, progress=progress)
     made = {}
     if broken:

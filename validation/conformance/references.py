@@ -267,25 +267,28 @@ def ensure_references(names=None, folder=None, progress=None, force: bool = Fals
     """
     import time
 
-    from reference.files import check_output_folder, write_text_atomic
+    from reference.files import check_output_folder, folder_lock, write_text_atomic
     from validation.conformance.scenes import CONFORMANCE_SCENES
 
     folder = check_output_folder(folder if folder is not None else reference_folder())
     names = list(CONFORMANCE_SCENES.names() if names is None else names)
     for name in names:
         CONFORMANCE_SCENES.lookup(name)
-    manifest = _read_manifest(folder)
     for i, name in enumerate(names, 1):
-        if not force and _intact(folder, manifest["scenes"].get(name)):
-            continue
-        start = time.perf_counter()
-        if progress is not None:
-            progress(f"[{i}/{len(names)}] {name}: rendering the reference")
-        manifest["scenes"][name] = write_reference(render_reference(name), folder)
-        write_text_atomic(folder / "manifest.json", json.dumps(manifest, indent=1) + "\n")
+        # one process renders a scene; the others wait and find it (the manifest read again)
+        with folder_lock(folder):
+            manifest = _read_manifest(folder)
+            if not force and _intact(folder, manifest["scenes"].get(name)):
+                continue
+            start = time.perf_counter()
+            if progress is not None:
+                progress(f"[{i}/{len(names)}] {name}: rendering the reference")
+            manifest["scenes"][name] = write_reference(render_reference(name), folder)
+            write_text_atomic(folder / "manifest.json", json.dumps(manifest, indent=1) + "\n")
         if progress is not None:
             progress(f"[{i}/{len(names)}] {name}: {time.perf_counter() - start:.1f} s")
-    return manifest
+    with folder_lock(folder):
+        return _read_manifest(folder)
 
 
 def load_reference(name: str, folder=None, progress=None) -> Reference:

@@ -1,4 +1,4 @@
-"""One folder of conformance references per test process, shared by the suite's modules."""
+"""One folder of conformance references per test run, shared by its modules and its workers."""
 
 from __future__ import annotations
 
@@ -6,6 +6,16 @@ import pytest
 
 
 @pytest.fixture(scope="session")
-def conformance_references(tmp_path_factory):
-    """A folder the references are rendered into where missing (``load_reference`` does it)."""
-    return tmp_path_factory.mktemp("conformance-references")
+def conformance_references(tmp_path_factory, request):
+    """A folder the references are rendered into where missing (``load_reference`` does it).
+
+    With pytest-xdist, the run's workers share it (the base folder's parent is the run's): each
+    reference is rendered once, by whichever worker needs it first, under the folder's lock
+    (``reference.files.folder_lock``), and the others read it.
+    """
+    worker = getattr(request.config, "workerinput", {}).get("workerid")
+    if worker is None:
+        return tmp_path_factory.mktemp("conformance-references")
+    folder = tmp_path_factory.getbasetemp().parent / "conformance-references"
+    folder.mkdir(exist_ok=True)
+    return folder

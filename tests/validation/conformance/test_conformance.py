@@ -321,3 +321,33 @@ def test_bad_outputs_and_settings_are_refused_and_the_inputs_stay_intact(
     assert len(err.splitlines()) == 1, err
     assert (render.read_bytes(), (references / "manifest.json").read_bytes()) == before
     assert (tmp_path / "afile").read_text() == "x"
+
+
+def _ensure_and_report(folder, names, queue):
+    from validation.conformance.references import ensure_references
+
+    lines = []
+    ensure_references(names, folder, progress=lines.append)
+    queue.put(sum("rendering the reference" in line for line in lines))
+
+
+def test_processes_filling_one_folder_render_each_reference_once(tmp_path):
+    # two commands (or the suite's workers) at once on one cache: the folder's lock makes the
+    # second wait and find each reference, and no scene is lost from the manifest
+    import multiprocessing
+
+    from validation.conformance.references import _read_manifest
+
+    names = ["colorchecker-d65", "lambert-point-d65"]
+    context = multiprocessing.get_context("spawn")
+    queue = context.Queue()
+    procs = [
+        context.Process(target=_ensure_and_report, args=(tmp_path, names, queue)) for _ in range(2)
+    ]
+    for p in procs:
+        p.start()
+    for p in procs:
+        p.join(timeout=300)
+    assert [p.exitcode for p in procs] == [0, 0]
+    assert queue.get(timeout=5) + queue.get(timeout=5) == len(names)
+    assert sorted(_read_manifest(tmp_path)["scenes"]) == names
