@@ -109,6 +109,93 @@ def scheduler_address(scheduler: str | None = None, default: str | None = None) 
 _TCP_ADDRESS = re.compile(r"^(tcp://)?(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]+):[0-9]{1,5}$")
 
 
+#: The most bytes a scheduler's first message (its handshake, ~60 bytes) may claim.
+MAX_HANDSHAKE_BYTES = 1 << 16
+
+
+def _receive(sock, n: int, deadline: float, address: str) -> bytes:
+    import time
+
+    data = b""
+    while len(data) < n:
+        sock.settimeout(max(deadline - time.monotonic(), 1e-3))
+        try:
+            chunk = sock.recv(n - len(data))
+        except TimeoutError:
+            raise SpecrefError(
+                f"--scheduler {address}: the peer accepted the connection but sent no Dask "
+                "handshake in time; is it a Dask scheduler?"
+            ) from None
+        require(chunk, f"--scheduler {address}: the peer closed the connection; not a scheduler")
+        data += chunk
+    return data
+
+
+def probe_scheduler(address: str, timeout: float) -> dict:
+    """Read a scheduler's handshake ourselves, bounded in time and size, before Dask connects.
+
+    Dask's client trusts what the peer sends: a peer that accepts and never answers keeps it
+    waiting past its timeout, and a length header of 2⁴⁰ bytes makes it allocate that much. A
+    scheduler sends its handshake (a frame of ~60 bytes: compression, Python version, pickle
+    protocol) as soon as it accepts; this reads it within ``timeout`` seconds and at most
+    :data:`MAX_HANDSHAKE_BYTES`, and refuses anything else in one line.
+
+    Returns
+    -------
+    dict
+        The handshake.
+
+    Raises
+    ------
+    SpecrefError
+        The peer sends nothing in time, closes, claims too many bytes, or sends what is not a
+        Dask handshake. OSError (connection refused, unreachable; tried again until the timeout,
+        as a scheduler that is starting refuses at first) is left to the caller.
+
+    Examples
+    --------
+    >>> probe_scheduler("tcp://127.0.0.1:9", 0.5)       # tried again until the timeout
+    Traceback (most recent call last):
+    ...
+    ConnectionRefusedError: [Errno 111] Connection refused
+    """
+    import socket
+    import struct
+    import time
+
+    from distributed.protocol.core import loads
+    from distributed.protocol.utils import unpack_frames
+
+    deadline = time.monotonic() + timeout
+    host, port = address.removeprefix("tcp://").rsplit(":", 1)
+    while True:  # as Dask's connect: a scheduler still starting refuses at first
+        try:
+            sock = socket.create_connection((host.strip("[]"), int(port)), timeout=timeout)
+            break
+        except OSError:
+            if time.monotonic() + 0.2 > deadline:
+                raise
+            time.sleep(0.2)
+    with sock:
+        (size,) = struct.unpack("Q", _receive(sock, 8, deadline, address))
+        not_dask = f"--scheduler {address}: the peer is not a Dask scheduler"
+        require(0 < size <= MAX_HANDSHAKE_BYTES, f"{not_dask} (it announced {size} bytes)")
+        try:
+            frames, missing = unpack_frames(_receive(sock, size, deadline, address), partial=True)
+            require(sum(missing) <= MAX_HANDSHAKE_BYTES, f"{not_dask} (frames too large)")
+            rest = [_receive(sock, m, deadline, address) for m in missing]
+            handshake = loads(list(frames) + rest, deserialize=False)
+        except SpecrefError:
+            raise
+        except Exception:  # what a stranger's bytes make the decoder raise
+            raise SpecrefError(f"{not_dask} (its first message is not a Dask message)") from None
+    require(
+        isinstance(handshake, dict) and "pickle-protocol" in handshake,
+        f"{not_dask} (no handshake)",
+    )
+    return handshake
+
+
 #: The most workers ``local:N`` starts on one machine (each is a process of a few hundred MB).
 MAX_LOCAL_WORKERS = 256
 
@@ -254,7 +341,10 @@ def dask_client(
         address, n_workers = None, local_workers(address)
     if address:
         try:
+            probe_scheduler(address, timeout)
             client = Client(address, timeout=timeout)
+        except SpecrefError:  # the probe's own line: a peer that is not a scheduler
+            raise
         except (OSError, TimeoutError, ValueError) as exc:
             raise SpecrefError(
                 f"--scheduler {address}: no Dask scheduler answered within {timeout:g} s "
