@@ -410,6 +410,11 @@ def _columns(path, header, rows, names) -> np.ndarray:
         raise SpecrefError(f"{path}: non-numeric or missing values in {', '.join(names)}") from None
 
 
+#: Reflectances a target file may hold: [0, 1] with room for measurement noise and the slight
+#: excess of fluorescent or glossy patches (ours, E104); -0.5 or 5.0 is a wrong file or unit.
+REFLECTANCE_RANGE = (-0.05, 1.5)
+
+
 def read_target(path, spectra_path=None, grid: SpectralGrid = GRID_41):
     r"""Read a measured camera target: RGB of the patches and their reflectances on ``grid``.
 
@@ -429,7 +434,7 @@ def read_target(path, spectra_path=None, grid: SpectralGrid = GRID_41):
     ------
     SpecrefError
         Missing columns, patch counts that differ, a grid that does not cover ``grid``,
-        negative or NaN RGB.
+        negative or NaN RGB, reflectances outside :data:`REFLECTANCE_RANGE`.
 
     Examples
     --------
@@ -462,6 +467,13 @@ def read_target(path, spectra_path=None, grid: SpectralGrid = GRID_41):
     require(
         np.isfinite(RGB).all() and (RGB >= 0).all(),
         f"{path}: RGB must be finite and >= 0 (found NaN, inf or negative values)",
+    )
+    low, high = REFLECTANCE_RANGE
+    bad = ~(np.isfinite(values) & (values >= low) & (values <= high)).all(axis=1)
+    require(
+        not bad.any(),
+        f"{spectra_file}: patch {int(np.argmax(bad)) + 1}: reflectances must be finite and in "
+        f"[{low:g}, {high:g}] (measurement noise allowed around [0, 1])",
     )
     require(
         (np.diff(wavelengths) > 0).all()

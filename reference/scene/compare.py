@@ -214,7 +214,8 @@ def compare_images(path_a, path_b, mask=None) -> tuple[dict, np.ndarray, list[st
     Raises
     ------
     SpecrefError
-        Unreadable files, missing channels, or sizes that differ (one line each).
+        Unreadable files, missing channels, non-finite pixels, or sizes that differ (one line
+        each).
 
     Examples
     --------
@@ -225,6 +226,10 @@ def compare_images(path_a, path_b, mask=None) -> tuple[dict, np.ndarray, list[st
     """
     XYZ_a, info_a = exr_to_XYZ(path_a)
     XYZ_b, info_b = exr_to_XYZ(path_b)
+    for path, XYZ in ((path_a, XYZ_a), (path_b, XYZ_b)):
+        # a NaN or an infinity would make every statistic NaN or hide the lit pixels
+        bad = int((~np.isfinite(XYZ)).any(axis=-1).sum())
+        require(bad == 0, f"{path}: {bad} pixels hold NaN or infinite values; compare needs finite")
     require(
         XYZ_a.shape == XYZ_b.shape,
         f"{path_a}: size {XYZ_a.shape[1]}×{XYZ_a.shape[0]} differs from {path_b}'s "

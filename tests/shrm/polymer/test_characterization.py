@@ -134,6 +134,27 @@ def test_cli_characterize_writes_a_readable_file(tmp_path, capsys):
     assert read_characterization(out).over_black.shape == (2, 2, 31)
 
 
+def test_a_backing_that_is_no_reflectance_and_a_partial_range_are_refused(tmp_path):
+    # both used to render: a white backing of reflectance 5, and spectra of 400-500 nm only
+    # (extrapolated flat over the rest of the visible range)
+    good = tmp_path / "chips.csv"
+    assert main(["polymer", "characterize", "-o", str(good), "--thickness", "0.762,3.048",
+                 "--tio2", "0,1", "--grid", "31"]) == 0  # fmt: skip
+    lines = good.read_text().splitlines()
+    bright = tmp_path / "bright.csv"
+    bright.write_text("\n".join(line.replace("backing_white: 0.9", "backing_white: 5")
+                                for line in lines) + "\n")  # fmt: skip
+    with pytest.raises(SpecrefError, match=r"bright\.csv: # backing_white: a reflectance, in"):
+        read_characterization(bright)
+    header = next(i for i, line in enumerate(lines) if line.startswith("thickness_mm"))
+    keep = 3 + sum(float(w) <= 500 for w in lines[header].split(",")[3:])
+    narrow = tmp_path / "narrow.csv"
+    cut = [",".join(line.split(",")[:keep]) for line in lines[header:]]
+    narrow.write_text("\n".join(lines[:header] + cut) + "\n")
+    with pytest.raises(SpecrefError, match=r"narrow\.csv:\d+: wavelengths must cover 400-700 nm"):
+        read_characterization(narrow)
+
+
 @pytest.mark.parametrize(
     ("flags", "message"),
     [

@@ -85,7 +85,7 @@ def test_fit_saves_a_model_that_loads(tmp_path, capsys):
 def test_fit_from_a_target_file(tmp_path, rng, capsys):
     RGB = rng.uniform(0, 1, (30, 3))
     wl = np.arange(380, 781, 5)
-    spectra = np.clip(RGB @ rng.uniform(0, 1, (3, wl.size)), 0, None)
+    spectra = np.clip(RGB @ rng.uniform(0, 1, (3, wl.size)) / 3, 0, None)  # reflectances <= 1
     header = "R,G,B," + ",".join(f"{w}nm" for w in wl)
     rows = [",".join(f"{v:.6f}" for v in (*c, *s)) for c, s in zip(RGB, spectra, strict=True)]
     (tmp_path / "t.csv").write_text(header + "\n" + "\n".join(rows) + "\n")

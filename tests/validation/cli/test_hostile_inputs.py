@@ -3,16 +3,19 @@
 A binary target file, a model file that is a JSON list, a truncated Radiance file, an image of zero
 rows (OpenEXR's writer aborted the process on it), a negative seed, a display file that is
 ``/dev/zero`` or nested 100,000 deep, a port above 65535, scheduler protocols specref does not
-speak, and a sibling output that is a folder (docs/bad-input.md).
+speak, and a sibling output that is a folder; and inputs that used to be accepted silently:
+images with NaN or infinite pixels, reflectances of -0.5 or 5 (docs/bad-input.md).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from reference.data import data_path
+from reference.images.formats import write_exr
 from validation.cli import main
 
 VENICE = data_path("environments/venice_sunset_1k.hdr")
@@ -34,6 +37,13 @@ def _make(tmp_path: Path, name: str) -> Path:
         path.write_text('kind = "phong"\n')
     elif name == "d.cube":
         path.mkdir()
+    elif name in ("nan.exr", "inf.exr", "fine.exr"):
+        image = np.full((4, 4, 3), 0.5)
+        image[1, 2, 1] = {"nan.exr": np.nan, "inf.exr": np.inf, "fine.exr": 0.5}[name]
+        write_exr(path, image, ["X", "Y", "Z"])
+    elif name in ("negative.csv", "percent.csv"):
+        value = -0.5 if name == "negative.csv" else 5.0
+        path.write_text(f"R,G,B,380,780\n0.2,0.2,0.2,0.3,0.3\n0.5,0.4,0.3,{value},0.3\n")
     return path
 
 
@@ -53,6 +63,13 @@ CASES = [
     (["sweep", "{sweep.toml}", "--scheduler", "ucx://127.0.0.1:8786"], "allowed: tcp://HOST:PORT"),
     (["sweep", "{sweep.toml}", "--scheduler", "tls://127.0.0.1:8786"], "allowed: tcp://HOST:PORT"),
     (["report", "--scheduler", "tcp://host:1/path"], "allowed: tcp://HOST:PORT"),
+    # silent accepts: "mean nan" for a NaN pixel, "no lit pixels" for an infinity in B
+    (["compare", "{nan.exr}", "{fine.exr}"], "nan.exr: 1 pixels hold NaN or infinite values"),
+    (["compare", "{fine.exr}", "{inf.exr}"], "inf.exr: 1 pixels hold NaN or infinite values"),
+    (["env", "fit", "--target", "{negative.csv}", "-o", "{out.json}"],
+     "patch 2: reflectances must be finite and in [-0.05, 1.5]"),
+    (["env", "fit", "--target", "{percent.csv}", "-o", "{out.json}"],
+     "patch 2: reflectances must be finite and in [-0.05, 1.5]"),
 ]  # fmt: skip
 
 
