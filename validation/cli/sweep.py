@@ -8,7 +8,7 @@ from validation.cli.parser import input_file, output_file
 def _cmd_sweep(args) -> int:
     from validation.studies.sweep import run_sweep, sweep_csv
 
-    rows = run_sweep(args.file, scheduler=args.scheduler)
+    rows = run_sweep(args.file, scheduler=args.scheduler, large=args.yes)
     text = sweep_csv(rows, args.out)
     if args.out:
         print(f"wrote {len(rows)} rows to {args.out}")
@@ -41,6 +41,11 @@ def add_parser(sub) -> None:
         type=output_file,
         metavar="CSV",
         help="write the table here (default: stdout)",
+    )
+    p.add_argument(
+        "--yes",
+        action="store_true",
+        help="run grids of more than 10,000 cells (up to 1,000,000)",
     )
     add_scheduler_option(p)
     p.set_defaults(func=_cmd_sweep)

@@ -30,6 +30,7 @@ import csv
 import functools
 import io
 import itertools
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -412,14 +413,23 @@ def _check_values(file: str, key: str, values, allowed) -> list:
     return checked
 
 
-def load_sweep(path) -> tuple[SweepKind, list[dict]]:
+#: Cells a sweep runs without ``--yes`` (``large=True``): a typing slip in a list should not
+#: start days of work; and the most it runs at all (the list of cells is held in memory).
+MAX_SWEEP_CELLS = 10_000
+HARD_MAX_SWEEP_CELLS = 1_000_000
+
+
+def load_sweep(path, large: bool = False) -> tuple[SweepKind, list[dict]]:
     """Read a sweep file: its kind and the grid's cells (every combination, in file order).
+
+    The number of cells is checked before any is made: at most :data:`MAX_SWEEP_CELLS`, or
+    with ``large`` :data:`HARD_MAX_SWEEP_CELLS`.
 
     Raises
     ------
     SpecrefError
-        Unreadable file, malformed TOML, unknown kind or key, an empty or invalid grid (one line
-        naming the file and the key).
+        Unreadable file, malformed TOML, unknown kind or key, an empty or invalid grid, too many
+        cells (one line naming the file and the key).
 
     Examples
     --------
@@ -453,6 +463,14 @@ def load_sweep(path) -> tuple[SweepKind, list[dict]]:
     scalars = {}
     for key in kind.scalars:
         scalars[key] = require_positive_int(grid[key], f"{file}: grid.{key}", 4096)
+    count = math.prod(len(values) for values in axes.values())
+    factors = " × ".join(f"{len(v)} {k}" for k, v in axes.items())
+    limit = HARD_MAX_SWEEP_CELLS if large else MAX_SWEEP_CELLS
+    require(
+        count <= limit,
+        f"{file}: grid: {count:,} cells ({factors}); at most {limit:,}"
+        + ("" if large else f" without --yes, {HARD_MAX_SWEEP_CELLS:,} with it"),
+    )
     cells = [
         {**dict(zip(axes, combo, strict=True)), **scalars}
         for combo in itertools.product(*axes.values())
@@ -460,8 +478,12 @@ def load_sweep(path) -> tuple[SweepKind, list[dict]]:
     return kind, cells
 
 
-def run_sweep(path, scheduler: str | None = None, progress: bool = True, client=None) -> list[dict]:
+def run_sweep(
+    path, scheduler: str | None = None, progress: bool = True, client=None, large: bool = False
+) -> list[dict]:
     r"""Run every cell of a sweep file; rows of the grid keys and the cell's figures, in order.
+
+    ``large``: allow more than :data:`MAX_SWEEP_CELLS` cells (:func:`load_sweep`).
 
     Examples
     --------
@@ -475,7 +497,7 @@ def run_sweep(path, scheduler: str | None = None, progress: bool = True, client=
     >>> [(r["entries"], r["rms"] < 0.05) for r in rows]
     [(32, True), (64, True)]
     """
-    kind, cells = load_sweep(path)
+    kind, cells = load_sweep(path, large)
     figures = run_tasks(
         kind.run_cell,
         cells,

@@ -96,3 +96,26 @@ def test_one_line_and_exit_2(argv, message, tmp_path, capsys):
     assert not (tmp_path / "out.zarr").exists()
     assert not (tmp_path / "out.exr").exists()
     assert not (tmp_path / "d.cal").exists()
+
+
+def test_a_sweep_grid_beyond_its_bound_is_refused_before_any_cell(tmp_path, capsys):
+    # a typing slip that makes a 24,000-cell grid asks for --yes; 2.4 million cells are refused
+    # even with it; the message states the count and its factors, and nothing runs
+    def grid(entries: int) -> Path:
+        path = tmp_path / f"g{entries}.toml"
+        path.write_text(
+            'kind = "phong"\n[grid]\nmaterials = ["R1", "R2", "R3"]\nviews = ["near", "far"]\n'
+            'placements = ["error", "uniform"]\ninterpolations = ["linear", "monotone"]\n'
+            f"entries = {list(range(8, 8 + entries))}\nresolution = 4\n"
+        )
+        return path
+
+    out = tmp_path / "out.csv"
+    assert main(["sweep", str(grid(1000)), "--scheduler", "serial", "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "grid: 24,000 cells (3 materials × 2 views × 2 placements × 2 interpolations × " in err
+    assert "at most 10,000 without --yes, 1,000,000 with it" in err
+    big = ["sweep", str(grid(100_000)), "--scheduler", "serial", "--yes", "-o", str(out)]
+    assert main(big) == 2
+    assert "grid: 2,400,000 cells" in capsys.readouterr().err
+    assert not out.exists()
