@@ -399,6 +399,11 @@ def _spectrum(doc, key, where, n):
     return values
 
 
+#: The brightest white a display file may state, cd/m²: the top of SMPTE ST 2084 (PQ), beyond
+#: any display; 1e308 used to print overflowing figures.
+MAX_WHITE_CD_M2 = 10_000.0
+
+
 def spectral_display_from_doc(doc: dict, where: str = "display file") -> SpectralDisplay:
     """A spectral display from a display file (JSON; format in ``docs/display.md``).
 
@@ -438,6 +443,11 @@ def spectral_display_from_doc(doc: dict, where: str = "display file") -> Spectra
         shape = () if key.endswith("cd_m2") else (3,)
         array = require_finite(value, f"{where}: {key}")
         require(array.shape == shape, f"{where}: {key}: must have shape {shape}, got {array.shape}")
+    white = float(kwargs.get("white_cd_m2", 120.0))
+    require(
+        0.0 < white <= MAX_WHITE_CD_M2,
+        f"{where}: white_cd_m2: must be in (0, {MAX_WHITE_CD_M2:g}] cd/m², got {white:g}",
+    )
     primaries = doc.get("primaries", "apple_studio")
     if isinstance(primaries, str):
         display = spectral_display(primaries, **kwargs)

@@ -41,6 +41,8 @@ def _make(tmp_path: Path, name: str) -> Path:
         image = np.full((4, 4, 3), 0.5)
         image[1, 2, 1] = {"nan.exr": np.nan, "inf.exr": np.inf, "fine.exr": 0.5}[name]
         write_exr(path, image, ["X", "Y", "Z"])
+    elif name == "bright.json":
+        path.write_text('{"white_cd_m2": 1e308}')
     elif name in ("negative.csv", "percent.csv"):
         value = -0.5 if name == "negative.csv" else 5.0
         path.write_text(f"R,G,B,380,780\n0.2,0.2,0.2,0.3,0.3\n0.5,0.4,0.3,{value},0.3\n")
@@ -64,6 +66,8 @@ CASES = [
     (["sweep", "{sweep.toml}", "--scheduler", "tls://127.0.0.1:8786"], "allowed: tcp://HOST:PORT"),
     (["report", "--scheduler", "tcp://host:1/path"], "allowed: tcp://HOST:PORT"),
     # silent accepts: "mean nan" for a NaN pixel, "no lit pixels" for an infinity in B
+    (["display", "calibrate", "--display", "{bright.json}", "-o", "{d.cal}"],
+     "white_cd_m2: must be in (0, 10000] cd/m², got 1e+308"),
     (["compare", "{nan.exr}", "{fine.exr}"], "nan.exr: 1 pixels hold NaN or infinite values"),
     (["compare", "{fine.exr}", "{inf.exr}"], "inf.exr: 1 pixels hold NaN or infinite values"),
     (["env", "fit", "--target", "{negative.csv}", "-o", "{out.json}"],
