@@ -202,6 +202,9 @@ def check_outputs(outputs, inputs=(), stores=()) -> list[Path]:
     - the same file as an input (inodes compared: hard and symbolic links count), or as another
       output of the same command.
 
+    An input whose name is too long for the file system, or a loop of symbolic links, is refused
+    too (a missing input is left to the command, which says so in its own words).
+
     An output *store* (a Zarr folder) must not be an input either; whether an existing folder may
     be replaced is its writer's decision (``reference.images.zarr_store``: only a Zarr store).
 
@@ -239,7 +242,19 @@ def check_outputs(outputs, inputs=(), stores=()) -> list[Path]:
     reference.errors.SpecrefError: /dev/null: cannot write (a device or special file, ...
     """
     outputs = [Path(o) for o in outputs if o is not None]
-    inputs = [Path(i) for i in inputs if i is not None and os.path.lexists(i)]
+    inputs = [Path(i) for i in inputs if i is not None]
+    for source in inputs:  # names the file system cannot look up at all
+        try:
+            os.stat(source)
+        except FileNotFoundError:
+            pass  # the command says "file not found" in its own words
+        except OSError as error:
+            reason = {errno.ENAMETOOLONG: "a name in the path is too long for the file system",
+                      errno.ELOOP: "a loop of symbolic links"}.get(error.errno)  # fmt: skip
+            if reason is None:
+                raise
+            raise SpecrefError(f"{source}: cannot read ({reason})") from None
+    inputs = [i for i in inputs if os.path.lexists(i)]
     for k, out in enumerate(outputs):
         with _write_errors(out):
             _require_file_target(out)

@@ -123,3 +123,23 @@ def test_a_sweep_grid_beyond_its_bound_is_refused_before_any_cell(tmp_path, caps
     assert main(big) == 2
     assert "grid: 2,400,000 cells" in capsys.readouterr().err
     assert not out.exists()
+
+
+@pytest.mark.parametrize("command", [["render", "{}.toml", "-o", "x.png"], ["sweep", "{}.toml"],
+                                     ["compare", "{}.exr", "{}.exr"]])  # fmt: skip
+def test_an_input_name_too_long_for_the_file_system_is_one_line(command, tmp_path, capsys):
+    name = str(tmp_path / ("y" * 300))
+    argv = [a.format(name) if "{}" in a else a for a in command]
+    if "-o" in argv:  # the output beside it
+        argv[-1] = str(tmp_path / argv[-1])
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.endswith("cannot read (a name in the path is too long for the file system)"), err
+    assert len(err.splitlines()) == 1
+
+
+def test_a_loop_of_symbolic_links_is_one_line(tmp_path, capsys):
+    (tmp_path / "a.toml").symlink_to(tmp_path / "b.toml")
+    (tmp_path / "b.toml").symlink_to(tmp_path / "a.toml")
+    assert main(["sweep", str(tmp_path / "a.toml")]) == 2
+    assert "a.toml: cannot read (a loop of symbolic links)" in capsys.readouterr().err
