@@ -186,10 +186,16 @@ def kernel_phong(s: float) -> RadialKernel:
     s = float(s)
     require(np.isfinite(s) and 0 <= s <= 1e5, f"kernel phong:{s:g}: exponent must be in [0, 1e5]")
     scale = (s + 1.0) / (2.0 * np.pi)
+    # cos^s γ ≈ exp(−s γ²/2): a lobe of width 1/√s. Above s = 256 the quadrature is split at
+    # 2^j/√s so that its nodes follow the lobe (a single segment missed it at s = 1e5)
+    edges = [0.0, np.pi / 2]
+    if s > 256:
+        edges = [0.0, *(2.0**j / np.sqrt(s) for j in range(-1, 12) if 2.0**j / np.sqrt(s) < 1.5)]
+        edges.append(np.pi / 2)
     return RadialKernel(
         f"phong:{s:g}",
         lambda g: scale * np.maximum(np.cos(g), 0.0) ** s,
-        np.array([0.0, np.pi / 2]),
+        np.array(edges),
         power=(s, scale),
     )
 

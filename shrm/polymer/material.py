@@ -677,6 +677,11 @@ def _parse_polymer(reader, table: dict, key: str, name: str) -> PolymerMaterial:
     effect = None
     if "effect" in table:
         value = table["effect"]
+        if not isinstance(value, str | dict):
+            reader.fail(
+                f"{key}.effect",
+                f'must be a BRDF key ("ggx") or a table {{ brdf = ... }}, got {value!r}',
+            )
         effect_table = {"brdf": value} if isinstance(value, str) else value
         effect = _parse_isotropic_brdf(reader, effect_table, f"{key}.effect", f"{name}.effect")
     modulation = _parse_modulation(reader, table.get("modulation", 0.0), f"{key}.modulation")

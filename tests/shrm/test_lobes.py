@@ -28,6 +28,22 @@ def test_phong_Lambda_matches_mpmath(s):
         assert abs(Lam[l] - phong_Lambda_mp(l, s)) <= 1e-12
 
 
+@pytest.mark.parametrize("s", [300.0, 1e4, 1e5])
+def test_narrow_phong_lobes_up_to_the_documented_maximum(s):
+    # Source: the closed recurrence of (s+1) ∫_0^1 t^s P_l(t) dt (Bonnet's recurrence integrated
+    # by parts): I_0 = 1/(s+1), I_1 = 1/(s+2), I_l = (s-l+2)/(s+l+1) I_{l-2}, in mpmath at 50
+    # digits. s = 1e5, the scene files' maximum, used to fail the quadrature's convergence check.
+    import mpmath
+
+    mpmath.mp.dps = 50
+    L = 511
+    I = [1 / mpmath.mpf(s + 1), 1 / mpmath.mpf(s + 2)]
+    for l in range(2, L + 1):
+        I.append(mpmath.mpf(s - l + 2) / (s + l + 1) * I[l - 2])
+    golden = np.array([float((s + 1) * v) for v in I])
+    np.testing.assert_allclose(parse_kernel(f"phong:{s:g}").Lambda(L), golden, rtol=0, atol=1e-12)
+
+
 def test_gaussian_approximation_is_percent_level_off():
     # Source: mpmath Λ_10 of phong:32; exp(-l²/2s) is 11 % too large there (erratum E10).
     exact = parse_kernel("phong:32").Lambda(10)[10]

@@ -216,6 +216,8 @@ def test_modulation_image_is_looked_up_by_uv(sky, tmp_path):
         ("gloss = 2.0", r"materials.p.gloss: must be <= 1, got 2.0$"),
         ("modulation = 0.5", r"materials.p.modulation: mixes in an effect pigment; set 'effect'"),
         ('effect = "table"', r"materials.p.effect: brdf = 'table' needs a key 'file'"),
+        ("effect = 5", r"materials.p.effect: must be a BRDF key .* or a table .*, got 5$"),
+        ("effect = [1, 2]", r"materials.p.effect: must be a BRDF key .*, got \[1, 2\]$"),
         ('mirror = "sharp"', r"materials.p.mirror: unknown value 'sharp'; allowed: cosine, "),
         ("thicknes = 1.0", r"materials.p: unknown key 'thicknes'; allowed: "),
     ],
