@@ -188,6 +188,24 @@ def check_output_store(path) -> Path:
     return path
 
 
+def _existing_inputs(inputs) -> list[Path]:
+    """The inputs that exist; names the file system cannot look up at all are refused."""
+    found = []
+    for source in inputs:
+        try:
+            os.stat(source)
+        except FileNotFoundError:
+            continue  # the command says "file not found" in its own words
+        except OSError as error:
+            reason = {errno.ENAMETOOLONG: "a name in the path is too long for the file system",
+                      errno.ELOOP: "a loop of symbolic links"}.get(error.errno)  # fmt: skip
+            if reason is None:
+                raise
+            raise SpecrefError(f"{source}: cannot read ({reason})") from None
+        found.append(source)
+    return found
+
+
 def check_outputs(outputs, inputs=(), stores=()) -> list[Path]:
     """The write policy: refuse, before any work, outputs that cannot or must not be written.
 
@@ -242,19 +260,7 @@ def check_outputs(outputs, inputs=(), stores=()) -> list[Path]:
     reference.errors.SpecrefError: /dev/null: cannot write (a device or special file, ...
     """
     outputs = [Path(o) for o in outputs if o is not None]
-    inputs = [Path(i) for i in inputs if i is not None]
-    for source in inputs:  # names the file system cannot look up at all
-        try:
-            os.stat(source)
-        except FileNotFoundError:
-            pass  # the command says "file not found" in its own words
-        except OSError as error:
-            reason = {errno.ENAMETOOLONG: "a name in the path is too long for the file system",
-                      errno.ELOOP: "a loop of symbolic links"}.get(error.errno)  # fmt: skip
-            if reason is None:
-                raise
-            raise SpecrefError(f"{source}: cannot read ({reason})") from None
-    inputs = [i for i in inputs if os.path.lexists(i)]
+    inputs = _existing_inputs(Path(i) for i in inputs if i is not None)
     for k, out in enumerate(outputs):
         with _write_errors(out):
             _require_file_target(out)

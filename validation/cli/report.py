@@ -46,8 +46,8 @@ def add_parser(sub) -> None:
         "the settings its checks need (the full-resolution studies and long sweeps at their "
         "quick settings: --full runs them in full). index.html is rewritten after every "
         "section, so a stopped run leaves a readable page. Measured on a shared two-core "
-        "machine: 3 min 39 s - 4 min 11 s with the default two processes (7 min 22 s with "
-        "--jobs 1); --full 54 min alone, 1 h 48 min beside other work.",
+        "machine: 3 min 48 s with the default two processes (6 min 45 s of CPU); --full "
+        "54 min alone, 1 h 48 min beside other work.",
     )
     p.add_argument("--out", default="report", help="output folder (default: report)")
     effort = p.add_mutually_exclusive_group()
