@@ -443,6 +443,12 @@ def spectral_display_from_doc(doc: dict, where: str = "display file") -> Spectra
         shape = () if key.endswith("cd_m2") else (3,)
         array = require_finite(value, f"{where}: {key}")
         require(array.shape == shape, f"{where}: {key}: must have shape {shape}, got {array.shape}")
+    if "gamma" in kwargs:
+        gamma = np.asarray(kwargs["gamma"], dtype=float)
+        require(
+            bool(((gamma > 0) & (gamma <= 10)).all()),
+            f"{where}: gamma: each channel's exponent must be in (0, 10], got {gamma.tolist()}",
+        )
     white = float(kwargs.get("white_cd_m2", 120.0))
     require(
         0.0 < white <= MAX_WHITE_CD_M2,

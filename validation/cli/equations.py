@@ -9,6 +9,7 @@ from validation.cli.parser import output_file
 
 
 def _cmd_equations(args) -> int:
+    from reference.errors import require
     from reference.files import check_output_file, write_text_atomic
     from validation.report.equations import (
         REGENERATE,
@@ -19,12 +20,18 @@ def _cmd_equations(args) -> int:
 
     if args.out and not args.check:
         check_output_file(args.out)  # before the index's seconds of parsing
+    path = Path(args.out or "docs/equations.md")
+    # outside a checkout (an installed wheel) there is nothing to compare: say so, not "out of date"
+    require(
+        not args.check or path.is_file(),
+        f"{path}: not found; --check compares a checkout's docs/equations.md (run it in the "
+        "repository, or give -o FILE)",
+    )
     citations = collect_citations()
     text = render_equation_index(citations=citations)
     if args.check:
-        path = Path(args.out or "docs/equations.md")
         problems = equation_problems(citations)
-        if not path.is_file() or path.read_text(encoding="utf-8") != text:
+        if path.read_text(encoding="utf-8") != text:
             problems.append(f"{path} is out of date; regenerate it with `{REGENERATE}`")
         for problem in problems:
             print(f"specref equations: {problem}", file=sys.stderr)

@@ -58,6 +58,8 @@ def input_file(value: str) -> InputPath:
     from reference.data import DATA_SCHEME, data_path
     from reference.errors import SpecrefError
 
+    if not value.strip():  # Path("") is ".", which would be reported as "./: file not found"
+        raise argparse.ArgumentTypeError("an empty file name")
     if not value.startswith(DATA_SCHEME):
         return InputPath(value)
     try:

@@ -41,6 +41,8 @@ def _make(tmp_path: Path, name: str) -> Path:
         image = np.full((4, 4, 3), 0.5)
         image[1, 2, 1] = {"nan.exr": np.nan, "inf.exr": np.inf, "fine.exr": 0.5}[name]
         write_exr(path, image, ["X", "Y", "Z"])
+    elif name == "gamma0.json":
+        path.write_text('{"gamma": [0, 0, 0]}')
     elif name == "bright.json":
         path.write_text('{"white_cd_m2": 1e308}')
     elif name in ("negative.csv", "percent.csv"):
@@ -68,6 +70,11 @@ CASES = [
     # silent accepts: "mean nan" for a NaN pixel, "no lit pixels" for an infinity in B
     (["display", "calibrate", "--display", "{bright.json}", "-o", "{d.cal}"],
      "white_cd_m2: must be in (0, 10000] cd/m², got 1e+308"),
+    # messages that name the cause (gamma 0 was "white outside the gamut", '' was ".: not found")
+    (["display", "calibrate", "--display", "{gamma0.json}", "-o", "{d.cal}"],
+     "gamma0.json: gamma: each channel's exponent must be in (0, 10], got [0.0, 0.0, 0.0]"),
+    (["env", "spectralize", VENICE, "--model", "", "-o", "{out.exr}"],
+     "argument --model: an empty file name"),
     (["compare", "{nan.exr}", "{fine.exr}"], "nan.exr: 1 pixels hold NaN or infinite values"),
     (["compare", "{fine.exr}", "{inf.exr}"], "inf.exr: 1 pixels hold NaN or infinite values"),
     (["env", "fit", "--target", "{negative.csv}", "-o", "{out.json}"],
@@ -143,3 +150,14 @@ def test_a_loop_of_symbolic_links_is_one_line(tmp_path, capsys):
     (tmp_path / "b.toml").symlink_to(tmp_path / "a.toml")
     assert main(["sweep", str(tmp_path / "a.toml")]) == 2
     assert "a.toml: cannot read (a loop of symbolic links)" in capsys.readouterr().err
+
+
+def test_equations_check_outside_a_checkout_says_so(tmp_path, monkeypatch, capsys):
+    # an installed wheel has no docs/equations.md: "not found", not "out of date"
+    monkeypatch.chdir(tmp_path)
+    assert main(["equations", "--check"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (
+        "specref: error: docs/equations.md: not found; --check compares a checkout's "
+        "docs/equations.md (run it in the repository, or give -o FILE)"
+    )
