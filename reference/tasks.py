@@ -375,6 +375,9 @@ def dask_client(
             processes=True,
             host="127.0.0.1",
             dashboard_address=None,
+            # the scheduler's HTTP routes (health, metrics) on a free loopback port: the
+            # default 8787 is taken when two commands run at once, and Dask then warns
+            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
             silence_logs=logging.ERROR,
         ) as cluster,
         Client(cluster) as client,
