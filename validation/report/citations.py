@@ -194,9 +194,18 @@ def _read_version(path: Path, root: Path, mtime_ns: int, size: int):
     return source, tree, module, owners
 
 
-def _file_citations(path: Path, root: Path) -> list[Citation]:
-    """The citations in one source file: docstrings, other string constants and comments."""
-    source, tree, module, owners = _read(path, root)
+def _file_citations(path: Path, root: Path) -> tuple[Citation, ...]:
+    """The citations in one source file: docstrings, other string constants and comments.
+
+    Found once per file version in a process, as :func:`_read` parses once.
+    """
+    stat = path.stat()
+    return _file_citations_version(path, root, stat.st_mtime_ns, stat.st_size)
+
+
+@functools.lru_cache(maxsize=4096)
+def _file_citations_version(path: Path, root: Path, mtime_ns: int, size: int):
+    source, tree, module, owners = _read_version(path, root, mtime_ns, size)
     relative = path.relative_to(root).as_posix()
     texts = [(t[0], t[1], t[2], _without_doctests(t[3])) for t in owners.texts]
     module_doc = ast.get_docstring(tree)
@@ -209,7 +218,7 @@ def _file_citations(path: Path, root: Path) -> list[Citation]:
         name = f"{module}.{owner}" if owner else module
         for author, number, grouped in parse_citations(text):
             found.append(Citation(relative, line, name, kind, author, number, grouped))
-    return found
+    return tuple(found)
 
 
 def _sources(root: Path, packages):
@@ -442,34 +451,41 @@ def read_tests(root: Path | None = None) -> list[_Test]:
     root = ROOT if root is None else Path(root)
     tests = []
     for path in sorted((root / "tests").rglob("test_*.py")):
-        tree = ast.parse(path.read_text(encoding="utf-8"))
-        modules, imported = set(), set()
-        for node in ast.walk(tree):
-            if isinstance(node, ast.Import):
-                modules |= {a.name for a in node.names}
-            elif isinstance(node, ast.ImportFrom) and node.module:
-                modules.add(node.module)
-                modules |= {f"{node.module}.{a.name}" for a in node.names}
-                imported |= {(a.name, node.module) for a in node.names}
-        functions = [(n, "") for n in tree.body if isinstance(n, ast.FunctionDef)]
-        for cls in (n for n in tree.body if isinstance(n, ast.ClassDef)):
-            functions += [(n, f"{cls.name}::") for n in cls.body if isinstance(n, ast.FunctionDef)]
-        for node, prefix in functions:
-            if node.name.startswith("test"):
-                strings = {
-                    n.value for n in ast.walk(node) if isinstance(n, ast.Constant) and n.value
-                }
-                tests.append(
-                    _Test(
-                        f"{path.relative_to(root).as_posix()}::{prefix}{node.name}",
-                        frozenset(_names(node)),
-                        frozenset().union(*(_names(d) for d in node.decorator_list)),
-                        frozenset(v for v in strings if isinstance(v, str)),
-                        frozenset(modules),
-                        tuple(sorted(imported)),
-                    )
-                )
+        stat = path.stat()
+        tests += _file_tests(path, root, stat.st_mtime_ns, stat.st_size)
     return tests
+
+
+@functools.lru_cache(maxsize=4096)
+def _file_tests(path: Path, root: Path, mtime_ns: int, size: int) -> tuple[_Test, ...]:
+    """The test functions of one test file, read once per file version in a process."""
+    tests = []
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    modules, imported = set(), set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            modules |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.module:
+            modules.add(node.module)
+            modules |= {f"{node.module}.{a.name}" for a in node.names}
+            imported |= {(a.name, node.module) for a in node.names}
+    functions = [(n, "") for n in tree.body if isinstance(n, ast.FunctionDef)]
+    for cls in (n for n in tree.body if isinstance(n, ast.ClassDef)):
+        functions += [(n, f"{cls.name}::") for n in cls.body if isinstance(n, ast.FunctionDef)]
+    for node, prefix in functions:
+        if node.name.startswith("test"):
+            strings = {n.value for n in ast.walk(node) if isinstance(n, ast.Constant) and n.value}
+            tests.append(
+                _Test(
+                    f"{path.relative_to(root).as_posix()}::{prefix}{node.name}",
+                    frozenset(_names(node)),
+                    frozenset().union(*(_names(d) for d in node.decorator_list)),
+                    frozenset(v for v in strings if isinstance(v, str)),
+                    frozenset(modules),
+                    tuple(sorted(imported)),
+                )
+            )
+    return tuple(tests)
 
 
 def _split(name: str) -> tuple[str, str]:
