@@ -301,6 +301,11 @@ def add_scheduler_option(parser, default: str | None = None) -> None:
     )
 
 
+#: A local cluster's scheduler serves its HTTP routes (health, metrics) on a free loopback port:
+#: Dask's default 8787 is taken when two commands run at once, and Dask then warns.
+LOCAL_SCHEDULER_HTTP = {"dashboard_address": "127.0.0.1:0"}
+
+
 @contextlib.contextmanager
 def dask_client(
     scheduler: str | None = None, n_workers: int | None = None, timeout: float | None = None
@@ -375,9 +380,7 @@ def dask_client(
             processes=True,
             host="127.0.0.1",
             dashboard_address=None,
-            # the scheduler's HTTP routes (health, metrics) on a free loopback port: the
-            # default 8787 is taken when two commands run at once, and Dask then warns
-            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+            scheduler_kwargs=LOCAL_SCHEDULER_HTTP,
             silence_logs=logging.ERROR,
         ) as cluster,
         Client(cluster) as client,

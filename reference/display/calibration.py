@@ -10,12 +10,20 @@ white's chromaticity across the tonal range. :func:`calibrate_display`:
 2. finds the brightest white of the target chromaticity (one channel at full drive);
 3. iterates per control point, from the white down: measure, correct the three channel drives
    through the model's Jacobian, re-measure, until the chromaticity (Δu'v') and the curve's
-   luminance hold or the iterations run out. The points are denser in the highlights and the
-   lowest sits at 1 % of white; the black is left alone (§6: "we do not try to adjust the black
-   point");
+   luminance hold, the difference left is within the instrument's noise, or the iterations run
+   out. Each measurement averages repeated readings, doubling their count until the mean's u'v'
+   noise is half the tolerance (at most :data:`MAX_READINGS`): a real instrument integrates
+   longer in the shadows, where one reading's noise exceeds the target. The points are denser in
+   the highlights and the lowest sits at 1 % of white; the black is left alone (§6: "we do not
+   try to adjust the black point");
 4. fills the 256-entry per-channel look-up table between the points: each point's correction to
    the model is interpolated (monotone cubic in the gray level) and added to the model's answer;
    below the lowest point the channels keep its ratio (the display's own colour, as the paper says).
+
+:func:`verify_calibration` reads the calibrated ramp with the
+:class:`~reference.display.instruments.ReferenceMeter` (1 nm, no band pass, no noise), independent
+of the instrument that calibrated, and :func:`calibration_targets` holds it to :data:`TARGET_DUV`
+above 5 % of white and :data:`TARGET_Y` above 1 %.
 
 References
 ----------
@@ -33,7 +41,7 @@ from typing import NamedTuple
 import numpy as np
 
 from reference.display.encodings import decode_gamma, decode_lstar_Herbert, decode_srgb
-from reference.display.instruments import INSTRUMENTS
+from reference.display.instruments import INSTRUMENTS, ReferenceMeter
 from reference.display.spectral import SpectralDisplay
 from reference.errors import SpecrefError, require
 from reference.registry import Method, Registry
@@ -41,23 +49,36 @@ from reference.registry import Method, Registry
 __all__ = [
     "CALIBRATION_CURVES",
     "LUT_SIZE",
+    "MAX_READINGS",
+    "TARGET_DUV",
+    "TARGET_Y",
     "WHITES",
     "Calibration",
     "XYZ_to_uv",
     "calibrate_display",
     "calibration_points",
+    "calibration_targets",
     "curve_bt1886",
     "curve_gamma_18",
     "curve_gamma_22",
     "curve_lstar_Herbert",
     "curve_srgb",
     "curve_target",
+    "targets_message",
     "verify_calibration",
     "white_xy",
 ]
 
 #: Entries of the per-channel look-up tables (8-bit input, as the paper's G = 0..255).
 LUT_SIZE = 256
+#: Readings averaged per measurement at most (the count doubles from two until the mean's u'v'
+#: noise is half the chromaticity tolerance; erratum E53).
+MAX_READINGS = 256
+#: The targets a calibration is held to, read by the reference meter (docs/display.md): the gray
+#: ramp's Δu'v' from the white above ``TARGET_DUV[1]`` of white, and its luminance error |ΔY|/Y
+#: above ``TARGET_Y[1]`` of white.
+TARGET_DUV = (0.001, 0.05)
+TARGET_Y = (0.01, 0.01)
 
 
 def curve_bt1886(G, black_relative: float = 0.0):
@@ -271,6 +292,64 @@ class _Characterization:
         return flat.reshape(rho.shape)
 
 
+class _Reading(NamedTuple):
+    """A measurement: mean XYZ, the standard errors of its u'v' and relative Y, readings taken.
+
+    ``XYZ`` (..., 3); ``se_uv`` (Euclidean over u', v'), ``se_Y`` and ``count`` (...).
+    """
+
+    XYZ: np.ndarray
+    se_uv: np.ndarray
+    se_Y: np.ndarray
+    count: np.ndarray
+
+
+@dataclass(frozen=True)
+class _Reader:
+    """Repeated readings of the instrument, averaged until the mean is quiet enough.
+
+    From two readings, the count doubles until the standard error of the mean's u'v' is at most
+    half ``tolerance_uv``, or ``max_readings`` are taken (the noise floor is then what is left). A
+    noise-free instrument gives two equal readings and stops there.
+    """
+
+    measure: Callable  # drives (..., 3) -> XYZ (..., 3), cd/m²
+    tolerance_uv: float
+    max_readings: int
+
+    def __post_init__(self):
+        require(
+            isinstance(self.max_readings, int) and self.max_readings >= 2,
+            f"max_readings: must be an integer >= 2, got {self.max_readings!r}",
+        )
+
+    def __call__(self, drives) -> _Reading:
+        drives = np.asarray(drives, dtype=np.float64)
+        flat = drives.reshape(-1, 3)
+        readings = [[] for _ in flat]
+        todo, n = np.arange(len(flat)), 2
+        while todo.size:
+            new = self.measure(np.repeat(flat[todo, None], n - len(readings[todo[0]]), axis=1))
+            for i, rows in zip(todo, new, strict=True):
+                readings[i].extend(rows)
+            _, se_uv, _ = _mean_and_errors([np.array(readings[i]) for i in todo])
+            todo = todo[(se_uv > 0.5 * self.tolerance_uv) & (2 * n <= self.max_readings)]
+            n *= 2
+        XYZ, se_uv, se_Y = _mean_and_errors([np.array(r) for r in readings])
+        count = np.array([len(r) for r in readings])
+        shape = drives.shape[:-1]
+        return _Reading(XYZ.reshape(*shape, 3), *(a.reshape(shape) for a in (se_uv, se_Y, count)))
+
+
+def _mean_and_errors(readings: list) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Mean XYZ and the standard errors of its u'v' and relative Y, per list of readings (n, 3)."""
+    XYZ = np.array([r.mean(axis=0) for r in readings])
+    se_uv = np.array([np.linalg.norm(XYZ_to_uv(r).std(axis=0, ddof=1)) for r in readings])
+    se_Y = np.array([r[:, 1].std(ddof=1) / max(abs(r[:, 1].mean()), 1e-300) for r in readings])
+    count = np.sqrt([len(r) for r in readings])
+    return XYZ, se_uv / count, se_Y / count
+
+
 def _characterize(display, measure, levels: int = 33) -> _Characterization:
     drive = np.linspace(0.0, 1.0, levels) ** 2  # denser near black, where ramps bend
     black = measure(np.zeros(3))
@@ -317,6 +396,7 @@ def calibrate_display(
     tolerance_Y: float = 2e-3,
     max_iterations: int = 12,
     refine_rounds: int = 2,
+    max_readings: int = MAX_READINGS,
 ) -> Calibration:
     """Calibrate a display to a white and a tone curve, iterating per point (module docstring).
 
@@ -338,10 +418,12 @@ def calibrate_display(
     tolerance_uv, tolerance_Y : float
         A point is done when Δu'v' and |ΔY|/Y are both within these.
     max_iterations : int
-        Readings per point at most.
+        Measurements per point at most.
     refine_rounds : int
         Rounds of adding points where the table misses between points (0: none); at most 64
         points in all.
+    max_readings : int
+        Readings averaged per measurement at most (module docstring, 3.).
 
     Returns
     -------
@@ -363,28 +445,21 @@ def calibrate_display(
     make_instrument = INSTRUMENTS.lookup(instrument).reference
     xy = white_xy(white)
     calibration_points(points, 0.5)  # checks the count first
-    # the instrument reading the display: drives (..., 3) -> XYZ (..., 3)
+    # the instrument reading the display: drives (..., 3) -> XYZ (..., 3); erratum E53: the
+    # loop's heuristics (characterisation, placement, tolerances, repeated readings) are ours
     measure = functools.partial(make_instrument().measure, display, rng=np.random.default_rng(seed))
-    # Erratum E53: the loop's heuristics (characterisation, placement, tolerances) are ours
-    model = _characterize(display, measure)
+    read = _Reader(measure, tolerance_uv, max_readings)
+    model = _characterize(display, lambda drives: read(drives).XYZ)
     XYZ_w1, Y_white = _brightest_white(model, xy, white)
-    loop = _Loop(model, measure, XYZ_w1, tolerance_uv, tolerance_Y, max_iterations)
+    loop = _Loop(model, read, XYZ_w1, tolerance_uv, tolerance_Y, max_iterations)
     # the white first: one channel stays at full drive
     done = {1.0: loop.run_point(Y_white * XYZ_w1, model.XYZ_to_rho(Y_white * XYZ_w1), True)}
     Y_white, Y_black = float(done[1.0].XYZ[1]), float(model.black_XYZ[1])
     aim = _Aim(Y_white, Y_black / Y_white, CALIBRATION_CURVES.lookup(curve).reference)
     loop.add_points(done, aim, points, refine_rounds)
-    return Calibration(
-        lut=loop.lut(done, aim),
-        white_xy=xy,
-        white=str(white),
-        curve=curve,
-        Y_white=Y_white,
-        Y_black=Y_black,
-        points=_points_record(done),
-        instrument=instrument,
-        display=getattr(display, "name", ""),
-    )
+    lut, record = loop.lut(done, aim), _points_record(done)
+    name = getattr(display, "name", "")
+    return Calibration(lut, xy, str(white), curve, Y_white, Y_black, record, instrument, name)
 
 
 def _points_record(done: dict) -> dict:
@@ -395,6 +470,8 @@ def _points_record(done: dict) -> dict:
         "drives": np.array([r.drives for r in rows]),
         "XYZ": np.array([r.XYZ for r in rows]),
         "iterations": np.array([r.iteration for r in rows]),
+        "readings": np.array([r.readings for r in rows]),
+        "floor_uv": np.array([r.floor_uv for r in rows]),
     }
 
 
@@ -411,12 +488,18 @@ def _brightest_white(model: _Characterization, xy, white: str) -> tuple[np.ndarr
 
 
 class _Point(NamedTuple):
-    """A control point's best reading: drives, XYZ, linear drives ρ, which reading (1 = first)."""
+    """A control point's best measurement and how it was reached.
+
+    Drives, XYZ, linear drives ρ, which measurement it was (1 = first), the readings taken for
+    the point in all and the u'v' standard error of the one kept.
+    """
 
     drives: np.ndarray
     XYZ: np.ndarray
     rho: np.ndarray
     iteration: int
+    readings: int
+    floor_uv: float
 
 
 class _Aim(NamedTuple):
@@ -436,7 +519,7 @@ class _Loop:
     """The calibration loop: the display's model, the instrument, the target white, tolerances."""
 
     model: _Characterization
-    measure: Callable  # drives (..., 3) -> XYZ (..., 3), cd/m²
+    read: _Reader  # drives (..., 3) -> averaged reading
     XYZ_w1: np.ndarray  # the target white, Y = 1
     tolerance_uv: float
     tolerance_Y: float
@@ -444,23 +527,33 @@ class _Loop:
 
     def run_point(self, target_XYZ, rho, is_white) -> _Point:
         """Measure and correct one point until it holds; the best reading (module docstring, 3.)."""
-        best = None
+        best, readings = None, 0
         for iteration in range(1, self.max_iterations + 1):
             drives = self.model.rho_to_drives(rho)
-            XYZ = self.measure(drives)
+            reading = self.read(drives)
+            XYZ, readings = reading.XYZ, readings + int(reading.count)
             duv = float(np.linalg.norm(XYZ_to_uv(XYZ) - XYZ_to_uv(target_XYZ)))
             dY = abs(XYZ[1] / target_XYZ[1] - 1.0)
-            score = duv / self.tolerance_uv + (0.0 if is_white else dY / self.tolerance_Y)
+            # the reading kept: the luminance held first (where the black makes the white's
+            # chromaticity unreachable, a reading closer in colour but off in Y is worse)
+            Y_held = is_white or dY <= max(self.tolerance_Y, 2.0 * reading.se_Y)
+            score = (
+                not Y_held,
+                duv / self.tolerance_uv + (0.0 if is_white else dY / self.tolerance_Y),
+            )
             if best is None or score < best[0]:
-                best = (score, drives, XYZ, rho, iteration)
-            if duv <= self.tolerance_uv and (is_white or dY <= self.tolerance_Y):
+                best = (score, drives, XYZ, rho, iteration, float(reading.se_uv))
+            # done when within the tolerances, or within what the instrument can still resolve
+            if duv <= max(self.tolerance_uv, 2.0 * reading.se_uv) and (
+                is_white or dY <= max(self.tolerance_Y, 2.0 * reading.se_Y)
+            ):
                 break
             if is_white:  # the white's luminance is whatever full drive gives
                 target_XYZ = XYZ[1] * self.XYZ_w1
             rho = _correct(self.model.P, rho, target_XYZ - XYZ)
             if is_white:  # the brightest white: one channel at full drive
                 rho = rho / rho.max()
-        return _Point(*best[1:])
+        return _Point(*best[1:5], readings, best[5])
 
     def add_point(self, done: dict, aim: _Aim, G_k) -> None:
         """Run the point at gray level ``G_k`` and record it in ``done``."""
@@ -481,7 +574,7 @@ class _Loop:
             room = 64 - len(G)
             if room <= 0:
                 break
-            XYZ = self.measure(_interp_lut(lut, middles))
+            XYZ = self.read(_interp_lut(lut, middles)).XYZ
             target_XYZ = aim.Y(middles)[:, None] * self.XYZ_w1
             miss_uv = np.linalg.norm(XYZ_to_uv(XYZ) - XYZ_to_uv(target_XYZ), axis=-1)
             miss_Y = np.abs(XYZ[:, 1] / target_XYZ[:, 1] - 1.0)
@@ -550,7 +643,7 @@ def _level_at(target, fraction, black_relative) -> float:
 
 
 def verify_calibration(
-    display: SpectralDisplay, calibration: Calibration, instrument: str = "ideal", seed: int = 1
+    display: SpectralDisplay, calibration: Calibration, instrument: str = "reference", seed: int = 1
 ) -> dict:
     """Measure the calibrated gray ramp at every input level (Figs. 6 and 7, Herbert et al.).
 
@@ -559,7 +652,9 @@ def verify_calibration(
     display : SpectralDisplay
     calibration : Calibration
     instrument : str
-        Who reads the ramp (default the noise-free ``ideal``: what the display really emits).
+        Who reads the ramp: ``"reference"`` (default), the
+        :class:`~reference.display.instruments.ReferenceMeter`, what the display really emits,
+        independent of the calibrating instruments; or a key of :data:`INSTRUMENTS`.
     seed : int
 
     Returns
@@ -579,7 +674,11 @@ def verify_calibration(
     """
     import colour
 
-    meter = INSTRUMENTS.lookup(instrument).reference()
+    meter = (
+        ReferenceMeter()
+        if instrument == "reference"
+        else INSTRUMENTS.lookup(instrument).reference()
+    )
     G = np.linspace(0.0, 1.0, calibration.lut.shape[1])
     XYZ = meter.measure(display, calibration.lut.T, np.random.default_rng(seed))
     target_uv = XYZ_to_uv(np.append(calibration.white_xy, 1.0 - calibration.white_xy.sum()))
@@ -593,3 +692,85 @@ def verify_calibration(
             "Y_target": Y_target,
             "Y_error": XYZ[:, 1] / Y_target - 1.0,
         }
+
+
+def calibration_targets(display: SpectralDisplay, calibration: Calibration) -> dict:
+    """The calibration against :data:`TARGET_DUV` and :data:`TARGET_Y`, read by the reference meter.
+
+    Returns
+    -------
+    dict
+        ``duv`` and ``Y``: the ``target``, the fraction of white it applies ``above``, the ``max``
+        found there, the fraction of white ``at`` which it is found, and whether it is ``met``;
+        ``met``: both; ``reachable_above``: the fraction of white below which no drives give the
+        white's chromaticity on this display (its black is of another colour), 0 if none.
+
+    Examples
+    --------
+    >>> from reference.display.spectral import spectral_display
+    >>> d = spectral_display()
+    >>> t = calibration_targets(d, calibrate_display(d, "D65", "gamma2.2", points=8))
+    >>> t["met"], t["duv"]["target"], t["reachable_above"]
+    (True, 0.001, 0.0)
+    """
+    v = verify_calibration(display, calibration)
+    fraction = v["Y_target"] / calibration.Y_white
+    found = {"meter": ReferenceMeter().name}
+    for key, values, (target, above) in (
+        ("duv", v["duv"], TARGET_DUV),
+        ("Y", np.abs(v["Y_error"]), TARGET_Y),
+    ):
+        where = np.flatnonzero(fraction > above)
+        worst = where[np.argmax(values[where])]
+        found[key] = {
+            "target": target,
+            "above": above,
+            "max": float(values[worst]),
+            "at": float(fraction[worst]),
+            "met": bool(values[worst] <= target),
+        }
+    found["met"] = found["duv"]["met"] and found["Y"]["met"]
+    found["reachable_above"] = _reachable_above(display, calibration)
+    return found
+
+
+def _reachable_above(display: SpectralDisplay, calibration: Calibration) -> float:
+    """The fraction of white below which the white's chromaticity needs a negative drive.
+
+    ``ρ(Y) = P⁻¹ (Y XYZ_w1 − XYZ_K)`` is affine in Y: channel c reaches zero at
+    ``Y = (P⁻¹ XYZ_K)_c / (P⁻¹ XYZ_w1)_c`` (read by the reference meter, channel drift aside).
+    """
+    meter = ReferenceMeter()
+    black = meter.measure(display, np.zeros(3))
+    P = (meter.measure(display, np.eye(3)) - black).T
+    xy = calibration.white_xy
+    direction = np.linalg.solve(P, [xy[0] / xy[1], 1.0, (1.0 - xy.sum()) / xy[1]])
+    Y_min = float(np.max(np.linalg.solve(P, black) / direction))
+    return max(Y_min / calibration.Y_white, 0.0)
+
+
+def targets_message(targets: dict) -> str:
+    """One line saying which target a calibration misses, where, and why if the display is why.
+
+    Examples
+    --------
+    >>> targets_message({"duv": {"target": 0.001, "above": 0.05, "max": 0.0246, "at": 0.051,
+    ...     "met": False}, "Y": {"met": True}, "met": False, "reachable_above": 0.062})
+    "Δu'v' 0.0246 at 5.1 % of white exceeds the target 0.001 above 5 % (this display gives the \
+white's chromaticity only above 6.2 % of white: its black is of another colour)"
+    """
+    parts = []
+    for key, name in (("duv", "Δu'v'"), ("Y", "|ΔY|/Y")):
+        t = targets[key]
+        if not t["met"]:
+            parts.append(
+                f"{name} {t['max']:.4f} at {100 * t['at']:.1f} % of white exceeds the target "
+                f"{t['target']:g} above {100 * t['above']:g} %"
+            )
+    line = "; ".join(parts)
+    if targets["reachable_above"] > TARGET_DUV[1]:
+        line += (
+            f" (this display gives the white's chromaticity only above "
+            f"{100 * targets['reachable_above']:.1f} % of white: its black is of another colour)"
+        )
+    return line

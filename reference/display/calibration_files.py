@@ -24,9 +24,14 @@ from pathlib import Path
 
 import numpy as np
 
-from reference.display.calibration import Calibration, curve_target, verify_calibration
+from reference.display.calibration import (
+    Calibration,
+    calibration_targets,
+    curve_target,
+    verify_calibration,
+)
 from reference.display.cgats import write_cal, write_ti3
-from reference.display.instruments import INSTRUMENTS
+from reference.display.instruments import INSTRUMENTS, ReferenceMeter
 from reference.display.spectral import SpectralDisplay
 from reference.errors import SpecrefError, require
 from reference.files import write_text_atomic
@@ -185,7 +190,10 @@ def read_cube(path) -> np.ndarray:
 
 
 def calibration_summary(display: SpectralDisplay, calibration: Calibration) -> dict:
-    """The JSON summary: targets, points and the verification (read by the noise-free instrument).
+    """The JSON summary: targets, points and the verification (read by the reference meter).
+
+    ``targets`` is :func:`~reference.display.calibration.calibration_targets` and
+    ``meets_targets`` whether both hold: a calibration that misses one is still written, marked.
 
     Examples
     --------
@@ -195,8 +203,11 @@ def calibration_summary(display: SpectralDisplay, calibration: Calibration) -> d
     >>> s = calibration_summary(d, cal)
     >>> s["white"], s["curve"], bool(s["verification"]["max_duv_above_5pct"] < 0.001)
     ('A', 'lstar', True)
+    >>> s["meets_targets"], s["verification"]["instrument"]
+    (True, 'reference')
     """
     v = verify_calibration(display, calibration)
+    targets = calibration_targets(display, calibration)
     above_5 = v["Y_target"] > 0.05 * calibration.Y_white
     above_1 = v["Y_target"] > 0.01 * calibration.Y_white
     levels = [*range(0, calibration.lut.shape[1], 16), calibration.lut.shape[1] - 1]
@@ -212,9 +223,12 @@ def calibration_summary(display: SpectralDisplay, calibration: Calibration) -> d
         "points": {
             "G": calibration.points["G"].tolist(),
             "iterations": calibration.points["iterations"].tolist(),
+            "readings": calibration.points["readings"].tolist(),
         },
+        "meets_targets": targets["met"],
+        "targets": targets,
         "verification": {
-            "instrument": "ideal",
+            "instrument": ReferenceMeter().name,
             "max_duv_above_5pct": float(v["duv"][above_5].max()),
             "max_abs_Y_error_above_1pct": float(np.abs(v["Y_error"][above_1]).max()),
             "gray": [

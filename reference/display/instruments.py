@@ -9,6 +9,9 @@ are our models of why (errata E51, E52):
   ``step_nm`` (5 nm, or 10 nm), with per-band noise ``σ = σ_dark + ρ L(λ)``; the dark part is
   absolute, so the relative error grows as the luminance falls. With both at zero it is the
   noise-free reference instrument (``ideal``).
+- :class:`ReferenceMeter`: the verifier, independent of both: the emitted spectrum integrated at
+  1 nm or finer without a band pass and without noise (what the display really emits). It is not
+  an instrument a calibration is read with, so it is not in :data:`INSTRUMENTS`.
 - :class:`Colorimeter`: three Gaussian filters that miss the CMFs, mapped to XYZ by a 3 × 3 matrix
   fitted in the factory on one display type (a CRT), so it errs on other (narrow-band) primaries;
   in the shadows an uncorrected dark offset and dark noise per filter (in cd/m² of white) take
@@ -39,6 +42,7 @@ from reference.registry import Method, Registry
 __all__ = [
     "INSTRUMENTS",
     "Colorimeter",
+    "ReferenceMeter",
     "Spectroradiometer",
     "colorimeter",
     "spectroradiometer",
@@ -177,6 +181,45 @@ class Colorimeter:
             sigma = self.dark_noise * unit + self.relative_noise * np.abs(signals)
             signals = signals + sigma * rng.standard_normal(signals.shape)
         return signals @ M.T
+
+
+@dataclass(frozen=True)
+class ReferenceMeter:
+    """The verification meter: the emitted spectrum integrated at ``step_nm`` or finer.
+
+    Independent of the calibrating instruments: no band pass (the display's spectra are resampled
+    linearly to ``step_nm`` where their grid is coarser, and summed with the CIE 1931 2° CMFs),
+    no noise. A calibration read by the 5 nm spectroradiometer is checked against it, not against
+    the noise-free version of its own band pass, which shares that instrument's error on
+    narrow-band primaries.
+
+    Attributes
+    ----------
+    step_nm : float
+        Integration step, nm.
+    name : str
+    """
+
+    step_nm: float = 1.0
+    name: str = "reference"
+
+    def measure(self, display: SpectralDisplay, drives, rng=None) -> np.ndarray:
+        """XYZ (cd/m²) the display emits for channel drives, shape (..., 3).
+
+        Examples
+        --------
+        >>> from reference.display.spectral import spectral_display
+        >>> ReferenceMeter().measure(spectral_display(), [1.0, 1.0, 1.0]).round(1)
+        array([105.8, 120. , 111. ])
+        """
+        spectra = display_drives_to_spectra(display, drives)
+        w = display.wavelengths_nm
+        if w[1] - w[0] > self.step_nm:
+            fine = np.arange(w[0], w[-1] + 1e-9, self.step_nm)
+            # linear resampling as one matrix: column i is the interpolant of the i-th unit vector
+            resample = np.stack([np.interp(fine, w, e) for e in np.eye(w.size)])
+            spectra, w = spectra @ resample, fine
+        return spectra_to_absolute_XYZ(spectra, w)
 
 
 def spectroradiometer() -> Spectroradiometer:

@@ -96,6 +96,40 @@ def primaries_crt_brainard():
     return _primaries_from_colour("Typical CRT Brainard 1997")
 
 
+def _gaussian_primaries(centres_nm, widths_nm):
+    """Three Gaussian primaries on a 1 nm grid, 380-780 nm, peak 1 (synthetic, erratum E105)."""
+    w = np.arange(380.0, 781.0, 1.0)
+    return w, np.stack(
+        [np.exp(-0.5 * ((w - c) / s) ** 2) for c, s in zip(centres_nm, widths_nm, strict=True)]
+    )
+
+
+def primaries_led_wide():
+    """A wide-gamut LED-like display: Gaussians at 630, 530, 460 nm (σ 12, 15, 10 nm), 1 nm grid.
+
+    Examples
+    --------
+    >>> w, s = primaries_led_wide()
+    >>> w.shape, s.shape
+    ((401,), (3, 401))
+    """
+    return _gaussian_primaries((630.0, 530.0, 460.0), (12.0, 15.0, 10.0))
+
+
+def primaries_laser():
+    """A narrow-band laser-like display: Gaussians at 638, 532, 450 nm (σ 1.5 nm), 1 nm grid.
+
+    Lines narrower than a 5 nm instrument's band pass (erratum E105).
+
+    Examples
+    --------
+    >>> w, s = primaries_laser()
+    >>> int(w[np.argmax(s[1])])
+    532
+    """
+    return _gaussian_primaries((638.0, 532.0, 450.0), (1.5, 1.5, 1.5))
+
+
 #: Display primaries by the keys of display files and the CLI; ``reference()`` returns
 #: ``(wavelengths_nm, spectra (3, n))``.
 DISPLAY_PRIMARIES = Registry("display primaries")
@@ -104,6 +138,12 @@ DISPLAY_PRIMARIES.register(
 )
 DISPLAY_PRIMARIES.register(
     Method("crt_brainard", primaries_crt_brainard, None, "colour: Typical CRT Brainard 1997")
+)
+DISPLAY_PRIMARIES.register(
+    Method("led_wide", primaries_led_wide, None, "synthetic: Gaussian LED-like primaries")
+)
+DISPLAY_PRIMARIES.register(
+    Method("laser", primaries_laser, None, "synthetic: 1.5 nm laser-like lines")
 )
 
 

@@ -5,6 +5,8 @@ Herbert et al. §6; docs/display.md.
 
 from __future__ import annotations
 
+import sys
+
 from validation.cli.parser import (
     Parser,
     input_file,
@@ -46,7 +48,8 @@ def _cmd_display_calibrate(args) -> int:
         )
     chart = v["colorchecker_delta_E00"]
     print(
-        f"verification (noise-free spectroradiometer): max Δu′v′ above 5 % of white "
+        "verification (reference meter: 1 nm, no band pass, no noise): max Δu′v′ above 5 % of "
+        f"white "
         f"{v['max_duv_above_5pct']:.5f}, max |ΔY|/Y above 1 % "
         f"{v['max_abs_Y_error_above_1pct']:.4f}; "
         f"ColorChecker ΔE00 mean {chart['mean']:.2f}, max {chart['max']:.2f}"
@@ -61,6 +64,16 @@ def _cmd_display_calibrate(args) -> int:
             f"max {check['max']:.2f}"
         )
     print("wrote " + ", ".join(summary["files"].values()))
+    if not summary["meets_targets"]:  # written and marked; the exit code says it (docs/display.md)
+        from reference.display.calibration import targets_message
+
+        json_file = summary["files"][".json"]
+        print(
+            f"display calibrate: {targets_message(summary['targets'])}; the files are written, "
+            f"marked meets_targets: false in {json_file}",
+            file=sys.stderr,
+        )
+        return 1
     return 0
 
 
@@ -84,7 +97,9 @@ def add_parser(sub) -> None:
         "calibrate",
         help="calibrate the simulated display; write .cal, .cube, .ti3 and .json",
         description="Iterate per point (measure, correct, re-measure) to a white and a tone "
-        "curve; see docs/display.md.",
+        "curve, and verify with an independent reference meter; see docs/display.md. Exit code 1 "
+        "when a target is missed (the files are written, marked meets_targets: false), 2 on bad "
+        "input.",
     )
     c.add_argument(
         "--white", default="D65", help=f"{', '.join(WHITES)} or x,y chromaticity (default D65)"

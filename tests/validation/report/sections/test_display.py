@@ -9,9 +9,19 @@ def test_report_display_section(tmp_path):
     )
     section = results["sections"]["display-calibration"]
     # 4 whites x 5 curves x 2 targets, the instrument comparison, 3 compensated observers (a
-    # gray and the painting), the scene on its calibrated display
-    assert len(results["checks"]) == 48
-    assert all(c["passed"] for c in results["checks"])
+    # gray and the painting), the scene on its calibrated display; the default instrument on four
+    # displays x 2 targets
+    assert len(results["checks"]) == 48 + 8
+    # a known limit (erratum E105): on the laser-like display the luminance misses between 1 and
+    # 1.4 % of white, where two channels are at zero; every other target holds
+    failed = [c["name"] for c in results["checks"] if not c["passed"]]
+    assert failed == [
+        "max |ΔY|/Y above 1 % of white, default spectroradiometer, held out: laser D65 gamma2.2, "
+        "reference meter"
+    ]
+    held_out = section["default_instrument"]
+    assert {r["role"] for r in held_out.values()} == {"designed on", "held out"}
+    assert max(r["max_duv_above_5pct"] for r in held_out.values()) <= 0.001
     assert set(section["whites"]) == {"D65", "F2", "A", "D50"}
     instruments = section["instruments"]
     assert instruments["colorimeter"]["bands"]["5-12.5 %"] > 0.004
