@@ -77,6 +77,7 @@ __all__ = [
     "CV_SEED",
     "DEFAULT_LOSS",
     "MAX_RIDGE",
+    "NONNEGATIVE_STRENGTH",
     "PIXELS_PER_BLOCK",
     "REGRESSION_FEATURES",
     "REGRESSION_LOSSES",
@@ -90,6 +91,8 @@ __all__ = [
     "features_RGB",
     "fit_regression",
     "load_regression",
+    "model_XYZ_weights",
+    "project_nonnegative",
     "save_regression",
     "spectralize_blocks",
     "spectralize_rows",
@@ -1004,6 +1007,71 @@ def load_regression(path, wavelengths_nm=None) -> SpectralRegression:
     return model
 
 
+#: μ of :func:`project_nonnegative`: how much the colour outweighs the spectrum's shape (in units
+#: of the weights' largest value), large enough to keep XYZ to ~1e-6 where a non-negative spectrum
+#: of that XYZ exists.
+NONNEGATIVE_STRENGTH = 1e3
+
+
+def project_nonnegative(spectra, weights, strength: float = NONNEGATIVE_STRENGTH):
+    """Spectra with negative values replaced by the nearest non-negative ones of the same colour.
+
+    A regression's prediction can go negative (a polynomial is not bounded below); a spectrum
+    cannot. Each spectrum ``s`` with a value below zero becomes
+
+    ``s' = argmin_{s' >= 0} ||s' − s||² + (μ/w)² ||Wᵀ (s' − s)||²``
+
+    with ``W`` the ``(n, 3)`` XYZ weights, ``w`` their largest value and ``μ`` = ``strength``:
+    non-negative least squares on the stacked system (Lawson & Hanson 1974,
+    ``scipy.optimize.nnls``). Where a non-negative spectrum of the same XYZ exists (any colour
+    inside the spectral locus) the colour is kept and the change is the least one; otherwise the
+    colour moves as little as the constraint allows. Our choice, erratum E106.
+
+    Parameters
+    ----------
+    spectra : array_like, shape (N, n)
+    weights : array_like, shape (n, 3)
+        XYZ per band (e.g. ``band_weights`` under the capture illuminant).
+    strength : float
+
+    Returns
+    -------
+    projected : ndarray, shape (N, n), float64
+        Rows without a negative value are returned unchanged.
+    changed : dict
+        ``values``: negative values replaced, ``pixels``: spectra projected, ``min``: the most
+        negative value found (0 if none).
+
+    Examples
+    --------
+    >>> W = np.array([[0.1, 0, 0.6], [0.3, 0.2, 0.9], [0.2, 0.7, 0.1], [0.6, 0.6, 0],
+    ...               [0.5, 0.1, 0]])
+    >>> s = np.array([[0.3, 0.5, 0.2, 0.4, 0.4], [0.4, -0.05, 0.7, 0.5, 0.6]])
+    >>> p, changed = project_nonnegative(s, W)
+    >>> p[1].round(4), changed
+    (array([0.3266, 0.    , 0.6902, 0.4958, 0.5936]), {'values': 1, 'pixels': 1, 'min': -0.05})
+    >>> bool(np.array_equal(p[0], s[0])), bool(np.abs(p @ W - s @ W).max() < 1e-6)
+    (True, True)
+    """
+    from scipy.optimize import nnls
+
+    S = np.array(spectra, dtype=np.float64)
+    W = np.asarray(weights, dtype=np.float64)
+    negative = S < 0.0
+    rows = np.flatnonzero(negative.any(axis=1))
+    changed = {
+        "values": int(negative.sum()),
+        "pixels": int(rows.size),
+        "min": float(S.min()) if rows.size else 0.0,
+    }
+    scale = strength / np.abs(W).max()
+    A = np.vstack([np.eye(S.shape[1]), scale * W.T])
+    for i in rows:
+        # Lawson & Hanson 1974: non-negative least squares on [I; μ/w Wᵀ] s' ≈ [s; μ/w Wᵀ s]
+        S[i], _ = nnls(A, np.concatenate([S[i], scale * (W.T @ S[i])]))
+    return S, changed
+
+
 def spectralize_blocks(model: SpectralRegression, RGB, rows_per_block: int | None = None):
     """Spectralize an image block of rows by block: yields ``(row0, spectra float32)``.
 
@@ -1047,8 +1115,46 @@ def spectralize_blocks(model: SpectralRegression, RGB, rows_per_block: int | Non
     return spectralize_rows(model, lambda a, b: RGB[a:b], *RGB.shape[:2], rows_per_block)
 
 
+def model_XYZ_weights(model: SpectralRegression) -> np.ndarray:
+    """``(n_bands, 3)`` XYZ weights of the model's bands under its capture illuminant.
+
+    Examples
+    --------
+    >>> from reference.colour.spectra import GRID_41
+    >>> model = SpectralRegression("polynomial", 1, np.ones((3, 41)), GRID_41.wavelengths_nm)
+    >>> model_XYZ_weights(model).shape
+    (41, 3)
+    """
+    from reference.colour.colorimetry import band_weights
+    from reference.colour.spectra import SpectralGrid, spectrum_from_dataset
+
+    w = model.wavelengths_nm
+    step = float(w[1] - w[0]) if w.size > 1 else 0.0
+    require(
+        step > 0 and np.allclose(np.diff(w), step),
+        "regression: the model's wavelengths must be a uniform grid",
+    )
+    grid = SpectralGrid(float(w[0]), float(w[-1]), step)
+    return band_weights(grid, spectrum_from_dataset("illuminant", model.illuminant))
+
+
+def _count_projected(total: dict | None, found: dict) -> None:
+    """Add :func:`project_nonnegative`'s ``changed`` to a running ``total`` (None: not kept)."""
+    if total is None:
+        return
+    total["values"] = total.get("values", 0) + found["values"]
+    total["pixels"] = total.get("pixels", 0) + found["pixels"]
+    total["min"] = min(total.get("min", 0.0), found["min"])
+
+
 def spectralize_rows(
-    model: SpectralRegression, read_rows, height: int, width: int, rows_per_block=None, where=None
+    model: SpectralRegression,
+    read_rows,
+    height: int,
+    width: int,
+    rows_per_block=None,
+    where=None,
+    projected: dict | None = None,
 ):
     """Spectralize rows that ``read_rows(row0, row1)`` supplies, block by block, in order.
 
@@ -1056,7 +1162,10 @@ def spectralize_rows(
     ``(row1 - row0, width, >= 3)`` RGB (extra channels ignored), e.g. a file's row window
     (:func:`reference.images.spectral.open_panorama_rows`), so neither the input nor the output is
     ever held whole. ``where`` names the input in error messages. Yields as
-    :func:`spectralize_blocks` does.
+    :func:`spectralize_blocks` does. Spectra with a negative value are projected onto
+    non-negative ones of the same colour under the model's illuminant
+    (:func:`project_nonnegative`, erratum E106); ``projected``, when given, receives the count
+    (``values``, ``pixels``, ``min``).
 
     Examples
     --------
@@ -1077,6 +1186,7 @@ def spectralize_rows(
     RGB32 = np.empty((rows * width, 3), np.float32)
     X_T = np.empty((model.coefficients.shape[0], rows * width), np.float32)
     S32 = np.empty((rows * width, model.n_bands), np.float32)
+    weights = None  # the XYZ weights, made when a block first needs them
     for row0 in range(0, height, rows):
         block = read_rows(row0, min(row0 + rows, height))[..., :3]
         n = block.shape[0] * block.shape[1]
@@ -1087,4 +1197,9 @@ def spectralize_rows(
             f"{where}: RGB must be finite and >= 0 (rows {row0}-{row0 + len(block) - 1})",
         )
         spectra = model._predict_flat(RGB32[:n], X_T[:, :n], S32[:n])
+        negative = (spectra < 0.0).any(axis=1)
+        if negative.any():  # erratum E106: no negative radiance, the colour kept
+            weights = model_XYZ_weights(model) if weights is None else weights
+            spectra[negative], found = project_nonnegative(spectra[negative], weights)
+            _count_projected(projected, found)
         yield row0, spectra.reshape(*block.shape[:2], model.n_bands)

@@ -257,6 +257,11 @@ def RGB_to_spectra_regression(RGB, grid: SpectralGrid, model=None) -> np.ndarray
     elif not hasattr(model, "predict"):
         model = load_upsampling_model(model, grid)
     S = model.predict(np.asarray(RGB, dtype=np.float64))
+    negative = (S < 0.0).any(axis=-1)
+    if negative.any():  # erratum E106: no negative spectrum, the colour kept
+        from reference.colour.spectral_regression import model_XYZ_weights, project_nonnegative
+
+        S[negative] = project_nonnegative(S[negative], model_XYZ_weights(model))[0]
     wl = grid.wavelengths_nm
     if wl.shape == model.wavelengths_nm.shape and np.array_equal(wl, model.wavelengths_nm):
         return S

@@ -534,7 +534,9 @@ def spectralize_file(panorama, model, out, rows_per_block: int | None = None) ->
     -------
     dict
         ``out``, ``height``, ``width``, ``bands``, ``blocks``, ``streamed`` (False when the
-        input's layout forced a whole read, :func:`open_panorama_rows`).
+        input's layout forced a whole read, :func:`open_panorama_rows`), ``projected``: the
+        negative values replaced, the pixels they were in and the most negative value (erratum
+        E106; a file's header is written before its rows, so the count is here, not in it).
 
     Raises
     ------
@@ -562,11 +564,11 @@ def spectralize_file(panorama, model, out, rows_per_block: int | None = None) ->
             suffix in SPECTRAL_FORMATS,
             f"{out}: unsupported spectral image type {suffix!r}; allowed: .exr, .tif, .tiff, .zarr",
         )
-        count = [0]
+        count, projected = [0], {"values": 0, "pixels": 0, "min": 0.0}
 
         def counted():
             blocks = spectralize_rows(
-                model, rows.read, rows.height, rows.width, rows_per_block, panorama
+                model, rows.read, rows.height, rows.width, rows_per_block, panorama, projected
             )
             for item in blocks:
                 count[0] += 1
@@ -580,6 +582,7 @@ def spectralize_file(panorama, model, out, rows_per_block: int | None = None) ->
         "bands": model.n_bands,
         "blocks": count[0],
         "streamed": rows.streamed,
+        "projected": projected,
     }
 
 

@@ -40,6 +40,13 @@ def _cmd_env_spectralize(args) -> int:
         f"wrote {info['out']}: {info['height']}x{info['width']}, {info['bands']} bands, "
         f"{info['blocks']} row blocks"
     )
+    projected = info["projected"]
+    if projected["values"]:
+        print(
+            f"projected {projected['values']} negative band values in {projected['pixels']} "
+            f"pixels (most negative {projected['min']:.4g}) onto non-negative spectra of the same "
+            "colour (erratum E106)"
+        )
     return 0
 
 

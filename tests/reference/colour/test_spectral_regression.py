@@ -353,7 +353,8 @@ def test_spectralize_float32_within_the_rounding_bound(rng, kind, degree):
 
     shipped = default_regression()
     K = len(feature_exponents(kind, degree))
-    C = rng.normal(0.0, 3.0, (K, shipped.n_bands))
+    # non-negative coefficients: non-negative spectra, none projected (erratum E106)
+    C = np.abs(rng.normal(0.0, 3.0, (K, shipped.n_bands)))
     model = SpectralRegression(kind, degree, C, shipped.wavelengths_nm)
     RGB = rng.uniform(0, 1, (16, 32, 3)) * 10.0 ** rng.uniform(-3, 4, (16, 32, 1))
     fast = np.concatenate([b.copy() for _, b in spectralize_blocks(model, RGB, rows_per_block=5)])

@@ -53,7 +53,12 @@ def test_tiny_settings_give_every_table_row_and_fit(tiny):
 def test_checks_and_headlines_name_the_features_they_gate(tiny):
     _, data, _ = tiny
     found = checks(data)
-    assert len(found) == 4
+    # the four targets of the fit, then the panorama's projection (erratum E106)
+    assert len(found) == 5
+    projection = found.pop()
+    assert "negative band values projected" in projection.name
+    assert projection.passed
+    assert data.results["nonnegative"]["values"] == 29
     assert all("root-polynomial 1, " in c.name for c in found)
     cc = data.results["regression"][0]["held_out"]["ColorChecker N Ohta"]
     measured = {c.name.split(" ΔE94")[0]: c.measured for c in found}
