@@ -20,7 +20,15 @@ import math
 
 import numpy as np
 
-from validation.report.types import Image, ReportPart, ReportSection, SectionResult, Table, Text
+from validation.report.types import (
+    CHECK_BASES,
+    Image,
+    ReportPart,
+    ReportSection,
+    SectionResult,
+    Table,
+    Text,
+)
 
 __all__ = ["MIN_WIDTH", "render_html", "render_markdown", "shown_size"]
 
@@ -104,23 +112,39 @@ def _html_checks(rows, with_section: bool) -> str:
     head = "<th>section</th>" if with_section else ""
     out = [
         f"<div class='scroll'><table><tr>{head}<th>check</th><th>target</th><th>measured</th>"
-        "<th>holds</th></tr>"
+        "<th>measured on</th><th>holds</th></tr>"
     ]
     for section, c in rows:
         mark = "<span class='ok'>yes</span>" if c.passed else "<span class='fail'>NO</span>"
         first = f"<td>{esc(section.title)}</td>" if with_section else ""
         out.append(
             f"<tr>{first}<td>{esc(c.name)}</td><td>{esc(c.target)}</td>"
-            f"<td>{esc(_cell(c.measured, '{:.4g}'))}</td><td>{mark}</td></tr>"
+            f"<td>{esc(_cell(c.measured, '{:.4g}'))}</td><td>{esc(_basis(c))}</td>"
+            f"<td>{mark}</td></tr>"
         )
     out.append("</table></div>")
     return "".join(out)
 
 
+def _basis(check) -> str:
+    """What a check is measured on, as its table shows it (``CHECK_BASES``)."""
+    return check.basis or "not stated"
+
+
 def _count(checks) -> str:
+    """How many targets hold; then, once any states its basis, the count per basis."""
     failed = sum(not c.passed for c in checks)
     text = f"{len(checks) - failed} of {len(checks)} targets hold"
-    return text + (f"; {failed} do not" if failed else "")
+    text += f"; {failed} do not" if failed else ""
+    if not any(c.basis for c in checks):
+        return text
+    parts = []
+    for basis in (*CHECK_BASES, ""):
+        group = [c for c in checks if c.basis == basis]
+        if group:
+            held = sum(c.passed for c in group)
+            parts.append(f"{basis or 'not stated'} {held} of {len(group)}")
+    return f"{text} (measured on {', '.join(parts)})"
 
 
 def _first_image(results: list[SectionResult], sections: list[ReportSection]) -> Image | None:
@@ -315,11 +339,15 @@ def render_html(title: str, meta: dict, sections, parts=None, pending=()) -> str
 
 def _md_checks(rows, with_section: bool) -> list[str]:
     head = "| section " if with_section else ""
-    lines = [f"{head}| check | target | measured | holds |", "|---" * (4 + with_section) + "|"]
+    lines = [
+        f"{head}| check | target | measured | measured on | holds |",
+        "|---" * (5 + with_section) + "|",
+    ]
     for section, c in rows:
         first = f"| {section.title} " if with_section else ""
         holds = "yes" if c.passed else "**NO**"
-        lines.append(f"{first}| {c.name} | {c.target} | {_cell(c.measured, '{:.4g}')} | {holds} |")
+        measured = _cell(c.measured, "{:.4g}")
+        lines.append(f"{first}| {c.name} | {c.target} | {measured} | {_basis(c)} | {holds} |")
     return lines
 
 

@@ -93,6 +93,38 @@ def test_registered_section_renders_blocks(tmp_path):
     assert f"cores: {meta['cores']}" in html
 
 
+def test_each_target_says_what_it_is_measured_on(tmp_path):
+    # A target's basis (design inputs, held-out inputs, an independent renderer) is a column of
+    # every targets table and the summary counts each apart, with those not yet stated
+    def checks(data):
+        return [
+            Check("a", "<= 1", 0.5, True, "design"),
+            Check("b", "<= 1", 2.0, False, "held out"),
+            Check("c", "<= 1", 0.1, True, "held out"),
+            Check("d", "<= 1", 0.1, True, "independent"),
+            Check("e", "<= 1", 0.1, True),
+        ]
+
+    section = ReportSection("test-only", "Test only", lambda ctx: SectionData(), lambda c, d: [],
+                            checks)  # fmt: skip
+    results = run_report(
+        tmp_path, effort="quick", only=["test-only"], progress=False, sections=[section]
+    )
+    html = (tmp_path / "index.html").read_text()
+    assert (
+        "4 of 5 targets hold; 1 do not (measured on design 1 of 1, held out 1 of 2, "
+        "independent 1 of 1, not stated 1 of 1)"
+    ) in html
+    assert "<th>measured on</th>" in html
+    assert "<td>held out</td>" in html
+    assert "<td>not stated</td>" in html
+    assert [c["basis"] for c in results["checks"]] == [
+        "design", "held out", "held out", "independent", ""
+    ]  # fmt: skip
+    with pytest.raises(ValueError, match="allowed: design, held out, independent"):
+        Check("f", "<= 1", 0.1, True, "tuned")
+
+
 def test_bench_groups_filters_by_prefix():
     ctx = ReportContext(out_dir=".", bench={"benchmarks": [{"group": "raster-a"}, {"group": "sh"}]})
     assert list(ctx.bench_groups("raster")) == ["raster-a"]

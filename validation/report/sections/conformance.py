@@ -78,7 +78,13 @@ def checks(data: SectionData) -> list:
     if not r["available"]:
         return []
     out = [
-        Check(f"{s['scene']}: Mitsuba 3 passes", "passed", s["block_rel_Y"], s["passed"])
+        Check(
+            f"{s['scene']}: Mitsuba 3 passes",
+            "passed",
+            s["block_rel_Y"],
+            s["passed"],
+            "independent",
+        )
         for s in r["scenes"]
     ]
     out += [
@@ -87,6 +93,7 @@ def checks(data: SectionData) -> list:
             b["made"],
             b["named"],
             (not b["passed"]) and b["named"] == b["made"],
+            "independent",
         )
         for b in r["broken"]
     ]

@@ -113,6 +113,7 @@ def checks(data: SectionData) -> list:
                 f"<= {limit:.3g}",
                 c["rms_z"],
                 c["rms_z"] <= limit,
+                "independent",
             )
         )
         out.append(
@@ -121,6 +122,7 @@ def checks(data: SectionData) -> list:
                 f"|.| <= {MEAN_REL_Y_TARGET}",
                 c["mean_rel_Y"],
                 abs(c["mean_rel_Y"]) <= MEAN_REL_Y_TARGET,
+                "independent",
             )
         )
     return out
