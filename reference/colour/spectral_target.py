@@ -18,6 +18,11 @@ from a camera's spectral sensitivities and reflectance sets that colour-science 
   of CIE 224:2017 (colour fidelity index; real objects chosen to cover colour space uniformly)
   minus those with a look-alike in the training set (same thresholds), measured after every
   design choice was made, to check that a choice did not fit the sets above.
+- **Every set** (:data:`EVALUATION_SETS`): the above, the other ColorChecker measurements
+  (BabelColor Average, ISO 17321-1, PMC: their look-alikes are out of training too), the CIE 1995
+  test colour samples and NIST CQS 7.4, and the 18 Nix Spectro 2 measurements that specref ships
+  (:data:`MEASURED_SET`, 400-700 nm, constant beyond); the last three minus the patches with a
+  training look-alike, as the CIE 2017 samples.
 - **Cameras** (:data:`CAMERAS`): colour-science's ``MSDS_CAMERA_SENSITIVITIES`` (Nikon 5100 and
   Sigma SD Merrill, NPL measurements), and ``sRGB``: the CIE 1931 2° observer through the XYZ →
   linear sRGB matrix, i.e. the RGB of the sRGB-encoded maps scenes use.
@@ -46,8 +51,10 @@ from reference.registry import Registry
 __all__ = [
     "CAMERAS",
     "DEFAULT_AUGMENTATION",
+    "EVALUATION_SETS",
     "FINE_GRID",
     "HELD_OUT_SETS",
+    "MEASURED_SET",
     "OTHER_TEST_SET",
     "TARGET_AUGMENTATIONS",
     "TRAINING_SET",
@@ -81,10 +88,21 @@ def _colour_sets():
 
 #: The CIE 2017 colour evaluation samples without a training look-alike (module docstring).
 OTHER_TEST_SET = "CIE 2017 TCS minus training look-alikes"
+#: The Nix Spectro 2 measurements specref ships, without a training look-alike.
+MEASURED_SET = "physicallybased Nix minus training look-alikes"
+# Sets evaluated without their training look-alikes: name -> source set.
+_FILTERED_SETS = {
+    OTHER_TEST_SET: "CIE 2017 TCS",
+    "CIE 1995 TCS minus training look-alikes": "CIE 1995 TCS",
+    "NIST CQS 7.4 minus training look-alikes": "NIST CQS 7.4",
+    MEASURED_SET: "physicallybased Nix",
+}
 #: Reflectance sets never used in training (and whose look-alikes are removed from training).
 HELD_OUT_SETS = ("ColorChecker N Ohta", "CIE 2024 TCS", "NIST CQS 9.0")
 # Further sets whose look-alikes are removed: the other ColorChecker measurements.
 _LOOKALIKE_SETS = (*HELD_OUT_SETS, "BabelColor Average", "ISO 17321-1", "PMC")
+#: Every reflectance set a fit is evaluated on (module docstring): none is read by the fitting.
+EVALUATION_SETS = (*_LOOKALIKE_SETS, *_FILTERED_SETS)
 # Look-alike thresholds (erratum E40).
 _LOOKALIKE_RMS = 0.03
 _LOOKALIKE_DELTA_E94 = 2.0
@@ -132,6 +150,32 @@ def _cie2017_samples() -> tuple[tuple[str, ...], np.ndarray]:
 
 
 @functools.cache
+def _source_set(name: str) -> tuple[tuple[str, ...], np.ndarray]:
+    """A source of :data:`_FILTERED_SETS` on :data:`FINE_GRID`, every patch."""
+    import colour
+
+    if name == "CIE 2017 TCS":
+        return _cie2017_samples()
+    if name == "physicallybased Nix":
+        from reference.colour.spectra import resample_spectrum, spectrum_from_csv
+        from reference.data import measured_spectra_folder
+
+        paths = sorted(measured_spectra_folder().glob("*__nix_export.csv"))
+        labels = tuple(p.name.split("__")[0] for p in paths)
+        values = np.stack(
+            [
+                resample_spectrum(spectrum_from_csv(p), FINE_GRID, extrapolation="constant")
+                for p in paths
+            ]
+        )
+        return labels, values
+    sds = {"CIE 1995 TCS": colour.quality.SDS_TCS["CIE 1995"]}
+    sds["NIST CQS 7.4"] = colour.quality.SDS_VS["NIST CQS 7.4"]
+    labels, values = _on_fine_grid(sds[name])
+    return tuple(labels), values
+
+
+@functools.cache
 def _reflectance_set(name: str) -> tuple[tuple[str, ...], np.ndarray]:
     if name == TRAINING_SET:
         from colour.characterisation import read_training_data_rawtoaces_v1
@@ -148,8 +192,8 @@ def _reflectance_set(name: str) -> tuple[tuple[str, ...], np.ndarray]:
         keep = ~_has_lookalike(values, np.concatenate(refs))
         labels = [label for label, k in zip(labels, keep, strict=True) if k]
         values = values[keep]
-    elif name == OTHER_TEST_SET:
-        all_labels, values = _cie2017_samples()
+    elif name in _FILTERED_SETS:
+        all_labels, values = _source_set(_FILTERED_SETS[name])
         keep = ~_has_lookalike(values, _reflectance_set(TRAINING_SET)[1])
         labels = [label for label, k in zip(all_labels, keep, strict=True) if k]
         values = values[keep]
@@ -158,7 +202,7 @@ def _reflectance_set(name: str) -> tuple[tuple[str, ...], np.ndarray]:
         require(
             name in sets,
             f"unknown reflectance set {name!r}; allowed: {', '.join(sets)}, {TRAINING_SET}, "
-            f"{OTHER_TEST_SET}",
+            f"{', '.join(_FILTERED_SETS)}",
         )
         labels, values = _on_fine_grid(sets[name])
     values.setflags(write=False)

@@ -135,3 +135,51 @@ def test_smoothness_prior_does_not_reach_the_peak(kind, degree):
     assert study["held_out"][CC]["D65 mean"] <= 0.77
     assert study["held_out"][CC]["D65 max"] > 1.5
     assert study["clipped"][CC]["D65 max"] > 1.5
+
+
+def test_the_fit_reads_the_training_set_alone(monkeypatch):
+    # The sets a fit is measured on are never read by the fit: the training set (built once, its
+    # look-alikes of the held-out charts removed, erratum E40) is the only set it asks for, and
+    # the regression (features, loss, augmentation weight, λ and β by cross-validation) gets the
+    # training patches' arrays only
+    import validation.studies.spectral_env as study
+    from reference.colour.spectral_target import TRAINING_SET, reflectance_set
+
+    asked, sizes = [], []
+    monkeypatch.setattr(
+        study, "reflectance_set", lambda name, *a: asked.append(name) or reflectance_set(name, *a)
+    )
+    fit = study.fit_regression
+    monkeypatch.setattr(
+        study,
+        "fit_regression",
+        lambda RGB, spectra, *a: sizes.append(len(RGB)) or fit(RGB, spectra, *a),
+    )
+    study._fit_target("root_polynomial", 2, study.CAMERA, True, None, "D65", "colorimetric",
+                      None, "products")  # fmt: skip
+    assert set(asked) == {TRAINING_SET}
+    assert sizes == [len(reflectance_set(TRAINING_SET)[0])]
+
+
+def test_every_set_is_measured_against_the_cameras_floor():
+    # The noise-free floor of every_set_study is XYZ_floor's (computed apart), and each target
+    # flag is its figure against that floor plus the margin (erratum E107)
+    from reference.colour.spectral_target import EVALUATION_SETS
+    from validation.studies.spectral_env import (
+        FLOOR_MARGIN_MAX,
+        FLOOR_MARGIN_MEAN,
+        XYZ_floor,
+        every_set_study,
+    )
+
+    rows = every_set_study("root_polynomial", 1)
+    assert [r["set"] for r in rows] == [*EVALUATION_SETS, *EVALUATION_SETS]
+    floor = XYZ_floor("root_polynomial", 1, sets=EVALUATION_SETS)
+    for r in rows[: len(EVALUATION_SETS)]:
+        assert r["floor mean"] == pytest.approx(floor[r["set"]]["D65 mean"], rel=1e-9)
+        assert r["floor max"] == pytest.approx(floor[r["set"]]["D65 max"], rel=1e-9)
+    for r in rows:
+        assert r["mean met"] == (r["mean"] <= r["floor mean"] + FLOOR_MARGIN_MEAN)
+        assert r["max met"] == (r["max"] <= r["floor max"] + FLOOR_MARGIN_MAX)
+    noisy = {r["set"]: r for r in rows[len(EVALUATION_SETS) :]}
+    assert all(noisy[r["set"]]["mean"] != r["mean"] for r in rows[: len(EVALUATION_SETS)])

@@ -21,7 +21,10 @@ from validation.report import (
 )
 from validation.studies.spectral_env import (
     CAMERA,
+    FLOOR_MARGIN_MAX,
+    FLOOR_MARGIN_MEAN,
     RECOVERY_METHODS,
+    every_set_study,
     fit_target,
     held_out_figures,
     recovery_figures,
@@ -205,6 +208,7 @@ def spectral_environments(
         }
     panorama = _panorama(s["box"])
     data.results["nonnegative"] = nonnegative_study()
+    data.results["every_set"] = every_set_study(*s["shipped"])
     data.results["picks"] = panorama["picks"]
     data.arrays["panorama"] = panorama
     return data
@@ -249,6 +253,7 @@ def present(ctx: ReportContext, data: SectionData) -> list:
                 f"(throughput ratio {speed['throughput_ratio']:.2f})."
             )
         )
+    blocks.append(_every_set_table(data))
     blocks += _panorama_blocks(ctx, data)
     return blocks
 
@@ -408,6 +413,51 @@ def _degree_chart(ctx: ReportContext, data: SectionData) -> list:
     return blocks
 
 
+def _every_set_table(data: SectionData) -> Table:
+    """The shipped fit on every reflectance set against the camera's floor (erratum E107)."""
+    rows = [
+        [
+            r["set"],
+            "yes" if r["noise"] else "no",
+            r["patches"],
+            r["mean"],
+            r["floor mean"],
+            r["max"],
+            r["floor max"],
+            r["A mean"],
+        ]
+        for r in data.results["every_set"]
+    ]
+    return Table(
+        ["set", "camera noise", "patches", "mean ΔE94", "floor mean", "max ΔE94", "floor max",
+         "A mean"],
+        rows,
+        f"{_features_label(data)} on every reflectance set, none of them read by the fit, against "
+        "the camera's floor (the least-squares RGB → XYZ map on the same features and training "
+        f"RGB, read from the same camera RGB): targets mean ≤ floor + {FLOOR_MARGIN_MEAN}, max ≤ "
+        f"floor + {FLOOR_MARGIN_MAX} (erratum E107)",
+    )  # fmt: skip
+
+
+def _every_set_checks(data: SectionData) -> list[Check]:
+    """Mean and max on every set against the camera's floor, noise-free and noisy (E107)."""
+    found = []
+    for r in data.results.get("every_set", []):
+        where = f"{r['set']}{', camera noise' if r['noise'] else ''}, {_features_label(data)}"
+        for key, margin in (("mean", FLOOR_MARGIN_MEAN), ("max", FLOOR_MARGIN_MAX)):
+            limit = r[f"floor {key}"] + margin
+            found.append(
+                Check(
+                    f"{key} ΔE94 (D65) within the camera's floor + {margin:g}, {where}",
+                    f"<= {limit:.3g}",
+                    r[key],
+                    r[f"{key} met"],
+                    "held out",
+                )
+            )
+    return found
+
+
 def _panorama_blocks(ctx: ReportContext, data: SectionData) -> list:
     """The spectral panorama relit under D65, A and FL2, and picked spectra."""
     import matplotlib.pyplot as plt
@@ -495,6 +545,7 @@ def checks(data: SectionData) -> list[Check]:
                 "held out",
             )
         )
+    found += _every_set_checks(data)
     if "Jakob 2019" in data.results["recovery"]:
         jakob = data.results["recovery"]["Jakob 2019"]["A mean"]
         found.append(

@@ -8,6 +8,7 @@ import json
 
 import pytest
 
+from reference.colour.spectral_target import EVALUATION_SETS
 from validation.report import ReportContext, to_jsonable
 from validation.report.sections.spectral_env import (
     SETTINGS,
@@ -53,13 +54,19 @@ def test_tiny_settings_give_every_table_row_and_fit(tiny):
 def test_checks_and_headlines_name_the_features_they_gate(tiny):
     _, data, _ = tiny
     found = checks(data)
-    # the four targets of the fit, then the panorama's projection (erratum E106)
+    # the four targets of the fit, the panorama's projection (erratum E106), then mean and max
+    # on every reflectance set, noise-free and noisy, against the camera's floor (erratum E107)
+    every = [c for c in found if "camera's floor" in c.name]
+    assert len(every) == 2 * 2 * len(EVALUATION_SETS)
+    assert {c.basis for c in every} == {"held out"}
+    found = [c for c in found if c not in every]
     assert len(found) == 5
     projection = found.pop()
     assert "negative band values projected" in projection.name
     assert projection.passed
     assert data.results["nonnegative"]["values"] == 29
     assert all("root-polynomial 1, " in c.name for c in found)
+    assert all(c.name.endswith(", root-polynomial 1") for c in every)
     cc = data.results["regression"][0]["held_out"]["ColorChecker N Ohta"]
     measured = {c.name.split(" ΔE94")[0]: c.measured for c in found}
     assert measured["D65 mean"] == cc["D65 mean"]
