@@ -58,7 +58,7 @@ import time
 import warnings
 import zlib
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -69,11 +69,13 @@ from reference.files import atomic_write, default_cache_dir, output_error
 __all__ = [
     "CACHE_MAGIC",
     "DEFAULT_MAX_BYTES",
+    "OTHER_SPECREF_CACHES",
     "Cache",
     "CacheInfo",
     "cache_key",
     "default_cache_dir",
     "hash_inputs",
+    "other_specref_cache",
 ]
 
 #: The first bytes of every entry; a file without them is not ours and is never deleted.
@@ -201,6 +203,9 @@ class CacheInfo:
         The size limit.
     foreign : list of str
         Names of files in the folder that are not ours (ignored, never deleted).
+    others : dict
+        specref's other caches in the folder (:data:`OTHER_SPECREF_CACHES`): name -> what it
+        is (neither map entries nor foreign; never deleted by ``clear``).
     """
 
     directory: Path
@@ -208,6 +213,32 @@ class CacheInfo:
     total_bytes: int
     max_bytes: int
     foreign: list
+    others: dict = field(default_factory=dict)
+
+
+#: specref's other caches under the same root as the map cache: file or folder name pattern ->
+#: what it is. They are neither map entries nor foreign files: never warned about or deleted here.
+OTHER_SPECREF_CACHES = {
+    "jakob2019-*.coeff": "Jakob 2019 coefficient table (reference.colour.jakob2019)",
+    "numba": "compiled kernels (reference.jit)",
+    "conformance": "conformance references (validation.conformance)",
+}
+
+
+def other_specref_cache(name: str) -> str:
+    """What another specref cache named ``name`` is, or ``""`` (:data:`OTHER_SPECREF_CACHES`).
+
+    Examples
+    --------
+    >>> other_specref_cache("jakob2019-sRGB-64.coeff"), other_specref_cache("notes.txt")
+    ('Jakob 2019 coefficient table (reference.colour.jakob2019)', '')
+    """
+    import fnmatch
+
+    return next(
+        (what for pattern, what in OTHER_SPECREF_CACHES.items() if fnmatch.fnmatch(name, pattern)),
+        "",
+    )
 
 
 def _encode_payload(arrays: Mapping[str, np.ndarray]) -> tuple[list, bytes]:
@@ -525,6 +556,8 @@ class Cache:
             return ours, foreign, stale
         now = time.time()
         for path in paths:
+            if other_specref_cache(path.name):  # another cache of specref's: not ours to judge
+                continue
             if _is_our_temp(path.name):
                 # A writer's temporary file: in progress, or left by a writer that died.
                 if _is_stale_temp(path, now):
@@ -587,9 +620,13 @@ class Cache:
     def info(self) -> CacheInfo:
         """Entries, their size, the limit and the foreign files of the cache folder."""
         ours, foreign, _ = self._scan()
-        return CacheInfo(
-            self.directory, len(ours), sum(size for _, size, _ in ours), self.max_bytes, foreign
-        )
+        try:
+            names = sorted(p.name for p in self.directory.iterdir())
+        except OSError:
+            names = []
+        others = {name: other_specref_cache(name) for name in names if other_specref_cache(name)}
+        total = sum(size for _, size, _ in ours)
+        return CacheInfo(self.directory, len(ours), total, self.max_bytes, foreign, others)
 
     def clear(self) -> int:
         """Delete every entry and the stale temporary files; foreign files stay.

@@ -307,6 +307,40 @@ def test_cli_cache_info_and_clear(tmp_path, capsys):
     assert (tmp_path / "README").read_text() == "foreign"
 
 
+def test_specrefs_other_caches_are_named_not_foreign(tmp_path):
+    # The Jakob 2019 tables, the numba kernels and the conformance references share the cache
+    # root: named for what they are, never warned about, never deleted; a stranger still is
+    (tmp_path / "jakob2019-sRGB-64.coeff").write_bytes(b"\0" * 16)
+    (tmp_path / "numba").mkdir()
+    (tmp_path / "conformance").mkdir()
+    (tmp_path / "notes.txt").write_text("mine")
+    with pytest.warns(SpecrefWarning, match="notes.txt: not a specref cache entry") as caught:
+        info = Cache(tmp_path).info()
+    assert not [w for w in caught if "jakob2019" in str(w.message) or "numba" in str(w.message)]
+    assert info.foreign == ["notes.txt"]
+    assert set(info.others) == {"jakob2019-sRGB-64.coeff", "numba", "conformance"}
+    with pytest.warns(SpecrefWarning, match="notes.txt"):
+        Cache(tmp_path).clear()
+    assert (tmp_path / "jakob2019-sRGB-64.coeff").exists()
+    assert (tmp_path / "numba").is_dir()
+
+
+def test_the_command_prints_a_warning_as_one_line(tmp_path):
+    (tmp_path / "notes.txt").write_text("mine")
+    (tmp_path / "jakob2019-sRGB-8.coeff").write_bytes(b"\0")
+    done = subprocess.run(
+        [sys.executable, "-m", "validation.cli", "cache", "info", "--cache-dir", str(tmp_path)],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    assert done.stderr.splitlines() == [
+        f"specref: warning: {tmp_path / 'notes.txt'}: not a specref cache entry (no specref "
+        "header); ignored"
+    ]
+    assert "also here: jakob2019-sRGB-8.coeff: Jakob 2019 coefficient table" in done.stdout
+
+
 # --- an unusable folder, races with clear, leftovers ----------------------------------------
 
 

@@ -10,8 +10,9 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 
-from reference.errors import SpecrefError
+from reference.errors import SpecrefError, SpecrefWarning
 from validation.cli import (
     brdf,
     cache,
@@ -32,7 +33,7 @@ from validation.cli import (
 )
 from validation.cli.parser import Parser, command_paths
 
-__all__ = ["COMMANDS", "build_parser", "main"]
+__all__ = ["COMMANDS", "build_parser", "main", "run"]
 
 #: The subcommands, in the order ``specref --help`` lists them.
 COMMANDS = (
@@ -68,6 +69,28 @@ def build_parser() -> argparse.ArgumentParser:
     for command in COMMANDS:
         command.add_parser(sub)
     return parser
+
+
+def _warning_line(message, category, filename, lineno, line=None) -> str:
+    """A specref warning as the command prints it: one line, no source file or code."""
+    if issubclass(category, SpecrefWarning):
+        return f"specref: warning: {message}\n"
+    return _FORMAT_WARNING(message, category, filename, lineno, line)
+
+
+_FORMAT_WARNING = warnings.formatwarning
+
+
+def run() -> int:
+    r"""The ``specref`` console command: :func:`main`, its warnings printed as one line each.
+
+    Examples
+    --------
+    >>> _warning_line("a.txt: ignored", SpecrefWarning, "cache.py", 3)
+    'specref: warning: a.txt: ignored\n'
+    """
+    warnings.formatwarning = _warning_line
+    return main()
 
 
 def main(argv: list[str] | None = None) -> int:

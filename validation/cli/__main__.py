@@ -2,6 +2,6 @@
 
 import sys
 
-from validation.cli import main
+from validation.cli import run
 
-sys.exit(main())
+sys.exit(run())

@@ -15,6 +15,8 @@ def _cmd_cache(args) -> int:
     print(f"location: {info.directory}")
     size, limit = info.total_bytes / 1e6, info.max_bytes / 1e6
     print(f"entries: {info.entries} ({size:.1f} MB of {limit:.0f} MB)")
+    for name, what in info.others.items():
+        print(f"also here: {name}: {what} (not map entries; kept)")
     if info.foreign:
         print(f"foreign files (ignored, never deleted): {', '.join(info.foreign)}")
     return 0

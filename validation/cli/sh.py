@@ -44,7 +44,7 @@ def add_parser(sub) -> None:
     r = sh.add_parser("prefilter", help="frequency-space prefiltered cube or lat-long map (.exr)")
     r.add_argument("env", type=input_file, help="lat-long map, .hdr or .exr")
     registry_option(r, "--kernel", PREFILTER_KERNELS, "prefilter kernel", required=True)
-    r.add_argument("--out", type=output_file, required=True, help="output .exr")
+    r.add_argument("-o", "--out", type=output_file, required=True, help="output .exr")
     r.add_argument("--tol", type=float, default=1e-2, help="adaptive-order tolerance")
     r.add_argument("--format", choices=("cube", "latlong"), default="cube")
     r.add_argument("--size", type=int, default=64, help="cube face size")
