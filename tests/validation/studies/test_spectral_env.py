@@ -181,5 +181,9 @@ def test_every_set_is_measured_against_the_cameras_floor():
     for r in rows:
         assert r["mean met"] == (r["mean"] <= r["floor mean"] + FLOOR_MARGIN_MEAN)
         assert r["max met"] == (r["max"] <= r["floor max"] + FLOOR_MARGIN_MAX)
+        better = min(r["A Jakob 2019"], r["A Otsu 2018"])
+        assert r["A met"] == (r["A mean"] <= better)
+        assert 0 < r["A Jakob 2019"] < 10
+        assert 0 < r["A Otsu 2018"] < 10
     noisy = {r["set"]: r for r in rows[len(EVALUATION_SETS) :]}
     assert all(noisy[r["set"]]["mean"] != r["mean"] for r in rows[: len(EVALUATION_SETS)])
