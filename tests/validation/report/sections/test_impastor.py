@@ -64,6 +64,22 @@ def test_checks_cover_every_target_and_pass_when_met():
     assert all(c.passed for c in found), [c for c in found if not c.passed]
 
 
+def test_the_six_channel_headline_is_the_targets_lights_and_names_the_others():
+    # The headline's figure is the worst of the lights the channels were designed for (what the
+    # targets check), and a light outside the fit is named with its own figure, not folded in
+    from validation.report.sections import impastor as section
+
+    six = {light: {"mean": 0.2, "max": 0.5} for light in ("D65", "D50", "A")}
+    six["FL2"] = {"mean": 2.11, "max": 4.0}
+    text = (
+        "six optimized channels render the ColorChecker within mean ΔE00 0.20 under the booth "
+        "lights they were designed for (D65, D50, A); 2.11 under FL2 (outside the fit)"
+    )
+    first = section._six_channel_headline(six)
+    assert first.text == text
+    assert first.anchor == f"target ≤ {TARGETS['optimized'][0]} under D65, D50, A"
+
+
 def test_a_failing_figure_fails_its_check():
     # path: (value just past the limit, words in the check's name, measured as shown)
     cases = {
