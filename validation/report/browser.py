@@ -8,7 +8,8 @@ as the browser laid it out:
 - every ``<img>``: loaded, with a natural width above zero;
 - the page's width against the window (no horizontal overflow at 1280 px);
 - the first content block after the title and provenance (the summary);
-- every in-page link (``href="#..."``): an element with that id exists.
+- every in-page link (``href="#..."``): an element with that id exists;
+- every table cell holding a number: on one line (a figure split over two lines misreads).
 """
 
 from __future__ import annotations
@@ -71,7 +72,7 @@ def screenshot_first_screen(page, out, width: int = 1280, height: int = 900) -> 
     return "written"
 
 
-_PAGE_CHECKS_JS = """
+_PAGE_CHECKS_JS = r"""
 const images = Array.from(document.images).map(i => ({
     src: i.getAttribute('src'), complete: i.complete, natural: i.naturalWidth, shown: i.width}));
 const links = Array.from(document.querySelectorAll('a[href^="#"]'))
@@ -80,7 +81,16 @@ const broken = links.filter(h => !document.getElementById(decodeURIComponent(h.s
 const title = document.querySelector('h1');
 let first = title ? title.nextElementSibling : null;
 while (first && first.id === 'provenance') { first = first.nextElementSibling; }
-return {images: images, links: links.length, broken_links: broken,
+const split = [];
+for (const td of document.querySelectorAll('td')) {
+    const text = td.textContent.trim();
+    if (!/\d/.test(text) || text.length > 24) continue;  // a figure: render.FIGURE_CHARS
+    const range = document.createRange();
+    range.selectNodeContents(td);
+    const tops = new Set(Array.from(range.getClientRects()).map(r => Math.round(r.top)));
+    if (tops.size > 1) split.push(text);
+}
+return {images: images, links: links.length, broken_links: broken, split_cells: split,
         scroll_width: document.documentElement.scrollWidth,
         client_width: document.documentElement.clientWidth,
         first_content: first ? first.id : null};
@@ -95,7 +105,9 @@ def check_report_page(page, width: int = 1280, height: int = 900) -> dict:
     dict
         ``images`` (``src``, ``complete``, ``natural`` and ``shown`` widths), ``links`` (the
         number of in-page links), ``broken_links``, ``scroll_width`` and ``client_width`` (CSS
-        pixels), ``first_content`` (the id of the first block after the title and provenance).
+        pixels), ``first_content`` (the id of the first block after the title and provenance),
+        ``split_cells``: the text of every figure cell (a digit, at most 24 characters) that the
+        layout spread over more than one line.
 
     Raises
     ------

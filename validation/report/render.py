@@ -39,6 +39,19 @@ MIN_WIDTH = 256
 MAX_WIDTH = 1060
 
 
+#: A text cell this short that holds a digit is a figure ("0.00672 / 7"): kept on one line.
+FIGURE_CHARS = 24
+
+
+def _td(value, fmt: str) -> str:
+    """A table cell: class ``n`` (never wrapped) for a number or a short text holding one."""
+    text = _cell(value, fmt)
+    figure = not isinstance(value, str) or (
+        len(text) <= FIGURE_CHARS and any(c.isdigit() for c in text)
+    )
+    return f"<td class='n'>{html.escape(text)}</td>" if figure else f"<td>{html.escape(text)}</td>"
+
+
 def _cell(value, fmt: str) -> str:
     if isinstance(value, float | np.floating):
         return fmt.format(float(value)) if math.isfinite(value) else "—"
@@ -69,7 +82,10 @@ def _caption(block: Image) -> str:
 _CSS = " ".join(
     [
         "body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;",
-        "line-height:1.45;color:#222} p,li,figcaption,td{overflow-wrap:anywhere}",
+        "line-height:1.45;color:#222} p,li,figcaption{overflow-wrap:anywhere}",
+        # a figure never splits across lines (td.n: a number, or a short text holding one; a wide
+        # table scrolls in its .scroll box); other cells wrap at spaces only
+        "td{overflow-wrap:normal} td.n{white-space:nowrap}",
         ".scroll{overflow-x:auto;max-width:100%}",
         "table{border-collapse:collapse;margin:.6em 0 1.4em}",
         "td,th{border:1px solid #ccc;padding:.25em .6em;text-align:right;",
@@ -118,8 +134,8 @@ def _html_checks(rows, with_section: bool) -> str:
         mark = "<span class='ok'>yes</span>" if c.passed else "<span class='fail'>NO</span>"
         first = f"<td>{esc(section.title)}</td>" if with_section else ""
         out.append(
-            f"<tr>{first}<td>{esc(c.name)}</td><td>{esc(c.target)}</td>"
-            f"<td>{esc(_cell(c.measured, '{:.4g}'))}</td><td>{esc(_basis(c))}</td>"
+            f"<tr>{first}<td>{esc(c.name)}</td>{_td(c.target, '{}')}"
+            f"{_td(c.measured, '{:.4g}')}<td>{esc(_basis(c))}</td>"
             f"<td>{mark}</td></tr>"
         )
     out.append("</table></div>")
@@ -214,7 +230,7 @@ def _html_blocks(blocks) -> list[str]:
             out.extend(f"<th>{esc(str(c))}</th>" for c in block.columns)
             out.append("</tr>")
             for row in block.rows:
-                cells = "".join(f"<td>{esc(_cell(v, block.fmt))}</td>" for v in row)
+                cells = "".join(_td(v, block.fmt) for v in row)
                 out.append(f"<tr>{cells}</tr>")
             out.append("</table></div>")
         elif isinstance(block, Image):

@@ -74,8 +74,8 @@ def test_registered_section_renders_blocks(tmp_path):
     assert section["arr"] == [0, 1]
     html = (tmp_path / "index.html").read_text()
     assert "<code>code</code>" in html
-    assert "<td>1.235</td>" in html
-    assert "<td>—</td>" in html
+    assert "<td class='n'>1.235</td>" in html  # a figure: kept on one line
+    assert "<td class='n'>—</td>" in html
     assert (tmp_path / "images" / "test-only-img.png").is_file()
     assert "1 of 2 targets hold; 1 do not" in html
     assert [c["passed"] for c in results["checks"]] == [True, False]

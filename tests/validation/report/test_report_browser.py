@@ -54,8 +54,9 @@ def test_quick_report_reads_in_a_browser(quick_report):
     assert broken == []
     narrow = [(i["src"], i["shown"]) for i in page["images"] if i["shown"] < 256]
     assert narrow == []
-    # Nothing overflows the page horizontally at 1280 px.
+    # Nothing overflows the page horizontally at 1280 px, and no figure is split over two lines
     assert page["scroll_width"] <= page["client_width"]
+    assert page["split_cells"] == []
     # The summary is the first content, and every in-page link resolves.
     assert page["first_content"] == "summary"
     assert page["broken_links"] == []
@@ -79,3 +80,14 @@ def test_first_screen_screenshot_is_written(quick_report):
         assert shot.size == (1280, 900)
         # Not a blank page: the first screen has text and pictures (many distinct colours).
         assert len(shot.convert("RGB").getcolors(maxcolors=1 << 20) or []) > 50
+
+
+def test_the_page_check_finds_a_figure_split_over_two_lines(tmp_path):
+    # The check can fail: a narrow cell that may break anywhere splits "0.00672 / 7"; the report's
+    # own cells (class n) do not
+    page = tmp_path / "split.html"
+    cell = "<td style='width:3em;max-width:3em;overflow-wrap:anywhere'>0.00672 / 7</td>"
+    kept = "<td class='n' style='white-space:nowrap'>0.00672 / 7</td>"
+    page.write_text(f"<h1>t</h1><table style='width:6em'><tr>{cell}{kept}</tr></table>")
+    found = check_report_page(page, width=400, height=300)
+    assert found["split_cells"] == ["0.00672 / 7"]
