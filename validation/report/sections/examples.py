@@ -344,6 +344,7 @@ def checks(data: SectionData) -> list[Check]:
                 f"<= {CHART_DXYZ_TARGET:g}",
                 100 * accuracy["max_abs_dXYZ"],
                 100 * accuracy["max_abs_dXYZ"] <= CHART_DXYZ_TARGET,
+                "independent",
             )
         )
     env = scenes[ENV_SCENE]

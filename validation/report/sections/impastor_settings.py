@@ -202,6 +202,7 @@ def checks(data: SectionData) -> list[Check]:
             "frame error / tolerance <= 1",
             worst,
             bool(kept) and worst <= 1.0,
+            "held out",
         ),
         Check(
             f"frame-time speed-up over fixed 32/32/36 at no more than its error (within "
