@@ -235,6 +235,7 @@ def checks(data: SectionData) -> list[Check]:
                     f"<= {MAX_FACTOR * DEFAULT_ACCURACY:g}",
                     c["measured_max"],
                     ok,
+                    "held out",  # directions the order was not chosen on
                 )
             )
     return found
