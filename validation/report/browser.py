@@ -84,7 +84,7 @@ while (first && first.id === 'provenance') { first = first.nextElementSibling; }
 const split = [];
 for (const td of document.querySelectorAll('td')) {
     const text = td.textContent.trim();
-    if (!/\d/.test(text) || text.length > 24) continue;  // a figure: render.FIGURE_CHARS
+    if (!/\d/.test(text) || text.length > FIGURE_CHARS) continue;  // a figure
     const range = document.createRange();
     range.selectNodeContents(td);
     const tops = new Set(Array.from(range.getClientRects()).map(r => Math.round(r.top)));
@@ -134,4 +134,7 @@ def check_report_page(page, width: int = 1280, height: int = 900) -> dict:
             "Promise.all(Array.from(document.images).map(i => i.decode().catch(() => null)))"
             ".then(() => done(true));"
         )
-        return driver.execute_script(_PAGE_CHECKS_JS)
+        from validation.report.render import FIGURE_CHARS
+
+        js = _PAGE_CHECKS_JS.replace("FIGURE_CHARS", str(FIGURE_CHARS))
+        return driver.execute_script(js)

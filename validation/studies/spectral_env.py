@@ -50,13 +50,8 @@ def delta_E94_spectra(truth, estimate, illuminant: str) -> np.ndarray:
     >>> delta_E94_spectra(S, S * 1.01, "A").round(2)
     array([0.31])
     """
-    import colour
-
     W = band_weights(GRID_41, spectrum_from_dataset("illuminant", illuminant))
-    white = white_XYZ(W)
-    Lab_1 = XYZ_to_Lab(np.asarray(truth) @ W, white)
-    Lab_2 = XYZ_to_Lab(np.asarray(estimate) @ W, white)
-    return np.asarray(colour.delta_E(Lab_1, Lab_2, method="CIE 1994"))
+    return _delta_E94_XYZ(np.asarray(truth) @ W, np.asarray(estimate) @ W, W)
 
 
 def _stats(truth, estimate, capture: str = "D65") -> dict:
@@ -169,21 +164,27 @@ def XYZ_floor(kind: str, degree: int, camera: str = CAMERA, sets=HELD_OUT_SETS) 
     none can beat this fit; held out it is the reference a spectral method should approach.
     """
     W = band_weights(GRID_41, spectrum_from_dataset("illuminant", "D65"))
-    white = white_XYZ(W)
-    _, spectra = reflectance_set(TRAINING_SET)
-    X = features_RGB(camera_RGB(spectra, camera, "D65"), kind, degree)
-    M = np.linalg.lstsq(X, spectra[:, ::2] @ W, rcond=None)[0]
+    M = _floor_map(kind, degree, camera, False, W)
     found = {}
     for name in sets:
-        import colour
-
         _, held = reflectance_set(name)
         XYZ = features_RGB(camera_RGB(held, camera, "D65"), kind, degree) @ M
-        dE = colour.delta_E(
-            XYZ_to_Lab(held[:, ::2] @ W, white), XYZ_to_Lab(XYZ, white), method="CIE 1994"
-        )
+        dE = _delta_E94_XYZ(held[:, ::2] @ W, XYZ, W)
         found[name] = {"D65 mean": float(np.mean(dE)), "D65 max": float(np.max(dE))}
     return found
+
+
+def _floor_map(kind: str, degree: int, camera: str, noise: bool, W) -> np.ndarray:
+    """The least-squares map from the training RGB's features to its XYZ (weights ``W``).
+
+    With ``noise``, the same noisy training RGB as :func:`fit_target`'s fit.
+    """
+    _, train = reflectance_set(TRAINING_SET)
+    RGB = camera_RGB(train, camera, "D65")
+    if noise:
+        RGB = camera_noise(RGB, np.random.default_rng(NOISE_SEED))
+    X = features_RGB(RGB, kind, degree)
+    return np.linalg.lstsq(X, train[:, ::2] @ W, rcond=None)[0]
 
 
 def regression_table(
@@ -259,15 +260,10 @@ def every_set_study(kind: str, degree: int, camera: str = CAMERA) -> list[dict]:
     from reference.colour.spectral_target import EVALUATION_SETS
 
     W = band_weights(GRID_41, spectrum_from_dataset("illuminant", "D65"))
-    _, train = reflectance_set(TRAINING_SET)
     rows = []
     for noise in (False, True):
         model, _ = fit_target(kind, degree, camera, noise)
-        RGB_train = camera_RGB(train, camera, "D65")
-        if noise:  # the same noisy training RGB as the regression's fit
-            RGB_train = camera_noise(RGB_train, np.random.default_rng(NOISE_SEED))
-        X = features_RGB(RGB_train, kind, degree)
-        M = np.linalg.lstsq(X, train[:, ::2] @ W, rcond=None)[0]
+        M = _floor_map(kind, degree, camera, noise, W)
         rng = np.random.default_rng(NOISE_SEED + 1)
         for name in EVALUATION_SETS:
             _, spectra = reflectance_set(name)
@@ -316,6 +312,7 @@ def _relit_from_camera_XYZ(truth, XYZ) -> dict:
 
 
 def _delta_E94_XYZ(XYZ_1, XYZ_2, weights) -> np.ndarray:
+    """ΔE94 between XYZ (white: the weights' white diffuser; any common scale of both)."""
     import colour
 
     white = white_XYZ(weights)

@@ -95,11 +95,12 @@ def nonnegative_study() -> dict:
         their Y; ``max_dE94_A``: their largest ΔE94 relit under A (each pixel's XYZ scaled to
         Y = 100 under the capture illuminant), raw polynomial against projected.
     """
-    from reference.colour.colorimetry import XYZ_to_Lab, band_weights
+    from reference.colour.colorimetry import band_weights
     from reference.colour.spectra import GRID_41, spectrum_from_dataset
     from reference.colour.spectral_regression import model_XYZ_weights, project_nonnegative
     from reference.colour.upsampling import default_regression
     from reference.images.formats import read_hdr
+    from validation.studies.spectral_env import _delta_E94_XYZ
 
     model = default_regression()
     raw = model.predict(read_hdr(PANORAMA)).reshape(-1, model.n_bands)
@@ -109,16 +110,9 @@ def nonnegative_study() -> dict:
     Y = np.maximum((raw @ W)[:, 1:2], 1e-300)
     found["max_XYZ_change"] = float(np.abs((projected - raw) @ W / Y).max(initial=0.0))
     W_A = band_weights(GRID_41, spectrum_from_dataset("illuminant", "A"))
-    white = W_A.sum(axis=0) / W_A.sum(axis=0)[1] * 100.0
-    Lab = [XYZ_to_Lab(100.0 * (S @ W_A) / Y, white) for S in (raw, projected)]
-    found["max_dE94_A"] = float(_delta_E94_Lab(*Lab).max(initial=0.0))
+    dE = _delta_E94_XYZ((raw @ W_A) / Y, (projected @ W_A) / Y, W_A)
+    found["max_dE94_A"] = float(dE.max(initial=0.0))
     return found
-
-
-def _delta_E94_Lab(Lab_1, Lab_2) -> np.ndarray:
-    import colour
-
-    return np.asarray(colour.delta_E(Lab_1, Lab_2, method="CIE 1994"))
 
 
 def _panorama(box: int) -> dict:
