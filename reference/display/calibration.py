@@ -326,27 +326,35 @@ class _Reader:
     def __call__(self, drives) -> _Reading:
         drives = np.asarray(drives, dtype=np.float64)
         flat = drives.reshape(-1, 3)
-        readings = [[] for _ in flat]
-        todo, n = np.arange(len(flat)), 2
-        while todo.size:
-            new = self.measure(np.repeat(flat[todo, None], n - len(readings[todo[0]]), axis=1))
+        readings = [np.empty((0, 3))] * len(flat)
+        todo, taken, n = np.arange(len(flat)), 0, 2
+        while todo.size:  # every drive still to do has ``taken`` readings
+            new = self.measure(np.repeat(flat[todo, None], n - taken, axis=1))
             for i, rows in zip(todo, new, strict=True):
-                readings[i].extend(rows)
-            _, se_uv, _ = _mean_and_errors([np.array(readings[i]) for i in todo])
+                readings[i] = np.concatenate([readings[i], rows])
+            _, se_uv, _ = _mean_and_errors(np.stack([readings[i] for i in todo]))
             todo = todo[(se_uv > 0.5 * self.tolerance_uv) & (2 * n <= self.max_readings)]
-            n *= 2
-        XYZ, se_uv, se_Y = _mean_and_errors([np.array(r) for r in readings])
+            taken, n = n, 2 * n
+        XYZ, se_uv, se_Y = np.empty((len(flat), 3)), np.empty(len(flat)), np.empty(len(flat))
         count = np.array([len(r) for r in readings])
+        for m in np.unique(count):  # drives with as many readings, at once
+            (rows,) = np.nonzero(count == m)
+            XYZ[rows], se_uv[rows], se_Y[rows] = _mean_and_errors(
+                np.stack([readings[i] for i in rows])
+            )
         shape = drives.shape[:-1]
         return _Reading(XYZ.reshape(*shape, 3), *(a.reshape(shape) for a in (se_uv, se_Y, count)))
 
 
-def _mean_and_errors(readings: list) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Mean XYZ and the standard errors of its u'v' and relative Y, per list of readings (n, 3)."""
-    XYZ = np.array([r.mean(axis=0) for r in readings])
-    se_uv = np.array([np.linalg.norm(XYZ_to_uv(r).std(axis=0, ddof=1)) for r in readings])
-    se_Y = np.array([r[:, 1].std(ddof=1) / max(abs(r[:, 1].mean()), 1e-300) for r in readings])
-    count = np.sqrt([len(r) for r in readings])
+def _mean_and_errors(readings: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Mean XYZ and the standard errors of its u'v' and relative Y, per drive.
+
+    ``readings`` (drives, n, 3): n readings of each drive.
+    """
+    XYZ = readings.mean(axis=1)
+    se_uv = np.linalg.norm(XYZ_to_uv(readings).std(axis=1, ddof=1), axis=-1)
+    se_Y = readings[..., 1].std(axis=1, ddof=1) / np.maximum(np.abs(XYZ[:, 1]), 1e-300)
+    count = np.sqrt(readings.shape[1])
     return XYZ, se_uv / count, se_Y / count
 
 

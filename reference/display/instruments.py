@@ -27,6 +27,7 @@ References
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -52,10 +53,32 @@ __all__ = [
 
 def _band_pass(wavelengths_nm: np.ndarray, step_nm: float) -> tuple[np.ndarray, np.ndarray]:
     """Centres every ``step_nm`` and the triangular band pass (n_centres, n), rows sum to 1."""
-    w = wavelengths_nm
+    w = np.asarray(wavelengths_nm, dtype=np.float64)
+    return _band_pass_on(w.tobytes(), float(step_nm))
+
+
+@lru_cache(maxsize=32)
+def _band_pass_on(grid: bytes, step_nm: float) -> tuple[np.ndarray, np.ndarray]:
+    w = np.frombuffer(grid, dtype=np.float64)
     centres = np.arange(w[0], w[-1] + 1e-9, step_nm)
     weights = np.maximum(1.0 - np.abs(w[None, :] - centres[:, None]) / step_nm, 0.0)
-    return centres, weights / weights.sum(axis=1, keepdims=True)
+    weights /= weights.sum(axis=1, keepdims=True)
+    centres.flags.writeable = weights.flags.writeable = False  # shared by every call
+    return centres, weights
+
+
+def _each_drive_once(display: SpectralDisplay, drives, read) -> np.ndarray:
+    """``read(spectra)`` of each distinct drive once, spread back to every reading, (..., k).
+
+    Repeated readings of one patch emit the same spectrum: it is computed once, and only the
+    instrument's noise differs between them.
+    """
+    d = np.asarray(drives, dtype=np.float64)
+    if d.ndim < 2 or d.shape[-1] != 3:
+        return read(display_drives_to_spectra(display, d))
+    unique, inverse = np.unique(d.reshape(-1, 3), axis=0, return_inverse=True)
+    out = read(display_drives_to_spectra(display, unique))
+    return out[inverse.ravel()].reshape(*d.shape[:-1], out.shape[-1])
 
 
 @dataclass(frozen=True)
@@ -88,9 +111,8 @@ class Spectroradiometer:
         >>> spectroradiometer_ideal().measure(d, [1.0, 1.0, 1.0]).round(1)
         array([105.9, 120. , 111.2])
         """
-        spectra = display_drives_to_spectra(display, drives)
         centres, band_pass = _band_pass(display.wavelengths_nm, self.step_nm)
-        bands = spectra @ band_pass.T
+        bands = _each_drive_once(display, drives, lambda spectra: spectra @ band_pass.T)
         if self.dark_noise > 0 or self.relative_noise > 0:
             require(rng is not None, f"{self.name}: a noisy reading needs a seeded rng")
             # Erratum E51: our noise model, σ = σ_dark + ρ L(λ) per band
@@ -171,9 +193,9 @@ class Colorimeter:
         >>> c.measure(spectral_display("crt_brainard"), [1.0, 1.0, 1.0], rng).round(0)
         array([111., 120., 154.])
         """
-        spectra = display_drives_to_spectra(display, drives)
         M, unit = self.factory()
-        signals = self._signals(spectra, display.wavelengths_nm)
+        w = display.wavelengths_nm
+        signals = _each_drive_once(display, drives, lambda spectra: self._signals(spectra, w))
         # Erratum E52: the shadow failure, an uncorrected dark signal and dark noise per filter
         signals = signals + np.asarray(self.dark_offset) * unit
         if self.dark_noise > 0 or self.relative_noise > 0:

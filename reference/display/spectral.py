@@ -29,6 +29,7 @@ References
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cache, lru_cache
 
 import numpy as np
 
@@ -59,11 +60,18 @@ K_M = 683.0
 CMFS_NAME = "CIE 1931 2 Degree Standard Observer"
 
 
-def _primaries_from_colour(key: str):
+@cache
+def _colour_primaries_table(key: str) -> tuple[np.ndarray, np.ndarray]:
+    # read once per process: colour-science builds the table's signals on every access
     import colour
 
     table = colour.MSDS_DISPLAY_PRIMARIES[key]
     return np.asarray(table.wavelengths, dtype=np.float64), np.asarray(table.values, float).T
+
+
+def _primaries_from_colour(key: str):
+    wavelengths, spectra = _colour_primaries_table(key)
+    return wavelengths.copy(), spectra.copy()
 
 
 def primaries_apple_studio():
@@ -155,10 +163,17 @@ def cmfs_on(wavelengths_nm) -> np.ndarray:
     >>> cmfs_on([555.0]).round(4)
     array([[0.5121, 1.    , 0.0057]])
     """
+    w = np.asarray(wavelengths_nm, dtype=np.float64)
+    return _cmfs_on_grid(w.tobytes(), w.shape).copy()
+
+
+@lru_cache(maxsize=64)
+def _cmfs_on_grid(grid: bytes, shape: tuple) -> np.ndarray:
+    # the calibration's instruments ask for the same grids thousands of times
     import colour
 
     cmfs = colour.MSDS_CMFS[CMFS_NAME]
-    w = np.asarray(wavelengths_nm, dtype=np.float64)
+    w = np.frombuffer(grid, dtype=np.float64).reshape(shape)
     return np.stack([np.interp(w, cmfs.wavelengths, cmfs.values[:, i]) for i in range(3)], -1)
 
 
