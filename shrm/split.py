@@ -105,17 +105,43 @@ def angular_sum(env, brdf, params: dict, normals, views) -> np.ndarray:
     if d.shape[0] == 0 or normals.shape[0] == 0:
         return out
     Lw = L * w[:, None]
+    params = _grey_once(params, C)
     step_k = max(1, min(d.shape[0], PAIRS_PER_BLOCK // max(1, C)))
     step_p = max(1, PAIRS_PER_BLOCK // step_k)
     for p in range(0, normals.shape[0], step_p):
-        n, v = normals[p : p + step_p, None, :], views[p : p + step_p, None, :]
+        n, v = normals[p : p + step_p], views[p : p + step_p]
         for k in range(0, d.shape[0], step_k):
-            wi = d[None, k : k + step_k, :]
-            cosine = np.maximum((wi * n).sum(-1), 0.0)
-            f = brdf(*np.broadcast_arrays(wi, v, n), **params)
+            cosine = n @ d[k : k + step_k].T
+            # only the pairs above the horizon add anything (cos θ_i ≤ 0 there): about half
+            i, j = np.nonzero(cosine > 0.0)  # row-major: each point's pairs together
+            if i.size == 0:
+                continue
+            f = brdf(d[k + j], v[i], n[i], **params)
+            if f.shape[-1] == 1:  # a grey BRDF: the sum below is a matrix product
+                A = np.zeros_like(cosine)
+                A[i, j] = f[:, 0] * cosine[i, j]
+                # The reflection equation (R&H 2002): Σ_k (f cos θ_i) L_k w_k
+                out[p : p + step_p] += A @ Lw[k : k + step_k]
+                continue
             # The reflection equation (R&H 2002): Σ_k f cos θ_i L_k w_k
-            out[p : p + step_p] += np.einsum("pk,pkc,kc->pc", cosine, f, Lw[k : k + step_k])
+            terms = f * (cosine[i, j][:, None] * Lw[k + j])
+            first = np.flatnonzero(np.r_[True, i[1:] != i[:-1]])
+            out[p + i[first]] += np.add.reduceat(terms, first, axis=0)
     return out
+
+
+def _grey_once(params: dict, C: int) -> dict:
+    """``params`` with each per-band parameter that is equal in all ``C`` bands given once.
+
+    A BRDF whose parameters are then all single values is evaluated once per pair of directions,
+    not once per band (the same values), and :func:`angular_sum` sums it as a matrix product.
+    """
+    return {
+        key: value[:1]
+        if isinstance(value, np.ndarray) and value.shape == (C,) and np.ptp(value) == 0
+        else value
+        for key, value in params.items()
+    }
 
 
 @dataclass(frozen=True)
