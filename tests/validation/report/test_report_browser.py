@@ -22,7 +22,7 @@ pytestmark = pytest.mark.skipif(
 #: One section of each part, the cheap ones (about half a minute in all): the page's layout,
 #: summary and links are the same code whatever the sections; each section's own blocks are
 #: checked by its test.
-SMALL_REPORT = ("spectral-core", "phong", "display-calibration", "impastor")
+SMALL_REPORT = ("spectral-core", "phong", "polymer-scene", "impastor")
 
 
 #: The Phong section's tiny sizes (an 8² image, one material): the page, not the figures, is tested.
