@@ -547,4 +547,12 @@ def _oracle_checks(oracle: dict) -> list[Check]:
     ]
 
 
-SECTION = ReportSection("polymer", "Herbert hybrid model", polymer_study, present, checks)
+SECTION = ReportSection(
+    "polymer",
+    "Herbert hybrid model",
+    polymer_study,
+    present,
+    checks,
+    # the same checks on coarser sweeps (30 s less); specref report --full sweeps every value
+    default_effort="quick",
+)
