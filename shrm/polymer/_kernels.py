@@ -1,9 +1,10 @@
 """numba twins of the polymer family: the oracle's rough specular sum, the shading of the hybrid.
 
-Twins of ``shrm.polymer.oracle.rough_specular_samples`` and of
-``shrm.polymer.material.polymer_shade_parts``. Each kernel keeps the names and equation comments of
-its NumPy reference, never validates, never prints, and writes into an output array that the public
-entry point allocated. The equality tests live in ``tests/shrm/polymer``.
+Twins of ``shrm.polymer.oracle.rough_specular_samples``, of
+``shrm.polymer.material.polymer_shade_parts`` and of its baseline
+``shrm.polymer.material.lambert_phong_shade_parts``. Each kernel keeps the names and equation
+comments of its NumPy reference, never validates, never prints, and writes into an output array
+that the public entry point allocated. The equality tests live in ``tests/shrm/polymer``.
 """
 
 from __future__ import annotations
@@ -14,7 +15,11 @@ import numpy as np
 
 from reference.jit import njit
 
-__all__ = ["polymer_shade_parts_kernel", "rough_specular_samples_kernel"]
+__all__ = [
+    "lambert_phong_shade_parts_kernel",
+    "polymer_shade_parts_kernel",
+    "rough_specular_samples_kernel",
+]
 
 
 @njit
@@ -136,4 +141,18 @@ def polymer_shade_parts_kernel(E_d, S, B, L, E_effect, D_Tint, Col_B, Col_L, glo
             if use_effect:
                 I += E_effect[p, b] * m
             out[p, b] = I
+    return out
+
+
+@njit
+def lambert_phong_shade_parts_kernel(E_d, E_s, k_d, k_s, out):
+    """Twin of ``shrm.polymer.material.lambert_phong_shade_parts``: one pass over the pixels.
+
+    ``k_d``, ``k_s`` (n_bands,).
+    """
+    N, n_bands = E_d.shape
+    for p in range(N):
+        for b in range(n_bands):
+            # §5.2, Herbert et al.: k_d E(N)/π + k_s E_s(r)
+            out[p, b] = k_d[b] * E_d[p, b] + k_s[b] * E_s[p, b]
     return out

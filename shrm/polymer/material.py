@@ -40,7 +40,7 @@ from pathlib import Path
 import numpy as np
 
 from reference.colour.spectra import SpectralGrid
-from reference.errors import SpecrefError, require
+from reference.errors import SpecrefError, require, require_nonnegative
 from reference.materials.types import MATERIAL_TYPES, MaterialType
 from reference.registry import Method, Registry
 from reference.scene.lights import EnvironmentLight
@@ -64,6 +64,7 @@ __all__ = [
     "POLYMER_KERNELS",
     "PolymerMaterial",
     "chip_lookup",
+    "lambert_phong_shade_parts",
     "modulation_at",
     "polymer_characterization",
     "polymer_environment_maps",
@@ -370,8 +371,9 @@ def polymer_pixel_parts(normal, view, maps: PolymerMaps, fresnel, mirror="fresne
     Returns
     -------
     dict of str to ndarray, shape (N, n_bands)
-        ``E_d`` (E(N)/π), ``S`` (``I_s F_r / gloss``), ``B`` (``E(−N)/π (1 − F_r)``), ``L``
-        (``L(−V) (1 − F_r)``), ``E_effect``.
+        ``E_d`` (E(N)/π), ``E_s`` (the Phong map at the reflection direction; read by
+        :func:`lambert_phong_shade_parts`), ``S`` (``I_s F_r / gloss``), ``B`` (``E(−N)/π
+        (1 − F_r)``), ``L`` (``L(−V) (1 − F_r)``), ``E_effect``.
 
     Examples
     --------
@@ -405,7 +407,7 @@ def polymer_pixel_parts(normal, view, maps: PolymerMaps, fresnel, mirror="fresne
     B = cubemap_lookup_bilinear(maps.irradiance, -N, backend="numba") / np.pi * (1.0 - F_r)
     L = latlong_lookup_bilinear(maps.radiance, -V) * (1.0 - F_r)
     effect = np.zeros_like(E_d) if E_effect is None else np.asarray(E_effect, dtype=np.float64)
-    return {"E_d": E_d, "S": S, "B": B, "L": L, "E_effect": effect}
+    return {"E_d": E_d, "E_s": E_s, "S": S, "B": B, "L": L, "E_effect": effect}
 
 
 def polymer_shade_parts(
@@ -488,6 +490,53 @@ def _shade_parts_compiled(parts: dict, look: PolymerLook, Mod: np.ndarray) -> np
     )
 
 
+def lambert_phong_shade_parts(parts: dict, k_d, k_s, compiled: bool = False) -> np.ndarray:
+    """A Lambert plus Phong material from the same per-pixel parts: ``k_d E_d + k_s E_s``, (N, C).
+
+    The cheapest shading a renderer would re-run after a material change through the polymer's
+    cached maps (§5.2, Herbert et al.: "a weighted sum of the maps"): the diffuse reflectance
+    times the irradiance ``E(N)/π`` and the specular one times the prefiltered normalized-Phong map
+    at the reflection direction. The polymer re-shade benchmark's baseline (erratum E61).
+
+    Parameters
+    ----------
+    parts : dict
+        From :func:`polymer_pixel_parts` (``E_d`` and ``E_s`` are read).
+    k_d, k_s : float or ndarray, shape (C,)
+        Diffuse and specular reflectance per band, >= 0.
+    compiled : bool
+        Through the numba twin ``shrm.polymer._kernels.lambert_phong_shade_parts_kernel``.
+
+    Returns
+    -------
+    ndarray, shape (N, C)
+
+    Examples
+    --------
+    >>> parts = {"E_d": np.full((1, 2), 2.0), "E_s": np.full((1, 2), 10.0)}
+    >>> lambert_phong_shade_parts(parts, 0.5, [0.0, 0.1])
+    array([[1., 2.]])
+    """
+    E_d, E_s = parts["E_d"], parts["E_s"]
+    C = E_d.shape[1]
+    k_d = np.broadcast_to(require_nonnegative(k_d, "lambert_phong: k_d"), (C,))
+    k_s = np.broadcast_to(require_nonnegative(k_s, "lambert_phong: k_s"), (C,))
+    if compiled:
+        from shrm.polymer._kernels import lambert_phong_shade_parts_kernel
+
+        return lambert_phong_shade_parts_kernel(
+            *(np.ascontiguousarray(a, dtype=np.float64) for a in (E_d, E_s, k_d, k_s)),
+            np.empty(E_d.shape),
+        )
+    # §5.2, Herbert et al.: the material's reflectances times the maps, k_d E(N)/π + k_s E_s(r)
+    return E_d * k_d + E_s * k_s
+
+
+def _lambert_phong_example(rng):
+    parts = {k: rng.uniform(0, 2, (7, 41)) for k in ("E_d", "E_s")}
+    return parts, rng.uniform(0, 1, 41), rng.uniform(0, 1, 41)
+
+
 def _shade_parts_example(rng):
     from shrm.polymer.characterization import characterize_model
     from shrm.polymer.hybrid import polymer_look
@@ -503,7 +552,7 @@ POLYMER_KERNELS = Registry("polymer shading kernel")
 
 
 def _register_kernels():
-    from shrm.polymer._kernels import polymer_shade_parts_kernel
+    from shrm.polymer._kernels import lambert_phong_shade_parts_kernel, polymer_shade_parts_kernel
 
     POLYMER_KERNELS.register(
         Method(
@@ -513,6 +562,16 @@ def _register_kernels():
             "Eq. (1), Herbert et al.",
             _shade_parts_example,
             compiled=functools.partial(polymer_shade_parts, compiled=True),
+        )
+    )
+    POLYMER_KERNELS.register(
+        Method(
+            "lambert_phong",
+            lambert_phong_shade_parts,
+            lambert_phong_shade_parts_kernel,
+            "§5.2, Herbert et al.",
+            _lambert_phong_example,
+            compiled=functools.partial(lambert_phong_shade_parts, compiled=True),
         )
     )
 
