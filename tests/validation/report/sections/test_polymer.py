@@ -21,8 +21,18 @@ def test_report_polymer_section_quick(tmp_path):
     assert sorted(section["fig2"]) == ["0.762", "1.524", "3.048"]
     assert all(len(c["L_transmission"]) == 11 for c in section["fig2"].values())
     checks = [c for c in results["checks"] if c["section"] == "polymer"]
-    assert len(checks) == 15
-    assert all(c["passed"] for c in checks), [c for c in checks if not c["passed"]]
+    held_out = [c for c in checks if "held-out chips" in c["name"]]
+    design = [c for c in checks if c not in held_out]
+    assert len(design) == 15
+    assert all(c["passed"] for c in design), [c for c in design if not c["passed"]]
+    # Held out: every shipped map, the object and rim targets a model beyond Herbert's is built
+    # for; Herbert's hybrid misses them under studio_small_03 (object mean about 2, rim above 4)
+    assert len(held_out) == 2 * 4
+    assert {c["basis"] for c in held_out} == {"held out"}
+    studio = [c for c in held_out if "studio_small_03" in c["name"]]
+    assert not any(c["passed"] for c in studio), studio
+    rows = section["held_out"]["rows"]
+    assert len(rows) == 4 * section["held_out"]["settings"]["chips"]
     names = ("fig2", "chips", "terms-fresnel", "terms-cosine", "terms-none", "oracle-images")
     for name in (*names, "oracle-sweeps", "oracle-speed"):
         assert (tmp_path / "images" / f"polymer-{name}.png").is_file()

@@ -1,0 +1,219 @@
+"""Herbert's hybrid against the layered oracle where its design never looked: real maps, new chips.
+
+The hybrid's sweeps in ``polymer_oracle_study`` (the design cases) vary one parameter at a time
+around one chip under one synthetic environment. Here every chip is held out: drawn by a seeded
+generator (:data:`HELD_OUT_SEED`) from the ranges the sweeps span (thickness log-uniform, TiO2 and
+gloss uniform), none equal to a sweep value, and each is shaded under every environment map
+specref ships (real captures: :data:`MAPS`). The measure is the one the sweeps use: ΔE00 of the
+hybrid (Eqs. (1)-(5), Herbert et al.; M_s = fresnel) against the oracle (``polymer_oracle``),
+relative to a white Lambertian surface facing the camera, over the sphere (mean, p95, max) and at
+its rim (cos θ_v < 0.3).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from reference.colour.spectra import DEFAULT_GRID
+from reference.data import data_path
+from shrm.polymer.characterization import characterize_model
+from validation.report.sections.polymer_oracle_study import SETTINGS as SWEEPS
+from validation.report.sections.polymer_oracle_study import (
+    Colour,
+    OracleStudy,
+    _hybrid,
+    _oracle,
+    _sphere,
+    _stats,
+    hybrid_maps,
+)
+from validation.report.types import Check, Table
+
+__all__ = [
+    "HELD_OUT",
+    "MAPS",
+    "TARGETS",
+    "held_out_checks",
+    "held_out_chips",
+    "held_out_study",
+    "held_out_table",
+    "map_environment",
+]
+
+#: The environment maps specref ships (``reference/data/environments``), every one.
+MAPS = (
+    "venice_sunset_1k.hdr",
+    "studio_small_03_1k.hdr",
+    "st_fagans_interior_1k.hdr",
+    "StageEnvLatLong.exr",
+)
+#: ΔE00 to the oracle that a real-time polymer model should hold on held-out chips and maps: the
+#: worst chip's object mean and rim mean (cos θ_v < 0.3) per map. Herbert's hybrid is measured
+#: against them; a model beyond it is built to meet them (docs/herbert-polymer.md).
+TARGETS = {"mean": 1.0, "rim": 2.0}
+#: Seed of the held-out chips.
+HELD_OUT_SEED = 20261128
+#: The ranges the chips are drawn from: those the design sweeps span (``SWEEPS["full"]``).
+RANGES = {"thickness_mm": (0.381, 4.572), "tio2_pct": (0.0, 2.0), "gloss": (0.4, 1.0)}
+
+
+@dataclass(frozen=True)
+class HeldOut:
+    """Sizes of the held-out study: chips per map, sphere pixels, map rows, oracle tolerance."""
+
+    chips: int
+    size: int
+    env_height: int
+    tol: float
+
+
+HELD_OUT = {
+    "tiny": HeldOut(1, 10, 8, 0.05),
+    "quick": HeldOut(3, 32, 32, 0.02),
+    "full": HeldOut(8, 48, 32, 0.01),
+}
+
+
+def held_out_chips(count: int, seed: int = HELD_OUT_SEED) -> list[dict]:
+    """``count`` chips from :data:`RANGES`, none equal to a value of the design sweeps.
+
+    Thickness is drawn log-uniform (mm), TiO2 (%) and gloss uniform; values rounded to 3 digits.
+
+    Examples
+    --------
+    >>> chips = held_out_chips(3)
+    >>> len(chips), sorted(chips[0])
+    (3, ['gloss', 'thickness_mm', 'tio2_pct'])
+    >>> all(0.4 <= c["gloss"] <= 1.0 for c in chips)
+    True
+    """
+    rng = np.random.default_rng(seed)
+    design = {
+        axis: {round(v, 3) for s in SWEEPS.values() for v in getattr(s, axis)} for axis in RANGES
+    }
+    (t0, t1), tio2, gloss = RANGES["thickness_mm"], RANGES["tio2_pct"], RANGES["gloss"]
+    chips: list[dict] = []
+    while len(chips) < count:
+        chip = {
+            "thickness_mm": round(float(np.exp(rng.uniform(np.log(t0), np.log(t1)))), 3),
+            "tio2_pct": round(float(rng.uniform(*tio2)), 3),
+            "gloss": round(float(rng.uniform(*gloss)), 3),
+        }
+        if all(chip[axis] not in design[axis] for axis in RANGES):
+            chips.append(chip)
+    return chips
+
+
+def map_environment(name: str, rows: int) -> np.ndarray:
+    """A shipped map, box-filtered to ``rows`` rows, as spectral radiance on the 41-band grid.
+
+    Examples
+    --------
+    >>> map_environment("venice_sunset_1k.hdr", 8).shape
+    (8, 16, 41)
+    """
+    from reference.geometry.camera import downsample_box
+    from reference.images.formats import read_image
+    from reference.scene.lights import EnvironmentLight
+    from shrm.environment import environment_spectral_radiance
+
+    image = read_image(data_path(f"environments/{name}"))
+    f = image.shape[0] // rows
+    image = downsample_box(image[: f * rows, : 2 * f * rows], f)
+    return environment_spectral_radiance(EnvironmentLight(image), DEFAULT_GRID)
+
+
+def held_out_study(name: str) -> dict:
+    """The hybrid against the oracle for every held-out chip under every shipped map.
+
+    ``name``: a key of :data:`HELD_OUT`.
+
+    Returns
+    -------
+    dict
+        ``settings``; ``rows``: per map and chip, the chip and the ΔE00 statistics of
+        ``polymer_oracle_study._stats`` (``mean``, ``p95``, ``max``, ``centre``, ``rim``);
+        ``worst``: per map, the largest object and rim means over its chips.
+
+    Examples
+    --------
+    >>> study = held_out_study("tiny")
+    >>> len(study["rows"]) == len(MAPS), sorted(study["worst"]) == sorted(MAPS)
+    (True, True)
+    """
+    s = HELD_OUT[name]
+    chips = held_out_chips(s.chips)
+    _, N, V = _sphere(s.size)
+    model = characterize_model()
+    oracle_settings = OracleStudy(s.size, s.env_height, (), (), (), (), s.tol)
+    rows = []
+    for map_name in MAPS:
+        env = map_environment(map_name, s.env_height)
+        maps, _ = hybrid_maps(env, sorted({c["gloss"] for c in chips}))
+        colour = Colour(env)
+        for chip in chips:
+            oracle = _oracle(N, V, env, chip, oracle_settings).result
+            hybrid = _hybrid(N, V, maps, model, chip, "fresnel")["I_result"]
+            rows.append(
+                {"map": map_name, **chip, **_stats(colour.delta_E(hybrid, oracle), N[:, 2])}
+            )
+    worst = {
+        m: {part: max(r[part] for r in rows if r["map"] == m) for part in ("mean", "rim")}
+        for m in MAPS
+    }
+    settings = {"name": name, "chips": s.chips, "size": s.size, "rows": s.env_height}
+    return {
+        "settings": settings | {"tol": s.tol, "seed": HELD_OUT_SEED},
+        "rows": rows,
+        "worst": worst,
+    }
+
+
+def held_out_checks(study: dict, model: str = "Herbert's hybrid") -> list:
+    """Per shipped map: the worst held-out chip's object and rim mean ΔE00 against :data:`TARGETS`.
+
+    Examples
+    --------
+    >>> study = {"worst": {"a.hdr": {"mean": 0.8, "rim": 2.5}}, "settings": {"chips": 3}}
+    >>> [(c.passed, c.basis) for c in held_out_checks(study)]
+    [(True, 'held out'), (False, 'held out')]
+    """
+    found = []
+    chips = study["settings"]["chips"]
+    for name, worst in study["worst"].items():
+        for part, label in (("mean", "object"), ("rim", "rim")):
+            value = worst[part]
+            found.append(
+                Check(
+                    f"{model} vs the layered oracle, {name}: worst {label} mean ΔE00 of "
+                    f"{chips} held-out chips",
+                    f"<= {TARGETS[part]:g}",
+                    value,
+                    value <= TARGETS[part],
+                    "held out",
+                )
+            )
+    return found
+
+
+def held_out_table(study: dict) -> Table:
+    """The study's rows: map, chip, ΔE00 mean, p95, max, centre and rim.
+
+    Examples
+    --------
+    >>> row = {"map": "a.hdr", "thickness_mm": 1.0, "tio2_pct": 0.5, "gloss": 0.8, "mean": 1.0,
+    ...        "p95": 2.0, "max": 3.0, "centre": 0.5, "rim": 2.5}
+    >>> held_out_table({"rows": [row], "settings": {"seed": 1}}).rows[0][:4]
+    ['a.hdr', 1.0, 0.5, 0.8]
+    """
+    keys = ("thickness_mm", "tio2_pct", "gloss", "mean", "p95", "max", "centre", "rim")
+    return Table(
+        ["map", "thickness mm", "TiO2 %", "gloss", "mean", "p95", "max", "centre", "rim"],
+        [[r["map"], *(r[k] for k in keys)] for r in study["rows"]],
+        "Herbert's hybrid (M_s = fresnel) against the layered oracle, ΔE00, on chips held out of "
+        f"the design (drawn with seed {study['settings']['seed']} from the sweeps' ranges) under "
+        "every shipped environment map",
+        "{:.3g}",
+    )
