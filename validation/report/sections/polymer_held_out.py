@@ -71,7 +71,7 @@ class HeldOut:
 
 HELD_OUT = {
     "tiny": HeldOut(1, 10, 8, 0.05),
-    "quick": HeldOut(3, 32, 32, 0.02),
+    "quick": HeldOut(3, 24, 32, 0.02),
     "full": HeldOut(8, 48, 32, 0.01),
 }
 
