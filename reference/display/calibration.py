@@ -34,6 +34,7 @@ References
 from __future__ import annotations
 
 import functools
+import numbers
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import NamedTuple
@@ -319,7 +320,9 @@ class _Reader:
 
     def __post_init__(self):
         require(
-            isinstance(self.max_readings, int) and self.max_readings >= 2,
+            isinstance(self.max_readings, numbers.Integral)
+            and not isinstance(self.max_readings, bool)
+            and self.max_readings >= 2,
             f"max_readings: must be an integer >= 2, got {self.max_readings!r}",
         )
 

@@ -23,6 +23,7 @@ from reference.display.calibration import (
 )
 from reference.display.instruments import ReferenceMeter, spectroradiometer, spectroradiometer_ideal
 from reference.display.spectral import display_drives_to_spectra, spectral_display
+from reference.errors import SpecrefError
 from validation.cli import main
 
 WAVELENGTHS = np.arange(380.0, 781.0, 1.0)
@@ -109,3 +110,18 @@ def test_a_missed_target_is_written_marked_and_said_in_one_line(tmp_path, capsys
     assert summary["targets"]["duv"]["max"] > TARGET_DUV[0]
     for suffix in (".cal", ".cube", ".ti3", ".json"):
         assert out.with_suffix(suffix).exists()
+
+
+@pytest.mark.parametrize("bad", [1, 0, -4, 2.5, "8", None, True])
+def test_a_bad_reading_count_is_refused_in_one_line(bad):
+    # the readings per point: an integer of at least two (two give the noise's first estimate)
+    with pytest.raises(SpecrefError, match=r"^max_readings: must be an integer >= 2, got "):
+        calibrate_display(spectral_display(), "D65", "gamma2.2", points=3, max_readings=bad)
+
+
+def test_a_numpy_integer_reading_count_is_taken():
+    # np.int64(4) is the same count as 4: the same calibration
+    args = (spectral_display(), "D65", "gamma2.2")
+    numpy_count = calibrate_display(*args, points=3, max_readings=np.int64(4))
+    plain = calibrate_display(*args, points=3, max_readings=4)
+    np.testing.assert_array_equal(numpy_count.points["G"], plain.points["G"])
