@@ -511,6 +511,37 @@ def checks(data: SectionData) -> list[Check]:
     )
 
 
+def printed_algorithm_ratios(
+    results: dict, interpolation: str = "parabolic", entries: int = 200
+) -> dict[str, float]:
+    """Per Table 1 row: RMS of the paper's algorithm over a uniform table's, same interpolation.
+
+    The algorithm as printed: importance placement with p = m and the parabola in t
+    (``parabolic``; ``parabolic_w`` reads it in w, Erratum E19); the uniform table with the same
+    interpolation; both at ``entries`` (rows that lack either are left out).
+
+    Examples
+    --------
+    >>> pts = [{"variant": "importance p=m", "interpolation": "parabolic", "entries": 200,
+    ...         "rms": 2.0}, {"variant": "uniform", "interpolation": "parabolic",
+    ...         "entries": 200, "rms": 0.01}]
+    >>> printed_algorithm_ratios({"R1 far": {"points": pts}, "nonfinite": 0})
+    {'R1 far': 200.0}
+    """
+    ratios = {}
+    for row, found in results.items():
+        if not (isinstance(found, dict) and "points" in found):
+            continue
+        rms = {
+            p["variant"]: p["rms"]
+            for p in found["points"]
+            if p["interpolation"] == interpolation and p["entries"] == entries
+        }
+        if rms.get("uniform", 0.0) > 0.0 and "importance p=m" in rms:
+            ratios[row] = float(rms["importance p=m"] / rms["uniform"])
+    return ratios
+
+
 def headlines(data: SectionData) -> list[Headline]:
     """The summary's figures: the error-placed table's accuracy and speed; the tolerance pick."""
     found = checks(data)
@@ -544,6 +575,18 @@ def headlines(data: SectionData) -> list[Headline]:
             f"target {pick.target}",
         )
     )
+    t, w = (printed_algorithm_ratios(data.results, i) for i in ("parabolic", "parabolic_w"))
+    if t and w:
+        worse = [r for r in t.values() if r > 1.0]
+        lines.append(
+            Headline(
+                "the paper's algorithm as printed (importance placement p = m, parabola in t) has "
+                f"{min(t.values()):.3g}–{max(t.values()):,.0f}× the RMS of a uniform table at 200 "
+                f"entries: worse on {len(worse)} of {len(t)} Table 1 rows",
+                f"read with the parabola in w (erratum E19): {min(w.values()):.2g}–"
+                f"{max(w.values()):.3g}× the uniform table's",
+            )
+        )
     return lines
 
 
