@@ -14,6 +14,7 @@ runs them. ``validation.report.render`` writes the HTML and Markdown.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -213,6 +214,10 @@ class ReportSection:
         they cost seconds, ``"quick"`` where the full settings take minutes (full-resolution maps,
         long sweeps); ``specref report --full`` runs every section at its full settings and
         ``--quick`` every section at its quick ones.
+    basis : str
+        What the section's checks that state no basis of their own are measured on (a key of
+        :data:`CHECK_BASES`, or ``""``): ``"design"`` for a section whose targets are measured on
+        the cases its methods were designed on; checks on other inputs say so themselves.
 
     Examples
     --------
@@ -236,6 +241,11 @@ class ReportSection:
     headlines: Callable[[SectionData], list] | None = None
     hero: str = ""
     default_effort: str = "full"
+    basis: str = ""
+
+    def __post_init__(self):
+        if self.basis:
+            require_choice(self.basis, tuple(CHECK_BASES), f"report section {self.name}: basis")
 
     def quick_under(self, effort: str) -> bool:
         """Whether this section runs its quick settings under a report ``effort``.
@@ -255,7 +265,10 @@ class ReportSection:
         """Compute, present and check: the section's blocks, results, checks and headlines."""
         data = self.compute(ctx)
         blocks = self.present(ctx, data)
-        checks = self.checks(data)
+        checks = [
+            c if c.basis or not self.basis else dataclasses.replace(c, basis=self.basis)
+            for c in self.checks(data)
+        ]
         if self.headlines is not None:
             headlines = list(self.headlines(data))
         else:

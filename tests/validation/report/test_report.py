@@ -284,3 +284,18 @@ def test_sections_side_by_side_give_the_serial_report(tmp_path):
     assert json.dumps(a, sort_keys=True) == json.dumps(b, sort_keys=True)
     names = [(c["section"], c["name"], c["passed"]) for c in serial["checks"]]
     assert [(c["section"], c["name"], c["passed"]) for c in forked["checks"]] == names
+
+
+def test_a_section_basis_labels_the_checks_that_state_none(tmp_path):
+    from validation.report.types import Check, ReportContext, ReportSection, SectionData
+
+    def two(data):
+        return [Check("a", "<= 1", 0.5, True), Check("b", "<= 1", 0.5, True, "held out")]
+
+    section = ReportSection(
+        "demo", "Demo", lambda ctx: SectionData(), lambda ctx, d: [], two, basis="design"
+    )
+    result = section.run(ReportContext(out_dir=tmp_path))
+    assert [c.basis for c in result.checks] == ["design", "held out"]
+    with pytest.raises(SpecrefError, match="basis"):
+        ReportSection("demo", "Demo", basis="tuned")

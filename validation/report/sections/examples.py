@@ -394,4 +394,5 @@ SECTION = ReportSection(
     checks,
     headlines=headlines,
     hero="colorchecker-d65-a",
+    basis="design",  # the shipped examples
 )

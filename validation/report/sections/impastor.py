@@ -863,12 +863,14 @@ def _held_out_checks(result) -> list:
             f">= {100 * HELD_OUT_SHARE:g} %",
             f"{100 * d['share_within_1.1']:.1f} %",
             d["share_within_1.1"] >= HELD_OUT_SHARE,
+            "held out",
         ),
         Check(
             f"hybrid / better method, worst of {pairs} ({worst['case']}, α = {worst['alpha']:g})",
             f"<= {HELD_OUT_MAX:g}",
             float(worst["ratio"]),
             worst["ratio"] <= HELD_OUT_MAX,
+            "held out",
         ),
     ]
 
@@ -937,4 +939,5 @@ SECTION = ReportSection(
     headlines=headlines,
     hero="painting-D65",
     default_effort="quick",  # the full settings take minutes: specref report --full
+    basis="design",  # the built-in painting and lights; the held-out cases say so
 )

@@ -396,4 +396,5 @@ SECTION = ReportSection(
     checks,
     headlines=headlines,
     hero="bottle",
+    basis="design",  # the demo bottle
 )

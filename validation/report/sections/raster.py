@@ -426,5 +426,11 @@ def headlines(data: SectionData) -> list[Headline]:
 
 
 SECTION = ReportSection(
-    "rasterizer", "Rasterizer", rasterizer_figures, present, checks, headlines=headlines
+    "rasterizer",
+    "Rasterizer",
+    rasterizer_figures,
+    present,
+    checks,
+    headlines=headlines,
+    basis="design",  # the tessellated spheres and closed meshes it was built on
 )

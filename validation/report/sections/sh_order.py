@@ -248,4 +248,5 @@ SECTION = ReportSection(
     present,
     checks,
     default_effort="quick",  # the full settings take minutes: specref report --full
+    basis="design",  # the shipped maps and the bright texel the rule was built on (E75)
 )

@@ -354,4 +354,5 @@ SECTION = ReportSection(
     present,
     checks,
     default_effort="quick",  # the full settings take minutes: specref report --full
+    basis="design",  # the environment the fits were chosen on
 )
