@@ -58,7 +58,7 @@ def _share_the_cores() -> None:
     from threadpoolctl import threadpool_limits
 
     share = max(1, (os.cpu_count() or 1) // workers)
-    for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "SPECREF_THREADS"):
+    for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ.setdefault(name, str(share))
     threadpool_limits(limits=int(os.environ["OPENBLAS_NUM_THREADS"]))
 

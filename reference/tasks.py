@@ -35,7 +35,6 @@ __all__ = [
     "PROFILE_SETTING",
     "SCHEDULER_ENV",
     "SERIAL",
-    "THREADS_ENV",
     "TIMEOUT_ENV",
     "TRIM_SETTING",
     "WORKER_MMAP_BYTES",
@@ -52,7 +51,6 @@ __all__ = [
     "scheduler_address",
     "set_malloc_trim",
     "specref_identity",
-    "thread_share",
     "usable_workers",
     "worker_problems",
 ]
@@ -62,10 +60,6 @@ SCHEDULER_ENV = "SPECREF_SCHEDULER"
 
 #: The environment variable that sets how long to wait for a remote scheduler, in seconds.
 TIMEOUT_ENV = "SPECREF_DASK_TIMEOUT"
-
-#: The environment variable that caps the threads a process gives its own parallel work (Mitsuba
-#: 3's renders): the report's side-by-side sections set it to their share of the cores.
-THREADS_ENV = "SPECREF_THREADS"
 
 #: The wait for a remote scheduler when ``$SPECREF_DASK_TIMEOUT`` is unset, in seconds.
 DEFAULT_TIMEOUT = 10.0
@@ -231,37 +225,6 @@ def local_workers(address: str | None) -> int | None:
         f"--scheduler {address}: allowed: local:N, N workers from 1 to {MAX_LOCAL_WORKERS}",
     )
     return int(count)
-
-
-def thread_share(environ=None) -> int:
-    """Threads this process may give its own parallel work: ``$SPECREF_THREADS``, else every core.
-
-    Two processes side by side on two cores whose renderer each starts a thread per core run
-    four threads on two cores, and the timings the other measures are off.
-
-    Raises
-    ------
-    SpecrefError
-        The variable is not a whole number >= 1 (one line naming it).
-
-    Examples
-    --------
-    >>> thread_share({"SPECREF_THREADS": "1"})
-    1
-    >>> thread_share({}) == (os.cpu_count() or 1)
-    True
-    >>> thread_share({"SPECREF_THREADS": "half"})
-    Traceback (most recent call last):
-    ...
-    reference.errors.SpecrefError: $SPECREF_THREADS: 'half' is not a whole number >= 1
-    """
-    text = (os.environ if environ is None else environ).get(THREADS_ENV, "").strip()
-    if not text:
-        return os.cpu_count() or 1
-    require(
-        text.isdigit() and int(text) >= 1, f"${THREADS_ENV}: {text!r} is not a whole number >= 1"
-    )
-    return int(text)
 
 
 def connect_timeout(environ=None) -> float:

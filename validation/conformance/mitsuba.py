@@ -59,11 +59,6 @@ def render_mitsuba(
         raise SpecrefError(
             f"Mitsuba 3 ({variant}) not available ({error}); {INSTALL_HINT}"
         ) from None
-    import drjit as dr
-
-    from reference.tasks import thread_share
-
-    dr.set_thread_count(thread_share())  # its share of the cores beside other work
     xml = Path(xml)
     scene = mi.load_file(str(xml))
     image = np.array(mi.render(scene, seed=seed, spp=spp or 0), dtype=np.float64)[..., :3]

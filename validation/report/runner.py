@@ -33,7 +33,7 @@ from pathlib import Path
 from reference.errors import require, require_choice
 from reference.files import read_json, write_bytes_atomic, write_text_atomic
 from reference.registry import Registry
-from reference.tasks import LOCAL, SERIAL, THREADS_ENV, dask_client, scheduler_address
+from reference.tasks import LOCAL, SERIAL, dask_client, scheduler_address
 from validation.report.render import render_html, render_markdown
 from validation.report.sections import (
     conformance,
@@ -394,7 +394,6 @@ def _run_forked(index: int) -> tuple[int, SectionResult]:
 
     run = _FORKED["run"]
     share = max(1, (os.cpu_count() or 1) // run.jobs)
-    os.environ[THREADS_ENV] = str(share)  # and Mitsuba 3's renders (reference.tasks.thread_share)
     with threadpool_limits(limits=share), matplotlib.rc_context(CHART_STYLE):
         return index, _run_section(run, run.sections[index], None)
 

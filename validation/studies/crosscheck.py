@@ -263,12 +263,8 @@ def _patch_means(XYZ: np.ndarray) -> np.ndarray:
 
 def _mitsuba_runs(scene_dict, settings, chart: bool) -> np.ndarray:
     """(seeds, ...) XYZ of independent Mitsuba renders."""
-    import drjit as dr
     import mitsuba as mi
 
-    from reference.tasks import thread_share
-
-    dr.set_thread_count(thread_share())  # its share of the cores beside other work
     scene = mi.load_dict(scene_dict)
     runs = []
     for seed in range(settings.seeds):
