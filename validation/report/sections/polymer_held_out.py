@@ -51,7 +51,7 @@ MAPS = (
 )
 #: ΔE00 to the oracle that a real-time polymer model should hold on held-out chips and maps: the
 #: worst chip's object mean and rim mean (cos θ_v < 0.3) per map. Herbert's hybrid is measured
-#: against them; a model beyond it is built to meet them (docs/herbert-polymer.md).
+#: against them; a model beyond it is to meet them (docs/herbert-polymer.md).
 TARGETS = {"mean": 1.0, "rim": 2.0}
 #: Seed of the held-out chips.
 HELD_OUT_SEED = 20261128
