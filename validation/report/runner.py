@@ -420,12 +420,11 @@ def _side_by_side(run: _Run, stack: contextlib.ExitStack):
 def start_order(sections, out_dir, effort: str) -> list[int]:
     """The order in which side-by-side sections start: the longest first.
 
-    Longest first (the LPT rule, Graham 1969) ends a run on few processes sooner than reading order
-    (the default report's section times measured here, on two processes: 190 s in reading order,
-    178 s longest first). The lengths are the last run's, from ``out_dir/results.json`` when it
-    ran at the same effort; without them, the sections whose settings are heavy enough to be quick
-    under the default effort (``default_effort="quick"``) start first. The page keeps the reading
-    order.
+    Longest first (the LPT rule, Graham 1969) ends a run on few processes sooner than reading
+    order, whose long sections came last. The lengths are the last run's, from
+    ``out_dir/results.json`` when it ran at the same effort; without them, the sections whose
+    settings are heavy enough to be quick under the default effort (``default_effort="quick"``)
+    start first. The page keeps the reading order.
 
     Examples
     --------

@@ -59,8 +59,8 @@ def sphere_points(R: int) -> tuple[np.ndarray, np.ndarray]:
     return n, np.broadcast_to(np.array([0.0, 0.0, 1.0]), n.shape)
 
 
-def environment_radiance(path, rows: int | None = None) -> np.ndarray:
-    """The spectral radiance ``(H, 2H, C)`` of a lat-long map on :data:`GRID`.
+def environment_radiance(path, rows: int | None = None, grid=None) -> np.ndarray:
+    """The spectral radiance ``(H, 2H, C)`` of a lat-long map on ``grid`` (default :data:`GRID`).
 
     ``rows`` box-filters the map to that height first (None: the full resolution).
 
@@ -81,7 +81,7 @@ def environment_radiance(path, rows: int | None = None) -> np.ndarray:
     if rows is not None and rows < image.shape[0]:
         f = image.shape[0] // rows
         image = downsample_box(image[: f * rows, : 2 * f * rows], f)
-    return environment_spectral_radiance(EnvironmentLight(image), GRID)
+    return environment_spectral_radiance(EnvironmentLight(image), GRID if grid is None else grid)
 
 
 def _errors(Y, truth) -> tuple[float, float]:

@@ -299,3 +299,17 @@ def test_a_section_basis_labels_the_checks_that_state_none(tmp_path):
     assert [c.basis for c in result.checks] == ["design", "held out"]
     with pytest.raises(SpecrefError, match="basis"):
         ReportSection("demo", "Demo", basis="tuned")
+
+
+@pytest.mark.parametrize(
+    "content", ["{not json", '{"meta": 3}', '{"meta": {"mode": "default", "section_seconds": 1}}']
+)
+def test_an_unreadable_earlier_results_file_falls_back_to_heavy_first(tmp_path, content):
+    # a stopped or foreign results.json neither stops the run nor reorders it by guesswork
+    from validation.report.runner import start_order
+    from validation.report.types import ReportSection
+
+    (tmp_path / "results.json").write_text(content)
+    sections = [ReportSection("a", "A"), ReportSection("b", "B", default_effort="quick")]
+    assert start_order(sections, tmp_path, "default") == [1, 0]
+    assert (tmp_path / "results.json").read_text() == content

@@ -114,15 +114,9 @@ def map_environment(name: str, rows: int) -> np.ndarray:
     >>> map_environment("venice_sunset_1k.hdr", 8).shape
     (8, 16, 41)
     """
-    from reference.geometry.camera import downsample_box
-    from reference.images.formats import read_image
-    from reference.scene.lights import EnvironmentLight
-    from shrm.environment import environment_spectral_radiance
+    from validation.studies.shrm_fullres import environment_radiance
 
-    image = read_image(data_path(f"environments/{name}"))
-    f = image.shape[0] // rows
-    image = downsample_box(image[: f * rows, : 2 * f * rows], f)
-    return environment_spectral_radiance(EnvironmentLight(image), DEFAULT_GRID)
+    return environment_radiance(data_path(f"environments/{name}"), rows, DEFAULT_GRID)
 
 
 def held_out_study(name: str) -> dict:
