@@ -198,12 +198,18 @@ def _sample_periodic(h, y, x):
 
 
 @njit
-def _horizon_along(h, pixel_size, j, i, phi, max_steps, step):
+def _horizon_along(h, pixel_size, j, i, phi, max_steps, step, h_max):
     dx, dy = math.cos(phi), math.sin(phi)
     best = 0.0
     n_steps = round(max_steps / step)
+    headroom = h_max - h[j, i]
     for k in range(1, n_steps + 1):
         t = k * step
+        # No later sample rises above h_max (bilinear samples stay within the heights) and t only
+        # grows, so once (h_max - h₀)/t cannot beat the best slope the march stops: the same
+        # result, exactly, at a fraction of the steps on most texels (a speed-up of our own).
+        if headroom <= best * (t * pixel_size):
+            break
         rise = _sample_periodic(h, j + t * dy, i + t * dx) - h[j, i]
         # Sloan & Cohen 2000: the horizon is the largest elevation angle seen along the ray
         best = max(best, rise / (t * pixel_size))
@@ -214,20 +220,22 @@ def _horizon_along(h, pixel_size, j, i, phi, max_steps, step):
 def horizon_map_kernel(h, pixel_size, n_sectors, max_steps, step, out):
     """Twin of ``horizon_map``: each sector marched along its centre azimuth."""
     H, W = h.shape
+    h_max = h.max()
     for s in range(n_sectors):
         phi = (s + 0.5) * 2.0 * math.pi / n_sectors
         for j in range(H):
             for i in range(W):
-                out[j, i, s] = _horizon_along(h, pixel_size, j, i, phi, max_steps, step)
+                out[j, i, s] = _horizon_along(h, pixel_size, j, i, phi, max_steps, step, h_max)
 
 
 @njit
 def horizon_at_texels_kernel(h, pixel_size, rows, cols, n_sectors, max_steps, step, out):
     """Twin of ``horizon_at_texels``: the horizon map's sectors at the listed texels only."""
+    h_max = h.max()
     for n in range(rows.shape[0]):
         for s in range(n_sectors):
             phi = (s + 0.5) * 2.0 * math.pi / n_sectors
-            out[n, s] = _horizon_along(h, pixel_size, rows[n], cols[n], phi, max_steps, step)
+            out[n, s] = _horizon_along(h, pixel_size, rows[n], cols[n], phi, max_steps, step, h_max)
 
 
 @njit
@@ -272,7 +280,8 @@ def diffuse_brute_force_kernel(P, N, horizon, frame, position, L, n_light, pixel
 def ray_march_shadows_kernel(h, pixel_size, phi, beta, max_steps, step, out):
     """Twin of ``ray_march_shadows``: lit where β exceeds the horizon along the exact azimuth."""
     H, W = h.shape
+    h_max = h.max()
     for j in range(H):
         for i in range(W):
-            horizon = _horizon_along(h, pixel_size, j, i, phi[j, i], max_steps, step)
+            horizon = _horizon_along(h, pixel_size, j, i, phi[j, i], max_steps, step, h_max)
             out[j, i] = beta[j, i] > horizon and beta[j, i] > 0.0

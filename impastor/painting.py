@@ -187,7 +187,8 @@ def impasto_painting(size: int = 256, seed: int = 1, width_m: float = 0.3, n_str
     rng = np.random.default_rng(seed)
     pixel = width_m / size
     n = n_strokes or int(400 * (width_m / 0.3) ** 2)
-    y, x = np.meshgrid(np.arange(size) * pixel, np.arange(size) * pixel, indexing="ij")
+    coordinate = np.arange(size) * pixel
+    y, x = np.meshgrid(coordinate, coordinate, indexing="ij")
     # Canvas weave: two crossed sinusoids, 1 mm period, 20 µm deep.
     height = 2e-5 * (np.sin(2 * np.pi * x / 1e-3) * np.sin(2 * np.pi * y / 1e-3))
     material = np.full((size, size), -1, dtype=np.int64)
@@ -200,8 +201,13 @@ def impasto_painting(size: int = 256, seed: int = 1, width_m: float = 0.3, n_str
         half_width = rng.uniform(0.002, 0.006)
         amplitude = rng.uniform(5e-4, 2e-3)
         # Minimum-image offsets: the canvas tiles.
-        dx = (x - cx + width_m / 2) % width_m - width_m / 2
-        dy = (y - cy + width_m / 2) % width_m - width_m / 2
+        dx = (coordinate - cx + width_m / 2) % width_m - width_m / 2
+        dy = (coordinate - cy + width_m / 2) % width_m - width_m / 2
+        # The stroke is zero beyond |along| = length/2 or |across| = half_width, so only the rows
+        # and columns within length/2 + half_width of its centre are computed (the same values).
+        reach = length / 2 + half_width
+        window = np.ix_(np.flatnonzero(np.abs(dy) < reach), np.flatnonzero(np.abs(dx) < reach))
+        dx, dy = dx[window[1]], dy[window[0]]
         along = dx * np.cos(theta) + dy * np.sin(theta)
         across = -dx * np.sin(theta) + dy * np.cos(theta)
         r = np.abs(across) / half_width
@@ -211,10 +217,11 @@ def impasto_painting(size: int = 256, seed: int = 1, width_m: float = 0.3, n_str
         bump = amplitude * body * ends
         covered = bump > 0.15 * amplitude
         # The new stroke lies on top: it replaces the surface where it is thick.
-        height = np.where(covered, np.maximum(height, bump + 0.5 * height), height)
-        material[covered] = rng.integers(0, len(PAINT_SPECTRA))
-        rho_s[covered] = rng.uniform(0.02, 0.08)
-        alpha[covered] = rng.uniform(0.04, 0.3)
+        under = height[window]
+        height[window] = np.where(covered, np.maximum(under, bump + 0.5 * under), under)
+        material[window] = np.where(covered, rng.integers(0, len(PAINT_SPECTRA)), material[window])
+        rho_s[window] = np.where(covered, rng.uniform(0.02, 0.08), rho_s[window])
+        alpha[window] = np.where(covered, rng.uniform(0.04, 0.3), alpha[window])
     return {
         "height": height,
         "material": material,
