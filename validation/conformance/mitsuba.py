@@ -16,7 +16,9 @@ from reference.errors import SpecrefError
 
 __all__ = [
     "PROOF_SPP",
+    "PROOF_SPP_OVERRIDE",
     "QUICK_PROOF",
+    "proof_spp",
     "render_mitsuba",
     "render_mitsuba_folder",
     "run_mitsuba_proof",
@@ -101,10 +103,33 @@ def render_mitsuba_folder(
     return written
 
 
-#: Samples per pixel of the proof: Mitsuba's noise averaged over 4 × 4 blocks stays well inside
-#: the 1 % floor; FL11's narrow lines make Mitsuba's wavelength sampling noisier, so more there.
+#: Samples per pixel of the proof, per scene (:func:`proof_spp`): as many as keep Mitsuba's noise,
+#: averaged over 4 × 4 blocks, near half the 1 % floor in Y or below (measured at 128 to 4096). The
+#: point-lit spheres and the broadband charts reach it at 256; FL11's narrow lines make Mitsuba's
+#: wavelength sampling noisier, and the studio map's small bright lamps its environment sampling.
 PROOF_SPP = 1024
-PROOF_SPP_OVERRIDE = {"colorchecker-fl11": 4096}
+PROOF_SPP_OVERRIDE = {
+    "lambert-point-d65": 256,
+    "lambert-point-orange-a": 256,
+    "ggx-point-d65": 256,
+    "colorchecker-d65": 256,
+    "colorchecker-a": 256,
+    "colorchecker-fl11": 4096,
+    "lambert-env-studio": 2048,
+}
+
+
+def proof_spp(name: str) -> int:
+    """Samples per pixel with which the proof renders scene ``name`` in Mitsuba 3.
+
+    Examples
+    --------
+    >>> proof_spp("colorchecker-fl11"), proof_spp("lambert-env-venice")
+    (4096, 1024)
+    """
+    return PROOF_SPP_OVERRIDE.get(name, PROOF_SPP)
+
+
 #: The scenes of the quick proof (``specref report``'s default effort): a point light, a lamp with
 #: lines and an environment, each with the mistake it is broken with.
 QUICK_PROOF = ("lambert-point-d65", "colorchecker-fl2", "lambert-env-venice")
@@ -149,7 +174,7 @@ def run_mitsuba_proof(
 
     docs/conformance.md ("Proof on Mitsuba 3"): every scene Mitsuba 3 can express (or those of
     ``names``; :data:`QUICK_PROOF` for the report's default effort) is rendered at
-    :data:`PROOF_SPP` and checked against its reference; with ``broken``, the venice map mirrored,
+    :func:`proof_spp` and checked against its reference; with ``broken``, the venice map mirrored,
     the point-lit sphere's values sRGB-encoded and the FL2 chart rendered by Mitsuba's
     ``scalar_rgb`` variant are checked too, each expected to fail with the mistake made (those
     three scenes are then rendered whatever ``names`` says). ``references`` is the references'

@@ -35,24 +35,26 @@ def conformance_figures(ctx) -> SectionData:
 
 def present(ctx, data: SectionData) -> list:
     """The check's table for Mitsuba's renders, and the broken renders with their diagnoses."""
-    from validation.conformance.mitsuba import PROOF_SPP
+    from validation.conformance.mitsuba import proof_spp
 
     r = data.results
     if not r["available"]:
         return [Text(f"The conformance proof did not run: {r['reason']}.")]
     return [
         Text(
-            f"The conformance scenes that Mitsuba 3 can express, exported by `specref "
-            f"conformance export --format mitsuba` and rendered by Mitsuba 3 (`scalar_spectral`, "
-            f"{PROOF_SPP} samples per pixel), checked by `specref conformance check` against "
+            "The conformance scenes that Mitsuba 3 can express, exported by `specref "
+            "conformance export --format mitsuba` and rendered by Mitsuba 3 (`scalar_spectral`, "
+            "at the samples per pixel of the column spp), checked by `specref conformance check` "
+            "against "
             "specref's references: the mean relative ΔY and ΔE00 of 4 × 4-pixel blocks against "
             "their tolerances (docs/conformance.md)."
         ),
         Table(
-            ["scene", "passed", "ΔY blocks", "tolerance", "ΔE00 blocks", "ΣY ratio − 1"],
+            ["scene", "spp", "passed", "ΔY blocks", "tolerance", "ΔE00 blocks", "ΣY ratio − 1"],
             [
                 [
                     s["scene"],
+                    proof_spp(s["scene"]),
                     s["passed"],
                     s["block_rel_Y"],
                     s["tol_Y"],
