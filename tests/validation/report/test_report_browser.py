@@ -11,7 +11,7 @@ import pytest
 from reference.browser import INSTALL_HINT, find_chromium
 from validation.report.browser import check_report_page
 from validation.report.runner import PARTS, run_report
-from validation.report.sections import impastor, phong
+from validation.report.sections import impastor, phong, polymer_scene
 from validation.report.sections.phong import PhongStudy
 
 pytestmark = pytest.mark.skipif(
@@ -27,6 +27,8 @@ SMALL_REPORT = ("spectral-core", "phong", "polymer-scene", "impastor")
 
 #: The Phong section's tiny sizes (an 8² image, one material): the page, not the figures, is tested.
 PHONG_TINY = PhongStudy(8, False, 1, (25,), ("R1",), ("near",), (10,), (50,), (10,), 64, True)
+#: The polymer scene's bottle on a coarse mesh in a 16 × 20 frame.
+POLYMER_SCENE_TINY = {"around": 16, "profile": 13, "width": 16, "height": 20}
 
 
 @pytest.fixture(scope="module")
@@ -36,6 +38,7 @@ def quick_report(tmp_path_factory):
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(phong, "QUICK", PHONG_TINY)
         patch.setattr(impastor, "QUICK", impastor.TINY)
+        patch.setitem(polymer_scene.SETTINGS, "quick", POLYMER_SCENE_TINY)
         results = run_report(out, "quick", only=list(SMALL_REPORT), progress=False, screenshot=True)
     return out, results
 
