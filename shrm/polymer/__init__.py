@@ -8,14 +8,17 @@
 - :mod:`~shrm.polymer.material` — the ``polymer`` scene material and its environment shader.
 - :mod:`~shrm.polymer.oracle` — the layered physical model behind Eq. (1), Herbert et al., by brute
   force.
+- :mod:`~shrm.polymer.layered` — that layered model from prefiltered maps: a real-time model beyond
+  the hybrid.
 """
 
 from __future__ import annotations
 
-from shrm.polymer import characterization, hybrid, kubelka_munk, material, oracle, tint
+from shrm.polymer import characterization, hybrid, kubelka_munk, layered, material, oracle, tint
 from shrm.polymer.characterization import *  # noqa: F403
 from shrm.polymer.hybrid import *  # noqa: F403
 from shrm.polymer.kubelka_munk import *  # noqa: F403
+from shrm.polymer.layered import *  # noqa: F403
 from shrm.polymer.material import *  # noqa: F403
 from shrm.polymer.oracle import *  # noqa: F403
 from shrm.polymer.tint import *  # noqa: F403
@@ -28,5 +31,6 @@ __all__ = sorted(
         *hybrid.__all__,
         *material.__all__,
         *oracle.__all__,
+        *layered.__all__,
     }
 )

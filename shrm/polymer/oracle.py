@@ -67,6 +67,7 @@ __all__ = [
     "ORACLE_KERNELS",
     "PHONG_EXPONENT_MAX",
     "OracleResult",
+    "body_factors",
     "gloss_alpha",
     "gloss_phong_exponent",
     "interface_coupling",
@@ -311,11 +312,31 @@ def interface_coupling(n: float, alpha: float, nodes: int = 129) -> Coupling:
     return Coupling(cos_nodes, enter, k_e, r_i)
 
 
-def _body_factors(K, S, d, r_t: float, r_b: float):
+def body_factors(K, S, d, r_t: float, r_b: float):
     """Diffuse reflection ``ρ_out`` and transmission ``τ`` of the slab between its two surfaces.
 
-    Fluxes: ``ρ_out`` of the flux entering at the front leaves at the front, ``τ`` of the flux
-    entering at the back leaves at the front (both already through the front surface).
+    The slab's part of the physical counterpart of Eq. (1), Herbert et al. Fluxes: ``ρ_out`` of
+    the flux entering at the front leaves at the front, ``τ`` of the flux entering at the back
+    leaves at the front (both already through the front surface).
+
+    Parameters
+    ----------
+    K, S : array_like, shape (n_bands,)
+        Absorption and scattering, 1/mm.
+    d : float
+        Thickness, mm.
+    r_t, r_b : float
+        Internal diffuse reflectances of the front and back surfaces (``Coupling.r_i``).
+
+    Returns
+    -------
+    rho_out, tau : ndarray, shape (n_bands,)
+
+    Examples
+    --------
+    >>> rho_out, tau = body_factors(np.array([0.0]), np.array([1e6]), 1.0, 0.6, 0.6)
+    >>> rho_out.round(6), tau.round(6)              # a white opaque body loses nothing
+    (array([1.]), array([0.]))
     """
     R_0, T = km_slab(K, S, d)
     # Kubelka (1948): body over the back surface, seen from the front
@@ -360,7 +381,7 @@ def oracle_bsdf(wi, wo, normal, K, S, d, n: float = 1.54, gloss: float = 1.0) ->
     alpha = gloss_alpha(gloss)
     front = interface_coupling(float(n), alpha)
     back = interface_coupling(float(n), 0.0)
-    rho_out, tau = _body_factors(np.asarray(K, float), np.asarray(S, float), d, front.r_i, back.r_i)
+    rho_out, tau = body_factors(np.asarray(K, float), np.asarray(S, float), d, front.r_i, back.r_i)
     ci, co = np.einsum("ij,ij->i", wi, N), np.einsum("ij,ij->i", wo, N)
     exit_ = front.lookup(co)[:, None] / (np.pi * (1.0 - front.k_e))
     body = np.where((ci > 0)[:, None], front.lookup(ci)[:, None] * rho_out, 0.0)
@@ -593,7 +614,7 @@ def oracle_diffuse(normal, view, radiance, K, S, d, n: float = 1.54, gloss: floa
     alpha = gloss_alpha(gloss)
     front, back = interface_coupling(float(n), alpha), interface_coupling(float(n), 0.0)
     K, S = (np.broadcast_to(np.asarray(a, float), radiance.shape[-1:]) for a in (K, S))
-    rho_out, tau = _body_factors(K, S, d, front.r_i, back.r_i)
+    rho_out, tau = body_factors(K, S, d, front.r_i, back.r_i)
     # the exit distribution: the flux leaving the front, (1 − E_ρ(θ_o)) / (π (1 − k_e)) per sr
     cos_o = np.einsum("ij,ij->i", N, V)
     exit_ = front.lookup(cos_o)[:, None] / (np.pi * (1.0 - front.k_e))

@@ -7,7 +7,7 @@ from reference.materials.isotropic import ggx_distribution, ggx_smith_G1
 from shrm.polymer.kubelka_munk import km_R_infinity, polymer_constituents, polymer_K_S
 from shrm.polymer.oracle import (
     ORACLE_KERNELS,
-    _body_factors,
+    body_factors,
     gloss_alpha,
     gloss_phong_exponent,
     interface_coupling,
@@ -151,8 +151,8 @@ def test_transmission_is_reciprocal_between_unlike_surfaces():
     K, S = polymer_K_S(HDPE, 0.2)
     n = 1.54
     front, back = interface_coupling(n, 0.3), interface_coupling(n, 0.0)
-    _, tau = _body_factors(K, S, 1.0, front.r_i, back.r_i)
-    _, tau_reverse = _body_factors(K, S, 1.0, back.r_i, front.r_i)
+    _, tau = body_factors(K, S, 1.0, front.r_i, back.r_i)
+    _, tau_reverse = body_factors(K, S, 1.0, back.r_i, front.r_i)
     np.testing.assert_allclose(tau / (1 - front.k_e), tau_reverse / (1 - back.k_e), rtol=1e-12)
 
 
