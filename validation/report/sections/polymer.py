@@ -525,6 +525,7 @@ def _failure_text(oracle: dict) -> str:
     )
     speed = oracle["speed"]
     ratio = speed["reference"]["seconds"] / speed["hybrid"][best]["seconds"]
+    layered = speed["layered"]
     return (
         f"Where the heuristic fails (mean ΔE00 above {FAIL_DELTA_E:g} over the object or at the "
         "rim, per sweep and M_s): "
@@ -534,7 +535,10 @@ def _failure_text(oracle: dict) -> str:
         f"{best}, the rim (cos θ_v < 0.3) averages {rim:.2f} against {centre:.2f} at the centre "
         f"(cos θ_v > 0.7). On the base chip (band means): {balance} (I_d is not weighted by "
         f"1 − F_r in Eq. (1), Herbert et al.; erratum E34). The hybrid's frame is {ratio:.0f}× "
-        "faster than the converged oracle's."
+        "faster than the converged oracle's. The layered model (shrm.polymer.layered) on the "
+        f"same chip: mean ΔE00 {layered['mean']:.2f} (rim {layered['rim']:.2f}), its maps "
+        f"{layered['maps_seconds']:.2f} s, a frame {1e3 * layered['seconds']:.1f} ms, a re-shade "
+        f"{1e3 * layered['reshade_seconds']:.2f} ms."
     )
 
 
@@ -549,6 +553,12 @@ def _speed_figure(ctx: ReportContext, speed: dict):
         ax.annotate(f"{r['samples']} spp", (r["seconds"], r["mean"]), fontsize=7)
     for i, (mirror, r) in enumerate(speed["hybrid"].items()):
         ax.loglog([r["seconds"]], [r["mean"]], "s", c=f"C{i}", label=f"hybrid, M_s = {mirror}")
+    layered = speed["layered"]
+    ax.loglog([layered["seconds"]], [layered["mean"]], "D", c="C4", label="layered model")
+    ax.loglog(
+        [layered["reshade_seconds"]], [layered["mean"]], "d", c="C4", mfc="none",
+        label="layered model, re-shade",
+    )  # fmt: skip
     ax.set_xlabel("seconds per frame")
     ax.set_ylabel("mean ΔE00 against the converged oracle")
     ax.legend(frameon=False, fontsize=8)
@@ -556,19 +566,28 @@ def _speed_figure(ctx: ReportContext, speed: dict):
     return ctx.figure(
         "oracle-speed",
         fig,
-        "Speed against accuracy on the base chip: the hybrid from maps built beforehand (look-up "
-        "and shading only) and the oracle at fixed sample counts (another seed), against the "
+        "Speed against accuracy on the base chip: the hybrid and the layered model from maps "
+        "built beforehand (look-up and shading only; the layered model's re-shade after a change "
+        "of the slab from its cached pixel parts) and the oracle at fixed sample counts (another "
+        "seed), against the "
         f"oracle converged at {reference['samples']} samples per pixel "
         f"({reference['seconds']:.2f} s)",
     )
 
 
+#: A dynamic change (thickness, TiO2, tint) re-shades the layered model from its cached pixel
+#: parts at least this much faster than a cold frame (its maps and a frame).
+LAYERED_RESHADE_SPEEDUP = 20.0
+
+
 def _oracle_checks(oracle: dict) -> list[Check]:
-    """The oracle's own checks: converged, and equal to smooth plastic in the white furnace."""
+    """The oracle converged and equal to smooth plastic in the furnace; the layered re-shade."""
     reference = oracle["speed"]["reference"]
     tol = oracle["settings"]["tol"]
     furnace = oracle["furnace_error"]
     converged = reference["relative_error"] <= tol
+    layered = oracle["speed"]["layered"]
+    cold = layered["maps_seconds"] + layered["seconds"]
     return [
         Check(
             "oracle converged (p99 relative standard error of the rough lobe)",
@@ -581,6 +600,13 @@ def _oracle_checks(oracle: dict) -> list[Check]:
             "<= 1e-3",
             furnace,
             furnace <= 1e-3,
+        ),
+        Check(
+            "layered model: a re-shade after a change of the slab against a cold frame (its maps "
+            "and a frame), speed-up",
+            f">= {LAYERED_RESHADE_SPEEDUP:g}×",
+            cold / layered["reshade_seconds"],
+            cold / layered["reshade_seconds"] >= LAYERED_RESHADE_SPEEDUP,
         ),
     ]
 

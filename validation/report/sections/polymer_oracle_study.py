@@ -28,6 +28,12 @@ from reference.geometry.envmap import latlong_pixel_directions, latlong_pixel_so
 from shrm.polymer.characterization import characterize_model
 from shrm.polymer.hybrid import MIRROR_FACTORS, PolymerMaps, polymer_look, polymer_terms
 from shrm.polymer.kubelka_munk import km_R_infinity, polymer_constituents, polymer_K_S
+from shrm.polymer.layered import (
+    layered_maps,
+    layered_pixel_parts,
+    layered_shade_parts,
+    layered_terms,
+)
 from shrm.polymer.oracle import (
     gloss_phong_exponent,
     oracle_diffuse,
@@ -236,8 +242,10 @@ def _seconds(function, repeat: int = 3) -> float:
 def speed_accuracy(env, settings: OracleStudy, maps: dict, references: dict) -> dict:
     """Seconds per frame and ΔE00 against the converged oracle, at the base chip.
 
-    The hybrid per M_s (from maps built beforehand: look-up and shading only); the oracle at fixed
-    sample counts with another seed than the reference.
+    The hybrid per M_s (from maps built beforehand: look-up and shading only); the layered model
+    (``shrm.polymer.layered``: its maps' time, a frame from them, and a re-shade from its pixel
+    parts after a change of the slab); the oracle at fixed sample counts with another seed than
+    the reference.
     """
     _, N, V = _sphere(settings.size)
     chips, colour = characterize_model(), Colour(env)
@@ -256,11 +264,30 @@ def speed_accuracy(env, settings: OracleStudy, maps: dict, references: dict) -> 
         seconds = _seconds(lambda m=mirror: _hybrid(N, V, maps, chips, BASE, m))
         dE = colour.delta_E(terms["I_result"], reference.result)
         out["hybrid"][mirror] = {"seconds": seconds, **_stats(dE, N[:, 2])}
+    out["layered"] = _layered_speed(N, V, env, colour, reference.result)
     for m in settings.samples:
         run = _oracle(N, V, env, BASE, settings, tol=0.0, samples=m, max_samples=m, seed=1)
         dE = colour.delta_E(run.result, reference.result)
         out["oracle"].append({"samples": m, "seconds": run.seconds, **_stats(dE, N[:, 2])})
     return out
+
+
+def _layered_speed(N, V, env, colour: Colour, reference: np.ndarray) -> dict:
+    """The layered model on the base chip: seconds for its maps, a frame and a re-shade; ΔE00."""
+    constituents = polymer_constituents()
+    K, S = polymer_K_S(constituents, BASE["tio2_pct"])
+    d = BASE["thickness_mm"]
+    t0 = time.perf_counter()
+    maps = layered_maps(env, constituents.index, BASE["gloss"])
+    maps_seconds = time.perf_counter() - t0
+    result = layered_terms(N, V, maps, K, S, d)["result"]
+    parts = layered_pixel_parts(N, V, maps)
+    return {
+        "maps_seconds": maps_seconds,
+        "seconds": _seconds(lambda: layered_terms(N, V, maps, K, S, d)),
+        "reshade_seconds": _seconds(lambda: layered_shade_parts(parts, K, S, 2.0 * d, maps)),
+        **_stats(colour.delta_E(result, reference), N[:, 2]),
+    }
 
 
 def demo_images(env, settings: OracleStudy, maps: dict, references: dict) -> dict:
