@@ -62,6 +62,7 @@ from shrm.polymer.hybrid import (
 __all__ = [
     "POLYMER_DEFAULTS",
     "POLYMER_KERNELS",
+    "POLYMER_MODELS",
     "PolymerMaterial",
     "chip_lookup",
     "lambert_phong_shade_parts",
@@ -84,7 +85,14 @@ POLYMER_DEFAULTS = {
     "transparency": 0.0,
     "mirror": "fresnel",
     "modulation": 0.0,
+    "model": "herbert",
 }
+#: The real-time models of ``type = "polymer"``: Herbert et al.'s hybrid (Eqs. (1)-(5)) and the
+#: layered model from prefiltered maps (``shrm.polymer.layered``, erratum E108).
+POLYMER_MODELS = ("herbert", "layered")
+#: Keys of the hybrid alone: the layered model refuses them (its slab is the constituents' KM).
+_HERBERT_ONLY = ("characterization", "tint", "gloss_exponent", "transparency", "mirror", "effect",
+                 "modulation")  # fmt: skip
 
 
 @dataclass(frozen=True, eq=False)
@@ -115,6 +123,9 @@ class PolymerMaterial:
         The effect pigment's BRDF (Eq. (3), Herbert et al.).
     modulation : float or ndarray, shape (H, W)
         Mod_effect, in [0, 1]: a constant or a greyscale image (row 0 at v = 0).
+    model : str
+        One of :data:`POLYMER_MODELS`: ``"herbert"`` (the hybrid) or ``"layered"`` (the layered
+        model from prefiltered maps, which reads the thickness, TiO2, gloss and index only).
     name : str
     """
 
@@ -129,6 +140,7 @@ class PolymerMaterial:
     characterization: str | None = None
     effect: IsotropicBRDFMaterial | None = None
     modulation: float | np.ndarray = 0.0
+    model: str = "herbert"
     name: str = "polymer"
 
 
@@ -641,6 +653,8 @@ def shade_polymer_environment(
     )
     if surface.normal.shape[0] == 0:
         return np.zeros((0, 3))
+    if material.model == "layered":
+        return _shade_layered(surface, material, light, ctx) @ ctx.weights(None)
     maps = polymer_environment_maps(light, ctx, material.gloss_exponent)
     look = polymer_material_look(material, ctx.grid)
     Mod = modulation_at(material.modulation, surface.uv)
@@ -649,6 +663,23 @@ def shade_polymer_environment(
         E_effect = _effect_radiance(surface, material.effect, light, ctx)
     terms = polymer_terms(surface.normal, surface.view, look, maps, Mod, E_effect)
     return terms["I_result"] @ ctx.weights(None)
+
+
+def _shade_layered(surface: Surface, material: PolymerMaterial, light, ctx) -> np.ndarray:
+    """Spectral radiance of the layered model (``shrm.polymer.layered``), maps cached per light."""
+    from shrm.environment import _state
+    from shrm.polymer.kubelka_munk import polymer_constituents, polymer_K_S
+    from shrm.polymer.layered import layered_maps, layered_terms
+
+    constituents = polymer_constituents(ctx.grid)
+    n = constituents.index if material.index is None else float(material.index)
+    state = _state(light, ctx)
+    key = ("layered", n, float(material.gloss))
+    if key not in state:
+        state[key] = layered_maps(state["radiance"], n, material.gloss)
+    K, S = polymer_K_S(constituents, material.tio2_pct)
+    terms = layered_terms(surface.normal, surface.view, state[key], K, S, material.thickness_mm)
+    return terms["result"]
 
 
 SHADERS.register(
@@ -676,6 +707,7 @@ _KEYS = (
     "mirror",
     "effect",
     "modulation",
+    "model",
 )
 
 
@@ -711,6 +743,15 @@ def _parse_polymer(reader, table: dict, key: str, name: str) -> PolymerMaterial:
     """Scene-file parser of ``type = "polymer"`` (docs/scene-format.md)."""
     reader.table(table, key, _KEYS)
     d = POLYMER_DEFAULTS
+    model = reader.choice(table.get("model", d["model"]), f"{key}.model", POLYMER_MODELS)
+    if model == "layered":
+        for k in _HERBERT_ONLY:
+            if k in table:
+                reader.fail(
+                    f"{key}.{k}",
+                    'belongs to Herbert\'s hybrid; the layered model (model = "layered") reads '
+                    "thickness, tio2, gloss and index",
+                )
     path = None
     if "characterization" in table:
         path = str(reader.file_path(table["characterization"], f"{key}.characterization"))
@@ -762,6 +803,7 @@ def _parse_polymer(reader, table: dict, key: str, name: str) -> PolymerMaterial:
         characterization=path,
         effect=effect,
         modulation=modulation,
+        model=model,
         name=name,
     )
     try:  # the whole look once at load time, so a bad combination is refused before rendering

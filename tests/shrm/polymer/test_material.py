@@ -132,6 +132,28 @@ def test_shader_under_a_uniform_sky_is_the_closed_form(view):
     )
 
 
+def test_the_layered_model_is_selectable_and_shades_its_terms():
+    # model = "layered": shrm.polymer.layered's result on the scene's grid, its maps made once
+    # per light, index and gloss (a second material of the same gloss shares them)
+    from shrm.environment import cached_map_names
+    from shrm.polymer.kubelka_munk import polymer_constituents, polymer_K_S
+    from shrm.polymer.layered import layered_maps, layered_terms
+
+    ctx = ShadingContext(GRID, options={"environment_size": 8})
+    light = EnvironmentLight(np.linspace(0.2, 1.0, 16 * 32 * 3).reshape(16, 32, 3))
+    surface = _one_pixel((0.0, 1.0, 0.0), (0.6, 0.8, 0.0))
+    m = PolymerMaterial(0.9, 0.3, gloss=0.7, model="layered")
+    got = shade_polymer_environment(surface, m, light, ctx)
+    constituents = polymer_constituents(GRID)
+    K, S = polymer_K_S(constituents, 0.3)
+    maps = layered_maps(environment_spectral_radiance(light, GRID), constituents.index, 0.7)
+    want = layered_terms(surface.normal, surface.view, maps, K, S, 0.9)["result"]
+    np.testing.assert_allclose(got, want @ ctx.weights(None), rtol=1e-12)
+    shade_polymer_environment(surface, PolymerMaterial(2.0, 1.0, gloss=0.7, model="layered"),
+                              light, ctx)  # fmt: skip
+    assert cached_map_names(light).count("layered") == 1
+
+
 def test_effect_term_is_the_effect_pigment_through_its_shrm():
     # Source: Eq. (1) with Tint 0 and Mod_effect 1 is E_effect plus the surface and transmission
     # terms, which do not depend on Mod_effect; E_effect alone is what the isotropic_brdf shader
@@ -228,6 +250,15 @@ def test_modulation_image_is_looked_up_by_uv(sky, tmp_path):
         ("effect = [1, 2]", r"materials.p.effect: must be a BRDF key .*, got \[1, 2\]$"),
         ('mirror = "sharp"', r"materials.p.mirror: unknown value 'sharp'; allowed: cosine, "),
         ("thicknes = 1.0", r"materials.p: unknown key 'thicknes'; allowed: "),
+        ('model = "phong"', r"materials.p.model: unknown value 'phong'; allowed: herbert, layered"),
+        (
+            'model = "layered"\ntint = 0.5',
+            r"materials.p.tint: belongs to Herbert's hybrid; the layered model .* reads thickness",
+        ),
+        (
+            'model = "layered"\nmirror = "cosine"',
+            r"materials.p.mirror: belongs to Herbert's hybrid",
+        ),
     ],
 )
 def test_bad_input_is_one_line_naming_the_key(sky, material, message):
