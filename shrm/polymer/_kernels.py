@@ -1,8 +1,9 @@
 """numba twins of the polymer family: the oracle's rough specular sum, the shading of the hybrid.
 
 Twins of ``shrm.polymer.oracle.rough_specular_samples``, of
-``shrm.polymer.material.polymer_shade_parts`` and of its baseline
-``shrm.polymer.material.lambert_phong_shade_parts``. Each kernel keeps the names and equation
+``shrm.polymer.material.polymer_shade_parts``, of its baseline
+``shrm.polymer.material.lambert_phong_shade_parts`` and of the layered model's re-shade
+``shrm.polymer.layered.layered_reshade_XYZ``. Each kernel keeps the names and equation
 comments of its NumPy reference, never validates, never prints, and writes into an output array
 that the public entry point allocated. The equality tests live in ``tests/shrm/polymer``.
 """
@@ -17,6 +18,7 @@ from reference.jit import njit
 
 __all__ = [
     "lambert_phong_shade_parts_kernel",
+    "layered_reshade_kernel",
     "polymer_shade_parts_kernel",
     "rough_specular_samples_kernel",
 ]
@@ -156,3 +158,18 @@ def lambert_phong_shade_parts_kernel(E_d, E_s, k_d, k_s, out):
             # §5.2, Herbert et al.: k_d E(N)/π + k_s E_s(r)
             out[p, b] = k_d[b] * E_d[p, b] + k_s[b] * E_s[p, b]
     return out
+
+
+@njit
+def layered_reshade_kernel(specular, front, back, rho_out, tau, W, out):
+    """Twin of ``layered_reshade_XYZ``: the three terms of each pixel, then the band weights."""
+    P, B = specular.shape
+    C = W.shape[1]
+    for p in range(P):
+        for c in range(C):
+            out[p, c] = 0.0
+        for b in range(B):
+            # specular + ρ_out exit E_f(n) + τ exit E_b(−n) (the parts hold exit × E)
+            L = specular[p, b] + rho_out[b] * front[p, b] + tau[b] * back[p, b]
+            for c in range(C):
+                out[p, c] += L * W[b, c]

@@ -19,7 +19,7 @@ three terms from maps prefiltered once per environment, index and gloss, with th
   assumes ``n = v = r`` for the lobe's shape (its only approximation; erratum E108).
 
 ``exit(θ_o) = (1 − E_ρ(θ_o)) / (π (1 − k_e))`` and the slab's ``ρ_out`` and ``τ`` are the
-oracle's (:func:`shrm.polymer.oracle.body_factors`). Thickness, TiO2 and tint change only
+oracle's (:func:`shrm.polymer.oracle.body_factors`). Thickness and TiO2 (the slab) change only
 ``ρ_out`` and ``τ``: a dynamic change re-shades from the per-pixel parts
 (:func:`layered_pixel_parts`, :func:`layered_shade_parts`) without prefiltering again; the gloss
 and the index choose the maps.
@@ -47,15 +47,18 @@ from reference.geometry.envmap import (
     latlong_pixel_solid_angles,
 )
 from reference.materials.fresnel import fresnel_dielectric
+from reference.registry import Method, Registry
 from shrm.polymer.oracle import Coupling, body_factors, gloss_alpha, interface_coupling
 
 __all__ = [
+    "LAYERED_KERNELS",
     "PREFILTER_MAX_ROWS",
     "LayeredMaps",
     "coupled_irradiance_latlong",
     "ggx_prefiltered_latlong",
     "layered_maps",
     "layered_pixel_parts",
+    "layered_reshade_XYZ",
     "layered_shade_parts",
     "layered_terms",
 ]
@@ -321,6 +324,91 @@ def layered_shade_parts(parts: dict, K, S, d: float, maps: LayeredMaps) -> dict:
         "transmission": transmission,
         "result": result,
     }
+
+
+def layered_reshade_XYZ(parts: dict, K, S, d: float, maps: LayeredMaps, weights, compiled=False):
+    """XYZ (or any channels) of the layered model from its pixel parts: the re-shade of a frame.
+
+    ``(specular + ρ_out front + τ back) @ W``: :func:`layered_shade_parts`'s result in the band
+    weights ``W``, the one thing a frame needs after a change of thickness or TiO2. With
+    ``compiled`` the numba twin fuses the terms and the weights in one pass
+    (``shrm.polymer._kernels.layered_reshade_kernel``, :data:`LAYERED_KERNELS`).
+
+    Parameters
+    ----------
+    parts : dict
+        From :func:`layered_pixel_parts`, each (P, n_bands).
+    K, S, d
+        The slab, as in :func:`layered_shade_parts`.
+    maps : LayeredMaps
+    weights : array_like, shape (n_bands, C)
+        Band weights (``reference.colour.colorimetry.band_weights``).
+    compiled : bool
+        The numba twin.
+
+    Returns
+    -------
+    ndarray, shape (P, C)
+
+    Examples
+    --------
+    >>> up = np.array([[0.0, 0.0, 1.0]])
+    >>> maps = layered_maps(np.ones((32, 64, 2)), 1.5, 1.0)
+    >>> parts = layered_pixel_parts(up, up, maps)
+    >>> W = np.array([[0.5], [0.5]])
+    >>> layered_reshade_XYZ(parts, [0.0, 0.0], [1e9, 1e9], 1.0, maps, W).round(3)
+    array([[1.]])
+    """
+    front = interface_coupling(maps.n, maps.alpha)
+    back = interface_coupling(maps.n, 0.0)
+    n_bands = parts["front"].shape[1]
+    K, S = (np.broadcast_to(np.asarray(a, dtype=np.float64), (n_bands,)) for a in (K, S))
+    rho_out, tau = body_factors(K, S, d, front.r_i, back.r_i)
+    W = np.asarray(weights, dtype=np.float64)
+    if compiled:
+        from shrm.polymer._kernels import layered_reshade_kernel
+
+        out = np.empty((parts["front"].shape[0], W.shape[1]))
+        layered_reshade_kernel(
+            *(
+                np.ascontiguousarray(parts[k], dtype=np.float64)
+                for k in ("specular", "front", "back")
+            ),
+            np.ascontiguousarray(rho_out, dtype=np.float64),
+            np.ascontiguousarray(tau, dtype=np.float64),
+            np.ascontiguousarray(W),
+            out,
+        )
+        return out
+    # the slab's factors on the cached parts: specular + ρ_out front + τ back, then the weights
+    return (parts["specular"] + rho_out * parts["front"] + tau * parts["back"]) @ W
+
+
+def _reshade_example(rng):
+    parts = {k: rng.uniform(0, 2, (9, 16)) for k in ("specular", "front", "back")}
+    maps = layered_maps(np.ones((8, 16, 16)), 1.54, 0.7)
+    K, S = rng.uniform(0, 0.5, 16), rng.uniform(1, 50, 16)
+    return parts, K, S, 1.3, maps, rng.uniform(0, 1, (16, 3))
+
+
+def _register():
+    from shrm.polymer._kernels import layered_reshade_kernel
+
+    LAYERED_KERNELS.register(
+        Method(
+            "reshade",
+            layered_reshade_XYZ,
+            layered_reshade_kernel,
+            "Eq. (1), Herbert et al. (its layered counterpart)",
+            _reshade_example,
+            compiled=lambda *args: layered_reshade_XYZ(*args, compiled=True),
+        )
+    )
+
+
+#: The layered model's re-shade and its numba twin (tests check the pair).
+LAYERED_KERNELS = Registry("layered polymer kernel")
+_register()
 
 
 def layered_terms(normal, view, maps: LayeredMaps, K, S, d: float) -> dict:

@@ -87,8 +87,8 @@ POLYMER_DEFAULTS = {
     "modulation": 0.0,
     "model": "herbert",
 }
-#: The real-time models of ``type = "polymer"``: Herbert et al.'s hybrid (Eqs. (1)-(5)) and the
-#: layered model from prefiltered maps (``shrm.polymer.layered``, erratum E108).
+#: The real-time models of ``type = "polymer"``: Herbert et al.'s hybrid (``shrm.polymer.hybrid``)
+#: and the layered model from prefiltered maps (``shrm.polymer.layered``, erratum E108).
 POLYMER_MODELS = ("herbert", "layered")
 #: Keys of the hybrid alone: the layered model refuses them (its slab is the constituents' KM).
 _HERBERT_ONLY = ("characterization", "tint", "gloss_exponent", "transparency", "mirror", "effect",

@@ -16,7 +16,12 @@ dragging a thickness, TiO2, tint, transparency or Mod_effect slider. Groups (rep
   (``shrm.polymer.material.lambert_phong_shade_parts``), with a new ``k_d`` every round and the
   same conversion to XYZ; target re-shade / baseline <= 3. The polymer re-shade does more per
   pixel and band (five terms, the chip look-up per frame, the session's bookkeeping), so this
-  baseline can win.
+  baseline can win;
+- ``polymer-dynamic-layered``: the layered model's re-shade (``shrm.polymer.layered``: its pixel
+  parts cached, a new thickness every round, the slab's factors, then its numba twin's three terms
+  and XYZ in one pass, ``layered_reshade_XYZ``) on the
+  same pixels, views and environment, against the hybrid's session re-shade (baseline); target
+  re-shade / baseline <= 1.5.
 """
 
 import itertools
@@ -31,6 +36,8 @@ from reference.data import data_path
 from reference.geometry.camera import Camera, downsample_box
 from reference.geometry.shapes import Sphere
 from reference.images.formats import read_image
+from shrm.polymer.kubelka_munk import polymer_constituents, polymer_K_S
+from shrm.polymer.layered import layered_maps, layered_pixel_parts, layered_reshade_XYZ
 from shrm.polymer.material import lambert_phong_shade_parts
 from shrm.session import POLYMER_STAGES, RenderSession
 
@@ -134,3 +141,36 @@ def test_polymer_reshade_against_lambert_phong(benchmark, warm):
     W = band_weights(GRID, None)
     _info(benchmark, "reshade", warm)
     benchmark(_reshade, warm, W)
+
+
+@pytest.fixture(scope="module")
+def layered(warm):
+    """The layered model's maps and pixel parts for the warm session's pixels, view and radiance."""
+    out = warm.render()
+    g = out["gbuffer"]["gbuffer"]
+    N = g.normal[g.mask]
+    V = np.broadcast_to(warm.state["viewpoint"].basis()[2], N.shape)
+    constituents = polymer_constituents(GRID)
+    maps = layered_maps(out["color_manage"]["radiance"], constituents.index, 0.8)
+    return maps, layered_pixel_parts(N, V, maps), constituents
+
+
+@pytest.mark.benchmark(group="polymer-dynamic-layered")
+def test_hybrid_reshade_baseline(benchmark, warm):
+    W = band_weights(GRID, None)
+    _info(benchmark, "baseline", warm)
+    benchmark(_reshade, warm, W)
+
+
+@pytest.mark.benchmark(group="polymer-dynamic-layered")
+def test_layered_reshade_against_the_hybrids(benchmark, layered, warm):
+    W = band_weights(GRID, None)
+    maps, parts, constituents = layered
+    K, S = polymer_K_S(constituents, 0.5)
+    _info(benchmark, "reshade", warm)
+
+    def reshade():
+        thickness = 1.0 + 1e-6 * next(_THICKNESS)
+        return layered_reshade_XYZ(parts, K, S, thickness, maps, W, compiled=True)
+
+    benchmark(reshade)

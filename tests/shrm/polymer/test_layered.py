@@ -16,10 +16,12 @@ from reference.geometry.envmap import latlong_pixel_directions, latlong_pixel_so
 from reference.materials.isotropic import ggx_distribution
 from shrm.polymer.kubelka_munk import polymer_constituents, polymer_K_S
 from shrm.polymer.layered import (
+    LAYERED_KERNELS,
     coupled_irradiance_latlong,
     ggx_prefiltered_latlong,
     layered_maps,
     layered_pixel_parts,
+    layered_reshade_XYZ,
     layered_shade_parts,
     layered_terms,
 )
@@ -152,6 +154,13 @@ def test_large_maps_are_box_filtered_before_the_sums(monkeypatch):
     )
 
 
+@pytest.mark.parametrize("name", LAYERED_KERNELS.names())
+def test_kernel_matches_reference(name, rng):
+    method = LAYERED_KERNELS.lookup(name)
+    args = method.example_inputs(rng)
+    np.testing.assert_allclose(method.compiled(*args), method.reference(*args), rtol=1e-12)
+
+
 def test_a_dynamic_change_reshades_from_the_pixel_parts(maps32):
     # thickness and TiO2 change the slab only: the cached parts give the full evaluation exactly
     N, V = _sphere(16)
@@ -163,6 +172,10 @@ def test_a_dynamic_change_reshades_from_the_pixel_parts(maps32):
         again = layered_shade_parts(parts, K, S, d, maps)
         for key in full:
             np.testing.assert_array_equal(again[key], full[key])
+        # the re-shade in band weights: the result's XYZ
+        W = np.random.default_rng(2).uniform(0.0, 1.0, (full["result"].shape[1], 3))
+        XYZ = layered_reshade_XYZ(parts, K, S, d, maps, W, compiled=True)
+        np.testing.assert_allclose(XYZ, full["result"] @ W, rtol=1e-12)
 
 
 @pytest.mark.parametrize(

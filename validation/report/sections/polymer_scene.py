@@ -56,8 +56,9 @@ GROUPS = (
 #: groups.
 TRIANGLES_TARGET = 100_000
 #: Herbert et al. §5.2 (erratum E61): re-shade after a dynamic change vs a cold frame, and vs a
-#: Lambert plus Phong re-shade through the same cached maps and look-ups.
-COLD_RATIO, LAMBERT_PHONG_RATIO = 20.0, 3.0
+#: Lambert plus Phong re-shade through the same cached maps and look-ups; the layered model's
+#: re-shade (``shrm.polymer.layered``, E108) vs the hybrid's on the same pixels.
+COLD_RATIO, LAMBERT_PHONG_RATIO, LAYERED_RATIO = 20.0, 3.0, 1.5
 
 
 def bottle_profile(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -254,6 +255,9 @@ def bench_ratios(groups: dict) -> dict:
     lam = [("polymer-dynamic-lambert-phong", role) for role in ("baseline", "reshade")]
     if all(k in medians for k in lam):
         out["reshade_over_lambert_phong"] = medians[lam[1]] / medians[lam[0]]
+    lay = [("polymer-dynamic-layered", role) for role in ("baseline", "reshade")]
+    if all(k in medians for k in lay):
+        out["layered_over_hybrid_reshade"] = medians[lay[1]] / medians[lay[0]]
     return out
 
 
@@ -360,6 +364,15 @@ def checks(data: SectionData) -> list:
                 f"<= {LAMBERT_PHONG_RATIO:g}×",
                 b["reshade_over_lambert_phong"],
                 b["reshade_over_lambert_phong"] <= LAMBERT_PHONG_RATIO,
+            )
+        )
+    if "layered_over_hybrid_reshade" in b:
+        out.append(
+            Check(
+                "make bench: layered model re-shade / hybrid re-shade (same pixels), 512²",
+                f"<= {LAYERED_RATIO:g}×",
+                b["layered_over_hybrid_reshade"],
+                b["layered_over_hybrid_reshade"] <= LAYERED_RATIO,
             )
         )
     return out
