@@ -329,7 +329,8 @@ def layered_shade_parts(parts: dict, K, S, d: float, maps: LayeredMaps) -> dict:
 def layered_reshade_XYZ(parts: dict, K, S, d: float, maps: LayeredMaps, weights, compiled=False):
     """XYZ (or any channels) of the layered model from its pixel parts: the re-shade of a frame.
 
-    ``(specular + ρ_out front + τ back) @ W``: :func:`layered_shade_parts`'s result in the band
+    The layered counterpart of Eq. (1), Herbert et al., re-shaded:
+    ``(specular + ρ_out front + τ back) @ W``, :func:`layered_shade_parts`'s result in the band
     weights ``W``, the one thing a frame needs after a change of thickness or TiO2. With
     ``compiled`` the numba twin fuses the terms and the weights in one pass
     (``shrm.polymer._kernels.layered_reshade_kernel``, :data:`LAYERED_KERNELS`).
