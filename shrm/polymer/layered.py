@@ -69,21 +69,27 @@ PREFILTER_MAX_ROWS = 64
 
 
 def _box_rows(radiance: np.ndarray, rows: int) -> np.ndarray:
-    """The map box-filtered to ``rows`` rows (a whole divisor), solid-angle weighted."""
+    """The map box-filtered to ``rows`` rows and ``2 rows`` columns, solid-angle weighted.
+
+    Output texel k averages the source rows (columns) from ``⌊k H / rows⌋`` up to the next
+    texel's start, so any height works; blocks are equal when ``rows`` divides it.
+    """
     H, W = radiance.shape[:2]
-    f = H // rows
+    starts_y = (np.arange(rows) * H) // rows
+    starts_x = (np.arange(2 * rows) * W) // (2 * rows)
     omega = latlong_pixel_solid_angles(H, W)[..., None]
-    blocks = (radiance * omega).reshape(rows, f, 2 * rows, f, -1).sum(axis=(1, 3))
-    return blocks / omega.reshape(rows, f, 2 * rows, f, 1).sum(axis=(1, 3))
+
+    def blocks(a):
+        return np.add.reduceat(np.add.reduceat(a, starts_y, axis=0), starts_x, axis=1)
+
+    return blocks(radiance * omega) / blocks(omega)
 
 
 def _radial_sum(radiance, weight, normalize: bool, chunk: int = 512) -> np.ndarray:
     """``Σ_ω w(d·ω) L(ω) Ω(ω)`` at every pixel direction d of the (box-filtered) map."""
     radiance = np.asarray(radiance, dtype=np.float64)
-    H = radiance.shape[0]
-    rows = next(r for r in range(min(H, PREFILTER_MAX_ROWS), 0, -1) if H % r == 0)
-    if rows < H:
-        radiance = _box_rows(radiance, rows)
+    if radiance.shape[0] > PREFILTER_MAX_ROWS:
+        radiance = _box_rows(radiance, PREFILTER_MAX_ROWS)
     H, W, B = radiance.shape
     D = latlong_pixel_directions(H, W).reshape(-1, 3)
     omega = latlong_pixel_solid_angles(H, W).ravel()

@@ -152,6 +152,10 @@ def test_large_maps_are_box_filtered_before_the_sums(monkeypatch):
     np.testing.assert_allclose(
         ggx_prefiltered_latlong(fine, 0.3), ggx_prefiltered_latlong(coarse, 0.3), rtol=1e-12
     )
+    # any height: a 13-row map (prime) goes to 8 rows, and a uniform sky stays uniform
+    odd = coupled_irradiance_latlong(np.ones((13, 26, 1)), coupling)
+    assert odd.shape == (8, 16, 1)
+    np.testing.assert_allclose(odd, np.pi * (1.0 - coupling.k_e), rtol=2e-2)
 
 
 @pytest.mark.parametrize("name", LAYERED_KERNELS.names())
