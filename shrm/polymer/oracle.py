@@ -277,9 +277,29 @@ class Coupling:
     r_i: float
 
     def lookup(self, cos_theta) -> np.ndarray:
-        """``1 − E_ρ(θ)`` at ``cos_theta`` (0 below the horizon)."""
+        """``1 − E_ρ(θ)`` at ``cos_theta`` (0 below the horizon).
+
+        Examples
+        --------
+        >>> c = Coupling(np.linspace(0.0, 1.0, 5), np.linspace(1.0, 0.0, 5), 0.5, 0.8)
+        >>> c.lookup([-0.5, 0.0, 0.1, 1.0, 1.5])
+        array([0. , 0. , 0.9, 0. , 0. ])
+        """
         c = np.asarray(cos_theta, dtype=np.float64)
-        return np.where(c > 0.0, np.interp(np.clip(c, 0.0, 1.0), self.cos_nodes, self.enter), 0.0)
+        m = self.cos_nodes.size - 1
+        if (
+            self.cos_nodes[0] == 0.0
+            and self.cos_nodes[-1] == 1.0
+            and np.array_equal(self.cos_nodes, np.linspace(0.0, 1.0, m + 1))
+        ):
+            # evenly spaced nodes (interface_coupling's): the interval by index, not by search
+            x = np.clip(c, 0.0, 1.0) * m
+            i = np.minimum(x.astype(np.int64), m - 1)
+            f = x - i
+            value = self.enter[i] * (1.0 - f) + self.enter[i + 1] * f
+        else:
+            value = np.interp(np.clip(c, 0.0, 1.0), self.cos_nodes, self.enter)
+        return np.where(c > 0.0, value, 0.0)
 
 
 @lru_cache(maxsize=32)
