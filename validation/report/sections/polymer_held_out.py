@@ -64,6 +64,10 @@ MODELS = {"hybrid": "Herbert's hybrid", "layered": "the layered model"}
 HELD_OUT_SEED = 20261128
 #: The ranges the chips are drawn from: those the design sweeps span (``SWEEPS["full"]``).
 RANGES = {"thickness_mm": (0.381, 4.572), "tio2_pct": (0.0, 2.0), "gloss": (0.4, 1.0)}
+#: The polymer's index, which the design never varies (the constituents' 1.54): drawn uniformly
+#: over common plastics (polypropylene 1.49 to polycarbonate 1.585 and polystyrene 1.59), from
+#: a generator of its own (seed + 1), so the other axes draw as before.
+INDEX_RANGE = (1.45, 1.65)
 
 
 @dataclass(frozen=True)
@@ -86,17 +90,18 @@ HELD_OUT = {
 def held_out_chips(count: int, seed: int = HELD_OUT_SEED) -> list[dict]:
     """``count`` chips from :data:`RANGES`, none equal to a value of the design sweeps.
 
-    Thickness is drawn log-uniform (mm), TiO2 (%) and gloss uniform; values rounded to 3 digits.
+    Thickness is drawn log-uniform (mm), TiO2 (%), gloss and index (:data:`INDEX_RANGE`)
+    uniform; values rounded to 3 digits.
 
     Examples
     --------
     >>> chips = held_out_chips(3)
     >>> len(chips), sorted(chips[0])
-    (3, ['gloss', 'thickness_mm', 'tio2_pct'])
+    (3, ['gloss', 'index', 'thickness_mm', 'tio2_pct'])
     >>> all(0.4 <= c["gloss"] <= 1.0 for c in chips)
     True
     """
-    rng = np.random.default_rng(seed)
+    rng, rng_index = np.random.default_rng(seed), np.random.default_rng(seed + 1)
     design = {
         axis: {round(v, 3) for s in SWEEPS.values() for v in getattr(s, axis)} for axis in RANGES
     }
@@ -109,7 +114,7 @@ def held_out_chips(count: int, seed: int = HELD_OUT_SEED) -> list[dict]:
             "gloss": round(float(rng.uniform(*gloss)), 3),
         }
         if all(chip[axis] not in design[axis] for axis in RANGES):
-            chips.append(chip)
+            chips.append(chip | {"index": round(float(rng_index.uniform(*INDEX_RANGE)), 3)})
     return chips
 
 
@@ -130,7 +135,7 @@ def _layered(N, V, env, chip: dict) -> np.ndarray:
     """The layered model's radiance for a chip (maps made per chip's gloss)."""
     constituents = polymer_constituents()
     K, S = polymer_K_S(constituents, chip["tio2_pct"])
-    maps = layered_maps(env, constituents.index, chip["gloss"])
+    maps = layered_maps(env, chip.get("index", constituents.index), chip["gloss"])
     return layered_terms(N, V, maps, K, S, chip["thickness_mm"])["result"]
 
 
@@ -225,14 +230,16 @@ def held_out_table(study: dict) -> Table:
     Examples
     --------
     >>> row = {"model": "layered", "map": "a.hdr", "thickness_mm": 1.0, "tio2_pct": 0.5,
-    ...        "gloss": 0.8, "mean": 1.0, "p95": 2.0, "max": 3.0, "centre": 0.5, "rim": 2.5}
+    ...        "gloss": 0.8, "index": 1.5, "mean": 1.0, "p95": 2.0, "max": 3.0, "centre": 0.5,
+    ...        "rim": 2.5}
     >>> held_out_table({"rows": [row], "settings": {"seed": 1}}).rows[0][:5]
     ['the layered model', 'a.hdr', 1.0, 0.5, 0.8]
     """
-    keys = ("thickness_mm", "tio2_pct", "gloss", "mean", "p95", "max", "centre", "rim")
+    keys = ("thickness_mm", "tio2_pct", "gloss", "index", "mean", "p95", "max", "centre", "rim")
+    head = ["model", "map", "thickness mm", "TiO2 %", "gloss", "index"]
     return Table(
-        ["model", "map", "thickness mm", "TiO2 %", "gloss", "mean", "p95", "max", "centre", "rim"],
-        [[MODELS[r["model"]], r["map"], *(r[k] for k in keys)] for r in study["rows"]],
+        [*head, "mean", "p95", "max", "centre", "rim"],
+        [[MODELS[r["model"]], r["map"], *(r.get(k, "") for k in keys)] for r in study["rows"]],
         "Herbert's hybrid (M_s = fresnel) and the layered model against the layered oracle, "
         "ΔE00, on chips held out of the design (drawn with seed "
         f"{study['settings']['seed']} from the sweeps' ranges) under every shipped environment map",

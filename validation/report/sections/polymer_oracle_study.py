@@ -158,7 +158,15 @@ def _oracle(N, V, env, chip: dict, settings: OracleStudy, **kwargs):
     K, S = polymer_K_S(constituents, chip["tio2_pct"])
     options = {"tol": settings.tol, "seed": 0, **kwargs}
     return polymer_oracle(
-        N, V, env, K, S, chip["thickness_mm"], constituents.index, chip["gloss"], **options
+        N,
+        V,
+        env,
+        K,
+        S,
+        chip["thickness_mm"],
+        chip.get("index", constituents.index),
+        chip["gloss"],
+        **options,
     )
 
 
@@ -188,7 +196,7 @@ def oracle_references(env, settings: OracleStudy) -> dict:
 
 def _hybrid(N, V, maps, chips, chip: dict, mirror: str) -> dict:
     d, c = chip["thickness_mm"], chip["tio2_pct"]
-    look = polymer_look(chips, d, c, gloss=chip["gloss"], mirror=mirror)
+    look = polymer_look(chips, d, c, gloss=chip["gloss"], mirror=mirror, index=chip.get("index"))
     return polymer_terms(N, V, look, maps[chip["gloss"]])
 
 
