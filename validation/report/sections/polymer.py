@@ -575,7 +575,7 @@ def _speed_figure(ctx: ReportContext, speed: dict):
     )
 
 
-#: A dynamic change (thickness, TiO2, tint) re-shades the layered model from its cached pixel
+#: A dynamic change (thickness, TiO2) re-shades the layered model from its cached pixel
 #: parts at least this much faster than a cold frame (its maps and a frame).
 LAYERED_RESHADE_SPEEDUP = 20.0
 
