@@ -289,6 +289,14 @@ def layered_pixel_parts(normal, view, maps: LayeredMaps) -> dict:
     }
 
 
+def _slab_factors(K, S, d: float, maps: LayeredMaps, n_bands: int):
+    """The slab's ``ρ_out`` and ``τ`` between the maps' front interface and a smooth back."""
+    front = interface_coupling(maps.n, maps.alpha)
+    back = interface_coupling(maps.n, 0.0)
+    K, S = (np.broadcast_to(np.asarray(a, dtype=np.float64), (n_bands,)) for a in (K, S))
+    return body_factors(K, S, d, front.r_i, back.r_i)
+
+
 def layered_shade_parts(parts: dict, K, S, d: float, maps: LayeredMaps) -> dict:
     """The layered model's terms from per-pixel parts and the slab (the re-shade).
 
@@ -316,11 +324,7 @@ def layered_shade_parts(parts: dict, K, S, d: float, maps: LayeredMaps) -> dict:
     >>> float(out["result"][0, 0]).__round__(3)       # white furnace, white opaque base
     1.0
     """
-    front = interface_coupling(maps.n, maps.alpha)
-    back = interface_coupling(maps.n, 0.0)
-    n_bands = parts["front"].shape[1]
-    K, S = (np.broadcast_to(np.asarray(a, dtype=np.float64), (n_bands,)) for a in (K, S))
-    rho_out, tau = body_factors(K, S, d, front.r_i, back.r_i)
+    rho_out, tau = _slab_factors(K, S, d, maps, parts["front"].shape[1])
     body = rho_out * parts["front"]
     transmission = tau * parts["back"]
     result = parts["specular"] + body + transmission
@@ -366,11 +370,7 @@ def layered_reshade_XYZ(parts: dict, K, S, d: float, maps: LayeredMaps, weights,
     >>> layered_reshade_XYZ(parts, [0.0, 0.0], [1e9, 1e9], 1.0, maps, W).round(3)
     array([[1.]])
     """
-    front = interface_coupling(maps.n, maps.alpha)
-    back = interface_coupling(maps.n, 0.0)
-    n_bands = parts["front"].shape[1]
-    K, S = (np.broadcast_to(np.asarray(a, dtype=np.float64), (n_bands,)) for a in (K, S))
-    rho_out, tau = body_factors(K, S, d, front.r_i, back.r_i)
+    rho_out, tau = _slab_factors(K, S, d, maps, parts["front"].shape[1])
     W = np.asarray(weights, dtype=np.float64)
     if compiled:
         from shrm.polymer._kernels import layered_reshade_kernel

@@ -46,7 +46,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from typing import NamedTuple
 
 import numpy as np
@@ -276,6 +276,11 @@ class Coupling:
     k_e: float
     r_i: float
 
+    @cached_property
+    def _evenly_spaced(self) -> bool:
+        """Whether the nodes are ``linspace(0, 1, m)`` (checked once per table)."""
+        return bool(np.array_equal(self.cos_nodes, np.linspace(0.0, 1.0, self.cos_nodes.size)))
+
     def lookup(self, cos_theta) -> np.ndarray:
         """``1 − E_ρ(θ)`` at ``cos_theta`` (0 below the horizon).
 
@@ -287,11 +292,7 @@ class Coupling:
         """
         c = np.asarray(cos_theta, dtype=np.float64)
         m = self.cos_nodes.size - 1
-        if (
-            self.cos_nodes[0] == 0.0
-            and self.cos_nodes[-1] == 1.0
-            and np.array_equal(self.cos_nodes, np.linspace(0.0, 1.0, m + 1))
-        ):
+        if self._evenly_spaced:
             # evenly spaced nodes (interface_coupling's): the interval by index, not by search
             x = np.clip(c, 0.0, 1.0) * m
             i = np.minimum(x.astype(np.int64), m - 1)
