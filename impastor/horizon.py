@@ -206,16 +206,12 @@ def horizon_at_texels(
     if backend == "numba":
         horizon_at_texels_kernel(h, pixel_size, r, c, S, steps, step, out)
         return out
+    t = step * np.arange(1, round(steps / step) + 1)[:, None]  # every step of the march at once
     for s in range(S):
         phi = (s + 0.5) * 2.0 * np.pi / S
-        dx, dy = np.cos(phi), np.sin(phi)
-        best = np.zeros(r.size)
-        for k in range(1, round(steps / step) + 1):
-            t = k * step
-            rise = _sample_periodic(h, r + t * dy, c + t * dx) - h[r, c]
-            # Sloan & Cohen 2000: the horizon is the largest elevation angle seen along the ray
-            best = np.maximum(best, rise / (t * pixel_size))
-        out[:, s] = np.arctan(best)
+        rise = _sample_periodic(h, r + t * np.sin(phi), c + t * np.cos(phi)) - h[r, c]
+        # Sloan & Cohen 2000: the horizon is the largest elevation angle seen along the ray
+        out[:, s] = np.arctan(np.maximum(0.0, (rise / (t * pixel_size)).max(axis=0)))
     return out
 
 

@@ -93,7 +93,7 @@ def airy_reflectance(
     >>> airy_reflectance(1.0, [550.0], 0.0, 1.3, 1.5).round(6)  # bare glass: ((1.5-1)/2.5)²
     array([0.04])
     """
-    cos_0 = np.clip(require_finite(cos_theta_0, "airy: cos_theta_0"), 0.0, 1.0)[..., None]
+    cos_0 = np.clip(require_finite(cos_theta_0, "airy: cos_theta_0"), 0.0, 1.0)
     lam = require_nonnegative(wavelengths_nm, "airy: wavelengths_nm")
     require(bool((lam > 0).all()), "airy: wavelengths_nm: must be > 0")
     d = float(require_nonnegative(thickness_nm, "airy: thickness_nm"))
@@ -101,7 +101,15 @@ def airy_reflectance(
     n_b = require_nonnegative(n_base, "airy: n_base")
     k_b = require_nonnegative(k_base, "airy: k_base")
     require(bool((n_1 > 0).all()) and bool((n_b > 0).all()), "airy: indices must be > 0")
-    n_2 = n_b + 1j * k_b
+    # The reflectance depends on the angle alone: evaluated once per distinct angle (a BRDF's
+    # R(cos θ_o) is one value over all its lights), then spread back
+    unique, where = np.unique(cos_0, return_inverse=True)
+    R = _airy(unique[:, None], lam, d, n_1, n_b + 1j * k_b, n_0)
+    return R[where.reshape(cos_0.shape)]
+
+
+def _airy(cos_0, lam, d, n_1, n_2, n_0):
+    """:func:`airy_reflectance` at the angles ``cos_0`` (shape (n, 1)), checked inputs."""
     sin2_0 = (n_0 * n_0) * (1.0 - cos_0 * cos_0)
     q_0, q_1, q_2 = n_0 * cos_0 + 0j, _q(n_1, sin2_0), _q(n_2, sin2_0)
     # Born & Wolf §1.6.4: phase difference of one round trip in the film, δ = 4π d n_1 cos θ_1 / λ
