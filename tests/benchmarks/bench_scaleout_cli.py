@@ -11,6 +11,11 @@ Scale-out section fits its model to these figures):
   included (target ≥ 1.7× on two cores); every CSV must equal the serial one byte for byte;
 - ``cli-startup``: a one-cell sweep, serially and on ``local:N``: what a run pays whatever its
   size (process start, imports, the cluster's start, the kernels' loading, one exact render);
+- ``cli-split``: the machine's own ceiling, without a scheduler: the same sweep cut by material
+  into as many parts as there are cores (at most the 4 materials), each part a serial
+  ``specref sweep`` in its own process, all started at once; the parts' rows are the serial
+  sweep's, in order. A cluster can only approach it (it pays its start and its scheduling), so
+  the report sets the cluster's speed-up beside it;
 - ``convert-memory``: ``specref env convert`` of a 4096 × 8192 RGB EXR in a new process, its peak
   resident set (``VmHWM``), beside the same command's on a 16 × 32 map (what the process holds
   without the map) and the size of one float32 chunk (target: at most four chunks above it, three
@@ -107,6 +112,45 @@ def test_cli_sweep_workers(benchmark, grid, workers):
     )
     out = benchmark.pedantic(_sweep, args=(grid, f"local:{workers}"), rounds=1, iterations=1)
     assert out.read_bytes() == _serial_csv(grid)
+
+
+MATERIALS = ["R1", "R2", "R3", "bimodal"]
+
+
+def _split_grids(folder: Path) -> list[Path]:
+    # the grid cut by material into min(cores, 4) parts, in the serial sweep's order
+    parts = np.array_split(MATERIALS, min(CORES, len(MATERIALS)))
+    paths = []
+    for i, part in enumerate(parts):
+        names = ", ".join(f'"{m}"' for m in part)
+        path = folder / f"part{i}.toml"
+        path.write_text(GRID.replace('"R1", "R2", "R3", "bimodal"', names))
+        paths.append(path)
+    return paths
+
+
+@pytest.mark.benchmark(group="scaleout-cli")
+def test_cli_sweep_split(benchmark, grid):
+    paths = _split_grids(grid)
+    benchmark.extra_info.update(
+        {"role": "cli-split", "cells": CELLS, "shared": SHARED, "workers": len(paths)}
+    )
+
+    def run_parts():
+        argv = [
+            [SPECREF, "sweep", str(p), "--scheduler", "serial", "-o", str(p.with_suffix(".csv"))]
+            for p in paths
+        ]
+        procs = [
+            subprocess.Popen(a, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) for a in argv
+        ]
+        assert [proc.wait() for proc in procs] == [0] * len(procs)
+
+    benchmark.pedantic(run_parts, rounds=1, iterations=1)
+    texts = [p.with_suffix(".csv").read_text() for p in paths]
+    header = texts[0].splitlines(keepends=True)[0]
+    joined = header + "".join(t.split("\n", 1)[1] for t in texts)
+    assert joined.encode() == _serial_csv(grid)
 
 
 @pytest.mark.parametrize("workers", range(CORES + 1))

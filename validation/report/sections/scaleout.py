@@ -114,6 +114,7 @@ def _cli_sweep(cli: dict) -> dict | None:
     serial_s = serial[0]["stats"]["min"]
     model = sweep_scaling_model(serial_s, startup, runs, e["cells"], e["shared"])
     best = max(runs)
+    split = cli.get("cli-split", [])
     return {
         "cells": e["cells"],
         "shared": e["shared"],
@@ -122,6 +123,12 @@ def _cli_sweep(cli: dict) -> dict | None:
         "startup_serial_s": startup[0],
         "workers": best,
         "local_s": runs[best],
+        # the machine's ceiling without a scheduler: the sweep cut into serial processes at once
+        **(
+            {"split_parts": split[0]["extra_info"]["workers"], "split_s": split[0]["stats"]["min"]}
+            if split
+            else {}
+        ),
         **model,
     }
 
@@ -167,10 +174,22 @@ def _present_cli(cli: dict | None) -> list:
             f"among the workers, {1e3 * s['overhead_s']:.0f} ms per Dask task; serial fraction "
             f"{100 * s['serial_fraction']:.0f} %."
         )
+        if "split_s" in s:
+            ceiling = s["serial_s"] / s["split_s"]
+            text.append(
+                f"Without a scheduler, the same sweep cut by material into {s['split_parts']} "
+                f"serial processes started at once took {s['split_s']:.1f} s ({ceiling:.2f}×): "
+                "what this machine's cores give the sweep with no cluster to start and no "
+                "scheduling, each part paying its own start-up; the cluster reached "
+                f"{100 * s['speedup'][s['workers']] / ceiling:.0f} % of it."
+            )
         measured = [
             [n, s["runs_s"][n], s["speedup"][n], s["fitted_speedup"][n]] for n in s["runs_s"]
         ]
         predicted = [[n, None, None, v] for n, v in s["predicted_speedup"].items()]
+        if "split_s" in s:  # the machine's ceiling: serial processes, no scheduler
+            split = [f"{s['split_parts']} serial processes", s["split_s"]]
+            measured.append([*split, s["serial_s"] / s["split_s"], None])
         tables.append(
             Table(
                 ["workers", "measured (s)", "speed-up", "model's speed-up"],

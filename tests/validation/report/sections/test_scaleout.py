@@ -146,6 +146,20 @@ def test_command_line_figures_and_their_targets(tmp_path):
     assert [c.passed for c in checks(data)] == [True, True, True]
 
 
+def test_the_split_sweep_is_set_beside_the_cluster_as_the_machines_ceiling(tmp_path):
+    # two serial processes of half the sweep each, 36 s: 70/36 = 1.94x; the cluster's 1.67x is
+    # 86 % of it. The split is a figure, not a target: the checks stay the two sweep targets.
+    records = [*_cli_records(), _record("scaleout-cli", "cli-split", 36.0, workers=2)]
+    data = scaleout_figures(ReportContext(out_dir=tmp_path, bench={"benchmarks": records}))
+    sweep = data.results["cli"]["sweep"]
+    assert (sweep["split_parts"], sweep["split_s"]) == (2, 36.0)
+    assert len(checks(data)) == 3
+    parts = present(ReportContext(out_dir=tmp_path), data)
+    assert "into 2 serial processes started at once took 36.0 s (1.94×)" in parts[-2].text
+    assert "the cluster reached 86 % of it" in parts[-2].text
+    assert ["2 serial processes", 36.0, pytest.approx(70 / 36), None] in parts[-1].rows
+
+
 def test_the_scaling_model_recovers_its_own_parameters():
     # runs made by the model itself (start-up 6 s + 0.5 s per worker, 64 s of work, 20 ms per
     # task) give back those parameters and its speed-ups, also beyond the measured counts
