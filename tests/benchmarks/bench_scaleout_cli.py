@@ -3,8 +3,8 @@
 Group ``scaleout-cli`` (docs/scale-out.md, "How it scales, and what does not"; the report's
 Scale-out section fits its model to these figures):
 
-- ``cli-serial``: ``specref sweep GRID --scheduler serial``, a 4,608-cell Phong sweep (4 materials
-  × 2 views × 3 placements × 4 interpolations × 48 table sizes, resolution 320; over a minute
+- ``cli-serial``: ``specref sweep GRID --scheduler serial``, a 6,144-cell Phong sweep (4 materials
+  × 2 views × 3 placements × 4 interpolations × 64 table sizes, resolution 320; over a minute
   serially), in a new process;
 - ``cli-workers``: the same sweep with ``--scheduler local:N`` for N = 1 … the cores present: a new
   local cluster of N workers, its start, the workers' imports and the shared exact renders
@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-ENTRIES = ", ".join(str(e) for e in range(40, 808, 16))
+ENTRIES = ", ".join(str(e) for e in range(40, 1064, 16))
 GRID = f"""kind = "phong"
 [grid]
 materials = ["R1", "R2", "R3", "bimodal"]
@@ -45,7 +45,7 @@ interpolations = ["parabolic", "parabolic_w", "linear", "monotone"]
 entries = [{ENTRIES}]
 resolution = 320
 """
-CELLS, SHARED = 4 * 2 * 3 * 4 * 48, 4 * 2
+CELLS, SHARED = 4 * 2 * 3 * 4 * 64, 4 * 2
 #: One cell of the same sweep: the cost of a run that does not depend on its size.
 ONE_CELL = """kind = "phong"
 [grid]
