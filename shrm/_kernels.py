@@ -252,3 +252,17 @@ def _polar_rotate_each_kernel(x, cos_ma, sin_ma, partner, out):
                     out[o, j, k, i] = (
                         cos_ma[j, i] * x[o, j, k, i] + sin_ma[j, i] * x[o, j, k, partner[i]]
                     )
+
+
+@njit
+def _pair_sum_kernel(f, cosine, Lw, texel, point, out):
+    """Twin of ``shrm.split.angular_sum``'s spectral sum over its (point, texel) pairs.
+
+    ``out[point[q]] += f[q] · cosine[q] · Lw[texel[q]]`` for every pair q, without the (pairs, C)
+    temporaries of the NumPy form.
+    """
+    for q in range(f.shape[0]):
+        a, b, c = point[q], texel[q], cosine[q]
+        for ch in range(f.shape[1]):
+            # The reflection equation (R&H 2002): Σ_k f cos θ_i L_k w_k
+            out[a, ch] += f[q, ch] * (c * Lw[b, ch])

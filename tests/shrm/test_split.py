@@ -5,6 +5,7 @@ import pytest
 
 from reference.colour.spectra import SpectralGrid
 from reference.data import data_path, environment_maps
+from reference.errors import SpecrefError
 from reference.geometry.camera import downsample_box
 from reference.images.formats import read_image
 from reference.materials.brdf import BRDF_METHODS
@@ -64,6 +65,21 @@ def test_angular_sum_equals_the_per_point_loop(rng):
     ours = angular_sum(env_quadrature(image), ggx, params, n, v)
     theirs = reflected_bruteforce(ggx, params, "normal", n, v, env_quadrature(image))
     np.testing.assert_allclose(ours, theirs, rtol=1e-12, atol=1e-14)
+
+
+def test_angular_sum_numba_and_numpy_agree(rng):
+    # the spectral pairs summed by shrm._kernels._pair_sum_kernel and by NumPy's reduceat
+    image = rng.uniform(0.0, 2.0, (16, 32, 5))
+    n = rng.normal(size=(300, 3))
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    params = {"rho_d": np.linspace(0.1, 0.5, 5), "F_0": 0.5, "alpha": 0.3}
+    ggx = BRDF_METHODS.lookup("ggx").reference
+    env = env_quadrature(image)
+    fast = angular_sum(env, ggx, params, n, n)
+    readable = angular_sum(env, ggx, params, n, n, backend="numpy")
+    np.testing.assert_allclose(fast, readable, rtol=1e-12, atol=1e-14)
+    with pytest.raises(SpecrefError, match="backend"):
+        angular_sum(env, ggx, params, n, n, backend="gpu")
 
 
 def test_split_is_exact_non_negative_and_bounded(rng):
