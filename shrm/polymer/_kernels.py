@@ -1,6 +1,6 @@
 """numba twins of the polymer family: the oracle's rough specular sum, the shading of the hybrid.
 
-Twins of ``shrm.polymer.oracle.rough_specular_samples``, of
+Twins of ``shrm.polymer.oracle.rough_specular_samples`` and ``rough_reflection_albedo``, of
 ``shrm.polymer.material.polymer_shade_parts``, of its baseline
 ``shrm.polymer.material.lambert_phong_shade_parts`` and of the layered model's re-shade
 ``shrm.polymer.layered.layered_reshade_XYZ``. Each kernel keeps the names and equation
@@ -20,6 +20,7 @@ __all__ = [
     "lambert_phong_shade_parts_kernel",
     "layered_reshade_kernel",
     "polymer_shade_parts_kernel",
+    "rough_reflection_albedo_kernel",
     "rough_specular_samples_kernel",
 ]
 
@@ -116,6 +117,45 @@ def rough_specular_samples_kernel(N, V, radiance, alpha, n, u, total, total_sq):
             for band in range(nb):
                 total[p, band] += x[band]
                 total_sq[p, band] += x[band] * x[band]
+
+
+@njit
+def rough_reflection_albedo_kernel(cos_o, alpha, n, u1, u2, weights, out):
+    """Twin of ``shrm.polymer.oracle.rough_reflection_albedo``: Σ w F(o·h) G_1(i) per view."""
+    for a in range(cos_o.shape[0]):
+        oz = min(max(cos_o[a], 1e-6), 1.0)
+        ox = math.sqrt(1.0 - oz * oz)
+        # Heitz 2018, listing 1: the view in the stretched configuration (o_y = 0)
+        vx, vz = alpha * ox, oz
+        norm = math.sqrt(vx * vx + vz * vz)
+        vx, vz = vx / norm, vz / norm
+        if vx * vx > 0:
+            t1x, t1y = 0.0, vx * (1.0 / math.sqrt(vx * vx))
+        else:
+            t1x, t1y = 1.0, 0.0
+        # T2 = V × T1 with V = (v_x, 0, v_z), T1 = (t1x, t1y, 0)
+        t2x, t2y, t2z = -vz * t1y, vz * t1x, vx * t1y
+        s = 0.5 * (1.0 + vz)
+        total = 0.0
+        for m in range(u1.shape[0]):
+            r = math.sqrt(u1[m])
+            phi = 2.0 * math.pi * u2[m]
+            q1 = r * math.cos(phi)
+            q2 = (1.0 - s) * math.sqrt(1.0 - q1 * q1) + s * r * math.sin(phi)
+            q3 = math.sqrt(max(0.0, 1.0 - q1 * q1 - q2 * q2))
+            hx = alpha * (q1 * t1x + q2 * t2x + q3 * vx)
+            hy = alpha * (q1 * t1y + q2 * t2y)
+            hz = max(0.0, q2 * t2z + q3 * vz)
+            norm = math.sqrt(hx * hx + hy * hy + hz * hz)
+            hx, hy, hz = hx / norm, hy / norm, hz / norm
+            # i = 2 (o·h) h − o; weight F(o·h) G_1(i) (Eq. (34), Walter et al. 2007)
+            oh = ox * hx + oz * hz
+            iz = 2.0 * oh * hz - oz
+            if iz > 0.0:
+                c2 = max(iz * iz, 1e-300)
+                G = 2.0 / (1.0 + math.sqrt(1.0 + alpha * alpha * (1.0 - c2) / c2))
+                total += weights[m] * (_fresnel_dielectric(oh, n) * G)
+        out[a] = total
 
 
 @njit

@@ -51,7 +51,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from reference.errors import require, require_finite
+from reference.errors import require, require_choice, require_finite
 from reference.geometry.envmap import (
     check_latlong_shape,
     latlong_lookup_bilinear,
@@ -213,7 +213,9 @@ def _reflect_weight(o, h, alpha, n):
     return fresnel_dielectric(oh, n) * _smith_G1(i[..., 2], alpha), i
 
 
-def rough_reflection_albedo(cos_o, n: float, alpha: float, order: int = 96) -> np.ndarray:
+def rough_reflection_albedo(
+    cos_o, n: float, alpha: float, order: int = 96, backend: str = "numpy"
+) -> np.ndarray:
     """Directional albedo ``E_ρ(θ_o)`` of the rough interface's reflection lobe.
 
     ``E_ρ = ∫ f_s cos θ_i dω_i`` for ``f_s`` of Eq. (20), Walter et al. 2007 (GGX, separable
@@ -232,6 +234,9 @@ def rough_reflection_albedo(cos_o, n: float, alpha: float, order: int = 96) -> n
         GGX width, >= 0.
     order : int
         Gauss–Legendre nodes per axis.
+    backend : {"numpy", "numba"}
+        Who sums: this readable form, or its twin of :data:`ORACLE_KERNELS` (the same to 1e-12;
+        :func:`interface_coupling` uses the twin).
 
     Returns
     -------
@@ -244,13 +249,13 @@ def rough_reflection_albedo(cos_o, n: float, alpha: float, order: int = 96) -> n
     >>> bool(rough_reflection_albedo([0.5], 1.5, 0.3)[0] < fresnel_dielectric(0.5, 1.5) + 0.02)
     True
     """
+    require_choice(backend, ("numpy", "numba"), "rough reflection albedo: backend")
     cos_o = np.atleast_1d(np.asarray(cos_o, dtype=np.float64))
     if alpha <= 0.0:
         return fresnel_dielectric(cos_o, n)
-    x, w = np.polynomial.legendre.leggauss(int(order))
-    x, w = 0.5 * (x + 1.0), 0.5 * w
-    u1, u2 = (a.ravel() for a in np.meshgrid(x, x, indexing="ij"))
-    weights = np.outer(w, w).ravel()
+    if backend == "numba":
+        return _albedo_kernel_call(cos_o, n, alpha, order)
+    u1, u2, weights = _albedo_nodes(order)
     o = _local_view(cos_o)[:, None, :]
     h = _sample_visible_normal(np.broadcast_to(o, (cos_o.size, u1.size, 3)), alpha, u1, u2)
     value, _ = _reflect_weight(o, h, alpha, n)
@@ -324,7 +329,7 @@ def interface_coupling(n: float, alpha: float, nodes: int = 129) -> Coupling:
         enter = 1.0 - fresnel_dielectric(cos_nodes, n)
         k_e, r_i = float(fresnel_diffuse(n)), float(fresnel_diffuse(n, "inside"))
     else:
-        enter = 1.0 - rough_reflection_albedo(cos_nodes, n, alpha)
+        enter = 1.0 - rough_reflection_albedo(cos_nodes, n, alpha, backend="numba")
         x, w = np.polynomial.legendre.leggauss(64)
         mu = 0.5 * (x + 1.0)
         k_e = float(0.5 * w @ ((1.0 - np.interp(mu, cos_nodes, enter)) * 2.0 * mu))
@@ -486,6 +491,27 @@ def _rough_specular_kernel_call(normal, view, radiance, alpha, n, u):
     return total, total_sq
 
 
+def _albedo_nodes(order: int):
+    """The unit square's ``order × order`` Gauss–Legendre nodes ``u1, u2`` and weights."""
+    x, w = np.polynomial.legendre.leggauss(int(order))
+    x, w = 0.5 * (x + 1.0), 0.5 * w
+    u1, u2 = (np.ascontiguousarray(a.ravel()) for a in np.meshgrid(x, x, indexing="ij"))
+    return u1, u2, np.outer(w, w).ravel()
+
+
+def _albedo_kernel_call(cos_o, n, alpha, order=96):
+    from shrm.polymer._kernels import rough_reflection_albedo_kernel
+
+    cos_o = np.ascontiguousarray(np.atleast_1d(cos_o), dtype=np.float64)
+    out = np.empty(cos_o.size)
+    rough_reflection_albedo_kernel(cos_o, float(alpha), float(n), *_albedo_nodes(order), out)
+    return out
+
+
+def _example_albedo_inputs(rng):
+    return np.r_[0.0, rng.uniform(0.0, 1.0, 7), 1.0], 1.54, 0.35, 24
+
+
 def _example_specular_inputs(rng):
     N = rng.normal(size=(5, 3))
     N /= np.linalg.norm(N, axis=-1, keepdims=True)
@@ -505,6 +531,16 @@ def _register():
             "Eq. (1), Herbert et al.",
             _example_specular_inputs,
             compiled=_rough_specular_kernel_call,
+        )
+    )
+    ORACLE_KERNELS.register(
+        Method(
+            "rough_reflection_albedo",
+            rough_reflection_albedo,
+            k.rough_reflection_albedo_kernel,
+            "Eq. (20), Walter et al. 2007",
+            _example_albedo_inputs,
+            compiled=_albedo_kernel_call,
         )
     )
 
