@@ -159,6 +159,29 @@ def rough_reflection_albedo_kernel(cos_o, alpha, n, u1, u2, weights, out):
 
 
 @njit
+def _coupled_weights_kernel(N, D, omega, side, enter, out):
+    """Twin of the weights of ``shrm.polymer.oracle._irradiance_in``: c(cos) max(cos, 0) ω.
+
+    ``out[p, k]`` for the normals ``N`` (P, 3) and the map's pixel directions ``D`` (K, 3) and
+    solid angles ``omega`` (K,); ``enter`` is ``Coupling.enter`` on evenly spaced nodes of [0, 1].
+    """
+    m = enter.shape[0] - 1
+    for p in range(N.shape[0]):
+        nx, ny, nz = side * N[p, 0], side * N[p, 1], side * N[p, 2]
+        for k in range(D.shape[0]):
+            cos = nx * D[k, 0] + ny * D[k, 1] + nz * D[k, 2]
+            if cos > 0.0:
+                # Coupling.lookup: linear between the evenly spaced nodes
+                x = min(cos, 1.0) * m
+                i = min(int(x), m - 1)
+                f = x - i
+                c = enter[i] * (1.0 - f) + enter[i + 1] * f
+                out[p, k] = c * cos * omega[k]
+            else:
+                out[p, k] = 0.0
+
+
+@njit
 def polymer_shade_parts_kernel(E_d, S, B, L, E_effect, D_Tint, Col_B, Col_L, gloss, Mod, out):
     """Twin of ``shrm.polymer.material.polymer_shade_parts``: Eq. (1), Herbert et al., one pass.
 

@@ -579,14 +579,35 @@ class OracleResult:
     seconds: float
 
 
-def _irradiance_in(N, radiance, coupling: Coupling, side: float, chunk: int = 512) -> np.ndarray:
-    """``∫ c(|cos θ|) |cos θ| L dω`` over one hemisphere, as a sum over the map's pixels."""
+def _irradiance_in(
+    N, radiance, coupling: Coupling, side: float, chunk: int = 512, backend: str = "numba"
+) -> np.ndarray:
+    """``∫ c(|cos θ|) |cos θ| L dω`` over one hemisphere, as a sum over the map's pixels.
+
+    ``backend="numba"`` makes each chunk's weights in one pass of
+    ``shrm.polymer._kernels._coupled_weights_kernel`` (tables on evenly spaced nodes, as
+    :func:`interface_coupling` makes them), not in the dozen array passes of the look-up.
+    """
     H, W = radiance.shape[:2]
     D = latlong_pixel_directions(H, W).reshape(-1, 3)
     omega = latlong_pixel_solid_angles(H, W).ravel()
     L = radiance.reshape(-1, radiance.shape[-1])
     out = np.empty((N.shape[0], L.shape[1]))
+    fast = backend == "numba" and coupling._evenly_spaced
+    if fast:
+        from shrm.polymer._kernels import _coupled_weights_kernel
+
+        N, D, weights = (
+            np.ascontiguousarray(N),
+            np.ascontiguousarray(D),
+            np.empty((chunk, D.shape[0])),
+        )
     for s in range(0, N.shape[0], chunk):
+        if fast:
+            A = weights[: min(chunk, N.shape[0] - s)]
+            _coupled_weights_kernel(N[s : s + chunk], D, omega, float(side), coupling.enter, A)
+            out[s : s + chunk] = A @ L
+            continue
         cos = side * (N[s : s + chunk] @ D.T)
         out[s : s + chunk] = (coupling.lookup(cos) * np.maximum(cos, 0.0) * omega) @ L
     return out

@@ -213,3 +213,19 @@ def test_bad_input(kwargs, match):
     N, V, _ = _views(2)
     with pytest.raises(SpecrefError, match=match):
         polymer_oracle(N, V, np.ones((4, 8, 1)), [0.1], [1.0], **args)
+
+
+@pytest.mark.parametrize("alpha", [0.0, 0.3])
+@pytest.mark.parametrize("side", [1.0, -1.0])
+def test_coupled_irradiance_weights_kernel_matches_the_lookup(rng, alpha, side):
+    # the body and transmission sums: the weights c(cos) max(cos, 0) ω made in one kernel pass
+    # (shrm.polymer._kernels._coupled_weights_kernel) against Coupling.lookup's array passes
+    from shrm.polymer.oracle import _irradiance_in
+
+    N = rng.normal(size=(700, 3))
+    N /= np.linalg.norm(N, axis=1, keepdims=True)
+    radiance = rng.uniform(0.0, 2.0, (16, 32, 5))
+    coupling = interface_coupling(1.5, alpha)
+    fast = _irradiance_in(N, radiance, coupling, side, chunk=256)
+    readable = _irradiance_in(N, radiance, coupling, side, chunk=256, backend="numpy")
+    np.testing.assert_allclose(fast, readable, rtol=1e-12, atol=1e-14)
