@@ -160,7 +160,7 @@ def rough_reflection_albedo_kernel(cos_o, alpha, n, u1, u2, weights, out):
 
 @njit
 def _coupled_weights_kernel(N, D, omega, side, enter, out):
-    """Twin of the weights of ``shrm.polymer.oracle._irradiance_in``: c(cos) max(cos, 0) ω.
+    """Twin of the weights of ``shrm.polymer.oracle.coupled_irradiance``: c(cos) max(cos, 0) ω.
 
     ``out[p, k]`` for the normals ``N`` (P, 3) and the map's pixel directions ``D`` (K, 3) and
     solid angles ``omega`` (K,); ``enter`` is ``Coupling.enter`` on evenly spaced nodes of [0, 1].

@@ -48,7 +48,13 @@ from reference.geometry.envmap import (
 )
 from reference.materials.fresnel import fresnel_dielectric
 from reference.registry import Method, Registry
-from shrm.polymer.oracle import Coupling, body_factors, gloss_alpha, interface_coupling
+from shrm.polymer.oracle import (
+    Coupling,
+    body_factors,
+    coupled_irradiance,
+    gloss_alpha,
+    interface_coupling,
+)
 
 __all__ = [
     "LAYERED_KERNELS",
@@ -85,8 +91,11 @@ def _box_rows(radiance: np.ndarray, rows: int) -> np.ndarray:
     return blocks(radiance * omega) / blocks(omega)
 
 
-def _radial_sum(radiance, weight, normalize: bool, chunk: int = 512) -> np.ndarray:
-    """``Σ_ω w(d·ω) L(ω) Ω(ω)`` at every pixel direction d of the (box-filtered) map."""
+def _radial_sum(radiance, weight, chunk: int = 512) -> np.ndarray:
+    """``Σ_ω w(d·ω) L(ω) Ω(ω) / Σ_ω w(d·ω) Ω(ω)`` at every pixel direction d of the map.
+
+    The map is box-filtered to :data:`PREFILTER_MAX_ROWS` rows first when taller.
+    """
     radiance = np.asarray(radiance, dtype=np.float64)
     if radiance.shape[0] > PREFILTER_MAX_ROWS:
         radiance = _box_rows(radiance, PREFILTER_MAX_ROWS)
@@ -97,8 +106,7 @@ def _radial_sum(radiance, weight, normalize: bool, chunk: int = 512) -> np.ndarr
     out = np.empty((H * W, B))
     for s in range(0, H * W, chunk):
         w = weight(np.clip(D[s : s + chunk] @ D.T, -1.0, 1.0)) * omega
-        total = w @ L
-        out[s : s + chunk] = total / w.sum(axis=1, keepdims=True) if normalize else total
+        out[s : s + chunk] = (w @ L) / w.sum(axis=1, keepdims=True)
     return out.reshape(H, W, B)
 
 
@@ -130,12 +138,13 @@ def coupled_irradiance_latlong(radiance, coupling: Coupling) -> np.ndarray:
     >>> bool(np.allclose(E, np.pi * (1 - c.k_e), rtol=2e-3))
     True
     """
-
-    def weight(cos_gamma):
-        # (1 − E_ρ(cos γ)) cos γ above the surface, 0 below
-        return coupling.lookup(cos_gamma) * np.maximum(cos_gamma, 0.0)
-
-    return _radial_sum(radiance, weight, normalize=False)
+    radiance = np.asarray(radiance, dtype=np.float64)
+    if radiance.shape[0] > PREFILTER_MAX_ROWS:
+        radiance = _box_rows(radiance, PREFILTER_MAX_ROWS)
+    H, W, B = radiance.shape
+    # the oracle's own sum (coupled_irradiance) with the map's pixel directions as the normals
+    D = latlong_pixel_directions(H, W).reshape(-1, 3)
+    return coupled_irradiance(D, radiance, coupling, 1.0).reshape(H, W, B)
 
 
 def ggx_prefiltered_latlong(radiance, alpha: float) -> np.ndarray:
@@ -173,7 +182,7 @@ def ggx_prefiltered_latlong(radiance, alpha: float) -> np.ndarray:
         D_h = a2 / (np.pi * (cos2_h * (a2 - 1.0) + 1.0) ** 2)
         return 0.25 * D_h * np.maximum(cos_gamma, 0.0)
 
-    return _radial_sum(radiance, weight, normalize=True)
+    return _radial_sum(radiance, weight)
 
 
 @dataclass(frozen=True)

@@ -68,6 +68,7 @@ __all__ = [
     "PHONG_EXPONENT_MAX",
     "OracleResult",
     "body_factors",
+    "coupled_irradiance",
     "gloss_alpha",
     "gloss_phong_exponent",
     "interface_coupling",
@@ -579,15 +580,55 @@ class OracleResult:
     seconds: float
 
 
-def _irradiance_in(
-    N, radiance, coupling: Coupling, side: float, chunk: int = 512, backend: str = "numba"
+def coupled_irradiance(
+    normals,
+    radiance,
+    coupling: Coupling,
+    side: float = 1.0,
+    chunk: int = 512,
+    backend: str = "numba",
 ) -> np.ndarray:
-    """``∫ c(|cos θ|) |cos θ| L dω`` over one hemisphere, as a sum over the map's pixels.
+    """``∫ c(cos θ) max(cos θ, 0) L dω`` about each normal: the light through an interface.
 
-    ``backend="numba"`` makes each chunk's weights in one pass of
-    ``shrm.polymer._kernels._coupled_weights_kernel`` (tables on evenly spaced nodes, as
-    :func:`interface_coupling` makes them), not in the dozen array passes of the look-up.
+    The body and transmission integrals of the oracle (the physical counterpart of Eq. (1),
+    Herbert et al.; E66): ``c = 1 − E_ρ`` of the coupling, ``θ`` the angle between the normal
+    (``side`` = −1: the opposite direction) and each pixel of the lat-long map, summed over the
+    map's pixels with their solid angles.
+
+    Parameters
+    ----------
+    normals : ndarray, shape (P, 3)
+        Unit normals.
+    radiance : ndarray, shape (H, W, n_bands)
+        Lat-long environment (W = 2H).
+    coupling : Coupling
+        The interface (:func:`interface_coupling`).
+    side : float
+        1 for the hemisphere about the normal, −1 for the one behind it.
+    chunk : int
+        Normals per block (memory: ``chunk × H W`` weights).
+    backend : {"numba", "numpy"}
+        Who makes a block's weights ``c(cos) max(cos, 0) ω``: one pass of
+        ``shrm.polymer._kernels._coupled_weights_kernel`` (tables on evenly spaced nodes, as
+        :func:`interface_coupling` makes them), or :meth:`Coupling.lookup`'s array passes (the
+        readable form; equal to 1e-12).
+
+    Returns
+    -------
+    ndarray, shape (P, n_bands)
+
+    Examples
+    --------
+    Under a uniform sky, ``π (1 − k_e)``:
+
+    >>> c = interface_coupling(1.5, 0.0)
+    >>> E = coupled_irradiance(np.array([[0.0, 1.0, 0.0]]), np.ones((32, 64, 1)), c)
+    >>> bool(np.allclose(E, np.pi * (1 - c.k_e), rtol=2e-3))
+    True
     """
+    require_choice(backend, ("numba", "numpy"), "coupled irradiance: backend")
+    N = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
+    radiance = np.asarray(radiance, dtype=np.float64)
     H, W = radiance.shape[:2]
     D = latlong_pixel_directions(H, W).reshape(-1, 3)
     omega = latlong_pixel_solid_angles(H, W).ravel()
@@ -696,8 +737,8 @@ def oracle_diffuse(normal, view, radiance, K, S, d, n: float = 1.54, gloss: floa
     # the exit distribution: the flux leaving the front, (1 − E_ρ(θ_o)) / (π (1 − k_e)) per sr
     cos_o = np.einsum("ij,ij->i", N, V)
     exit_ = front.lookup(cos_o)[:, None] / (np.pi * (1.0 - front.k_e))
-    body = exit_ * rho_out * _irradiance_in(N, radiance, front, 1.0)
-    transmission = exit_ * tau * _irradiance_in(N, radiance, back, -1.0)
+    body = exit_ * rho_out * coupled_irradiance(N, radiance, front, 1.0)
+    transmission = exit_ * tau * coupled_irradiance(N, radiance, back, -1.0)
     return body, transmission
 
 

@@ -220,12 +220,12 @@ def test_bad_input(kwargs, match):
 def test_coupled_irradiance_weights_kernel_matches_the_lookup(rng, alpha, side):
     # the body and transmission sums: the weights c(cos) max(cos, 0) ω made in one kernel pass
     # (shrm.polymer._kernels._coupled_weights_kernel) against Coupling.lookup's array passes
-    from shrm.polymer.oracle import _irradiance_in
+    from shrm.polymer.oracle import coupled_irradiance
 
     N = rng.normal(size=(700, 3))
     N /= np.linalg.norm(N, axis=1, keepdims=True)
     radiance = rng.uniform(0.0, 2.0, (16, 32, 5))
     coupling = interface_coupling(1.5, alpha)
-    fast = _irradiance_in(N, radiance, coupling, side, chunk=256)
-    readable = _irradiance_in(N, radiance, coupling, side, chunk=256, backend="numpy")
+    fast = coupled_irradiance(N, radiance, coupling, side, chunk=256)
+    readable = coupled_irradiance(N, radiance, coupling, side, chunk=256, backend="numpy")
     np.testing.assert_allclose(fast, readable, rtol=1e-12, atol=1e-14)
