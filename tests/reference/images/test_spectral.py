@@ -181,7 +181,7 @@ def test_nan_in_a_late_block_leaves_no_output(tmp_path, rng):
 
 def test_spectralize_zarr_to_zarr_equals_in_memory(tmp_path, rng):
     # docs/scale-out.md: a 512×1024 RGB store in, a 41-band store out, streamed by row blocks (7
-    # rows, so blocks straddle the output's 64-row chunks); equal, bit for bit, to the blocks
+    # rows, so blocks straddle the output's 128-row chunks); equal, bit for bit, to the blocks
     # spectralized in memory (the same float32 arithmetic, erratum E45).
     from reference.colour.spectral_regression import spectralize_blocks
     from reference.colour.upsampling import default_regression
