@@ -27,11 +27,11 @@ from validation.report.sections.polymer_oracle_study import SETTINGS as SWEEPS
 from validation.report.sections.polymer_oracle_study import (
     Colour,
     OracleStudy,
-    _hybrid,
-    _oracle,
-    _sphere,
-    _stats,
+    chip_hybrid,
+    chip_oracle,
     hybrid_maps,
+    object_delta_E_stats,
+    orthographic_sphere,
 )
 from validation.report.types import Check, Table
 
@@ -160,7 +160,7 @@ def held_out_study(name: str) -> dict:
     """
     s = HELD_OUT[name]
     chips = held_out_chips(s.chips)
-    _, N, V = _sphere(s.size)
+    _, N, V = orthographic_sphere(s.size)
     model = characterize_model()
     oracle_settings = OracleStudy(s.size, s.env_height, (), (), (), (), s.tol)
     rows = []
@@ -169,14 +169,16 @@ def held_out_study(name: str) -> dict:
         maps, _ = hybrid_maps(env, sorted({c["gloss"] for c in chips}))
         colour = Colour(env)
         for chip in chips:
-            oracle = _oracle(N, V, env, chip, oracle_settings).result
+            oracle = chip_oracle(N, V, env, chip, oracle_settings).result
             shaded = {
-                "hybrid": _hybrid(N, V, maps, model, chip, "fresnel")["I_result"],
+                "hybrid": chip_hybrid(N, V, maps, model, chip, "fresnel")["I_result"],
                 "layered": _layered(N, V, env, chip),
             }
             for key, radiance in shaded.items():
                 dE = colour.delta_E(radiance, oracle)
-                rows.append({"model": key, "map": map_name, **chip, **_stats(dE, N[:, 2])})
+                rows.append(
+                    {"model": key, "map": map_name, **chip, **object_delta_E_stats(dE, N[:, 2])}
+                )
     worst = {
         key: {
             m: {

@@ -100,8 +100,22 @@ SETTINGS = {
 }
 
 
-def _sphere(size: int):
-    """Mask, normals and views of an orthographic unit sphere seen along −z."""
+def orthographic_sphere(size: int):
+    """Mask, normals and views of an orthographic unit sphere seen along −z.
+
+    Returns
+    -------
+    mask : ndarray of bool, shape (size, size)
+        The pixels whose centres fall on the sphere.
+    normals, views : ndarray, shape (P, 3)
+        Unit normals at those pixels (row-major) and the direction towards the camera, +z.
+
+    Examples
+    --------
+    >>> mask, N, V = orthographic_sphere(4)
+    >>> int(mask.sum()), N.shape, bool(np.allclose(np.linalg.norm(N, axis=1), 1.0)), V[0].tolist()
+    (12, (12, 3), True, [0.0, 0.0, 1.0])
+    """
     x = (np.arange(size) + 0.5) / size * 2.0 - 1.0
     X, Y = np.meshgrid(x, -x)
     mask = X**2 + Y**2 < 1.0
@@ -155,7 +169,21 @@ def hybrid_maps(env, gloss_values, size: int = 32) -> tuple[dict, float]:
     return out, time.perf_counter() - t0
 
 
-def _oracle(N, V, env, chip: dict, settings: OracleStudy, **kwargs):
+def chip_oracle(N, V, env, chip: dict, settings: OracleStudy, **kwargs):
+    """The layered oracle (``shrm.polymer.oracle.polymer_oracle``) for one chip.
+
+    The chip's K and S from its TiO2 load (``shrm.polymer.kubelka_munk``), its thickness, index
+    (the constituents' when the chip has none) and gloss; the study's tolerance, seed 0;
+    ``kwargs`` override the oracle's keywords.
+
+    Examples
+    --------
+    >>> _, N, V = orthographic_sphere(4)
+    >>> run = chip_oracle(N[:2], V[:2], np.ones((8, 16, 41)), {**BASE, "gloss": 1.0},
+    ...                   SETTINGS["tiny"])
+    >>> run.result.shape, bool((run.result > 0).all())
+    ((2, 41), True)
+    """
     constituents = polymer_constituents()
     K, S = polymer_K_S(constituents, chip["tio2_pct"])
     options = {"tol": settings.tol, "seed": 0, **kwargs}
@@ -191,19 +219,45 @@ def oracle_references(env, settings: OracleStudy) -> dict:
     >>> sorted(refs), refs[1.0].samples
     ([0.6, 0.8, 1.0], 0)
     """
-    _, N, V = _sphere(settings.size)
+    _, N, V = orthographic_sphere(settings.size)
     values = sorted({*settings.gloss, BASE["gloss"]})
-    return {g: _oracle(N, V, env, {**BASE, "gloss": g}, settings) for g in values}
+    return {g: chip_oracle(N, V, env, {**BASE, "gloss": g}, settings) for g in values}
 
 
-def _hybrid(N, V, maps, chips, chip: dict, mirror: str) -> dict:
+def chip_hybrid(N, V, maps, chips, chip: dict, mirror: str) -> dict:
+    """Herbert's hybrid (Eq. (1), Herbert et al.) for one chip: its terms per pixel.
+
+    The chip's look from the characterized model ``chips`` (``shrm.polymer.characterization``)
+    at its thickness, TiO2 load, gloss and index, shaded with the maps of its gloss
+    (:func:`hybrid_maps`); ``mirror`` is the specular map's Fresnel treatment.
+
+    Examples
+    --------
+    >>> from shrm.polymer.characterization import characterize_model
+    >>> _, N, V = orthographic_sphere(4)
+    >>> maps, _ = hybrid_maps(np.ones((8, 16, 41)), (1.0,), size=4)
+    >>> terms = chip_hybrid(N[:2], V[:2], maps, characterize_model(), {**BASE, "gloss": 1.0},
+    ...                     "fresnel")
+    >>> terms["I_result"].shape
+    (2, 41)
+    """
     d, c = chip["thickness_mm"], chip["tio2_pct"]
     look = polymer_look(chips, d, c, gloss=chip["gloss"], mirror=mirror, index=chip.get("index"))
     return polymer_terms(N, V, look, maps[chip["gloss"]])
 
 
-def _stats(dE, cos_view) -> dict:
-    """Mean, p95, max of ΔE00 over the object; means at the centre and the rim."""
+def object_delta_E_stats(dE, cos_view) -> dict:
+    """Mean, p95, max of ΔE00 over the object; means at the centre and the rim.
+
+    The centre is where the view is within about 45° of the normal (``cos_view > 0.7``), the rim
+    where it is beyond about 73° (``cos_view < 0.3``).
+
+    Examples
+    --------
+    >>> s = object_delta_E_stats([1.0, 2.0, 3.0, 4.0], np.array([0.9, 0.8, 0.2, 0.1]))
+    >>> s["mean"], s["max"], s["centre"], s["rim"]
+    (2.5, 4.0, 1.5, 3.5)
+    """
     d = np.asarray(dE).ravel()
     return {
         "mean": float(d.mean()),
@@ -224,7 +278,7 @@ def sweeps(env, settings: OracleStudy, maps: dict, references: dict) -> dict:
         thickness_mm, tio2_pct and stats ``mean``, ``p95``, ``max`` over the sphere's pixels and
         the means at the centre (cos θ_v > 0.7) and the rim (cos θ_v < 0.3).
     """
-    _, N, V = _sphere(settings.size)
+    _, N, V = orthographic_sphere(settings.size)
     chips, colour = characterize_model(), Colour(env)
     out = {}
     for axis in ("gloss", "thickness_mm", "tio2_pct"):
@@ -233,9 +287,9 @@ def sweeps(env, settings: OracleStudy, maps: dict, references: dict) -> dict:
             chip = {**BASE, axis: value}
             oracle = _oracle_result(N, V, env, chip, references)
             for mirror in MIRROR_FACTORS.names():
-                terms = _hybrid(N, V, maps, chips, chip, mirror)
+                terms = chip_hybrid(N, V, maps, chips, chip, mirror)
                 dE = colour.delta_E(terms["I_result"], oracle)
-                row.setdefault(mirror, []).append(_stats(dE, N[:, 2]))
+                row.setdefault(mirror, []).append(object_delta_E_stats(dE, N[:, 2]))
         out[axis] = row
     return out
 
@@ -257,7 +311,7 @@ def speed_accuracy(env, settings: OracleStudy, maps: dict, references: dict) -> 
     parts after a change of the slab); the oracle at fixed sample counts with another seed than
     the reference.
     """
-    _, N, V = _sphere(settings.size)
+    _, N, V = orthographic_sphere(settings.size)
     chips, colour = characterize_model(), Colour(env)
     reference = references[BASE["gloss"]]
     out: dict = {
@@ -270,15 +324,17 @@ def speed_accuracy(env, settings: OracleStudy, maps: dict, references: dict) -> 
         "oracle": [],
     }
     for mirror in MIRROR_FACTORS.names():
-        terms = _hybrid(N, V, maps, chips, BASE, mirror)
-        seconds = _seconds(lambda m=mirror: _hybrid(N, V, maps, chips, BASE, m))
+        terms = chip_hybrid(N, V, maps, chips, BASE, mirror)
+        seconds = _seconds(lambda m=mirror: chip_hybrid(N, V, maps, chips, BASE, m))
         dE = colour.delta_E(terms["I_result"], reference.result)
-        out["hybrid"][mirror] = {"seconds": seconds, **_stats(dE, N[:, 2])}
+        out["hybrid"][mirror] = {"seconds": seconds, **object_delta_E_stats(dE, N[:, 2])}
     out["layered"] = _layered_speed(N, V, env, colour, reference.result)
     for m in settings.samples:
-        run = _oracle(N, V, env, BASE, settings, tol=0.0, samples=m, max_samples=m, seed=1)
+        run = chip_oracle(N, V, env, BASE, settings, tol=0.0, samples=m, max_samples=m, seed=1)
         dE = colour.delta_E(run.result, reference.result)
-        out["oracle"].append({"samples": m, "seconds": run.seconds, **_stats(dE, N[:, 2])})
+        out["oracle"].append(
+            {"samples": m, "seconds": run.seconds, **object_delta_E_stats(dE, N[:, 2])}
+        )
     return out
 
 
@@ -303,7 +359,7 @@ def _layered_speed(N, V, env, colour: Colour, reference: np.ndarray) -> dict:
         "maps_seconds": maps_seconds,
         "seconds": _seconds(lambda: layered_terms(N, V, maps, K, S, d)),
         "reshade_seconds": _seconds(lambda: layered_shade_parts(parts, K, S, 2.0 * d, maps)),
-        **_stats(colour.delta_E(result, reference), N[:, 2]),
+        **object_delta_E_stats(colour.delta_E(result, reference), N[:, 2]),
     }
 
 
@@ -317,8 +373,8 @@ def demo_images(env, settings: OracleStudy, maps: dict, references: dict) -> dic
         ``hybrid``, ``oracle`` and the oracle's terms (``oracle specular``, ``oracle body``,
         ``oracle transmission``); (size, size) ``delta_E``; ``mask``.
     """
-    mask, N, V = _sphere(settings.size)
-    terms = _hybrid(N, V, maps, characterize_model(), BASE, "fresnel")
+    mask, N, V = orthographic_sphere(settings.size)
+    terms = chip_hybrid(N, V, maps, characterize_model(), BASE, "fresnel")
     reference = references[BASE["gloss"]]
     oracle = reference.result
     pieces = {
