@@ -51,7 +51,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from reference.errors import require, require_choice, require_finite
+from reference.errors import require, require_choice, require_finite, require_positive_int
 from reference.geometry.envmap import (
     check_latlong_shape,
     latlong_lookup_bilinear,
@@ -627,8 +627,14 @@ def coupled_irradiance(
     True
     """
     require_choice(backend, ("numba", "numpy"), "coupled irradiance: backend")
-    N = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
-    radiance = np.asarray(radiance, dtype=np.float64)
+    chunk = require_positive_int(chunk, "coupled irradiance: chunk")
+    N = np.asarray(require_finite(normals, "coupled irradiance: normals"), dtype=np.float64)
+    require(N.shape[-1:] == (3,), f"coupled irradiance: normals must be (P, 3), got {N.shape}")
+    N = N.reshape(-1, 3)
+    radiance = np.asarray(
+        require_finite(radiance, "coupled irradiance: radiance"), dtype=np.float64
+    )
+    check_latlong_shape(radiance.shape, "coupled irradiance: radiance")
     H, W = radiance.shape[:2]
     D = latlong_pixel_directions(H, W).reshape(-1, 3)
     omega = latlong_pixel_solid_angles(H, W).ravel()

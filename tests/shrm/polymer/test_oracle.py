@@ -8,6 +8,7 @@ from shrm.polymer.kubelka_munk import km_R_infinity, polymer_constituents, polym
 from shrm.polymer.oracle import (
     ORACLE_KERNELS,
     body_factors,
+    coupled_irradiance,
     gloss_alpha,
     gloss_phong_exponent,
     interface_coupling,
@@ -220,7 +221,6 @@ def test_bad_input(kwargs, match):
 def test_coupled_irradiance_weights_kernel_matches_the_lookup(rng, alpha, side):
     # the body and transmission sums: the weights c(cos) max(cos, 0) ω made in one kernel pass
     # (shrm.polymer._kernels._coupled_weights_kernel) against Coupling.lookup's array passes
-    from shrm.polymer.oracle import coupled_irradiance
 
     N = rng.normal(size=(700, 3))
     N /= np.linalg.norm(N, axis=1, keepdims=True)
@@ -229,3 +229,20 @@ def test_coupled_irradiance_weights_kernel_matches_the_lookup(rng, alpha, side):
     fast = coupled_irradiance(N, radiance, coupling, side, chunk=256)
     readable = coupled_irradiance(N, radiance, coupling, side, chunk=256, backend="numpy")
     np.testing.assert_allclose(fast, readable, rtol=1e-12, atol=1e-14)
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda c: coupled_irradiance(np.eye(3), np.ones((8, 16, 1)), c, backend="gpu"), "backend"),
+        (lambda c: coupled_irradiance(np.eye(3), np.ones((8, 16, 1)), c, chunk=0), "chunk"),
+        (lambda c: coupled_irradiance(np.eye(3), np.ones((8, 16, 1)), c, chunk=-4), "chunk"),
+        (lambda c: coupled_irradiance(np.eye(3)[:, :2], np.ones((8, 16, 1)), c), r"\(P, 3\)"),
+        (lambda c: coupled_irradiance(np.full((1, 3), np.nan), np.ones((8, 16, 1)), c), "normals"),
+        (lambda c: coupled_irradiance(np.eye(3), np.ones((8, 9, 1)), c), "radiance"),
+        (lambda c: rough_reflection_albedo([0.5], 1.5, 0.3, backend="gpu"), "backend"),
+    ],
+)
+def test_the_coupling_sums_refuse_bad_input_in_one_line(call, message):
+    with pytest.raises(SpecrefError, match=message):
+        call(interface_coupling(1.5, 0.3))
