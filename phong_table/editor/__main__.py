@@ -1,4 +1,4 @@
-"""``python -m phong_table.editor [FILE] [--port N]``: the editor server alone (browser tests).
+"""``python -m phong_table.editor [FILE] [--port N] [--save-dir DIR]``: the editor server alone.
 
 ``specref phong edit`` is the command users run; this entry point starts the same server without
 the ``specref`` command line, so that :mod:`phong_table.editor.browser` needs nothing outside
@@ -20,9 +20,10 @@ def _announce(line: str) -> None:
 parser = argparse.ArgumentParser(prog="python -m phong_table.editor")
 parser.add_argument("file", nargs="?", help="a material file (TOML) to open")
 parser.add_argument("--port", type=int, default=5006, help="port on 127.0.0.1 (default 5006)")
+parser.add_argument("--save-dir", help="the folder saves go to")
 args = parser.parse_args()
 try:
-    serve_editor(args.file, args.port, _announce)
+    serve_editor(args.file, args.port, _announce, save_dir=args.save_dir)
 except SpecrefError as error:
     sys.stderr.write(f"python -m phong_table.editor: {error}\n")
     sys.exit(2)

@@ -27,7 +27,8 @@ def _cmd_phong(args) -> int:
             editor_browser.editor_screenshot(path, args.screenshot, args.port)
             print(f"wrote {args.screenshot}")
             return 0
-        editor_app.serve_editor(path, args.port, partial(print, flush=True))
+        announce = partial(print, flush=True)
+        editor_app.serve_editor(path, args.port, announce, save_dir=args.save_dir)
         return 0
     if args.file is not None:
         raise SpecrefError(f"specref phong: {args.file}: a file is taken by 'edit' only")
@@ -89,7 +90,7 @@ def add_parser(sub) -> None:
         "phong",
         help="spectral Phong tables: Table 1 of Wang et al., or one material file",
         description="specref phong table1 [--json FILE] [--images DIR] | specref phong edit "
-        "[MATERIAL.toml] [--port N] | specref phong --material FILE.toml "
+        "[MATERIAL.toml] [--port N] [--save-dir DIR] | specref phong --material FILE.toml "
         "--view V --entries M --placement P --interp I [--segments S] [--tolerance T] "
         "[--json FILE]",
     )
@@ -101,7 +102,16 @@ def add_parser(sub) -> None:
     )
     p.add_argument("file", nargs="?", metavar="MATERIAL.toml", help="edit: the file to open")
     p.add_argument(
-        "--port", type=port_number, default=5006, help="edit: the local port (default 5006)"
+        "--port",
+        type=port_number,
+        default=5006,
+        help="edit: the local port (default 5006; 0: any free port, announced)",
+    )
+    p.add_argument(
+        "--save-dir",
+        metavar="DIR",
+        help="edit: the one folder the page saves to (default: the opened file's folder, else "
+        "the current one)",
     )
     p.add_argument(
         "--screenshot",
