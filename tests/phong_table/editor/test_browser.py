@@ -24,6 +24,18 @@ pytestmark = pytest.mark.skipif(
 )
 
 
+_INJECTED_JS = """
+function images(root) {
+    let count = root.querySelectorAll('img').length;
+    for (const el of root.querySelectorAll('*')) {
+        if (el.shadowRoot) { count += images(el.shadowRoot); }
+    }
+    return count;
+}
+return [window.injected !== undefined, images(document)];
+"""
+
+
 def test_an_edit_in_the_browser_renders_and_saves(tmp_path):
     from phong_table.editor.browser import (
         click_button,
@@ -71,18 +83,24 @@ def test_an_edit_in_the_browser_renders_and_saves(tmp_path):
         click_button(driver, "save")
         wait_for(driver, lambda d: saved.is_file(), 30, "the saved file")
         wait_for(driver, lambda d: "saved" in page_value(d, "error"), 30, "the saved message")
-        # A file that fails to parse: the one-line error on the page; saving does not touch it.
-        bad = tmp_path / "bad.toml"
+        # A file that fails to parse, named as markup: the one-line error on the page, shown as
+        # text (no element made, no script run); saving does not touch the file.
+        bad = tmp_path / "<img src=x onerror=window.injected=1>.toml"
         bad.write_text("[material]\nk_d = 0.2\n")
         set_widget(driver, "path", "value", str(bad))
         click_button(driver, "open")
-        wait_for(driver, lambda d: "bad.toml" in (page_value(d, "error") or ""), 30, "error")
+        wait_for(driver, lambda d: "<img" in (page_value(d, "error") or ""), 30, "error")
         message = page_value(driver, "error")
         assert "k_s" in message
         assert "\n" not in message
+        assert driver.execute_script(_INJECTED_JS) == [False, 0]
         click_button(driver, "save")
         wait_for(driver, lambda d: "not overwritten" in page_value(d, "error"), 30, "refusal")
         assert bad.read_text() == "[material]\nk_d = 0.2\n"
+        # The difference image's toggle is on the page and hides the image.
+        assert page_value(driver, "diff_plot", "visible") is True
+        click_button(driver, "difference image")
+        wait_for(driver, lambda d: page_value(d, "diff_plot", "visible") is False, 30, "hidden")
         assert process.poll() is None
     # The saved file holds the edit and `specref phong --material` accepts it.
     model = load_material_file(saved)
