@@ -24,6 +24,7 @@ from phong_table.table import build_table
 from validation.report import (
     Check,
     Headline,
+    Image,
     ReportContext,
     ReportSection,
     SectionData,
@@ -486,6 +487,7 @@ def present(ctx: ReportContext, data: SectionData) -> list:
         blocks += paper_figures(
             ctx, study.figures, study.compiled, repeats=study.repeats, quick=study.quick
         )
+    blocks += editor_blocks(ctx, screenshot=not study.quick)
     if "bench" in results:
         blocks.append(
             Table(
@@ -496,6 +498,64 @@ def present(ctx: ReportContext, data: SectionData) -> list:
             )
         )
     return blocks
+
+
+def editor_blocks(ctx: ReportContext, screenshot: bool = True) -> list:
+    """The material editor (§1, §5, Wang et al.): what it does, and a screenshot of it.
+
+    The screenshot is taken by :func:`phong_table.editor.browser.editor_screenshot` (a server on a
+    free port, headless Chromium); without Chromium, or when ``screenshot`` is False (the quick
+    report), a line says how to get it.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     blocks = editor_blocks(ReportContext(Path(d)), screenshot=False)
+    >>> len(blocks), "specref phong edit" in blocks[0].text
+    (2, True)
+    """
+    import shutil
+
+    from phong_table.editor.app import MAX_SESSIONS
+    from phong_table.editor.state import CONTROL_STRIDE, CURVES
+    from reference.browser import find_chromium
+    from reference.errors import SpecrefError
+
+    curves = ", ".join(label for label, *_ in CURVES.values())
+    about = Text(
+        "The material editor Wang et al. build their tables for (§1, §5): "
+        "`specref phong edit [MATERIAL.toml]` serves a page on 127.0.0.1 with the "
+        f"{len(CURVES)} curves ({curves}), each kept whole (the light at its own sampling) and "
+        f"edited through control points at every {CONTROL_STRIDE}th wavelength of the grid "
+        "(Erratum E28). Every drag re-renders the sphere through the table path; the exact image "
+        "follows once the drag ends (Erratum E29), then the RMS and the difference image. It is "
+        "built as a local web app: its own Host only, messages as text, saves inside one folder, "
+        f"at most {MAX_SESSIONS} pages (docs/phong-tables.md)."
+    )
+    if not screenshot:
+        return [about, Text("The screenshot is in the default report (`specref phong edit "
+                            "--screenshot PNG` writes it).")]  # fmt: skip
+    if find_chromium() is None or shutil.which("chromedriver") is None:
+        return [about, Text("No screenshot: Chromium and chromedriver are not installed here.")]
+    from phong_table.editor.browser import editor_screenshot
+
+    rel = f"images/{ctx.section or 'phong'}-editor.png"
+    (ctx.out_dir / "images").mkdir(parents=True, exist_ok=True)
+    try:
+        editor_screenshot(None, ctx.out_dir / rel)
+    except SpecrefError as error:
+        return [about, Text(f"No screenshot: {str(error).splitlines()[0]}")]
+    from PIL import Image as PILImage
+
+    with PILImage.open(ctx.out_dir / rel) as png:
+        width, height = png.size
+    caption = (
+        "The editor after the k_s point at 500 nm was dragged to 0.8 with 50 uniform entries: "
+        "the table's highlight departs from the exact one where the difference image is bright"
+    )
+    return [about, Image(rel, caption, width, height)]
 
 
 def checks(data: SectionData) -> list[Check]:
