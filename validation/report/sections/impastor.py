@@ -31,7 +31,6 @@ __all__ = [
     "TARGETS",
     "TINY",
     "ImpastorSettings",
-    "canvas_view",
     "checks",
     "frame_methods",
     "impastor_validation",
@@ -646,58 +645,17 @@ def _gloss_blocks(ctx, result) -> list:
     ]
 
 
-def canvas_view(image) -> np.ndarray:
-    """The largest axis-aligned rectangle of an oblique canvas render that holds only canvas.
-
-    The booth camera sees the canvas as a trapezoid over a black background; the report frames
-    the painting so that the canvas fills the view, dropping the black bands and the corners.
-
-    Examples
-    --------
-    >>> image = np.zeros((6, 8, 3))
-    >>> image[1:5, 1:7] = 0.5
-    >>> image[1, 1] = image[1, 6] = 0.0   # a narrower top row
-    >>> canvas_view(image).shape   # rows 2-4 are covered from column 1 to 6
-    (3, 6, 3)
-    """
-    covered = np.asarray(image).reshape(image.shape[0], image.shape[1], -1).max(axis=-1) > 0
-    best, frame = 0, (slice(None), slice(None))
-    rows = np.flatnonzero(covered.any(axis=1))
-    for top in rows:
-        # widen from each top row: the columns covered on every row from `top` down
-        span = covered[top].copy()
-        for bottom in range(top, covered.shape[0]):
-            span &= covered[bottom]
-            cols = np.flatnonzero(span)
-            if cols.size == 0:
-                break
-            # the longest run of consecutive covered columns
-            breaks = np.flatnonzero(np.diff(cols) > 1)
-            starts = np.concatenate([[0], breaks + 1])
-            ends = np.concatenate([breaks, [cols.size - 1]])
-            run = int(np.argmax(ends - starts))
-            width = int(ends[run] - starts[run] + 1)
-            area = width * (bottom - top + 1)
-            if area > best:
-                best = area
-                left = int(cols[starts[run]])
-                frame = (slice(top, bottom + 1), slice(left, left + width))
-    return np.asarray(image)[frame]
-
-
 def _frame_blocks(ctx, data: SectionData) -> list:
     settings = data.arrays["settings"]
     size = settings.frame_size
     blocks = []
     for light, image in data.arrays["painting"].items():
-        framed = canvas_view(image)
         blocks.append(
             ctx.image(
                 f"painting-{light}",
-                framed,
-                f"Demo painting under the booth light, {light}: the canvas as the viewer sees it "
-                f"(the largest view inside the canvas, {framed.shape[1]}×{framed.shape[0]} of a "
-                f"{size}×{size} render)",
+                image,
+                f"Demo painting under the booth light, {light}: the whole {size}×{size} frame "
+                "that `specref impastor render` writes, the canvas seen from the booth's viewer",
             )
         )
     rows = [
