@@ -90,7 +90,18 @@ for (const td of document.querySelectorAll('td')) {
     const tops = new Set(Array.from(range.getClientRects()).map(r => Math.round(r.top)));
     if (tops.size > 1) split.push(text);
 }
+const bar = document.getElementById('bar');
+function barShown() {
+    if (!bar) { return false; }
+    const r = bar.getBoundingClientRect();
+    return r.height > 0 && r.top >= 0 && r.bottom <= window.innerHeight;
+}
+const barFirst = barShown();
+window.scrollTo(0, document.documentElement.scrollHeight);
+const barLast = barShown();
+window.scrollTo(0, 0);
 return {images: images, links: links.length, broken_links: broken, split_cells: split,
+        contents_on_every_screen: barFirst && barLast,
         scroll_width: document.documentElement.scrollWidth,
         client_width: document.documentElement.clientWidth,
         first_content: first ? first.id : null};
@@ -106,6 +117,8 @@ def check_report_page(page, width: int = 1280, height: int = 900) -> dict:
         ``images`` (``src``, ``complete``, ``natural`` and ``shown`` widths), ``links`` (the
         number of in-page links), ``broken_links``, ``scroll_width`` and ``client_width`` (CSS
         pixels), ``first_content`` (the id of the first block after the title and provenance),
+        ``contents_on_every_screen`` (the bar ``#bar`` is in view at the top of the page and
+        scrolled to its end),
         ``split_cells``: the text of every figure cell (a digit, at most 24 characters) that the
         layout spread over more than one line.
 

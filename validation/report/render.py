@@ -1,6 +1,8 @@
 """The report's HTML and Markdown renderings (``index.html``, ``docs/results.md``).
 
-Both follow the same order, written for a reader rather than a test log:
+Both follow the same order, written for a reader rather than a test log (the HTML page also has
+a bar on every screen, :func:`_html_bar`: the summary, each part, a contents menu and the way back
+to the top; each section has its own "↑ top"):
 
 1. provenance (commit, date, mode, cores, run time);
 2. the summary: one block per part (each paper, and the shared core) with a hero image, the
@@ -102,6 +104,15 @@ _CSS = " ".join(
         ".anchor{color:#666} .fail{color:#a00;font-weight:600} .ok{color:#060}",
         ".banner{margin:2.2em 0 0;padding:.3em .6em;background:#eef2f7;font-weight:600}",
         "details{margin:.4em 0 1em} summary{cursor:pointer}",
+        # the bar: on every screen, the parts, the contents (a menu) and the way back up
+        ".bar{position:sticky;top:0;z-index:10;background:#fff;border-bottom:1px solid #ddd;",
+        "padding:.35em 0;display:flex;flex-wrap:wrap;gap:.3em 1em;align-items:baseline;",
+        "font-size:.92em} .bar details{margin:0;position:relative}",
+        ".bar details ul{position:absolute;left:0;top:1.6em;background:#fff;border:1px solid #ccc;",
+        "border-radius:4px;padding:.4em 1em .4em 1.6em;margin:0;max-height:70vh;overflow-y:auto;",
+        "width:max-content;max-width:90vw;box-shadow:0 2px 8px rgba(0,0,0,.15)}",
+        "section{scroll-margin-top:2.6em} .banner,#top{scroll-margin-top:2.6em}",
+        "a.up{float:right;margin-top:1.6em;font-size:.85em;color:#666}",
     ]
 )
 
@@ -243,7 +254,8 @@ def _html_blocks(blocks) -> list[str]:
 
 def _html_section(section: ReportSection, result: SectionResult) -> list[str]:
     esc = html.escape
-    out = [f"<section id='{esc(section.name)}'><h2>{esc(section.title)}</h2>"]
+    up = "<a class='up' href='#top'>↑ top</a>"
+    out = [f"<section id='{esc(section.name)}'>{up}<h2>{esc(section.title)}</h2>"]
     failed = [(section, c) for c in result.checks if not c.passed]
     if failed:
         out.append("<p class='fail'>Targets that do not hold:</p>")
@@ -260,6 +272,33 @@ def _html_section(section: ReportSection, result: SectionResult) -> list[str]:
         f"<p class='meta'>Section time {result.seconds:.1f} s ({settings} settings).</p></section>"
     )
     return out
+
+
+def _html_bar(parts: list[ReportPart], sections, pending) -> str:
+    """The bar at the top of every screen: the summary, each part, a contents menu, the top.
+
+    Examples
+    --------
+    >>> s, t = ReportSection("s", "S"), ReportSection("t", "T")
+    >>> parts = [ReportPart("a", "Part A", "", (s,)), ReportPart("b", "Part B", "", (t,))]
+    >>> bar = _html_bar(parts, [(s, None)], [t])
+    >>> "href='#part-a'" in bar, "href='#part-b'" in bar, "Contents (2 sections)" in bar
+    (True, False, True)
+    """
+    esc = html.escape
+    listed = [s for s, _ in sections] + list(pending)
+    items = "".join(f"<li><a href='#{esc(s.name)}'>{esc(s.title)}</a></li>" for s in listed)
+    links = ["<a href='#top'>↑ top</a>", "<a href='#summary'>Summary</a>"]
+    if len(parts) > 1:  # the parts with a section on the page (each has its banner)
+        done = {s.name for s, _ in sections}
+        shown = [p for p in parts if any(s.name in done for s in p.sections)]
+        links += [f"<a href='#part-{esc(p.name)}'>{esc(p.title)}</a>" for p in shown]
+    links.append("<a href='#targets'>All targets</a>")
+    menu = (
+        f"<details><summary>Contents ({len(listed)} sections)</summary><ul>{items}"
+        "<li><a href='#targets'>All targets</a></li></ul></details>"
+    )
+    return f"<nav class='bar' id='bar'>{menu}{' '.join(links)}</nav>"
 
 
 def _html_pending(pending) -> list[str]:
@@ -315,7 +354,8 @@ def render_html(title: str, meta: dict, sections, parts=None, pending=()) -> str
         "<meta name='viewport' content='width=device-width, initial-scale=1'>",
         f"<title>{esc(title)}</title>",
         f"<style>{_CSS}</style></head><body>",
-        f"<h1>{esc(title)}</h1>",
+        _html_bar(parts, sections, pending),
+        f"<h1 id='top'>{esc(title)}</h1>",
         f"<p class='meta' id='provenance'>{esc(_meta_line(meta))}</p>",
     ]
     parts_html += _html_summary(parts, sections)

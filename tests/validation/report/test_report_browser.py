@@ -62,6 +62,8 @@ def test_quick_report_reads_in_a_browser(quick_report):
     assert page["split_cells"] == []
     # The summary is the first content, and every in-page link resolves.
     assert page["first_content"] == "summary"
+    # The bar (the parts, the contents menu, the way up) is on the first screen and the last.
+    assert page["contents_on_every_screen"]
     assert page["broken_links"] == []
     assert page["links"] >= 2 * len(SMALL_REPORT)
     # Each part of the summary states figures and links to its sections.
@@ -91,6 +93,10 @@ def test_the_page_check_finds_a_figure_split_over_two_lines(tmp_path):
     page = tmp_path / "split.html"
     cell = "<td style='width:3em;max-width:3em;overflow-wrap:anywhere'>0.00672 / 7</td>"
     kept = "<td class='n' style='white-space:nowrap'>0.00672 / 7</td>"
-    page.write_text(f"<h1>t</h1><table style='width:6em'><tr>{cell}{kept}</tr></table>")
+    # and a bar that scrolls away with the page is found out
+    bar = "<nav id='bar'>contents</nav>"
+    tall = "<p style='height:2000px'>a long section</p>"
+    page.write_text(f"{bar}<h1>t</h1><table style='width:6em'><tr>{cell}{kept}</tr></table>{tall}")
     found = check_report_page(page, width=400, height=300)
     assert found["split_cells"] == ["0.00672 / 7"]
+    assert found["contents_on_every_screen"] is False
