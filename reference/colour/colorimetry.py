@@ -59,6 +59,7 @@ __all__ = [
     "display_RGB_to_XYZ",
     "spectra_to_RGB_matrix",
     "spectra_to_XYZ",
+    "spectral_channel_weights",
     "white_XYZ",
 ]
 
@@ -534,3 +535,47 @@ def delta_E_00(Lab_1, Lab_2) -> np.ndarray:
     import colour
 
     return colour.delta_E(np.asarray(Lab_1, float), np.asarray(Lab_2, float), method="CIE 2000")
+
+
+def spectral_channel_weights(wavelengths_nm, where: str = "spectral channels") -> np.ndarray:
+    """Equal-energy weights ``W`` (``XYZ = bands @ W``) for an image's evenly spaced bands.
+
+    A spectral image's bands hold relative radiance normalised with the equal-energy light
+    (docs/render-outputs.md), so its XYZ is ``bands @ W`` with ``W = band_weights(grid, None)``:
+    ASTM E308 where it tabulates the grid, else point sampling.
+
+    Parameters
+    ----------
+    wavelengths_nm : array_like, shape (B,)
+        The bands' centres, evenly spaced.
+    where : str
+        What the message of a refusal names (a file).
+
+    Returns
+    -------
+    ndarray, shape (B, 3)
+
+    Examples
+    --------
+    >>> W = spectral_channel_weights(np.arange(380.0, 781.0, 10.0))
+    >>> W.shape, round(float(W[:, 1].sum()), 6)
+    ((41, 3), 1.0)
+    >>> spectral_channel_weights([400.0, 410.0, 430.0], "a.exr")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: a.exr: spectral channels must be evenly spaced, got [400.0, ...
+    """
+    from reference.colour.spectra import SpectralGrid
+    from reference.errors import SpecrefError
+
+    wavelengths = np.asarray(wavelengths_nm, dtype=np.float64)
+    steps = np.diff(wavelengths)
+    require(
+        wavelengths.size >= 2 and np.allclose(steps, steps[0]),
+        f"{where}: spectral channels must be evenly spaced, got {wavelengths.tolist()}",
+    )
+    grid = SpectralGrid(float(wavelengths[0]), float(wavelengths[-1]), float(steps[0]))
+    try:
+        return band_weights(grid, None, "astm_e308")
+    except SpecrefError:  # a grid that ASTM E308 does not tabulate
+        return band_weights(grid, None, "point")

@@ -30,8 +30,12 @@ from pathlib import Path
 
 import numpy as np
 
-from reference.colour.colorimetry import XYZ_to_Lab, band_weights, delta_E_00, display_RGB_to_XYZ
-from reference.colour.spectra import SpectralGrid
+from reference.colour.colorimetry import (
+    XYZ_to_Lab,
+    delta_E_00,
+    display_RGB_to_XYZ,
+    spectral_channel_weights,
+)
 from reference.errors import SpecrefError, require
 from reference.images.formats import channel_wavelengths_nm, read_exr, read_image
 from reference.scene.metadata import LIT_FRACTION, read_exr_metadata
@@ -64,19 +68,6 @@ def XYZ_to_uv_prime(XYZ) -> np.ndarray:
     return np.stack(
         [np.where(d > 0, 4.0 * X / safe, 0.0), np.where(d > 0, 9.0 * Y / safe, 0.0)], -1
     )
-
-
-def _spectral_weights(wavelengths: np.ndarray, where: str) -> np.ndarray:
-    steps = np.diff(wavelengths)
-    require(
-        wavelengths.size >= 2 and np.allclose(steps, steps[0]),
-        f"{where}: spectral channels must be evenly spaced, got {wavelengths.tolist()}",
-    )
-    grid = SpectralGrid(float(wavelengths[0]), float(wavelengths[-1]), float(steps[0]))
-    try:
-        return band_weights(grid, None, "astm_e308")
-    except SpecrefError:  # a grid that ASTM E308 does not tabulate
-        return band_weights(grid, None, "point")
 
 
 def exr_to_XYZ(path) -> tuple[np.ndarray, dict]:
@@ -120,7 +111,7 @@ def exr_to_XYZ(path) -> tuple[np.ndarray, dict]:
     spectral = [i for i, n in enumerate(names) if channel_wavelengths_nm([n]) is not None]
     if spectral:
         wavelengths = channel_wavelengths_nm([names[i] for i in spectral])
-        W = _spectral_weights(wavelengths, str(path))
+        W = spectral_channel_weights(wavelengths, str(path))
         info["kind"] = "spectral"
         return image[..., spectral] @ W, info
     if all(c in names for c in "RGB"):

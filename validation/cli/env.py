@@ -1,4 +1,4 @@
-"""``specref env``: fit an RGB → spectrum regression and spectralize HDR panoramas (Herbert §4)."""
+"""``specref env``: an RGB → spectrum regression, spectralized panoramas (Herbert §4), previews."""
 
 from __future__ import annotations
 
@@ -50,6 +50,21 @@ def _cmd_env_spectralize(args) -> int:
     return 0
 
 
+def _cmd_env_preview(args) -> int:
+    import sys
+
+    from reference.images.preview import image_preview
+
+    info = image_preview(args.image, args.out, args.width, args.exposure, progress=sys.stderr)
+    rows, columns = info["preview"]
+    print(
+        f"wrote {info['out']}: {columns}×{rows} sRGB preview of a {info['width']}×"
+        f"{info['height']} {info['kind']} image (box filter {info['factor']}×{info['factor']}, "
+        f"exposure {info['exposure_ev']:+.2f} EV, {100 * info['clipped']:.1f} % of values clipped)"
+    )
+    return 0
+
+
 def _cmd_env_convert(args) -> int:
     from reference.images.spectral import convert_to_zarr
 
@@ -63,7 +78,7 @@ def _cmd_env_convert(args) -> int:
 
 
 def add_parser(sub) -> None:
-    """Add ``specref env fit|spectralize|convert`` to the subcommand parsers ``sub``."""
+    """Add ``specref env fit|spectralize|convert|preview`` to the subcommand parsers ``sub``."""
     from reference.colour.spectral_regression import (
         DEFAULT_LOSS,
         REGRESSION_FEATURES,
@@ -125,6 +140,30 @@ def add_parser(sub) -> None:
     )
     s.set_defaults(func=_cmd_env_spectralize, streamed=True)
     _add_convert(env)
+    _add_preview(env)
+
+
+def _add_preview(env) -> None:
+    """Add ``specref env preview`` to the ``env`` subcommands."""
+    v = env.add_parser(
+        "preview",
+        help="an sRGB PNG of a spectral, XYZ or RGB image (e.g. a 41-band panorama) to look at",
+    )
+    v.add_argument(
+        "image",
+        type=input_file,
+        help="linear image: .exr (spectral, XYZ or RGB), .hdr, .tif, .zarr",
+    )
+    v.add_argument("-o", "--out", type=output_file, required=True, help="the preview .png")
+    v.add_argument("--width", type=int, default=2048, help="widest preview in pixels (2048)")
+    v.add_argument(
+        "--exposure",
+        type=float,
+        default=None,
+        metavar="EV",
+        help="stops applied before display (default: the median luminance to 18 %% grey)",
+    )
+    v.set_defaults(func=_cmd_env_preview, streamed=True)
 
 
 def _add_convert(env) -> None:

@@ -79,3 +79,11 @@ def test_the_command_says_how_many_values_it_projected(tmp_path, capsys, suffix)
     assert main(["env", "spectralize", str(pano), "--model", "default", "-o", str(out)]) == 0
     printed = capsys.readouterr().out
     assert "projected 29 negative band values in 8 pixels (most negative -285.3)" in printed
+    # and its preview, the line docs/spectral-environments.md quotes
+    assert main(["env", "preview", str(out), "-o", str(tmp_path / "v.png")]) == 0
+    printed = capsys.readouterr().out
+    quoted = (
+        "1024×512 sRGB preview of a 1024×512 spectral image (box filter 1×1, exposure -0.69 EV, "
+        "3.5 % of values clipped)"
+    )
+    assert quoted in printed
