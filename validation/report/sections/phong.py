@@ -352,7 +352,11 @@ def _pareto_figure(data: SectionData):
     study = data.arrays["study"]
     scenes, views = study.scenes, study.views
     fig, axes = plt.subplots(
-        len(views), len(scenes), figsize=(4.2 * len(scenes), 3.6 * len(views)), squeeze=False
+        len(views),
+        len(scenes),
+        figsize=(3.6 * len(scenes) + 1.6, 3.2 * len(views)),
+        squeeze=False,
+        layout="constrained",  # no label runs into the next panel's title
     )
     names = [v.name for v in table_variants()]
     markers = dict(zip(names, itertools.cycle(MARKERS), strict=False))
@@ -376,11 +380,15 @@ def _pareto_figure(data: SectionData):
             ax.set_xscale("log")
             ax.set_yscale("log")
             ax.set_title(f"{scene} {view}")
-            ax.set_xlabel("shading time incl. build (s); dotted: exact")
+            ax.set_xlabel("shading time incl. build (s)")
             ax.set_ylabel("RMS (8-bit)")
     handles = [plt.Line2D([], [], marker=markers[n], ls="", c="k", label=n) for n in names]
     handles += [plt.Line2D([], [], marker="o", ls="", c=c, label=i) for i, c in colours.items()]
-    axes[0][0].legend(handles=handles, fontsize=7)
+    handles += [
+        plt.Line2D([], [], c="k", lw=0.8, label="Pareto front"),
+        plt.Line2D([], [], c="grey", ls=":", lw=0.8, label="exact shading"),
+    ]
+    fig.legend(handles=handles, loc="outside right center", fontsize=8)  # beside, not on, the data
     return fig
 
 
