@@ -42,7 +42,6 @@ Fritsch, F. N., & Carlson, R. E. (1980). Monotone piecewise cubic interpolation.
 from __future__ import annotations
 
 import csv
-import io
 import itertools
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -52,16 +51,19 @@ from scipy.interpolate import RegularGridInterpolator
 
 from reference.colour.spectra import DEFAULT_GRID, SpectralGrid
 from reference.errors import SpecrefError, require
-from reference.files import write_text_atomic
+from reference.files import atomic_write
 from shrm.polymer.kubelka_munk import PolymerConstituents, polymer_K_S, slab_measured
 
 __all__ = [
     "DEFAULT_THICKNESS_MM",
     "DEFAULT_TIO2_PCT",
+    "HARD_MAX_CHIPS",
     "HERBERT_THICKNESS_MM",
+    "MAX_CHIPS",
     "MEASUREMENTS",
     "Characterization",
     "characterize_model",
+    "check_chip_count",
     "read_characterization",
     "write_characterization",
 ]
@@ -75,6 +77,13 @@ DEFAULT_THICKNESS_MM = (0.381, 0.762, 1.143, 1.524, 2.286, 3.048, 4.572)
 DEFAULT_TIO2_PCT = (0.0, 0.02, 0.05, 0.1, 0.2, 0.35, 0.5, 0.75, 1.0, 1.5, 2.0)
 #: The three measurements of each chip, in file order.
 MEASUREMENTS = ("over_black", "over_white", "transmittance")
+#: Chips (thicknesses × loads) a characterization makes without being asked twice (``--yes``);
+#: the default grid has 77, a finely sampled one a few thousand.
+MAX_CHIPS = 10_000
+#: Chips it makes at all: about 1.7 GB of CSV on the 41-band grid.
+HARD_MAX_CHIPS = 1_000_000
+#: Bytes of CSV per written value (``%.10g`` and a comma), measured on the default model.
+_CSV_BYTES_PER_VALUE = 14
 _MAGIC = "# specref polymer characterization, version 1"
 
 
@@ -230,7 +239,35 @@ def _axis(values, name: str, where: str) -> np.ndarray:
     return axis
 
 
-def write_characterization(path, ch: Characterization) -> Path:
+def check_chip_count(n_thickness: int, n_tio2: int, n_bands: int, large: bool = False) -> int:
+    """The number of chips of a grid, refused above :data:`MAX_CHIPS` (or :data:`HARD_MAX_CHIPS`).
+
+    Checked before any work, with the estimated size of the file in the message.
+
+    Examples
+    --------
+    >>> check_chip_count(7, 11, 41)
+    77
+    >>> check_chip_count(2000, 300, 41)
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: grid: 600,000 chips (2,000 thicknesses × 300 TiO2 loads ×
+    41 bands, about 1.0 GB of CSV); at most 10,000 without --yes, 1,000,000 with it
+    """
+    chips = n_thickness * n_tio2
+    limit = HARD_MAX_CHIPS if large else MAX_CHIPS
+    size = chips * len(MEASUREMENTS) * n_bands * _CSV_BYTES_PER_VALUE
+    shown = f"{size / 1e9:.1f} GB" if size >= 1e9 else f"{size / 1e6:.0f} MB"
+    require(
+        chips <= limit,
+        f"grid: {chips:,} chips ({n_thickness:,} thicknesses × {n_tio2:,} TiO2 loads × "
+        f"{n_bands} bands, about {shown} of CSV); at most {limit:,}"
+        + ("" if large else f" without --yes, {HARD_MAX_CHIPS:,} with it"),
+    )
+    return chips
+
+
+def write_characterization(path, ch: Characterization, progress=None) -> Path:
     """Write a characterization file (atomically).
 
     Parameters
@@ -238,6 +275,8 @@ def write_characterization(path, ch: Characterization) -> Path:
     path : str or Path
         The ``.csv`` to write.
     ch : Characterization
+    progress : file-like, optional
+        Where a progress line goes (the command line's stderr).
 
     Returns
     -------
@@ -251,20 +290,26 @@ def write_characterization(path, ch: Characterization) -> Path:
     >>> read_characterization(write_characterization(path, ch)).over_black.shape
     (2, 2, 41)
     """
-    out = io.StringIO()
-    out.write(_MAGIC + "\n")
-    for key, value in ch.meta.items():
-        out.write(f"# {key}: {value}\n")
-    writer = csv.writer(out, lineterminator="\n")
-    writer.writerow(
-        ["thickness_mm", "tio2_pct", "measurement", *(f"{w:g}" for w in ch.wavelengths_nm)]
-    )
-    for i, d in enumerate(ch.thickness_mm):
-        for j, c in enumerate(ch.tio2_pct):
-            for name in MEASUREMENTS:
-                values = getattr(ch, name)[i, j]
-                writer.writerow([f"{d:g}", f"{c:g}", name, *(f"{v:.10g}" for v in values)])
-    return write_text_atomic(path, out.getvalue())
+    from reference.progress import Progress
+
+    # streamed into the temporary file (a large grid's CSV is never one string in memory)
+    with atomic_write(path, "w") as out:
+        out.write(_MAGIC + "\n")
+        for key, value in ch.meta.items():
+            out.write(f"# {key}: {value}\n")
+        writer = csv.writer(out, lineterminator="\n")
+        writer.writerow(
+            ["thickness_mm", "tio2_pct", "measurement", *(f"{w:g}" for w in ch.wavelengths_nm)]
+        )
+        desc = f"writing {Path(path).name}"
+        with Progress(desc, ch.thickness_mm.size, progress, unit="thicknesses") as bar:
+            for i, d in enumerate(ch.thickness_mm):
+                for j, c in enumerate(ch.tio2_pct):
+                    for name in MEASUREMENTS:
+                        values = getattr(ch, name)[i, j]
+                        writer.writerow([f"{d:g}", f"{c:g}", name, *(f"{v:.10g}" for v in values)])
+                bar.update(1)
+    return Path(path)
 
 
 def _float(cell: str, where: str) -> float:

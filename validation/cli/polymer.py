@@ -15,18 +15,22 @@ def _numbers(text: str, name: str) -> list[float]:
 
 
 def _cmd_polymer_characterize(args) -> int:
+    import sys
+
     from reference.colour.spectra import GRIDS
-    from shrm.polymer.characterization import characterize_model, write_characterization
+    from shrm.polymer.characterization import (
+        characterize_model,
+        check_chip_count,
+        write_characterization,
+    )
     from shrm.polymer.kubelka_munk import polymer_constituents
 
+    thickness, tio2 = _numbers(args.thickness, "thickness"), _numbers(args.tio2, "tio2")
+    # the grid's size before any work (docs/bad-input.md, bounded work)
+    check_chip_count(len(thickness), len(tio2), GRIDS[args.grid].n_bands, args.yes)
     constituents = polymer_constituents(GRIDS[args.grid], args.constituents)
-    ch = characterize_model(
-        constituents,
-        _numbers(args.thickness, "thickness"),
-        _numbers(args.tio2, "tio2"),
-        args.backing_white,
-    )
-    write_characterization(args.out, ch)
+    ch = characterize_model(constituents, thickness, tio2, args.backing_white)
+    write_characterization(args.out, ch, progress=sys.stderr)
     print(
         f"wrote {args.out}: {ch.meta['material']}, {ch.thickness_mm.size} thicknesses x "
         f"{ch.tio2_pct.size} TiO2 loads x {ch.wavelengths_nm.size} bands"
@@ -65,4 +69,9 @@ def add_parser(sub) -> None:
     )
     q.add_argument("--backing-white", type=float, default=0.9, help="white backing reflectance")
     q.add_argument("--grid", choices=sorted(GRIDS), default="41", help="spectral grid")
+    q.add_argument(
+        "--yes",
+        action="store_true",
+        help="make a grid of more than 10,000 chips (at most 1,000,000)",
+    )
     q.set_defaults(func=_cmd_polymer_characterize)

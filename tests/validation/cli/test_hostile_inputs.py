@@ -132,6 +132,25 @@ def test_a_sweep_grid_beyond_its_bound_is_refused_before_any_cell(tmp_path, caps
     assert not out.exists()
 
 
+def test_a_characterization_grid_beyond_its_bound_is_refused_before_any_chip(tmp_path, capsys):
+    # 200 thicknesses × 60 loads asks for --yes; 1,000 × 1,001 is refused even with it; the
+    # message gives the count, its factors and the file's size, and nothing is written
+    def axis(n: int, start: float) -> str:
+        return ",".join(f"{start + 0.001 * i:.3f}" for i in range(n))
+
+    out = tmp_path / "c.csv"
+    command = ["polymer", "characterize", "-o", str(out), "--thickness", axis(200, 0.1)]
+    assert main([*command, "--tio2", axis(60, 0.0)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert "grid: 12,000 chips (200 thicknesses × 60 TiO2 loads × 41 bands, about 21 MB" in err
+    assert "at most 10,000 without --yes, 1,000,000 with it" in err
+    command = ["polymer", "characterize", "-o", str(out), "--thickness", axis(1000, 0.1)]
+    assert main([*command, "--tio2", axis(1001, 0.0), "--yes"]) == 2
+    assert "grid: 1,001,000 chips" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize("command", [["render", "{}.toml", "-o", "x.png"], ["sweep", "{}.toml"],
                                      ["compare", "{}.exr", "{}.exr"]])  # fmt: skip
 def test_an_input_name_too_long_for_the_file_system_is_one_line(command, tmp_path, capsys):
