@@ -11,6 +11,8 @@ from __future__ import annotations
 import contextlib
 import errno
 import os
+import re
+import shutil
 import tempfile
 from pathlib import Path
 
@@ -28,7 +30,9 @@ __all__ = [
     "folder_lock",
     "output_error",
     "read_json",
+    "remove_stale_temporaries",
     "same_file",
+    "temporary_prefix",
     "write_bytes_atomic",
     "write_text_atomic",
 ]
@@ -97,6 +101,87 @@ def _write_errors(path):
         raise translated from None
 
 
+#: Marks specref's temporary files and folders: ``.<name>.specref-<pid>.<8 random><suffix>``.
+_TEMP_MARK = "specref-"
+_TEMP_PATTERN = re.compile(r"specref-(\d+)\.[A-Za-z0-9_]{8}")
+#: Bytes a temporary name adds to the file's own: ".", ".specref-", a pid of up to 7 digits,
+#: ".", 8 random characters and a suffix of up to 6 (".probe").
+_TEMP_EXTRA = 1 + len(_TEMP_MARK) + 1 + 7 + 1 + 8 + 6
+
+
+def temporary_prefix(path) -> str:
+    """How a temporary file or folder beside ``path`` starts: ``.<name>.specref-<pid>.``.
+
+    ``tempfile.mkstemp`` and ``mkdtemp`` add 8 random characters and a suffix. The process id
+    lets a later write to the same path remove what a killed process left
+    (:func:`remove_stale_temporaries`).
+
+    Examples
+    --------
+    >>> temporary_prefix("out/a.exr") == f".a.exr.specref-{os.getpid()}."
+    True
+    """
+    return f".{Path(path).name}.{_TEMP_MARK}{os.getpid()}."
+
+
+def _alive(pid: int) -> bool:
+    """Whether a process with this id runs (on this machine)."""
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError, ValueError):
+        return pid < 2**22  # another user's process (or an id no machine gives out)
+    return True
+
+
+def remove_stale_temporaries(path) -> list[Path]:
+    """Remove the temporary files and folders beside ``path`` whose process no longer runs.
+
+    A write renames its temporary file into place or removes it, whatever exception ends it; a
+    process killed outright (SIGKILL, a crash, a power cut) cannot, so every write first removes
+    the leftovers of earlier writes to the same path: names made by :func:`temporary_prefix`
+    whose process id is not running. Files of running processes and anything else stay.
+
+    Returns
+    -------
+    list of Path
+        What was removed.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     dead = Path(d) / ".a.exr.specref-4194303.abcd1234.tmp"   # no such process
+    ...     live = Path(d) / (temporary_prefix("a.exr") + "efgh5678.tmp")
+    ...     mine = Path(d) / ".a.exr.1.bak"
+    ...     for p in (dead, live, mine):
+    ...         _ = p.write_text("x")
+    ...     [p.name for p in remove_stale_temporaries(Path(d) / "a.exr")], len(os.listdir(d))
+    (['.a.exr.specref-4194303.abcd1234.tmp'], 2)
+    """
+    path = Path(path)
+    head, removed = f".{path.name}.", []
+    try:
+        entries = list(os.scandir(path.parent))
+    except OSError:
+        return removed
+    for entry in entries:
+        name = entry.name
+        match = _TEMP_PATTERN.match(name, len(head)) if name.startswith(head) else None
+        if match is None or _alive(int(match.group(1))):
+            continue
+        with contextlib.suppress(OSError):
+            if entry.is_dir(follow_symlinks=False):
+                shutil.rmtree(entry.path)
+            else:
+                os.unlink(entry.path)
+            removed.append(Path(entry.path))
+    return removed
+
+
 def _existing_ancestor(path: Path) -> Path:
     """The nearest folder (or file) on ``path``'s way that exists."""
     parent = path.absolute().parent
@@ -122,12 +207,12 @@ def _require_file_target(path: Path) -> None:
         name_max = os.pathconf(ancestor, "PC_NAME_MAX")
     except (AttributeError, OSError, ValueError):  # no pathconf (Windows): the common limit
         name_max = 255
-    # the temporary file beside it adds a dot and a suffix of 8 random characters and ".tmp"
+    # the temporary file beside it adds _TEMP_EXTRA bytes to the name (temporary_prefix)
     sizes = [len(part.encode("utf-8", "surrogateescape")) for part in path.parts]
     require(
-        max(sizes[:-1], default=0) <= name_max and sizes[-1] + 14 <= name_max,
+        max(sizes[:-1], default=0) <= name_max and sizes[-1] + _TEMP_EXTRA <= name_max,
         f"{path}: cannot write (a name in the path is longer than the file system's "
-        f"{name_max} bytes, {name_max - 14} for the file's own name)",
+        f"{name_max} bytes, {name_max - _TEMP_EXTRA} for the file's own name)",
     )
 
 
@@ -314,7 +399,8 @@ def atomic_write(path, mode: str = "wb"):
     with _write_errors(path):
         _require_file_target(path)
         path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        remove_stale_temporaries(path)
+        fd, tmp = tempfile.mkstemp(prefix=temporary_prefix(path), suffix=".tmp", dir=path.parent)
         try:
             _new_file_permissions(tmp)
             with os.fdopen(fd, mode) as handle:
@@ -349,7 +435,8 @@ def atomic_path(path, suffix: str = ""):
     with _write_errors(path):
         _require_file_target(path)
         path.parent.mkdir(parents=True, exist_ok=True)
-        fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
+        remove_stale_temporaries(path)
+        fd, name = tempfile.mkstemp(prefix=temporary_prefix(path), suffix=suffix, dir=path.parent)
         os.close(fd)
         tmp = Path(name)
         try:
@@ -429,7 +516,10 @@ def check_output_file(path) -> Path:
     with _write_errors(path):
         _require_file_target(path)
         path.parent.mkdir(parents=True, exist_ok=True)
-        fd, probe = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".probe", dir=path.parent)
+        remove_stale_temporaries(path)
+        fd, probe = tempfile.mkstemp(
+            prefix=temporary_prefix(path), suffix=".probe", dir=path.parent
+        )
         try:
             os.write(fd, b"specref")
             os.fsync(fd)

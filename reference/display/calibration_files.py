@@ -34,7 +34,7 @@ from reference.display.cgats import write_cal, write_ti3
 from reference.display.instruments import INSTRUMENTS, ReferenceMeter
 from reference.display.spectral import SpectralDisplay
 from reference.errors import SpecrefError, require
-from reference.files import write_text_atomic
+from reference.files import remove_stale_temporaries, temporary_prefix, write_text_atomic
 
 __all__ = [
     "CalibratedDisplay",
@@ -158,7 +158,8 @@ def write_cube(path, lut, title: str = "specref calibration") -> Path:
 
     path = Path(path)
     table = colour.LUT3x1D(np.asarray(lut, dtype=np.float64).T, name=title)
-    handle, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".cube")
+    remove_stale_temporaries(path)
+    handle, tmp = tempfile.mkstemp(dir=path.parent, prefix=temporary_prefix(path), suffix=".cube")
     os.close(handle)
     try:
         colour.io.write_LUT(table, tmp)

@@ -37,7 +37,12 @@ from pathlib import Path
 import numpy as np
 
 from reference.errors import SpecrefError, format_allowed, require, require_positive_int
-from reference.files import check_output_store, output_error
+from reference.files import (
+    check_output_store,
+    output_error,
+    remove_stale_temporaries,
+    temporary_prefix,
+)
 from reference.geometry.cubemap import latlong_blocks_to_cubemap
 from reference.images.formats import channel_wavelengths_nm
 
@@ -207,13 +212,14 @@ def _atomic_folder(path: Path):
     path = check_output_store(path)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.", dir=path.parent))
+        remove_stale_temporaries(path)
+        tmp = Path(tempfile.mkdtemp(prefix=temporary_prefix(path), dir=path.parent))
     except OSError as exc:
         raise (output_error(path, exc) or SpecrefError(f"{path}: cannot write ({exc})")) from None
     try:
         yield tmp
         if path.exists():  # replace an old store: move it aside, move the new one in, drop it
-            old = Path(tempfile.mkdtemp(prefix=f".{path.name}.old.", dir=path.parent))
+            old = Path(tempfile.mkdtemp(prefix=temporary_prefix(path), dir=path.parent))
             os.replace(path, old / "store")
             os.replace(tmp, path)
             shutil.rmtree(old, ignore_errors=True)

@@ -81,15 +81,30 @@ def _warning_line(message, category, filename, lineno, line=None) -> str:
 _FORMAT_WARNING = warnings.formatwarning
 
 
+def _terminated(signum, _frame):
+    """SIGTERM or SIGHUP: unwind as an exception, so every output's temporary file is removed."""
+    raise SystemExit(128 + signum)
+
+
 def run() -> int:
     r"""The ``specref`` console command: :func:`main`, its warnings printed as one line each.
+
+    A SIGTERM or SIGHUP (``kill``, a closed terminal, a CI timeout) ends the command as an
+    exception does, so the temporary file of an output being written is removed (exit code
+    128 + the signal's number), as after Ctrl-C; what a SIGKILL leaves, the next write to the same
+    path removes (``reference.files.remove_stale_temporaries``).
 
     Examples
     --------
     >>> _warning_line("a.txt: ignored", SpecrefWarning, "cache.py", 3)
     'specref: warning: a.txt: ignored\n'
     """
+    import signal
+
     warnings.formatwarning = _warning_line
+    for name in ("SIGTERM", "SIGHUP"):
+        if hasattr(signal, name):
+            signal.signal(getattr(signal, name), _terminated)
     return main()
 
 
