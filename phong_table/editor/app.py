@@ -568,13 +568,20 @@ def _page_maker(path, view, resolution, save_dir):
 
 
 def serve_editor(
-    path=None, port: int = 5006, announce=None, view="far", resolution=256, save_dir=None
+    path=None,
+    port: int = 5006,
+    announce=None,
+    view="far",
+    resolution=256,
+    save_dir=None,
+    idle_seconds: float = UNUSED_SESSION_S,
 ) -> None:
     """Serve the editor on ``http://127.0.0.1:PORT/`` until interrupted; ``announce(url line)``.
 
     ``port`` 0 takes a free port; the announced line names the port listened on. The kernels
     are loaded before the line is announced. ``save_dir`` is the one folder saves go to
-    (default: the folder of ``path``, else the current folder).
+    (default: the folder of ``path``, else the current folder); a page whose tab has gone is
+    closed after ``idle_seconds``.
 
     Raises
     ------
@@ -614,8 +621,8 @@ def serve_editor(
         {"/": Application(FunctionHandler(_page_maker(path, view, resolution, save_dir)))},
         extra_websocket_origins=[f"127.0.0.1:{port}", f"localhost:{port}"],
         auth_provider=_loopback_hosts(port),
-        check_unused_sessions_milliseconds=1000,
-        unused_session_lifetime_milliseconds=UNUSED_SESSION_S * 1000,
+        check_unused_sessions_milliseconds=int(min(1000, 500 * idle_seconds)),
+        unused_session_lifetime_milliseconds=int(idle_seconds * 1000),
     )
     http = HTTPServer(app)
     http.add_sockets(sockets)

@@ -37,16 +37,18 @@ def free_port() -> int:
 
 
 @contextlib.contextmanager
-def editor_server(path=None, port: int | None = None, timeout: float = 60.0, save_dir=None):
+def editor_server(path=None, port: int | None = None, timeout: float = 60.0, **options):
     """Run ``python -m phong_table.editor`` as a child; yield ``(url, process)``; stop it by pid.
 
-    ``port`` None takes a free port (the server's own choice, port 0, read from its first line).
+    ``port`` None takes a free port (the server's own choice, port 0, read from its first line);
+    ``options`` are that command's (``save_dir``, ``resolution``, ``idle_seconds``).
     """
     port = 0 if port is None else port
     command = [sys.executable, "-m", "phong_table.editor"]
     command += [] if path is None else [str(path)]
     command += ["--port", str(port)]
-    command += [] if save_dir is None else ["--save-dir", str(save_dir)]
+    for key, value in options.items():
+        command += [f"--{key.replace('_', '-')}", str(value)]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         line = process.stdout.readline()  # the URL, once the server listens

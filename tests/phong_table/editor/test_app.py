@@ -8,13 +8,14 @@ stopped by its process id.
 
 import http.client
 import os
+import threading
 import time
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from phong_table.editor.app import MAX_SESSIONS, UNUSED_SESSION_S, EditorPage
+from phong_table.editor.app import MAX_SESSIONS, EditorPage
 from phong_table.editor.state import EditorState, render_exact_frame, render_table_frame
 
 RES = 16
@@ -150,6 +151,41 @@ def test_preset_menus_name_their_curve(page):
     assert page.sources["light"][1].data["x"].size == 81  # FL2's own 5 nm samples
 
 
+def test_at_most_max_sessions_pages_are_served_and_a_closed_one_frees_its_place(tmp_path):
+    from bokeh.document import Document
+    from bokeh.models import Div
+
+    from phong_table.editor.app import _page_maker
+
+    make = _page_maker(None, "far", RES, tmp_path)
+    docs = [Document() for _ in range(MAX_SESSIONS + 2)]
+    for doc in docs:
+        make(doc)
+
+    def refused(doc):
+        roots = list(doc.roots)
+        return len(roots) == 1 and isinstance(roots[0], Div) and "pages are open" in roots[0].text
+
+    def workers():
+        return sum(t.name == "editor-worker" and t.is_alive() for t in threading.enumerate())
+
+    assert [refused(d) for d in docs] == [False] * MAX_SESSIONS + [True, True]
+    running = workers()
+    assert running >= 2 * MAX_SESSIONS
+    for callback in list(docs[0].callbacks.session_destroyed_callbacks):
+        callback(None)  # the first page's tab is closed: its threads end, its place is free
+    end = time.monotonic() + 30
+    while workers() > running - 2 and time.monotonic() < end:
+        time.sleep(0.05)
+    assert workers() == running - 2
+    again = Document()
+    make(again)
+    assert not refused(again)
+    for doc in [*docs[1:MAX_SESSIONS], again]:
+        for callback in list(doc.callbacks.session_destroyed_callbacks):
+            callback(None)
+
+
 def _get(port, host, path="/"):
     connection = http.client.HTTPConnection("127.0.0.1", port, timeout=30)
     connection.request("GET", path, headers={"Host": host})
@@ -170,7 +206,8 @@ def _threads(pid) -> int:
 def test_the_server_serves_its_own_host_and_a_bounded_number_of_pages():
     from phong_table.editor.browser import editor_server
 
-    with editor_server() as (url, process):
+    idle = 2.0
+    with editor_server(resolution=RES, idle_seconds=idle) as (url, process):
         port = int(url.rstrip("/").rsplit(":", 1)[1])
         assert port != 0  # --port 0: the port bound, announced
         base = _threads(process.pid)
@@ -188,10 +225,9 @@ def test_the_server_serves_its_own_host_and_a_bounded_number_of_pages():
         grown = _threads(process.pid) - base
         assert grown <= 2 * MAX_SESSIONS
         # Pages whose browser never connected are closed, and their threads end.
-        end = time.monotonic() + 6 * UNUSED_SESSION_S
+        end = time.monotonic() + 30 * idle
         while _threads(process.pid) > base + 1 and time.monotonic() < end:
             time.sleep(0.25)
         assert _threads(process.pid) <= base + 1
-        print(f"\nthreads: {base} at start, +{grown} with {MAX_SESSIONS + 2} pages, then back")  # noqa: T201
         assert process.poll() is None
     assert not os.path.exists(f"/proc/{process.pid}/status") or process.poll() is not None
