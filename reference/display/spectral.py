@@ -46,6 +46,7 @@ __all__ = [
     "display_drives_to_XYZ",
     "display_drives_to_spectra",
     "load_spectral_display",
+    "primaries_from_chromaticities",
     "spectra_to_absolute_XYZ",
     "spectral_display",
     "spectral_display_from_doc",
@@ -136,6 +137,185 @@ def primaries_laser():
     532
     """
     return _gaussian_primaries((638.0, 532.0, 450.0), (1.5, 1.5, 1.5))
+
+
+#: How close a primary's stand-in spectrum must come to its stated chromaticity (CIE 1931 xy):
+#: half the last digit of a datasheet's three decimals (a primary on the spectrum locus, as
+#: BT.2020's, is reached only in the limit of a line; a 0.5 nm Gaussian comes within 3e-4).
+XY_TOLERANCE = 5e-4
+
+
+def _inside_locus(xy, w: np.ndarray) -> bool:
+    """Whether ``xy`` is inside the locus and the line of purples, or within the tolerance of it.
+
+    A datasheet's locus point, rounded to three decimals, may lie just outside.
+    """
+    from matplotlib.path import Path as Polygon
+
+    locus = cmfs_on(w)
+    locus = locus[:, :2] / locus.sum(axis=1, keepdims=True)
+    if Polygon(locus).contains_point(xy):
+        return True
+    # the distance to the closed outline, segment by segment
+    a, b = locus, np.roll(locus, -1, axis=0)
+    t = np.clip(np.einsum("ij,ij->i", xy - a, b - a) / np.einsum("ij,ij->i", b - a, b - a), 0, 1)
+    return float(np.min(np.linalg.norm(a + t[:, None] * (b - a) - xy, axis=1))) <= XY_TOLERANCE
+
+
+def _gaussian_xy(centre_nm: float, width_nm: float, w: np.ndarray) -> np.ndarray:
+    XYZ = spectra_to_absolute_XYZ(np.exp(-0.5 * ((w - centre_nm) / width_nm) ** 2), w)
+    return XYZ[:2] / XYZ.sum()
+
+
+def _gaussian_for_xy(xy, w: np.ndarray) -> tuple[np.ndarray, float]:
+    """The Gaussian whose chromaticity is nearest ``xy`` (started at the nearest hue), its miss."""
+    from scipy.optimize import least_squares
+
+    target = np.asarray(xy, dtype=np.float64)
+    locus = np.array([_gaussian_xy(c, 2.0, w) for c in w[::5]])
+    start = float(w[::5][np.argmin(np.linalg.norm(locus - target, axis=1))])
+    best = None
+    for width in (5.0, 20.0, 60.0):
+        fit = least_squares(
+            lambda p: _gaussian_xy(p[0], p[1], w) - target,
+            (start, width),
+            bounds=((w[0], 0.5), (w[-1], 150.0)),
+            xtol=1e-12,
+            ftol=1e-12,
+        )
+        if best is None or fit.cost < best.cost:
+            best = fit
+    centre, width = best.x
+    return np.exp(-0.5 * ((w - centre) / width) ** 2), float(np.linalg.norm(best.fun))
+
+
+def _smooth_for_xy(xy, w: np.ndarray) -> tuple[np.ndarray, float]:
+    """The smoothest non-negative spectrum of chromaticity ``xy`` (Meng et al. 2015), its miss."""
+    import warnings
+
+    import colour
+
+    shape = colour.SpectralShape(float(w[0]), float(w[-1]), 5.0)
+    cmfs = colour.MSDS_CMFS[CMFS_NAME].copy().align(shape)
+    target = np.asarray(xy, dtype=np.float64)
+    aim, spectrum, miss = target.copy(), np.zeros_like(w), np.inf
+    Y = 0.05  # dark enough that the object colours reach saturated chromaticities
+    for _ in range(3):  # solved at 5 nm, read at 1 nm: aim off by what the 1 nm grid shows
+        x, y = aim
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                sd = colour.XYZ_to_sd(
+                    np.array([x / y * Y, Y, (1 - x - y) / y * Y]),
+                    method="Meng 2015",
+                    cmfs=cmfs,
+                    illuminant=colour.sd_constant(1.0, shape),
+                )
+        except RuntimeError:  # no spectrum in [0, 1] of that colour at that luminance
+            break
+        spectrum = np.clip(np.interp(w, sd.wavelengths, sd.values), 0.0, None)
+        XYZ = spectra_to_absolute_XYZ(spectrum, w)
+        error = XYZ[:2] / XYZ.sum() - target
+        miss = float(np.linalg.norm(error))
+        if miss <= XY_TOLERANCE:
+            break
+        aim = aim - error
+    return spectrum, miss
+
+
+def _primary_for_xy(xy, w: np.ndarray, where: str) -> np.ndarray:
+    """A Gaussian where one has the colour, else Meng et al.'s smoothest spectrum (E109)."""
+    require(
+        _inside_locus(xy, w),
+        f"{where}: chromaticity ({xy[0]:g}, {xy[1]:g}) is outside the spectrum locus: no light "
+        "has that colour",
+    )
+    spectrum, miss = _gaussian_for_xy(xy, w)
+    if miss > XY_TOLERANCE:
+        smooth, smooth_miss = _smooth_for_xy(xy, w)
+        spectrum, miss = (smooth, smooth_miss) if smooth_miss < miss else (spectrum, miss)
+    require(
+        miss <= XY_TOLERANCE,
+        f"{where}: chromaticity ({xy[0]:g}, {xy[1]:g}) is not the colour of a Gaussian nor of "
+        f"a smooth spectrum (closest Δxy {miss:.2g}: on or outside the spectrum locus); give "
+        "the primary's spectrum (wavelengths_nm, R, G, B) instead",
+    )
+    return spectrum
+
+
+def primaries_from_chromaticities(xy, white_xy=(0.3127, 0.3290), where: str = "primaries"):
+    """Spectral stand-ins for primaries given by chromaticities (erratum E109).
+
+    A display known by its datasheet (the xy of R, G, B and of the white) has no spectra, but
+    specref's displays and instruments are spectral. Each primary becomes, on a 1 nm grid, the
+    Gaussian whose CIE 1931 chromaticity is the stated one (a display-like band; it reaches the
+    spectrum locus as it narrows), or where no Gaussian has that colour (towards the purples:
+    sRGB's red) the smoothest non-negative spectrum that does (Meng et al. 2015, through
+    colour-science), each within :data:`XY_TOLERANCE`. The three are weighted so that full drive
+    gives the white's chromaticity: ``S = M⁻¹ XYZ_w`` of the usual RGB-to-XYZ derivation (``M``:
+    the primaries' XYZ at Y = 1).
+
+    Parameters
+    ----------
+    xy : (3, 2) array_like
+        R, G, B chromaticities.
+    white_xy : (2,) array_like
+        The white's chromaticity (default D65).
+    where : str
+        What a refusal names (the file and key).
+
+    Returns
+    -------
+    (ndarray (401,), ndarray (3, 401))
+        Wavelengths (nm) and spectra, relative (the display scales them to its white).
+
+    Raises
+    ------
+    SpecrefError
+        A chromaticity no Gaussian reaches, or a white outside the primaries' triangle.
+
+    Examples
+    --------
+    >>> w, spectra = primaries_from_chromaticities([[0.64, 0.33], [0.30, 0.60], [0.15, 0.06]])
+    >>> XYZ = spectra_to_absolute_XYZ(spectra, w)
+    >>> (XYZ[:, :2] / XYZ.sum(axis=1, keepdims=True)).round(4).tolist()
+    [[0.64, 0.33], [0.3, 0.6], [0.15, 0.06]]
+    >>> white = XYZ.sum(axis=0)
+    >>> (white[:2] / white.sum()).round(4).tolist()
+    [0.3127, 0.329]
+    """
+    xy = require_finite(xy, where)
+    white = require_finite(white_xy, f"{where}: white")
+    require(xy.shape == (3, 2), f"{where}: must be three [x, y] pairs (R, G, B), got {xy.shape}")
+    require(white.shape == (2,), f"{where}: white: must be one [x, y] pair, got {white.shape}")
+    for label, (x, y) in zip("RGBW", [*xy, white], strict=True):
+        require(
+            0 < x < 1 and 0 < y < 1 and x + y <= 1,
+            f"{where}: {label}: ({x:g}, {y:g}) is not a chromaticity (x, y > 0, x + y <= 1)",
+        )
+    w = np.arange(380.0, 781.0, 1.0)
+    try:
+        unit = _unit_primaries(tuple(map(tuple, xy.tolist())))
+    except SpecrefError as error:
+        raise SpecrefError(f"{where}: {error}") from None
+    # M: the primaries' XYZ at Y = 1, columns R, G, B; S = M⁻¹ XYZ_w (white at Y = 1)
+    M = np.stack([[x / y, 1.0, (1 - x - y) / y] for x, y in xy]).T
+    S = np.linalg.solve(M, [white[0] / white[1], 1.0, (1 - white.sum()) / white[1]])
+    require(
+        bool((S > 0).all()),
+        f"{where}: white ({white[0]:g}, {white[1]:g}) is outside the primaries' triangle",
+    )
+    Y_unit = spectra_to_absolute_XYZ(unit, w)[:, 1]
+    return w, unit * (S / Y_unit)[:, None]
+
+
+@lru_cache(maxsize=16)
+def _unit_primaries(xy: tuple) -> np.ndarray:
+    """The three stand-in spectra (1 nm, 380-780 nm), once per set of chromaticities."""
+    w = np.arange(380.0, 781.0, 1.0)
+    unit = np.stack([_primary_for_xy(c, w, k) for c, k in zip(xy, "RGB", strict=True)])
+    unit.flags.writeable = False  # shared by every caller of the cache
+    return unit
 
 
 #: Display primaries by the keys of display files and the CLI; ``reference()`` returns
@@ -514,6 +694,9 @@ def spectral_display_from_doc(doc: dict, where: str = "display file") -> Spectra
         display = spectral_display(primaries, **kwargs)
     else:
         require(isinstance(primaries, dict), f"{where}: primaries: must be a key or an object")
+        if "xy" in primaries:
+            display = _display_from_xy(primaries, kwargs, f"{where}: primaries")
+            return _finish_display(display, doc, where)
         w = require_finite(primaries.get("wavelengths_nm"), f"{where}: primaries.wavelengths_nm")
         require(
             w.ndim == 1 and w.size >= 3 and np.allclose(np.diff(w), w[1] - w[0]) and w[1] > w[0],
@@ -521,11 +704,30 @@ def spectral_display_from_doc(doc: dict, where: str = "display file") -> Spectra
         )
         spectra = np.stack([_spectrum(primaries, c, f"{where}: primaries", w.size) for c in "RGB"])
         display = _replace(spectral_display((w, spectra), **kwargs), name=where)
+    return _finish_display(display, doc, where)
+
+
+def _finish_display(display, doc, where) -> SpectralDisplay:
     if "ramps" in doc:
         display = _with_ramps(display, doc["ramps"], where)
     if "name" in doc:
         display = _replace(display, name=str(doc["name"]))
     return display
+
+
+def _display_from_xy(primaries: dict, kwargs: dict, where: str) -> SpectralDisplay:
+    """``primaries = {"xy": {"R": [x, y], "G": ..., "B": ...}, "white_xy": [x, y]}``."""
+    unknown = sorted(set(primaries) - {"xy", "white_xy"})
+    shown = unknown[0] if unknown else ""
+    require(not unknown, f"{where}: unknown key {shown!r}; allowed: white_xy, xy")
+    xy = primaries["xy"]
+    require(
+        isinstance(xy, dict) and sorted(xy) == ["B", "G", "R"],
+        f"{where}.xy: must be an object with R, G and B, each [x, y]",
+    )
+    white = primaries.get("white_xy", [0.3127, 0.3290])
+    spectra = primaries_from_chromaticities([xy[c] for c in "RGB"], white, f"{where}.xy")
+    return _replace(spectral_display(spectra, **kwargs), name=where.split(":")[0])
 
 
 def _replace(display, **changes):
