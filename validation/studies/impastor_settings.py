@@ -6,6 +6,11 @@
 measures each against the brute force (:func:`impastor.settings.painting_brute_force`) on pixels
 of the frame itself: the pilot's pixels are a coarser grid, so the promise is tested where it
 was not made. :func:`tolerance_study` runs the cases as tasks.
+
+:func:`method_speed_accuracy` charts every lighting method of the painting (median cut, variance
+minimisation, FIS, the hybrid with and without its fail-safe) and the brute force on one set of
+canvas pixels: the time of a frame's shading against its error, over the counts of lights and
+samples.
 """
 
 from __future__ import annotations
@@ -14,17 +19,22 @@ import time
 
 import numpy as np
 
+from impastor.horizon import horizon_at_texels
 from impastor.multispectral import channels_to_XYZ
 from impastor.painting import (
+    HORIZON_SECTORS,
+    PAINTING_LIGHTING_METHODS,
     cached_horizon_map,
     canvas_pixels,
     impasto_painting,
     load_paint_spectra,
     painting_scene,
     render_painting,
+    shade_canvas,
 )
 from impastor.settings import (
     FIXED_SETTINGS,
+    LIGHT_LADDER,
     PILOT_SIZE,
     PaintingPilot,
     painting_brute_force,
@@ -32,7 +42,79 @@ from impastor.settings import (
     settings_from_tolerance,
 )
 
-__all__ = ["EQUAL_ERROR", "best_speedup_at_fixed_error", "tolerance_case", "tolerance_study"]
+__all__ = [
+    "EQUAL_ERROR",
+    "best_speedup_at_fixed_error",
+    "method_speed_accuracy",
+    "tolerance_case",
+    "tolerance_study",
+]
+
+
+def _best_time(function, repeats: int) -> tuple:
+    """``function()``'s result and its best wall time over ``repeats`` calls."""
+    best, result = np.inf, None
+    for _ in range(max(1, repeats)):
+        start = time.perf_counter()
+        result = function()
+        best = min(best, time.perf_counter() - start)
+    return result, best
+
+
+def method_speed_accuracy(
+    seed: int = 61,
+    light: str = "D65",
+    size: int = PILOT_SIZE,
+    light_resolution: tuple = (128, 64),
+    counts=LIGHT_LADDER,
+    repeats: int = 3,
+    backend: str = "numba",
+) -> dict:
+    """Each lighting method's shading time against its error, and the brute force's time.
+
+    §3.5, Ferwerda: on the visible canvas pixels of a ``size``² frame of a held-out painting under
+    a booth light, every method of :data:`impastor.painting.PAINTING_LIGHTING_METHODS` shades
+    with N point lights and K FIS samples, N = K = each of ``counts`` (the hybrid with its
+    fail-safe on and off), shadows from a :data:`~impastor.painting.HORIZON_SECTORS`-sector
+    horizon; each is timed (the best of ``repeats``, the horizon look-up included) and measured
+    against :func:`impastor.settings.painting_brute_force` (relative RMS of XYZ), whose own time
+    is the baseline every method must beat.
+
+    Returns
+    -------
+    dict
+        ``pixels``, ``brute_force_seconds`` and ``rows``: per method and count ``method``,
+        ``count``, ``seconds`` and ``error``.
+
+    Examples
+    --------
+    >>> r = method_speed_accuracy(size=8, light_resolution=(16, 8), counts=(4,), repeats=1,
+    ...                           backend="numpy")
+    >>> sorted({row["method"] for row in r["rows"]})
+    ['fis', 'hybrid', 'hybrid, no fail-safe', 'median_cut', 'variance_min']
+    """
+    painting = impasto_painting(max(size, 16), seed=seed)
+    px = canvas_pixels(painting, size)
+    horizon = horizon_at_texels(
+        painting["height"], painting["pixel_size"], px.row, px.col, HORIZON_SECTORS, 32, backend
+    )
+    reference_scene = painting_scene(light, "hybrid", painting, light_resolution=light_resolution)
+    truth, brute_seconds = _best_time(lambda: painting_brute_force(reference_scene, px, backend), 1)
+    reference = channels_to_XYZ(truth, reference_scene.design)
+    variants = [(m, m, m == "hybrid") for m in PAINTING_LIGHTING_METHODS.names()]
+    variants.append(("hybrid, no fail-safe", "hybrid", False))
+    rows = []
+    for label, method, failsafe in variants:
+        scene = painting_scene(light, method, painting, light_resolution=light_resolution)
+        for count in counts:
+            settings = {"n_lights": count, "n_samples": count, "failsafe": failsafe}
+            (L, _), seconds = _best_time(
+                lambda s=settings, sc=scene: shade_canvas(sc, px, s, lambda: horizon, backend),
+                repeats,
+            )
+            error = relative_rms_error(channels_to_XYZ(L, scene.design), reference)
+            rows.append({"method": label, "count": int(count), "seconds": seconds, "error": error})
+    return {"pixels": int(px.P.shape[0]), "brute_force_seconds": brute_seconds, "rows": rows}
 
 
 def _frames(scene, light, size, chosen: list, spectra, repeats, backend):

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from impastor.settings import PILOT_SIZE
 from validation.report import (
     Check,
     Headline,
@@ -27,6 +28,7 @@ from validation.report import (
 from validation.studies.impastor_settings import (
     EQUAL_ERROR,
     best_speedup_at_fixed_error,
+    method_speed_accuracy,
     tolerance_study,
 )
 
@@ -97,11 +99,16 @@ def settings_figures(ctx: ReportContext | None = None, study: SettingsStudy | No
     )  # fmt: skip
     for case in cases:
         case["speedup_at_fixed_error"] = best_speedup_at_fixed_error(case)
+    seed, light = study.cases[0]
+    methods = method_speed_accuracy(
+        seed, light, min(PILOT_SIZE, study.size), study.light_resolution,
+        repeats=study.repeats, backend=study.backend,
+    )  # fmt: skip
     settings = {
         "size": study.size, "light_resolution": list(study.light_resolution),
         "tolerances": list(study.tolerances), "eval_pixels": study.eval_pixels,
     }  # fmt: skip
-    return SectionData({"cases": cases, "study": settings})
+    return SectionData({"cases": cases, "study": settings, "methods": methods})
 
 
 def _figure(cases: list):
@@ -129,6 +136,44 @@ def _figure(cases: list):
     ax.legend(fontsize=7)
     fig.tight_layout()
     return fig
+
+
+def _methods_figure(methods: dict):
+    """Each lighting method's shading time per pixel against its error, brute force beside."""
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
+    per_pixel = 1e3 / methods["pixels"]
+    labels = list(dict.fromkeys(r["method"] for r in methods["rows"]))
+    for k, label in enumerate(labels):
+        rows = [r for r in methods["rows"] if r["method"] == label]
+        x = [per_pixel * r["seconds"] for r in rows]
+        y = [100 * r["error"] for r in rows]
+        ax.plot(x, y, "o-", color=f"C{k}", label=label)
+    brute = per_pixel * methods["brute_force_seconds"]
+    ax.axvline(brute, color="k", ls="--", lw=0.8, label="brute force (the reference)")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    counts = ", ".join(str(r["count"]) for r in methods["rows"] if r["method"] == labels[0])
+    ax.set_xlabel(f"shading time per pixel (ms); each line N = K = {counts}, left to right")
+    ax.set_ylabel("relative RMS error of XYZ (%)")
+    fig.legend(fontsize=7, loc="outside right center")
+    return fig
+
+
+def _methods_caption(methods: dict) -> str:
+    """The chart's conclusion, from its own rows: the fail-safe's price at N = K = 32."""
+    at = {r["method"]: r for r in methods["rows"] if r["count"] == 32}
+    if "hybrid" not in at or "hybrid, no fail-safe" not in at:
+        return "Shading time against error for each lighting method, brute force dashed"
+    on, off = at["hybrid"], at["hybrid, no fail-safe"]
+    brute, price = methods["brute_force_seconds"], on["seconds"] / off["seconds"]
+    return (
+        f"At the paper's N = K = 32 the hybrid's fail-safe costs {price:.1f}× "
+        f"the hybrid's time for {100 * on['error']:.2g} % error against {100 * off['error']:.2g} % "
+        f"without it; brute force is {brute / on['seconds']:.0f}× slower than the hybrid with it, "
+        f"{brute / off['seconds']:.0f}× without (time per pixel, log-log; brute force dashed)"
+    )
 
 
 def _rows(cases: list) -> list:
@@ -169,6 +214,7 @@ def present(ctx: ReportContext, data: SectionData) -> list:
             "Frame error against frame time: the settings each tolerance chooses (joined) and "
             "the fixed settings (stars)",
         ),
+        *_methods_blocks(ctx, data.results["methods"]),
         Table(
             [
                 "case",
@@ -184,6 +230,31 @@ def present(ctx: ReportContext, data: SectionData) -> list:
             ],
             _rows(cases),
             "Settings chosen per tolerance on held-out paintings, their errors and frame times",
+            "{:.3g}",
+        ),
+    ]
+
+
+def _methods_blocks(ctx: ReportContext, methods: dict) -> list:
+    rows = [
+        [r["method"], r["count"], 1e3 * r["seconds"] / methods["pixels"], 100 * r["error"]]
+        for r in methods["rows"]
+    ]
+    rows.append(["brute force", "every light pixel", 1e3 * methods["brute_force_seconds"] /
+                 methods["pixels"], 0.0])  # fmt: skip
+    return [
+        Text(
+            "Speed against accuracy of every lighting method (§3.5, Ferwerda): on the "
+            f"{methods['pixels']} visible canvas pixels of the first painting's pilot frame, each "
+            "method shades with N point lights and K FIS samples (N = K), shadows from the "
+            "36-sector horizon, timed (best of the repeats, the horizon look-up included) and "
+            "measured against the brute force above."
+        ),
+        ctx.figure("methods", _methods_figure(methods), _methods_caption(methods)),
+        Table(
+            ["method", "N = K", "ms per pixel", "error (%)"],
+            rows,
+            "Each lighting method's shading time and error on the pilot frame's pixels",
             "{:.3g}",
         ),
     ]

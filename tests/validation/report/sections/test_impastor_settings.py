@@ -55,4 +55,13 @@ def test_tiny_study_presents_a_chart_and_a_table(tmp_path):
     assert case["rows"][0]["settings"]["n_lights"] == 32
     blocks = present(ReportContext(tmp_path, section="impastor-settings"), data)
     assert (tmp_path / "images" / "impastor-settings-time-vs-error.png").exists()
-    assert len(blocks[2].rows) == 2
+    tables = {b.caption.split(" ")[0]: b for b in blocks if hasattr(b, "rows")}
+    assert len(tables["Settings"].rows) == 2
+    # every lighting method's time against its error, and the brute force they are measured on
+    assert (tmp_path / "images" / "impastor-settings-methods.png").exists()
+    methods = tables["Each"].rows
+    names = [row[0] for row in methods]
+    assert {"median_cut", "variance_min", "fis", "hybrid", "hybrid, no fail-safe"} <= set(names)
+    assert names[-1] == "brute force"
+    assert all(row[2] > 0 for row in methods)  # times measured
+    assert all(row[3] > 0 for row in methods[:-1])  # errors against the brute force
