@@ -46,7 +46,9 @@ def add_parser(sub) -> None:
         "the settings its checks need (the full-resolution studies and long sweeps at their "
         "quick settings: --full runs them in full). index.html is rewritten after every "
         "section, so a stopped run leaves a readable page. Measured on a shared two-core "
-        "machine: 1 min 55 s with the default two processes (3 min 26 s of CPU); --full "
+        "machine: 1 min 55 s – 2 min 32 s with the default two processes (3 min 26 s – 4 min "
+        "31 s of CPU, the later run with the editor's screenshot and every ImpastoR lighting "
+        "method timed); --full "
         "54 min alone, 1 h 48 min beside other work.",
     )
     p.add_argument("--out", default="report", help="output folder (default: report)")
