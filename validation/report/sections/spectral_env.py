@@ -403,7 +403,23 @@ def _degree_chart(ctx: ReportContext, data: SectionData) -> list:
     ax.set_xlabel("degree")
     ax.set_ylabel("held-out ColorChecker mean ΔE94 (D65)")
     ax.legend(fontsize=7)
-    blocks.append(ctx.figure("degree", fig, "Error against degree, with and without noise"))
+    rows = data.results["regression"]
+    clean = min((r for r in rows if not r["noise"]), key=lambda r: r["held_out"][CC]["D65 mean"])
+    noisy = min((r for r in rows if r["noise"]), key=lambda r: r["held_out"][CC]["D65 mean"],
+                default=None)  # fmt: skip
+    caption = (
+        f"Held-out error against degree: the best without noise is {clean['features']} "
+        f"degree {clean['degree']} ({clean['held_out'][CC]['D65 mean']:.2f} ΔE94)"
+    )
+    if noisy is not None:
+        caption += (
+            f"; with camera noise {noisy['features']} degree {noisy['degree']} "
+            f"({noisy['held_out'][CC]['D65 mean']:.2f}): higher degrees fit the noise"
+            if noisy["degree"] < clean["degree"]
+            else f"; with camera noise {noisy['features']} degree {noisy['degree']} "
+            f"({noisy['held_out'][CC]['D65 mean']:.2f})"
+        )
+    blocks.append(ctx.figure("degree", fig, caption))
     return blocks
 
 
