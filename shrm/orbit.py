@@ -130,7 +130,10 @@ def _parse_isotropic_brdf(reader, table: dict, key: str, name: str):
     for p, default in defaults.items():
         if p in table:
             where = f"{key}.{p}"
-            spectral = np.ndim(default) == 1
+            # a spectral default takes a spectrum (or a number); a scalar one a number, or a
+            # spectrum table where the BRDF takes one per band (GGX's F_0 of a fitted paint:
+            # under environment light each band then has its own SHRM)
+            spectral = np.ndim(default) == 1 or (isinstance(table[p], dict) and p != "alpha")
             params[p] = (
                 reader.spectrum_on_grid(table[p], where)
                 if spectral
