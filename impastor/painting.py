@@ -548,6 +548,9 @@ def lights_visibility(horizon: np.ndarray, P: np.ndarray, lights) -> np.ndarray:
 def canvas_materials(painting: dict, spectra: dict, d, px: _CanvasPixels):
     """Six-channel materials per pixel: ρ_d from the measured spectra, ρ_s and α from the maps.
 
+    A painting read from files (:func:`impastor.painting_files.read_painting`) has a reflectance
+    spectrum per texel instead of the demo's paint indices.
+
     Returns ``rho_d`` (n, 6), ``rho_s`` (n, 1) and the Ward–Dür ``alpha`` (n,) at the pixels'
     texels.
 
@@ -560,12 +563,15 @@ def canvas_materials(painting: dict, spectra: dict, d, px: _CanvasPixels):
     >>> rho_d.shape[1], bool((alpha > 0).all())
     (6, True)
     """
-    names = list(PAINT_SPECTRA)
-    R6 = spectra_to_channels(np.stack([spectra[n] for n in names]), d)
-    canvas = spectra_to_channels(spectra.get("office-paper", np.full(81, 0.85)), d)
-    table = np.concatenate([R6, canvas[None]])
-    material = painting["material"][px.row, px.col]
-    rho_d = table[np.where(material < 0, len(names), material)]
+    if "reflectance" in painting:  # a painting read from files: a spectrum per texel
+        rho_d = spectra_to_channels(painting["reflectance"][px.row, px.col], d)
+    else:
+        names = list(PAINT_SPECTRA)
+        R6 = spectra_to_channels(np.stack([spectra[n] for n in names]), d)
+        canvas = spectra_to_channels(spectra.get("office-paper", np.full(81, 0.85)), d)
+        table = np.concatenate([R6, canvas[None]])
+        material = painting["material"][px.row, px.col]
+        rho_d = table[np.where(material < 0, len(names), material)]
     rho_s = painting["rho_s"][px.row, px.col][:, None]
     alpha = painting["alpha"][px.row, px.col]
     return rho_d, rho_s, alpha

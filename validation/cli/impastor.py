@@ -55,8 +55,22 @@ def _cmd_impastor_render(args) -> int:
             args.light_luminance,
             progress=sys.stderr,
             tolerance=args.tolerance,
+            painting=args.painting,
         )
     )
+    return 0
+
+
+def _cmd_impastor_painting(args) -> int:
+    from impastor.painting import impasto_painting
+    from impastor.painting_files import write_painting
+    from reference.errors import require_positive_int
+    from reference.files import check_output_folder
+
+    size = require_positive_int(args.size, "--size", 4096)
+    check_output_folder(args.out)  # before the painting is made
+    written = write_painting(args.out, impasto_painting(size, seed=args.seed), f"demo-{args.seed}")
+    print(f"wrote {written} and its images: the demo painting, {size}×{size}, seed {args.seed}")
     return 0
 
 
@@ -82,7 +96,20 @@ def add_parser(sub) -> None:
     )
     add_scheduler_option(t, default=SERIAL)
     t.set_defaults(func=_cmd_impastor_table1)
-    r = isub.add_parser("render", help="render the demo painting under a booth light to a PNG")
+    w = isub.add_parser(
+        "painting", help="write the demo painting as a painting folder (docs/impastor.md)"
+    )
+    w.add_argument("out", metavar="DIR", help="the folder to write (painting.toml and images)")
+    w.add_argument("--size", type=int, default=256, help="texels per side (default 256)")
+    w.add_argument("--seed", type=int, default=1, help="the demo painting's seed (default 1)")
+    w.set_defaults(func=_cmd_impastor_painting)
+    r = isub.add_parser("render", help="render a painting (the demo one by default) to a PNG")
+    r.add_argument(
+        "--painting",
+        type=input_file,
+        metavar="DIR",
+        help="a painting folder or its painting.toml (docs/impastor.md); default the demo",
+    )
     r.add_argument("--light", default="D65", help="illuminant key (D65, D50, A, FL2, ...)")
     r.add_argument("--size", type=int, default=512, help="image side in pixels")
     registry_option(r, "--method", PAINTING_LIGHTING_METHODS, "specular lighting", default="hybrid")

@@ -86,8 +86,12 @@ def render_for_cli(
     light_luminance: float | None = None,
     progress=None,
     tolerance: float | None = None,
+    painting=None,
 ) -> str:
-    """Render the demo painting and write it as a PNG; return a one-line summary.
+    """Render a painting (the demo one by default) and write it as a PNG; return a one-line summary.
+
+    ``painting`` is a painting folder or its ``painting.toml`` (``docs/impastor.md``, "Painting
+    files"), read before any work.
 
     ``progress`` (a stream) gets a line per stage of the render with its time. With
     ``tolerance``, N, K, S and the fail-safe come from it (:mod:`impastor.settings`); the
@@ -109,7 +113,7 @@ def render_for_cli(
     reference.errors.SpecrefError: unknown lighting method 'nearest'; allowed: fis, hybrid,
     median_cut, variance_min
     """
-    from impastor.painting import PAINTING_LIGHTING_METHODS, render_painting
+    from impastor.painting import PAINTING_LIGHTING_METHODS
     from reference.colour.spectra import spectrum_from_dataset
     from reference.errors import require_positive_int
     from reference.images.formats import write_png
@@ -138,12 +142,7 @@ def render_for_cli(
             np.isfinite(light_luminance) and light_luminance >= 0,
             f"--light-luminance: must be >= 0 cd/m², got {light_luminance!r}",
         )
-    if tolerance is None:
-        result = render_painting(light, size, method, progress=progress)
-    else:
-        from impastor.settings import render_painting_to_tolerance
-
-        result = render_painting_to_tolerance(light, size, tolerance, method, progress=progress)
+    result = _render(light, size, method, tolerance, painting, progress)
     write_png(out, result["sRGB"], {"specref": json.dumps(result["settings"])})
     seconds = sum(result["seconds"].values())
     summary = f"wrote {out} ({size}×{size}, {light}, {method}, shading {seconds:.2f} s"
@@ -152,6 +151,21 @@ def render_for_cli(
         flare = {"screen_lux": screen_lux, "position": lamp, "luminance": light_luminance}
         summary += "; " + _write_counts(result["XYZ"], counts_out, geometry, observer, flare)
     return summary
+
+
+def _render(light, size, method, tolerance, painting, progress) -> dict:
+    """The painting (read from its folder, else the demo) at fixed or tolerance-chosen settings."""
+    from impastor.painting import render_painting
+
+    if painting is not None:
+        from impastor.painting_files import read_painting
+
+        painting = read_painting(painting)
+    if tolerance is None:
+        return render_painting(light, size, method, painting, progress=progress)
+    from impastor.settings import render_painting_to_tolerance
+
+    return render_painting_to_tolerance(light, size, tolerance, method, painting, progress=progress)
 
 
 def _check_before_render(tolerance, out, counts_out) -> None:

@@ -155,7 +155,8 @@ def test_profile_without_its_tools_writes_nothing(tmp_path, capsys, monkeypatch)
 
 
 FOLDER_OUTPUTS = {("report", "out"), ("shrm orbit", "out"), ("conformance references", "out"),
-                  ("conformance export", "out"), ("phong", "images")}  # fmt: skip
+                  ("conformance export", "out"), ("phong", "images"),
+                  ("impastor painting", "out")}  # fmt: skip
 OUTPUT_DESTS = {"out", "output", "json", "html", "diff", "exr", "counts", "screenshot", "markdown"}
 
 
