@@ -32,6 +32,7 @@ __all__ = [
     "analytic_isotropic_brdf_names",
     "brdf_params_on_grid",
     "demo_state",
+    "merl_to_spectral_brdf_table",
     "orbit_camera",
     "render_orbit",
     "scene_state",
@@ -149,13 +150,20 @@ def _parse_isotropic_brdf(reader, table: dict, key: str, name: str):
 
 
 def _table_on_grid(reader, table: dict, key: str) -> dict:
-    """``{"table": BRDFTable}`` of a material's ``file``, resampled onto the scene's grid."""
+    """``{"table": BRDFTable}`` of a material's ``file``, resampled onto the scene's grid.
+
+    A ``.binary`` file is a MERL BRDF (Matusik et al. 2003, :mod:`reference.materials.merl`),
+    tabulated at 2° in θ and 4° in Δφ, its RGB turned into spectra on the grid by Mallett &
+    Yuksel's primaries (the RGB taken as linear sRGB; docs/brdf-format.md).
+    """
     from reference.materials.table import BRDFTable, read_brdf_table
 
     reader.table(table, key, ("type", "brdf", "file"))
     if "file" not in table:
         reader.fail(key, "brdf = 'table' needs a key 'file' (a BRDF table, docs/brdf-format.md)")
     path = reader.file_path(table["file"], f"{key}.file")
+    if path.suffix.lower() == ".binary":
+        return {"table": _merl_on_grid(reader, path, key)}
     with reader.context(f"{key}.file"):
         t = read_brdf_table(path)
     wl, target = np.asarray(t.wavelengths_nm), reader.grid.wavelengths_nm
@@ -163,6 +171,52 @@ def _table_on_grid(reader, table: dict, key: str) -> dict:
     M = np.stack([np.interp(target, wl, np.eye(wl.size)[i]) for i in range(wl.size)])
     values = t.values @ M
     return {"table": BRDFTable(t.theta_i_deg, t.theta_o_deg, t.phi_d_deg, target, values, t.name)}
+
+
+def merl_to_spectral_brdf_table(merl, grid, theta_step_deg: float = 2.0, phi_step_deg: float = 4.0):
+    """A MERL BRDF as a spectral BRDF table on ``grid``: RGB by Mallett & Yuksel's primaries.
+
+    Matusik et al. 2003 (the measured RGB BRDF, :func:`reference.materials.merl.brdf_merl`,
+    resampled by :func:`reference.materials.merl.merl_to_brdf_table`); each channel c becomes
+    the basis spectrum ``b_c(λ)`` of Mallett & Yuksel 2019, the MERL RGB taken as linear
+    sRGB (our heuristic: the database does not state its primaries; docs/brdf-format.md).
+
+    Parameters
+    ----------
+    merl : reference.materials.merl.MERLBRDF
+        The measured BRDF.
+    grid : reference.colour.spectra.SpectralGrid
+        The bands.
+    theta_step_deg, phi_step_deg : float
+        The table's steps in θ_i, θ_o and Δφ, degrees (dividing 90 and 180).
+
+    Returns
+    -------
+    reference.materials.table.BRDFTable
+
+    Examples
+    --------
+    >>> from reference.colour.spectra import SpectralGrid
+    >>> from reference.materials.merl import MERLBRDF
+    >>> grey = MERLBRDF(np.full((90, 90, 180, 3), 0.1))
+    >>> t = merl_to_spectral_brdf_table(grey, SpectralGrid(400.0, 700.0, 100.0), 45.0, 90.0)
+    >>> t.values.shape, t.values[0, 0, 0].round(4)  # white stays flat
+    ((3, 3, 3, 4), array([0.1, 0.1, 0.1, 0.1]))
+    """
+    from reference.colour.upsampling import RGB_to_spectra_Mallett2019
+    from reference.materials.merl import merl_to_brdf_table
+
+    # Mallett & Yuksel 2019, the spectral primaries: f(λ) = f_R b_R(λ) + f_G b_G(λ) + f_B b_B(λ)
+    basis = RGB_to_spectra_Mallett2019(np.eye(3), grid)
+    return merl_to_brdf_table(merl, basis, grid.wavelengths_nm, theta_step_deg, phi_step_deg)
+
+
+def _merl_on_grid(reader, path, key: str):
+    """The BRDF table of a MERL file on the scene's grid, or a one-line error naming the key."""
+    from reference.materials.merl import read_merl_brdf
+
+    with reader.context(f"{key}.file"):
+        return merl_to_spectral_brdf_table(read_merl_brdf(path), reader.grid)
 
 
 MATERIAL_TYPES.register(

@@ -157,6 +157,37 @@ def test_scene_files_take_tabulated_brdfs(tmp_path):
     assert fast.records["shrm"]["method"] == "shrm+angular"
 
 
+def test_scene_files_take_merl_brdfs(tmp_path):
+    # A MERL file (docs/brdf-format.md, "MERL measured BRDFs") takes the tables' path: read,
+    # tabulated at 2° in θ and 4° in Δφ, its RGB made spectral by Mallett & Yuksel's primaries.
+    from reference.errors import SpecrefError
+    from reference.materials.isotropic import brdf_ggx
+    from reference.materials.merl import read_merl_brdf, write_merl_brdf
+    from shrm.orbit import merl_to_spectral_brdf_table
+
+    grey = {"rho_d": 0.2, "F_0": 0.9, "alpha": 0.3}
+    path = write_merl_brdf(tmp_path / "ggx.binary", brdf_ggx, grey)
+    MATERIALS["table"] = 'brdf = "table"' + "\n" + 'file = "ggx.binary"'
+    try:
+        scene = _scene(tmp_path, "table")
+        table = scene.materials[0].params["table"]
+        expected = merl_to_spectral_brdf_table(read_merl_brdf(path), scene.grid)
+        np.testing.assert_array_equal(table.values, expected.values)
+        # A grey BRDF stays flat across the bands: the primaries sum to 1 (to 1e-5).
+        flat = np.broadcast_to(table.values[..., :1], table.values.shape)
+        np.testing.assert_allclose(table.values, flat, rtol=1e-4, atol=1e-12)
+        fast = render_scene(scene)
+        assert fast.records["shrm"]["method"] == "shrm+angular"
+        assert (fast.XYZ[fast.gbuffer.mask][:, 1] > 0).all()
+        path.write_bytes(path.read_bytes()[:1000])
+        with pytest.raises(
+            SpecrefError, match=r"s\.toml: materials\.m\.file: .*ggx\.binary: 1,000"
+        ):
+            _scene(tmp_path, "table")
+    finally:
+        del MATERIALS["table"]
+
+
 @pytest.mark.xfail(
     strict=True,
     reason="erratum E94 (docs/errata.md): a tabulated GGX on a 16-row map misses 1 % of the peak "

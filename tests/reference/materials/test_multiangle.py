@@ -141,3 +141,25 @@ def test_a_binary_file_is_refused_in_one_line(tmp_path):
     path.write_bytes(b"\xff\xfe\x00binary")
     with pytest.raises(SpecrefError, match="cannot read a UTF-8 CSV file"):
         read_five_angle_csv(path)
+
+
+def test_the_command_fits_a_file_and_writes_a_material(tmp_path, capsys):
+    import tomllib
+
+    from validation.cli import main
+
+    rng = np.random.default_rng(8)
+    truth = partial(brdf_ggx, rho_d=_smooth(rng, 0.1, 0.4), F_0=_smooth(rng, 0.4, 0.8), alpha=0.18)
+    path = write_five_angle_csv(tmp_path / "blue.csv", five_angle_readings(truth, WL, "blue paint"))
+    out = tmp_path / "blue.toml"
+    assert main(["brdf", "fit", str(path), "-o", str(out)]) == 0
+    assert "GGX α 0.18" in capsys.readouterr().out
+    material = tomllib.loads(out.read_text())["materials"]["blue_paint"]
+    assert material["brdf"] == "ggx"
+    assert material["alpha"] == pytest.approx(0.18, rel=1e-4)
+    path.write_text("aspecular_deg,400\n15,0.1\n")
+    assert main(["brdf", "fit", str(path), "-o", str(tmp_path / "x.toml")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert "a five-angle file needs exactly one row at each of" in err
+    assert not (tmp_path / "x.toml").exists()
