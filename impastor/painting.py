@@ -62,6 +62,7 @@ __all__ = [
     "canvas_frame",
     "canvas_materials",
     "canvas_pixels",
+    "check_eye",
     "impasto_painting",
     "lights_visibility",
     "load_paint_spectra",
@@ -232,13 +233,40 @@ def impasto_painting(size: int = 256, seed: int = 1, width_m: float = 0.3, n_str
     }
 
 
-def _painting_gbuffer(size: int, width_m: float):
+def check_eye(eye, where: str = "--observer") -> np.ndarray:
+    """A viewer's position (m) in the booth's frame, in front of the canvas (y > 0).
+
+    Examples
+    --------
+    >>> check_eye((0.0, 0.45, 0.6)).tolist()
+    [0.0, 0.45, 0.6]
+    >>> check_eye((0.0, -0.1, 0.6))
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: --observer: (0, -0.1, 0.6) m is behind the canvas (its plane
+    is y = 0, facing +y)
+    """
+    point = np.asarray(eye, dtype=np.float64)
+    require(
+        point.shape == (3,) and bool(np.isfinite(point).all()),
+        f"{where}: must be x,y,z in metres, got {eye!r}",
+    )
+    require(
+        point[1] > 1e-3,
+        f"{where}: ({', '.join(f'{c:g}' for c in point)}) m is behind the canvas (its plane is "
+        "y = 0, facing +y)",
+    )
+    return point
+
+
+def _painting_gbuffer(size: int, width_m: float, eye=EYE):
     from reference.geometry.camera import Camera
     from reference.geometry.gbuffer import render_gbuffer
     from reference.geometry.shapes import Plane
 
     plane = Plane((0.0, 0.0, 0.0), (0.0, 1.0, 0.0), (1.0, 0.0, 0.0), size=(width_m, width_m))
-    camera = Camera(eye=EYE, target=(0.0, 0.0, 0.0), fov_deg=25.0)
+    # the camera at the viewer, aimed at the canvas's centre (§3.4: the painting follows the viewer)
+    camera = Camera(eye=tuple(eye), target=(0.0, 0.0, 0.0), fov_deg=25.0)
     return render_gbuffer([plane], camera, size, size)
 
 
@@ -310,8 +338,9 @@ def render_painting(
     progress=None,
     n_sectors: int = HORIZON_SECTORS,
     failsafe: bool = True,
+    eye=EYE,
 ) -> dict:
-    """Render the demo painting under a booth light through the whole ImpastoR pipeline.
+    """Render a painting (the demo one by default) under a booth light through ImpastoR.
 
     G-buffer of the canvas, normals from the height map, six-channel ρ_d from measured spectra,
     diffuse light from median-cut lights (Eqs. (2)-(3), Ferwerda) with horizon-map shadows,
@@ -337,6 +366,8 @@ def render_painting(
         Kernels or their NumPy twins (no JIT warm-up: for small images).
     progress : file-like, optional
         Where to write a line per stage with its time (``specref impastor render``).
+    eye : (3,) array_like
+        The viewer (m; :data:`EYE` by default): the camera and the specular term follow it.
 
     Returns
     -------
@@ -354,7 +385,7 @@ def render_painting(
     """
     painting = painting or impasto_painting(size)
     scene = painting_scene(light, method, painting, design, light_resolution, spectra)
-    px = canvas_pixels(painting, size)
+    px = canvas_pixels(painting, size, check_eye(eye, "eye"))
     timer = StageTimer(progress, f"painting {size}×{size} under {light}")
     settings = {"n_lights": n_lights, "n_samples": n_samples, "n_sectors": n_sectors} | {
         "failsafe": bool(failsafe)
@@ -366,13 +397,17 @@ def render_painting(
         return cached_horizon_map(height, pixel_size, n_sectors, 32, backend)[px.row, px.col]
 
     L, E = shade_canvas(scene, px, settings, horizon if shadows else None, backend, timer)
+    XYZ, sRGB = _frame_images(px, L, E, scene.design)
+    return {"XYZ": XYZ, "sRGB": sRGB, "seconds": timer.seconds, "settings": settings}
+
+
+def _frame_images(px, L, E, design) -> tuple[np.ndarray, np.ndarray]:
+    """The frame's XYZ and its display encoding: sRGB, the white diffuser at 1/1.2 of white."""
     XYZ = np.zeros((*px.gbuffer.shape, 3))
-    XYZ[px.gbuffer.mask] = channels_to_XYZ(L, scene.design)
-    # Display: linear sRGB with the white diffuser under the booth light at 1/1.2 of white.
+    XYZ[px.gbuffer.mask] = channels_to_XYZ(L, design)
     white_Y = float(np.median(E)) / np.pi
     rgb = XYZ_to_display_RGB(XYZ / (1.2 * white_Y))
-    sRGB = linear_to_display(rgb, "srgb")
-    return {"XYZ": XYZ, "sRGB": sRGB, "seconds": timer.seconds, "settings": settings}
+    return XYZ, linear_to_display(rgb, "srgb")
 
 
 class PaintingScene(NamedTuple):
@@ -482,8 +517,8 @@ class _CanvasPixels(NamedTuple):
         return _CanvasPixels(None, *(x[index] for x in self[1:]))
 
 
-def canvas_pixels(painting: dict, size: int) -> _CanvasPixels:
-    """The canvas seen from :data:`EYE` at ``size²`` pixels, normals from the height map.
+def canvas_pixels(painting: dict, size: int, eye=EYE) -> _CanvasPixels:
+    """The canvas seen from ``eye`` (default :data:`EYE`) at ``size²`` pixels, normal-mapped.
 
     Returns the visible pixels' G-buffer, points P, views V, texel rows and columns and
     normal-mapped normals N.
@@ -494,7 +529,7 @@ def canvas_pixels(painting: dict, size: int) -> _CanvasPixels:
     >>> px.P.shape == px.N.shape == px.V.shape, px.row.shape == px.P.shape[:1]
     (True, True)
     """
-    g = _painting_gbuffer(size, painting["width_m"])
+    g = _painting_gbuffer(size, painting["width_m"], eye)
     mask = g.mask
     P, V = g.position[mask], g.view[mask]
     # Texel of each visible pixel (uv: u along +x columns, v along +z rows).

@@ -61,6 +61,25 @@ def _cmd_impastor_render(args) -> int:
     return 0
 
 
+def _cmd_impastor_path(args) -> int:
+    from validation.studies.impastor_commands import render_path_for_cli
+
+    summary = render_path_for_cli(
+        args.light,
+        args.size,
+        args.method,
+        args.out,
+        _vector(args.eye_from, "--from"),
+        _vector(args.eye_to, "--to"),
+        args.frames,
+        painting=args.painting,
+        fps=args.fps,
+        progress=sys.stderr,
+    )
+    print(summary)
+    return 0
+
+
 def _cmd_impastor_painting(args) -> int:
     from impastor.painting import impasto_painting
     from impastor.painting_files import write_painting
@@ -103,6 +122,7 @@ def add_parser(sub) -> None:
     w.add_argument("--size", type=int, default=256, help="texels per side (default 256)")
     w.add_argument("--seed", type=int, default=1, help="the demo painting's seed (default 1)")
     w.set_defaults(func=_cmd_impastor_painting)
+    _add_path(isub)
     r = isub.add_parser("render", help="render a painting (the demo one by default) to a PNG")
     r.add_argument(
         "--painting",
@@ -149,3 +169,32 @@ def add_parser(sub) -> None:
         "fixed 32/32/36 with the fail-safe; the PNG records the settings and the promised bound",
     )
     r.set_defaults(func=_cmd_impastor_render)
+
+
+def _add_path(isub) -> None:
+    """``specref impastor path``: the painting from a moving viewer, as an animated PNG."""
+    from impastor.painting import PAINTING_LIGHTING_METHODS
+
+    a = isub.add_parser(
+        "path", help="render the painting from a path of viewer positions as an animated PNG"
+    )
+    a.add_argument(
+        "--from",
+        dest="eye_from",
+        default="-0.25,0.45,0.6",
+        help="the viewer's first position x,y,z in metres (default -0.25,0.45,0.6)",
+    )
+    a.add_argument(
+        "--to",
+        dest="eye_to",
+        default="0.25,0.45,0.6",
+        help="the viewer's last position x,y,z in metres (default 0.25,0.45,0.6)",
+    )
+    a.add_argument("--frames", type=int, default=24, help="frames along the path (default 24)")
+    a.add_argument("--fps", type=float, default=12.0, help="frames per second (default 12)")
+    a.add_argument("--painting", type=input_file, metavar="DIR", help="a painting folder")
+    a.add_argument("--light", default="D65", help="illuminant key (D65, D50, A, FL2, ...)")
+    a.add_argument("--size", type=int, default=256, help="image side in pixels (default 256)")
+    registry_option(a, "--method", PAINTING_LIGHTING_METHODS, "specular lighting", default="hybrid")
+    a.add_argument("-o", "--out", type=output_file, required=True, help="the animated PNG")
+    a.set_defaults(func=_cmd_impastor_path)  # fmt: skip

@@ -9,7 +9,16 @@ import numpy as np
 from impastor.multispectral import MIN_CHANNELS, MULTISPECTRAL_DESIGNS
 from reference.errors import require
 
-__all__ = ["format_table1", "render_for_cli", "table1_for_cli"]
+__all__ = [
+    "MAX_PATH_FRAMES",
+    "format_table1",
+    "render_for_cli",
+    "render_path_for_cli",
+    "table1_for_cli",
+]
+
+#: Frames a path may have (a 20 s animation at 30 frames per second).
+MAX_PATH_FRAMES = 600
 
 
 def table1_for_cli(
@@ -166,6 +175,70 @@ def _render(light, size, method, tolerance, painting, progress) -> dict:
     from impastor.settings import render_painting_to_tolerance
 
     return render_painting_to_tolerance(light, size, tolerance, method, painting, progress=progress)
+
+
+def render_path_for_cli(
+    light: str,
+    size: int,
+    method: str,
+    out,
+    eye_from,
+    eye_to,
+    frames: int,
+    painting=None,
+    fps: float = 12.0,
+    progress=None,
+) -> str:
+    """Render the painting from a path of viewer positions; write an animated PNG (APNG).
+
+    The viewer moves in a straight line from ``eye_from`` to ``eye_to`` (m, the booth's frame)
+    over ``frames`` frames; the camera and the specular term follow it, while the horizon map
+    (pose-independent, §3.5.3, Ferwerda) is computed once for all frames. Every input is
+    checked, and the output proved writable, before the first frame.
+
+    Examples
+    --------
+    >>> render_path_for_cli("D65", 16, "median_cut", "x.png", (0, 0.45, 0.6), (0, -1, 0.6), 2)
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: --to: (0, -1, 0.6) m is behind the canvas (its plane is y = 0,
+    facing +y)
+    """
+    import imageio.v3 as iio
+
+    from impastor.painting import PAINTING_LIGHTING_METHODS, check_eye
+    from reference.errors import require, require_positive_int
+    from reference.files import atomic_path, check_output_file
+
+    PAINTING_LIGHTING_METHODS.lookup(method)
+    size = require_positive_int(size, "--size", 4096)
+    frames = require_positive_int(frames, "--frames", MAX_PATH_FRAMES)
+    require(np.isfinite(fps) and 0 < fps <= 120, f"--fps: must be in (0, 120], got {fps!r}")
+    start, end = check_eye(eye_from, "--from"), check_eye(eye_to, "--to")
+    check_output_file(out)
+    if painting is not None:
+        from impastor.painting_files import read_painting
+
+        painting = read_painting(painting)
+    images = []
+    for k in range(frames):
+        eye = start + (end - start) * (k / max(frames - 1, 1))
+        result = _render_pose(light, size, method, painting, eye)
+        images.append(np.round(np.clip(result["sRGB"], 0, 1) * 255).astype(np.uint8))
+        if progress is not None:
+            seconds = sum(result["seconds"].values())
+            eye_text = ", ".join(f"{c:.3f}" for c in eye)
+            progress.write(f"frame {k + 1}/{frames} from ({eye_text}) m: {seconds:.2f} s\n")
+            progress.flush()
+    with atomic_path(out, suffix=".png") as tmp:
+        iio.imwrite(tmp, np.stack(images), extension=".png", duration=1000.0 / fps, loop=0)
+    return f"wrote {out}: {frames} frames of {size}×{size} at {fps:g} frames per second (APNG)"
+
+
+def _render_pose(light, size, method, painting, eye) -> dict:
+    from impastor.painting import render_painting
+
+    return render_painting(light, size, method, painting, eye=eye)
 
 
 def _check_before_render(tolerance, out, counts_out) -> None:
