@@ -46,7 +46,7 @@ from reference.colour.colorimetry import XYZ_to_display_RGB
 from reference.colour.spectra import resample_spectrum, spectrum_from_csv, spectrum_from_dataset
 from reference.data import measured_spectra_folder
 from reference.display.encodings import linear_to_display
-from reference.errors import require, require_positive_int
+from reference.errors import SpecrefError, require, require_positive_int
 from reference.progress import StageTimer
 from reference.registry import Method, Registry
 
@@ -57,6 +57,7 @@ __all__ = [
     "PAINT_SPECTRA",
     "PaintingScene",
     "booth_lamp_kind",
+    "booth_light_spectrum",
     "booth_plane_light",
     "cached_horizon_map",
     "canvas_frame",
@@ -109,6 +110,47 @@ def booth_plane_light(kind: str = "fluorescent", width: int = 128, height: int =
     """
     image = booth_light_image(kind, width, height)
     return PlaneLight(image, (-0.6, 0.6, -1.0), (1.0, 0.0, 0.0), (0.0, 0.0, 1.0), 1.2, 0.8)
+
+
+def booth_light_spectrum(light: str):
+    """The booth light's spectrum: an illuminant key, or a measured lamp's CSV file.
+
+    A file (``*.csv`` or ``*.txt``: wavelength in nm and relative power per line, or a wide
+    export; :func:`reference.colour.spectra.spectrum_from_csv`) is a spectroradiometer's reading
+    of the lamp; it must cover 400-700 nm, be finite and >= 0, and is held constant beyond its
+    ends (erratum E113). It lights the booth's fluorescent luminaire (:func:`booth_lamp_kind`).
+
+    Examples
+    --------
+    >>> booth_light_spectrum("FL2").name
+    'illuminant:FL2'
+    >>> booth_light_spectrum("/nonexistent/lamp.csv")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: /nonexistent/lamp.csv: the lamp's spectrum: file not found
+    """
+    if Path(str(light)).suffix.lower() not in (".csv", ".txt"):
+        return spectrum_from_dataset("illuminant", light)
+    path = Path(light)
+    require(path.is_file(), f"{path}: the lamp's spectrum: file not found")
+    try:
+        spectrum = spectrum_from_csv(path, name=path.stem)
+    except SpecrefError as error:
+        raise SpecrefError(f"{path}: the lamp's spectrum: {error}") from None
+    wl, values = spectrum.wavelengths_nm, spectrum.values
+    require(
+        bool(np.isfinite(values).all() and (values >= 0).all()),
+        f"{path}: the lamp's spectrum: values must be finite and >= 0",
+    )
+    require(
+        wl[0] <= 400 and wl[-1] >= 700,
+        f"{path}: the lamp's spectrum covers {wl[0]:g}-{wl[-1]:g} nm; it must cover 400-700 nm",
+    )
+    from reference.colour.spectra import Spectrum
+
+    grid = MS_GRID.wavelengths_nm
+    # ImpastoR's 5 nm grid, linear between the readings, their ends held (erratum E113)
+    return Spectrum(grid.copy(), np.interp(grid, wl, values), name=f"lamp:{path.stem}")
 
 
 def booth_lamp_kind(light: str) -> str:
@@ -447,7 +489,7 @@ def painting_scene(
     spectra = spectra or load_paint_spectra()
     d = MULTISPECTRAL_DESIGNS.lookup(design).reference(6)
     plane = booth_plane_light(booth_lamp_kind(light), *light_resolution)
-    S6 = light_to_channels(spectrum_from_dataset("illuminant", light), d)
+    S6 = light_to_channels(booth_light_spectrum(light), d)
     return PaintingScene(painting, spectra, d, plane, S6, lighting)
 
 

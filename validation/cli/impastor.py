@@ -96,7 +96,6 @@ def _cmd_impastor_painting(args) -> int:
 def add_parser(sub) -> None:
     """Add ``specref impastor`` and its options to the subcommand parsers ``sub``."""
     from impastor.multispectral import MULTISPECTRAL_DESIGNS
-    from impastor.painting import PAINTING_LIGHTING_METHODS
 
     p = sub.add_parser("impastor", help="ImpastoR (Ferwerda 2015): Table 1 and the demo painting")
     isub = p.add_subparsers(dest="impastor_command", required=True, parser_class=Parser)
@@ -123,6 +122,42 @@ def add_parser(sub) -> None:
     w.add_argument("--seed", type=int, default=1, help="the demo painting's seed (default 1)")
     w.set_defaults(func=_cmd_impastor_painting)
     _add_path(isub)
+    _add_render(isub)
+
+
+def _add_path(isub) -> None:
+    """``specref impastor path``: the painting from a moving viewer, as an animated PNG."""
+    from impastor.painting import PAINTING_LIGHTING_METHODS
+
+    a = isub.add_parser(
+        "path", help="render the painting from a path of viewer positions as an animated PNG"
+    )
+    a.add_argument(
+        "--from",
+        dest="eye_from",
+        default="-0.25,0.45,0.6",
+        help="the viewer's first position x,y,z in metres (default -0.25,0.45,0.6)",
+    )
+    a.add_argument(
+        "--to",
+        dest="eye_to",
+        default="0.25,0.45,0.6",
+        help="the viewer's last position x,y,z in metres (default 0.25,0.45,0.6)",
+    )
+    a.add_argument("--frames", type=int, default=24, help="frames along the path (default 24)")
+    a.add_argument("--fps", type=float, default=12.0, help="frames per second (default 12)")
+    a.add_argument("--painting", type=input_file, metavar="DIR", help="a painting folder")
+    a.add_argument("--light", default="D65", help="illuminant key (D65, D50, A, FL2, ...)")
+    a.add_argument("--size", type=int, default=256, help="image side in pixels (default 256)")
+    registry_option(a, "--method", PAINTING_LIGHTING_METHODS, "specular lighting", default="hybrid")
+    a.add_argument("-o", "--out", type=output_file, required=True, help="the animated PNG")
+    a.set_defaults(func=_cmd_impastor_path)  # fmt: skip
+
+
+def _add_render(isub) -> None:
+    """``specref impastor render``: one frame of a painting under a booth light."""
+    from impastor.painting import PAINTING_LIGHTING_METHODS
+
     r = isub.add_parser("render", help="render a painting (the demo one by default) to a PNG")
     r.add_argument(
         "--painting",
@@ -130,7 +165,12 @@ def add_parser(sub) -> None:
         metavar="DIR",
         help="a painting folder or its painting.toml (docs/impastor.md); default the demo",
     )
-    r.add_argument("--light", default="D65", help="illuminant key (D65, D50, A, FL2, ...)")
+    r.add_argument(
+        "--light",
+        default="D65",
+        help="illuminant key (D65, D50, A, FL2, ...) or a measured lamp's spectrum file "
+        "(wavelength and power per line; docs/impastor.md)",
+    )
     r.add_argument("--size", type=int, default=512, help="image side in pixels")
     registry_option(r, "--method", PAINTING_LIGHTING_METHODS, "specular lighting", default="hybrid")
     r.add_argument("--out", type=output_file, default="impastor.png", help="output PNG")
@@ -169,32 +209,3 @@ def add_parser(sub) -> None:
         "fixed 32/32/36 with the fail-safe; the PNG records the settings and the promised bound",
     )
     r.set_defaults(func=_cmd_impastor_render)
-
-
-def _add_path(isub) -> None:
-    """``specref impastor path``: the painting from a moving viewer, as an animated PNG."""
-    from impastor.painting import PAINTING_LIGHTING_METHODS
-
-    a = isub.add_parser(
-        "path", help="render the painting from a path of viewer positions as an animated PNG"
-    )
-    a.add_argument(
-        "--from",
-        dest="eye_from",
-        default="-0.25,0.45,0.6",
-        help="the viewer's first position x,y,z in metres (default -0.25,0.45,0.6)",
-    )
-    a.add_argument(
-        "--to",
-        dest="eye_to",
-        default="0.25,0.45,0.6",
-        help="the viewer's last position x,y,z in metres (default 0.25,0.45,0.6)",
-    )
-    a.add_argument("--frames", type=int, default=24, help="frames along the path (default 24)")
-    a.add_argument("--fps", type=float, default=12.0, help="frames per second (default 12)")
-    a.add_argument("--painting", type=input_file, metavar="DIR", help="a painting folder")
-    a.add_argument("--light", default="D65", help="illuminant key (D65, D50, A, FL2, ...)")
-    a.add_argument("--size", type=int, default=256, help="image side in pixels (default 256)")
-    registry_option(a, "--method", PAINTING_LIGHTING_METHODS, "specular lighting", default="hybrid")
-    a.add_argument("-o", "--out", type=output_file, required=True, help="the animated PNG")
-    a.set_defaults(func=_cmd_impastor_path)  # fmt: skip

@@ -122,15 +122,14 @@ def render_for_cli(
     reference.errors.SpecrefError: unknown lighting method 'nearest'; allowed: fis, hybrid,
     median_cut, variance_min
     """
-    from impastor.painting import PAINTING_LIGHTING_METHODS
-    from reference.colour.spectra import spectrum_from_dataset
+    from impastor.painting import PAINTING_LIGHTING_METHODS, booth_light_spectrum
     from reference.errors import require_positive_int
     from reference.images.formats import write_png
 
     PAINTING_LIGHTING_METHODS.lookup(method)
     size = require_positive_int(size, "--size", 4096)
     _check_before_render(tolerance, out, counts_out)
-    spectrum_from_dataset("illuminant", light)
+    booth_light_spectrum(light)  # an unknown key or a bad lamp file fails before any work
     if counts_out is not None:
         from reference.display.pipeline import ScreenGeometry, screen_view_angles
         from reference.errors import require_finite
