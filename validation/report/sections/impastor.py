@@ -640,7 +640,12 @@ def _gloss_blocks(ctx, result) -> list:
     ax.grid(alpha=0.3)
     rows = [[s["rho_s"], s["alpha"], s["max_relative_error"]] for s in result["samples"]]
     return [
-        ctx.figure("gloss", fig, "Gloss validation (Fig. 15): pipeline (dots) vs brute force"),
+        ctx.figure(
+            "gloss",
+            fig,
+            "Gloss validation (Fig. 15): the pipeline (dots) follows the brute force (lines) "
+            f"within {100 * max(r[2] for r in rows):.2g} % on {len(rows)} glosses",
+        ),
         Table(["ρ_s", "α", "max relative error"], rows, "Goniometric curves", "{:.4g}"),
     ]
 

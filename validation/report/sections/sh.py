@@ -528,7 +528,15 @@ def _ringing_chart(ctx, ringing):
     b.set_xlabel("order L")
     b.set_ylabel("share of negative pixels")
     a.legend(fontsize=8)
-    return ctx.figure("ringing", fig, "Undershoot and negative pixels of venice_sunset by window")
+    top = {w: max(stats) for w, stats in ringing.items()}
+    worst = max(ringing, key=lambda w: ringing[w][top[w]]["negative_share"])
+    best = min(ringing, key=lambda w: ringing[w][top[w]]["negative_share"])
+    caption = (
+        f"Undershoot and negative pixels of venice_sunset by window: at the highest order "
+        f"{worst} leaves {100 * ringing[worst][top[worst]]['negative_share']:.2g} % of pixels "
+        f"negative, {best} {100 * ringing[best][top[best]]['negative_share']:.2g} %"
+    )
+    return ctx.figure("ringing", fig, caption)
 
 
 def _prefilter_chart(ctx, agreement):
