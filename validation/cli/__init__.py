@@ -33,7 +33,7 @@ from validation.cli import (
 )
 from validation.cli.parser import Parser, command_paths
 
-__all__ = ["COMMANDS", "build_parser", "main", "run"]
+__all__ = ["COMMANDS", "build_parser", "main", "run", "run_command"]
 
 #: The subcommands, in the order ``specref --help`` lists them.
 COMMANDS = (
@@ -127,16 +127,84 @@ def main(argv: list[str] | None = None) -> int:
     # Streamed commands keep the default, which returns each chunk's memory to the system.
     if not getattr(args, "streamed", False):
         set_malloc_trim()
+    return run_command(args, lambda: check_outputs(*command_paths(args)))
+
+
+class _HeldWarnings:
+    """Warnings held until the command writes anything or ends (docs/bad-input.md).
+
+    A command refused for bad input prints one line: a warning raised while it read its inputs
+    (an unusable cache folder, say) would otherwise come first. The first line the command writes
+    (a progress line, a result) releases what is held, in order; a refusal drops it.
+    """
+
+    def __init__(self, stream):
+        self.stream, self.pending = stream, []
+
+    def show(self, message, category, filename, lineno, file=None, line=None):
+        self.pending.append(_warning_line(message, category, filename, lineno, line))
+
+    def release(self):
+        pending, self.pending = self.pending, []
+        for text in pending:
+            self.stream.write(text)
+
+
+class _Releasing:
+    """A stream that releases the held warnings before its first write (else as ``stream``)."""
+
+    def __init__(self, stream, held: _HeldWarnings):
+        self._stream, self._held = stream, held
+
+    def write(self, text):
+        if self._held.pending:
+            self._held.release()
+        return self._stream.write(text)
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
+def run_command(args, check=lambda: None) -> int:
+    r"""``check()`` then ``args.func(args)``: the exit code, a refusal as one line on stderr.
+
+    Warnings are held until the command writes its first line or ends (:class:`_HeldWarnings`),
+    so bad input is one line, code 2, whatever was warned before it; Ctrl-C is code 130.
+
+    Examples
+    --------
+    >>> import contextlib, io
+    >>> from types import SimpleNamespace
+    >>> def refused(args):
+    ...     warnings.warn("cache.db: unusable", SpecrefWarning)
+    ...     raise SpecrefError("scene.toml: width: must be > 0")
+    >>> err = io.StringIO()
+    >>> with contextlib.redirect_stderr(err):
+    ...     code = run_command(SimpleNamespace(func=refused))
+    >>> code, err.getvalue()
+    (2, 'specref: error: scene.toml: width: must be > 0\n')
+    """
+    out, err = sys.stdout, sys.stderr
+    held = _HeldWarnings(err)
+    sys.stdout, sys.stderr = _Releasing(out, held), _Releasing(err, held)
     try:
-        # The write policy (docs/bad-input.md): every output checked before any work
-        check_outputs(*command_paths(args))
-        return int(args.func(args) or 0)
+        with warnings.catch_warnings():
+            warnings.showwarning = held.show
+            # The write policy (docs/bad-input.md): every output checked before any work
+            check()
+            code = int(args.func(args) or 0)
+        held.release()
+        return code
     except SpecrefError as error:
-        print(f"specref: error: {error}", file=sys.stderr)
+        held.pending.clear()  # a refusal is one line
+        print(f"specref: error: {error}", file=err)
         return 2
     except KeyboardInterrupt:
-        print("specref: interrupted", file=sys.stderr)
+        held.release()
+        print("specref: interrupted", file=err)
         return 130
+    finally:
+        sys.stdout, sys.stderr = out, err
 
 
 if __name__ == "__main__":
