@@ -400,8 +400,12 @@ def atomic_write(path, mode: str = "wb"):
         _require_file_target(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         remove_stale_temporaries(path)
-        fd, tmp = tempfile.mkstemp(prefix=temporary_prefix(path), suffix=".tmp", dir=path.parent)
+        tmp = None
         try:
+            with _termination_held():  # the file and its name together, or neither
+                fd, tmp = tempfile.mkstemp(
+                    prefix=temporary_prefix(path), suffix=".tmp", dir=path.parent
+                )
             _new_file_permissions(tmp)
             with os.fdopen(fd, mode) as handle:
                 yield handle
@@ -409,9 +413,36 @@ def atomic_write(path, mode: str = "wb"):
                 os.fsync(handle.fileno())
             os.replace(tmp, path)
         except BaseException:
-            with contextlib.suppress(FileNotFoundError):
-                os.unlink(tmp)
+            if tmp is not None:
+                with contextlib.suppress(FileNotFoundError):
+                    os.unlink(tmp)
             raise
+
+
+@contextlib.contextmanager
+def _termination_held():
+    """SIGTERM and SIGHUP wait (in the main thread) until the block has run.
+
+    A termination signal makes the ``specref`` command unwind (``validation.cli.run``); arriving
+    between a temporary file's creation and the recording of its name, it would leave the file
+    behind. Held here, it is delivered once the name is known, inside the writer's cleanup.
+    """
+    import signal
+    import threading
+
+    masked = (
+        hasattr(signal, "pthread_sigmask") and threading.current_thread() is threading.main_thread()
+    )
+    old = (
+        signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGTERM, signal.SIGHUP})
+        if masked
+        else None
+    )
+    try:
+        yield
+    finally:
+        if masked:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 @contextlib.contextmanager
@@ -436,18 +467,23 @@ def atomic_path(path, suffix: str = ""):
         _require_file_target(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         remove_stale_temporaries(path)
-        fd, name = tempfile.mkstemp(prefix=temporary_prefix(path), suffix=suffix, dir=path.parent)
-        os.close(fd)
-        tmp = Path(name)
+        tmp = None
         try:
+            with _termination_held():  # the file and its name together, or neither
+                fd, name = tempfile.mkstemp(
+                    prefix=temporary_prefix(path), suffix=suffix, dir=path.parent
+                )
+                tmp = Path(name)
+            os.close(fd)
             yield tmp
             with open(tmp, "rb+") as handle:
                 os.fsync(handle.fileno())
             _new_file_permissions(tmp)
             os.replace(tmp, path)
         except BaseException:
-            with contextlib.suppress(FileNotFoundError):
-                os.unlink(tmp)
+            if tmp is not None:
+                with contextlib.suppress(FileNotFoundError):
+                    os.unlink(tmp)
             raise
 
 
