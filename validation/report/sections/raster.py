@@ -300,6 +300,7 @@ def present(ctx: ReportContext, data: SectionData) -> list:
         ]
         for band, e in errors.items()
     ]
+    coarse, fine = min(rows, key=lambda r: r[1]), max(rows, key=lambda r: r[1])
     normals = data.arrays["normals"]
     blocks = [
         Text(
@@ -329,7 +330,8 @@ def present(ctx: ReportContext, data: SectionData) -> list:
         ctx.figure(
             "convergence",
             _convergence_figure(list(errors.values()), size),
-            "Normal error and coverage mismatch against triangle count",
+            "Normal error and coverage mismatch against triangle count: the mean normal error "
+            f"is {coarse[4]:.3g}° at {coarse[1]} triangles and {fine[4]:.3g}° at {fine[1]}",
         ),
         ctx.image(
             "normals",
