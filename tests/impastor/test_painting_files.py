@@ -125,3 +125,20 @@ def test_the_commands_write_and_render_a_painting(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1
     assert "missing key 'colour'" in err
+
+
+def test_the_painting_command_refuses_bad_numbers_and_outputs(tmp_path, capsys):
+    (tmp_path / "file").write_text("not a folder")
+    for argv, message in (
+        (["--seed", "-1"], "--seed: must be an integer >= 0"),
+        (["--size", "0"], "--size"),
+        (["--size", "100000"], "--size"),
+    ):
+        assert main(["impastor", "painting", str(tmp_path / "p"), *argv]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1
+        assert message in err
+    assert main(["impastor", "painting", str(tmp_path / "file"), "--size", "8"]) == 2
+    assert "cannot write" in capsys.readouterr().err
+    assert (tmp_path / "file").read_text() == "not a folder"
+    assert not (tmp_path / "p").exists()

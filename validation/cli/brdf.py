@@ -78,7 +78,8 @@ def _cmd_brdf_fit(args) -> int:
 
     readings = read_five_angle_csv(args.file)
     fit = fit_ggx_five_angle(readings)
-    name = args.name or "".join(c if c.isalnum() else "_" for c in readings.name) or "paint"
+    # a TOML bare key: letters, digits and underscores
+    name = "".join(c if c.isalnum() else "_" for c in (args.name or readings.name)) or "paint"
     header = (
         f"# GGX + Lambert fitted to {Path(args.file).name} by specref brdf fit "
         f"(docs/herbert-polymer.md §9); relative error per aspecular angle: "

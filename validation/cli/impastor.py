@@ -83,10 +83,11 @@ def _cmd_impastor_path(args) -> int:
 def _cmd_impastor_painting(args) -> int:
     from impastor.painting import impasto_painting
     from impastor.painting_files import write_painting
-    from reference.errors import require_positive_int
+    from reference.errors import require, require_positive_int
     from reference.files import check_output_folder
 
     size = require_positive_int(args.size, "--size", 4096)
+    require(args.seed >= 0, f"--seed: must be an integer >= 0, got {args.seed}")
     check_output_folder(args.out)  # before the painting is made
     written = write_painting(args.out, impasto_painting(size, seed=args.seed), f"demo-{args.seed}")
     print(f"wrote {written} and its images: the demo painting, {size}×{size}, seed {args.seed}")

@@ -231,3 +231,14 @@ def test_the_server_serves_its_own_host_and_a_bounded_number_of_pages():
         assert _threads(process.pid) <= base + 1
         assert process.poll() is None
     assert not os.path.exists(f"/proc/{process.pid}/status") or process.poll() is not None
+
+
+def test_a_save_folder_that_is_not_a_folder_is_refused_before_the_server_starts(tmp_path, capsys):
+    from validation.cli import main
+
+    (tmp_path / "file").write_text("x")
+    for folder in (tmp_path / "missing", tmp_path / "file"):
+        assert main(["phong", "edit", "--port", "0", "--save-dir", str(folder)]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1
+        assert "--save-dir: not a folder" in err

@@ -103,3 +103,24 @@ def test_the_command_writes_a_preview_and_refuses_in_one_line(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1
     assert "--width" in err
+
+
+def test_the_command_keeps_its_input_and_refuses_bad_outputs(tmp_path, capsys):
+    # the write policy's cases for this command: the input itself, a folder, a device, no parent
+    src = write_exr(tmp_path / "s.exr", np.full((4, 8, 41), 0.3), spectral_channel_names(WL))
+    before = src.read_bytes()
+    (tmp_path / "folder.png").mkdir()
+    for out in (src, tmp_path / "folder.png", "/dev/null", tmp_path / "no" / "such" / "x.png"):
+        code = main(["env", "preview", str(src), "-o", str(out)])
+        err = capsys.readouterr().err.strip()
+        if out == tmp_path / "no" / "such" / "x.png":  # the folder is made, as for every output
+            assert code == 0
+            continue
+        assert code == 2, out
+        assert len(err.splitlines()) == 1
+    assert src.read_bytes() == before
+    for bad in ("nan", "-inf", "1e9"):
+        argv = ["env", "preview", str(src), "-o", str(tmp_path / "e.png"), f"--exposure={bad}"]
+        assert main(argv) == 2
+        assert "--exposure" in capsys.readouterr().err
+    assert not (tmp_path / "e.png").exists()

@@ -157,6 +157,10 @@ def test_the_command_fits_a_file_and_writes_a_material(tmp_path, capsys):
     material = tomllib.loads(out.read_text())["materials"]["blue_paint"]
     assert material["brdf"] == "ggx"
     assert material["alpha"] == pytest.approx(0.18, rel=1e-4)
+    # a name that is not a TOML bare key is made one
+    assert main(["brdf", "fit", str(path), "-o", str(out), "--name", 'my "red" paint']) == 0
+    assert "my__red__paint" in tomllib.loads(out.read_text())["materials"]
+    capsys.readouterr()
     path.write_text("aspecular_deg,400\n15,0.1\n")
     assert main(["brdf", "fit", str(path), "-o", str(tmp_path / "x.toml")]) == 2
     err = capsys.readouterr().err.strip()
