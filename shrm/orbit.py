@@ -26,6 +26,7 @@ from reference.materials.types import MATERIAL_TYPES, MaterialType
 from reference.registry import Method
 from reference.scene.lights import EnvironmentLight, PointLight
 from reference.scene.shading import SHADERS, Surface
+from reference.scene.sphere_light import sphere_light_shader
 
 __all__ = [
     "IsotropicBRDFMaterial",
@@ -38,6 +39,7 @@ __all__ = [
     "scene_state",
     "shade_isotropic_brdf_environment",
     "shade_isotropic_brdf_point",
+    "shade_isotropic_brdf_sphere",
 ]
 
 
@@ -361,6 +363,40 @@ SHADERS.register(
         shade_isotropic_brdf_point,
         None,
         "§12.1, Pharr et al. (pbrt-v4); Eq. (1), Wang et al. (attenuation)",
+    )
+)
+_isotropic_brdf_sphere = sphere_light_shader(shade_isotropic_brdf_point)
+
+
+def shade_isotropic_brdf_sphere(
+    surface: Surface, material: IsotropicBRDFMaterial, light, ctx
+) -> np.ndarray:
+    """XYZ of an isotropic 3-D BRDF under a sphere light: ``L_e ∫ f cos θ_i dω`` over its cone.
+
+    The cone above the horizon (Pharr et al., pbrt-v4 §12.2; ``reference.scene.sphere_light``).
+
+    Examples
+    --------
+    >>> from reference.scene.lights import SphereLight
+    >>> from reference.scene.shading import ShadingContext
+    >>> from reference.colour.spectra import SpectralGrid
+    >>> ctx = ShadingContext(SpectralGrid(400.0, 700.0, 20.0))
+    >>> white = IsotropicBRDFMaterial("lambert", {"rho_d": np.ones(16)})
+    >>> n = np.array([[0.0, 0.0, 1.0]])
+    >>> XYZ = shade_isotropic_brdf_sphere(Surface(n * 0, n, n, np.zeros((1, 2))), white,
+    ...                                   SphereLight((0.0, 0.0, 2.0), 1.0, intensity=0.5), ctx)
+    >>> round(float(XYZ[0, 1]), 9)                   # a white diffuser: L r²/d²
+    0.125
+    """
+    return _isotropic_brdf_sphere(surface, material, light, ctx)
+
+
+SHADERS.register(
+    Method(
+        "IsotropicBRDFMaterial/SphereLight",
+        shade_isotropic_brdf_sphere,
+        None,
+        "§12.2, Pharr et al. (pbrt-v4)",
     )
 )
 SHADERS.register(

@@ -1,7 +1,9 @@
 """Scenes: lights, deferred shading, scene files, rendering, render metadata and comparison.
 
-- :mod:`~reference.scene.lights` — point (Wang's attenuation), ambient and environment lights.
+- :mod:`~reference.scene.lights` — point (Wang's attenuation), ambient, sphere and environment
+  lights.
 - :mod:`~reference.scene.shading` — deferred shading (``SHADERS``), the exact spectral Phong model.
+- :mod:`~reference.scene.sphere_light` — sphere lights, integrated over the cone they fill.
 - :mod:`~reference.scene.values`, :mod:`~reference.scene.items`, :mod:`~reference.scene.loader` —
   the TOML scene format: typed values, object and light types, the loader.
 - :mod:`~reference.scene.colorchecker` — the ColorChecker chart material.
@@ -20,6 +22,7 @@ from reference.scene import (
     metadata,
     render,
     shading,
+    sphere_light,
     values,
 )
 from reference.scene.colorchecker import *  # noqa: F403
@@ -30,12 +33,14 @@ from reference.scene.loader import *  # noqa: F403
 from reference.scene.metadata import *  # noqa: F403
 from reference.scene.render import *  # noqa: F403
 from reference.scene.shading import *  # noqa: F403
+from reference.scene.sphere_light import *  # noqa: F403
 from reference.scene.values import *  # noqa: F403
 
 __all__ = sorted(
     {
         *lights.__all__,
         *shading.__all__,
+        *sphere_light.__all__,
         *values.__all__,
         *colorchecker.__all__,
         *items.__all__,

@@ -44,6 +44,7 @@ from reference.materials.types import MATERIAL_TYPES, MaterialType
 from reference.registry import Method
 from reference.scene.lights import AmbientLight, PointLight, attenuation_Wang, point_light_vectors
 from reference.scene.shading import SHADERS, Surface
+from reference.scene.sphere_light import sphere_light_shader
 from reference.scene.values import SceneReader
 
 __all__ = [
@@ -55,6 +56,7 @@ __all__ = [
     "colorchecker_patch_pixels",
     "shade_colorchecker_ambient",
     "shade_colorchecker_point",
+    "shade_colorchecker_sphere",
 ]
 
 #: Columns and rows of the standard chart.
@@ -381,6 +383,38 @@ SHADERS.register(
         shade_colorchecker_point,
         None,
         "Eq. (2), Wang et al.",
+    )
+)
+_colorchecker_sphere = sphere_light_shader(shade_colorchecker_point)
+
+
+def shade_colorchecker_sphere(
+    surface: Surface, material: ColorCheckerMaterial, light, ctx
+) -> np.ndarray:
+    """XYZ of a ColorChecker chart under a sphere light, over the light's cone.
+
+    Eq. (2), Wang et al.'s diffuse term integrated over the cone (``reference.scene.sphere_light``).
+
+    Examples
+    --------
+    >>> from reference.scene.lights import SphereLight
+    >>> from reference.scene.shading import ShadingContext
+    >>> s = Surface(np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]), np.array([[0.0, 0.0, 1.0]]),
+    ...             np.array([[0.05, 0.1]]))
+    >>> m = colorchecker_material()
+    >>> light = SphereLight((0.0, 0.0, 3.0), 1.0, intensity=9.0)   # L r²/d² = 1
+    >>> shade_colorchecker_sphere(s, m, light, ShadingContext()).round(4)
+    array([[0.1098, 0.0971, 0.0604]])
+    """
+    return _colorchecker_sphere(surface, material, light, ctx)
+
+
+SHADERS.register(
+    Method(
+        "ColorCheckerMaterial/SphereLight",
+        shade_colorchecker_sphere,
+        None,
+        "§12.2, Pharr et al. (pbrt-v4); Eq. (2), Wang et al.",
     )
 )
 SHADERS.register(

@@ -24,7 +24,7 @@ from reference.geometry.mesh import TriangleMesh, mesh_from_obj
 from reference.geometry.shapes import Plane, Sphere
 from reference.images.formats import channel_wavelengths_nm, read_exr, read_hdr
 from reference.registry import Registry
-from reference.scene.lights import AmbientLight, EnvironmentLight, PointLight
+from reference.scene.lights import AmbientLight, EnvironmentLight, PointLight, SphereLight
 from reference.scene.values import SceneReader
 
 __all__ = ["LIGHT_TYPES", "OBJECT_TYPES", "SceneItemType"]
@@ -146,6 +146,19 @@ def _parse_point_light(reader: SceneReader, table: dict, key: str) -> PointLight
         return PointLight(position, spectrum, intensity, c)
 
 
+def _parse_sphere_light(reader: SceneReader, table: dict, key: str) -> SphereLight:
+    reader.table(table, key, ("type", "position", "radius", "spectrum", "intensity"),
+                 ("position", "radius"))  # fmt: skip
+    position = reader.vector(table["position"], f"{key}.position")
+    radius = reader.number(table["radius"], f"{key}.radius", minimum=0)
+    if radius <= 0:
+        reader.fail(f"{key}.radius", f"must be > 0, got {radius}")
+    spectrum = _light_spectrum(reader, table, key)
+    intensity = reader.number(table.get("intensity", 1.0), f"{key}.intensity", minimum=0)
+    with reader.context(key, alias="light"):
+        return SphereLight(position, radius, spectrum, intensity)
+
+
 def _light_spectrum(reader: SceneReader, table: dict, key: str) -> Spectrum:
     if "spectrum" not in table:
         return spectrum_from_dataset("illuminant", "D65")
@@ -240,6 +253,14 @@ LIGHT_TYPES.register(
         _parse_point_light,
         ("position", "spectrum", "intensity", "attenuation"),
         "a point light with Wang et al.'s attenuation",
+    )
+)
+LIGHT_TYPES.register(
+    SceneItemType(
+        "sphere",
+        _parse_sphere_light,
+        ("position", "radius", "spectrum", "intensity"),
+        "a sphere of uniform radiance (an area light), integrated over the cone it fills",
     )
 )
 LIGHT_TYPES.register(

@@ -11,6 +11,8 @@ of
   Eq. (1), Wang et al., with the erratum ``f_att = min(1/(c1 + c2 d + c3 d²), 1)`` (docs/errata.md,
   E2). The default ``(1, 0, 0)`` means no fall-off.
 - :class:`AmbientLight`: the ``I_a`` of Eq. (1), Wang et al.
+- :class:`SphereLight`: an emitting sphere of uniform radiance (not in the papers; integrated over
+  the cone it subtends by :mod:`reference.scene.sphere_light`, docs/errata.md, E114).
 - :class:`EnvironmentLight`: a lat-long radiance map (RGB or one channel per band) in the
 orientation of
   ``reference.geometry.envmap``; the SH engine prefilters it.
@@ -38,6 +40,7 @@ __all__ = [
     "AmbientLight",
     "EnvironmentLight",
     "PointLight",
+    "SphereLight",
     "attenuation_Wang",
     "point_light_vectors",
 ]
@@ -147,6 +150,57 @@ class PointLight:
         )
         object.__setattr__(self, "position", tuple(float(x) for x in p))
         object.__setattr__(self, "attenuation", tuple(float(x) for x in c))
+        object.__setattr__(self, "intensity", float(self.intensity))
+
+
+@dataclass(frozen=True)
+class SphereLight:
+    """A sphere that emits a uniform radiance ``intensity · S(λ)`` from every point of its surface.
+
+    Not in the three papers (docs/errata.md, E114): the area light of physically based renderers
+    (Mitsuba 3's ``sphere`` shape with an ``area`` emitter, pbrt-v4's ``diffuse`` area light on a
+    sphere). Its spectrum is folded into the band weights as a point light's is, so a surface
+    seeing the light's own face has Y = ``intensity``, and a white diffuser at distance ``d`` from
+    the centre, facing it (the whole sphere above its horizon), has Y = ``intensity · r²/d²``:
+    the value of a point light of intensity ``intensity · r²`` at the centre with
+    ``attenuation = [0, 0, 1]``. The light is not seen by the camera and casts no shadows on other
+    objects (as specref's point lights); a surface inside the sphere receives nothing.
+
+    Parameters
+    ----------
+    position : array_like, shape (3,)
+        Centre, in scene units.
+    radius : float
+        Radius, > 0.
+    spectrum : Spectrum
+        Relative spectral radiance ``S(λ)``; default CIE D65.
+    intensity : float
+        Scale, >= 0.
+
+    Examples
+    --------
+    >>> SphereLight((0.0, 0.0, 3.0), 0.5).radius
+    0.5
+    """
+
+    position: tuple = (0.0, 0.0, 10.0)
+    radius: float = 1.0
+    spectrum: Spectrum = field(default_factory=_default_spectrum)
+    intensity: float = 1.0
+
+    def __post_init__(self):
+        p = require_finite(self.position, "light.position")
+        require(p.shape == (3,), f"light.position: must be 3 numbers, got shape {p.shape}")
+        require(
+            np.isfinite(self.radius) and self.radius > 0,
+            f"light.radius: must be finite and > 0, got {self.radius}",
+        )
+        require(
+            np.isfinite(self.intensity) and self.intensity >= 0,
+            f"light.intensity: must be finite and >= 0, got {self.intensity}",
+        )
+        object.__setattr__(self, "position", tuple(float(x) for x in p))
+        object.__setattr__(self, "radius", float(self.radius))
         object.__setattr__(self, "intensity", float(self.intensity))
 
 
