@@ -16,6 +16,9 @@ render passes (or comes closest):
 - ``rgb_rendering``: colours multiplied in RGB instead of spectra: the scene's light replaced by
   D65 gives the linear sRGB "albedo" a renderer would store, which is multiplied by the light's
   own linear sRGB colour (Y = 1);
+- ``area_light_as_point``: a sphere light of radiance ``L`` and radius ``r`` lit as a point light
+  of intensity ``L r²`` at its centre (right far from it, wrong at the terminator and in a
+  highlight, which then has the point's shape, not the light's);
 - ``environment_mirrored``, ``environment_rotated_90`` (either way), ``environment_rotated_180``:
   the lat-long map read flipped left-right or turned about the vertical axis.
 
@@ -220,6 +223,22 @@ def _light_RGB(spectrum, scene) -> np.ndarray:
     return XYZ_to_display_RGB(XYZ / XYZ[1])
 
 
+def _area_light_as_point(ctx: DiagnosisContext) -> list:
+    from reference.scene.lights import PointLight, SphereLight
+
+    scene = ctx.scene()
+    if not any(isinstance(x, SphereLight) for x in scene.lights):
+        return []
+    lights = tuple(
+        PointLight(x.position, x.spectrum, x.intensity * x.radius**2, (0.0, 0.0, 1.0))
+        if isinstance(x, SphereLight)
+        else x
+        for x in scene.lights
+    )
+    variant = ctx.rendered(dataclasses.replace(scene, lights=lights))
+    return [("a point of L r² at the centre", variant)]
+
+
 def _environment_variants(transforms: dict) -> Callable[[DiagnosisContext], list]:
     def variants(ctx: DiagnosisContext) -> list:
         from reference.scene.lights import EnvironmentLight
@@ -265,6 +284,14 @@ DIAGNOSES.register(
         "rgb_rendering",
         "colours were multiplied in RGB, not per wavelength",
         _rgb_rendering,
+        rendered=True,
+    )
+)
+DIAGNOSES.register(
+    Diagnosis(
+        "area_light_as_point",
+        "the sphere light was lit as a point light at its centre",
+        _area_light_as_point,
         rendered=True,
     )
 )

@@ -12,8 +12,9 @@ Lambertian materials as ``diffuse``; the GGX conductor as ``roughconductor`` wit
 ``distribution = "ggx"`` and ``material = "none"`` (F = 1). specref's units become Mitsuba's
 (docs/conformance.md): a light spectrum ``S`` normalized to Y = 1 (``Y_S = Σ S ȳ / Σ ȳ``); a
 point light of ``intensity`` I is ``π I S / Y_S`` in W/sr (a white diffuser facing it at unit
-distance then reflects radiance ``I S / Y_S``, specref's Y = I), an ambient light is a
-``constant`` emitter of radiance ``I S / Y_S``. The ColorChecker is 24 ``rectangle`` shapes (the
+distance then reflects radiance ``I S / Y_S``, specref's Y = I), a sphere light of ``intensity``
+I is a ``sphere`` shape with an ``area`` emitter of radiance ``I S / Y_S``, and an ambient light is
+a ``constant`` emitter of radiance ``I S / Y_S``. The ColorChecker is 24 ``rectangle`` shapes (the
 chart's black gaps are the background). Spectra are written as ``wavelength:value`` pairs at 5 nm.
 """
 
@@ -161,6 +162,12 @@ def _emitters(data: dict) -> list[str]:
             out.append(f'  <emitter type="point"><point name="position" value="{p}"/>'
                        f'<spectrum name="intensity" value="{_pairs(np.pi * intensity * S, wl)}"/>'
                        "</emitter>")  # fmt: skip
+        elif kind == "sphere":  # an emitting sphere of radiance I S / Y_S
+            p = ",".join(map(str, light["position"]))
+            out.append(f'  <shape type="sphere"><point name="center" value="{p}"/>'
+                       f'<float name="radius" value="{light["radius"]}"/>'
+                       f'<emitter type="area"><spectrum name="radiance" '
+                       f'value="{_pairs(intensity * S, wl)}"/></emitter></shape>')  # fmt: skip
         else:  # ambient: a uniform sky of radiance I S / Y_S
             out.append(f'  <emitter type="constant"><spectrum name="radiance" '
                        f'value="{_pairs(intensity * S, wl)}"/></emitter>')  # fmt: skip

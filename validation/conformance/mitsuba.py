@@ -106,7 +106,8 @@ def render_mitsuba_folder(
 #: Samples per pixel of the proof, per scene (:func:`proof_spp`): as many as keep Mitsuba's noise,
 #: averaged over 4 × 4 blocks, near half the 1 % floor in Y or below (measured at 128 to 4096). The
 #: point-lit spheres and the broadband charts reach it at 256; FL11's narrow lines make Mitsuba's
-#: wavelength sampling noisier, and the studio map's small bright lamps its environment sampling.
+#: wavelength sampling noisier, and the studio map's small bright lamps its environment sampling;
+#: the sphere-lit spheres reach it at 512.
 PROOF_SPP = 1024
 PROOF_SPP_OVERRIDE = {
     "lambert-point-d65": 256,
@@ -116,6 +117,8 @@ PROOF_SPP_OVERRIDE = {
     "colorchecker-a": 256,
     "colorchecker-fl11": 4096,
     "lambert-env-studio": 2048,
+    "lambert-sphere-light-d65": 512,
+    "ggx-sphere-light-a": 512,
 }
 
 

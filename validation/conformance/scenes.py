@@ -15,8 +15,8 @@ Mitsuba 3's orientation, constant over each texel (``texel_placement = "centred"
 spans rows ``j/H`` to ``(j + 1)/H``), each texel's RGB upsampled by Jakob and Hanika 2019 as
 Mitsuba 3 and pbrt-v4 do (``upsampling = "jakob2019"``, erratum E80); the scenes lit by point
 and ambient lights are on a 1 nm grid (:data:`FINE_GRID`), so that lamps with lines (FL2, FL11)
-meet the materials as in a renderer that samples wavelengths; pixels are box-filtered over their
-area.
+meet the materials as in a renderer that samples wavelengths (the sphere-lit scenes, whose
+materials are flat, are on the 41-band grid); pixels are box-filtered over their area.
 """
 
 from __future__ import annotations
@@ -151,6 +151,28 @@ def _illuminant_of(key: str) -> str:
     return {"R1": "D65", "R2": "A", "R3": "FL11", "bimodal": "D65"}[key]
 
 
+def _sphere_lit(material: list[str], illuminant: str) -> Callable[[], str]:
+    """A sphere of ``material`` under a sphere light of ``illuminant`` (radius 1.5, off camera).
+
+    The light's radiance is ``25 / 1.5²``, so that far from it it is the point light of the
+    point-lit scenes (intensity 25 at the same place). Flat spectra: on the 41-band grid a
+    material meets the light as on a finer one (the light is folded in at its own sampling, E7).
+    48 × 48 pixels of 2 × 2 samples: each sample integrates over the light (the GGX lobe needs
+    about a thousand directions where it meets the light's edge).
+    """
+
+    def body() -> str:
+        return "\n".join([
+            _sphere_camera(48, 2),
+            "[materials.m]", *material,
+            "[[objects]]", 'type = "sphere"', 'material = "m"',
+            "[[lights]]", 'type = "sphere"', "position = [3, 2, 4]", "radius = 1.5",
+            f'spectrum = {{ illuminant = "{illuminant}" }}', f"intensity = {25 / 1.5**2:.9g}",
+        ])  # fmt: skip
+
+    return body
+
+
 def _chart(illuminant: str) -> Callable[[], str]:
     def body() -> str:
         return "\n".join([
@@ -231,6 +253,23 @@ CONFORMANCE_SCENES.register(ConformanceScene(
     _point_lit(['type = "isotropic_brdf"', 'brdf = "ward_isotropic"', "rho_d = 0.2",
                  "rho_s = 0.2", "alpha = 0.15"], "A"),
     {"mitsuba": _NO_WARD},
+))  # fmt: skip
+CONFORMANCE_SCENES.register(ConformanceScene(
+    "lambert-sphere-light-d65",
+    "an area light: a grey Lambertian sphere (ρ = 0.5) under a D65 sphere light of radius 1.5, "
+    "integrated over the part of the light above each point's horizon: the soft terminator that "
+    "a point light at its centre does not give",
+    ("area_light_as_point", "illuminant_not_normalized", *_SCALE_MISTAKES),
+    _sphere_lit(_LAMBERT_HALF, "D65"),
+))  # fmt: skip
+CONFORMANCE_SCENES.register(ConformanceScene(
+    "ggx-sphere-light-a",
+    "an area light in a highlight: a GGX conductor (α = 0.2, F = 1) under an illuminant A "
+    "sphere light of radius 1.5: the highlight is the light's disc blurred by the lobe, wider and "
+    "lower than a point light's",
+    ("area_light_as_point", "illuminant_not_normalized", *_SCALE_MISTAKES),
+    _sphere_lit(['type = "isotropic_brdf"', 'brdf = "ggx"', "rho_d = 0", "F_0 = 1",
+                 "alpha = 0.2"], "A"),
 ))  # fmt: skip
 for _key, _what in (
     ("R1", "smooth spectra, n(λ) = 20-80, D65"),

@@ -246,6 +246,18 @@ def test_the_mitsuba_units_are_specrefs(tmp_path):
         colour.SpectralShape(wl[0], wl[-1], 1)).values[:, 1]  # fmt: skip
     Y = (values * ybar).sum() / ybar.sum()
     assert pytest.approx(np.pi * 25, rel=1e-6) == Y
+    # A sphere light of specref intensity L: Mitsuba's area emitter of radiance L S / Y_S on a
+    # sphere of the same centre and radius (a white diffuser facing it has Y = L r²/d² in both).
+    root = ET.fromstring(mitsuba_xml("lambert-sphere-light-d65"))
+    shape = root.find("shape/emitter[@type='area']/..")
+    assert shape.get("type") == "sphere"
+    assert float(shape.find("float[@name='radius']").get("value")) == 1.5
+    assert shape.find("point[@name='center']").get("value") == "3,2,4"
+    pairs = [tuple(map(float, p.split(":"))) for p in
+             shape.find("emitter/spectrum").get("value").split(",")]  # fmt: skip
+    wl, values = np.array(pairs).T
+    Y = (values * ybar).sum() / ybar.sum()
+    assert pytest.approx(25 / 1.5**2, rel=1e-6) == Y
 
 
 def test_the_specref_export_is_self_contained_and_renders_the_same(tmp_path):
