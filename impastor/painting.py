@@ -381,6 +381,7 @@ def render_painting(
     n_sectors: int = HORIZON_SECTORS,
     failsafe: bool = True,
     eye=EYE,
+    n_channels: int = 6,
 ) -> dict:
     """Render a painting (the demo one by default) under a booth light through ImpastoR.
 
@@ -410,6 +411,8 @@ def render_painting(
         Where to write a line per stage with its time (``specref impastor render``).
     eye : (3,) array_like
         The viewer (m; :data:`EYE` by default): the camera and the specular term follow it.
+    n_channels : int
+        Channels of the design (Ferwerda's six by default; 3-10 for the speed-accuracy study).
 
     Returns
     -------
@@ -426,7 +429,7 @@ def render_painting(
     ((32, 32, 3), ['diffuse', 'shadows', 'specular'], 32)
     """
     painting = painting or impasto_painting(size)
-    scene = painting_scene(light, method, painting, design, light_resolution, spectra)
+    scene = painting_scene(light, method, painting, design, light_resolution, spectra, n_channels)
     px = canvas_pixels(painting, size, check_eye(eye, "eye"))
     timer = StageTimer(progress, f"painting {size}×{size} under {light}")
     settings = {"n_lights": n_lights, "n_samples": n_samples, "n_sectors": n_sectors} | {
@@ -475,6 +478,7 @@ def painting_scene(
     design: str = "optimized",
     light_resolution: tuple = (128, 64),
     spectra=None,
+    n_channels: int = 6,
 ) -> PaintingScene:
     """The painting, its paints, the channel design and the booth light, ready to shade.
 
@@ -487,7 +491,7 @@ def painting_scene(
     lighting = PAINTING_LIGHTING_METHODS.lookup(method)
     painting = painting or impasto_painting(256)
     spectra = spectra or load_paint_spectra()
-    d = MULTISPECTRAL_DESIGNS.lookup(design).reference(6)
+    d = MULTISPECTRAL_DESIGNS.lookup(design).reference(n_channels)
     plane = booth_plane_light(booth_lamp_kind(light), *light_resolution)
     S6 = light_to_channels(booth_light_spectrum(light), d)
     return PaintingScene(painting, spectra, d, plane, S6, lighting)

@@ -132,7 +132,10 @@ def test_compute_returns_every_figure_of_results_json(tiny):
         "painting_D65_seconds",
         "painting_A_seconds",
         *(f"frame_seconds_{m}" for m in frame_methods(every=False)),
+        "channel_frame_seconds",
     ]
+    # a frame timed at every channel count of the error study
+    assert set(tiny.results["channel_frame_seconds"]) == set(tiny.results["channels"]["optimized"])
     # Every registered channel design is measured; the designs with targets are among them.
     assert list(tiny.results["channels"]) == MULTISPECTRAL_DESIGNS.names()
     assert set(TARGETS) <= set(MULTISPECTRAL_DESIGNS.names())
