@@ -539,3 +539,60 @@ def fit_file(
     save_regression(model, out)
     lines = _fit_lines(out, fit, model, in_sample, held_out)
     return {"model": model, "in_sample": in_sample, "held_out": held_out, "lines": lines}
+
+
+def upsampling_speed_accuracy(panorama, sets=HELD_OUT_SETS, repeats: int = 3, methods=None) -> dict:
+    """Speed against accuracy of the render's RGB upsamplers (``UPSAMPLING_METHODS``).
+
+    Speed: the fastest of ``repeats`` runs of :func:`reference.colour.upsampling.
+    RGB_to_radiance_spectra` on the whole ``panorama`` (41 bands), after a warm-up call that loads
+    each method's tables or model. Accuracy: the same method on the held-out reflectance sets
+    through the sRGB "camera" (the linear sRGB a texel carries; :func:`held_out_figures`), the
+    relit figure under A averaged over the sets and its worst patch. ``methods``: keys of
+    ``UPSAMPLING_METHODS`` (default all; ``jakob2019`` builds its tables the first time on a
+    machine, minutes).
+
+    Returns
+    -------
+    dict
+        Per method ``seconds``, ``megapixels`` (the panorama's), ``A mean``, ``A max`` (ΔE94)
+        and ``D65 mean``.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from reference.images.formats import write_exr
+    >>> sky = write_exr(pathlib.Path(tempfile.mkdtemp()) / "s.exr", np.ones((8, 16, 3), np.float32))
+    >>> found = upsampling_speed_accuracy(sky, sets=("ColorChecker N Ohta",), repeats=1)
+    >>> sorted(found), found["mallett2019"]["megapixels"]
+    (['jakob2019', 'mallett2019', 'regression'], 0.000128)
+    """
+    import time
+
+    from reference.colour.upsampling import (
+        UPSAMPLING_METHODS,
+        RGB_to_radiance_spectra,
+        RGB_to_spectra,
+    )
+    from reference.images.formats import read_image
+
+    RGB = np.asarray(read_image(panorama)[..., :3], dtype=np.float64)
+    found = {}
+    for method in UPSAMPLING_METHODS.names() if methods is None else methods:
+        RGB_to_radiance_spectra(RGB[:2, :2], GRID_41, method)  # tables, the shipped model
+        times = []
+        for _ in range(repeats):
+            start = time.perf_counter()
+            RGB_to_radiance_spectra(RGB, GRID_41, method)
+            times.append(time.perf_counter() - start)
+        figures = held_out_figures(
+            lambda rgb, m=method: RGB_to_spectra(rgb, GRID_41, m), camera="sRGB", sets=sets
+        )
+        found[method] = {
+            "seconds": min(times),
+            "megapixels": RGB.shape[0] * RGB.shape[1] / 1e6,
+            "A mean": float(np.mean([f["A mean"] for f in figures.values()])),
+            "A max": float(max(f["A max"] for f in figures.values())),
+            "D65 mean": float(np.mean([f["D65 mean"] for f in figures.values()])),
+        }
+    return found

@@ -29,6 +29,7 @@ from validation.studies.spectral_env import (
     held_out_figures,
     recovery_figures,
     regression_table,
+    upsampling_speed_accuracy,
 )
 
 CC = "ColorChecker N Ohta"
@@ -45,12 +46,19 @@ QUICK_LEAVE_OUT = (("polynomial", 4), ("polynomial", 5))
 #: the panorama's box filter. ``tiny`` is for tests: every figure, table and check, on degree-1
 #: features (its checks gate nothing; the targets are for root-polynomial 4).
 SETTINGS = {
-    "full": {"leave_out": (), "shipped": SHIPPED, "recovery": RECOVERY_METHODS, "box": 2},
+    "full": {
+        "leave_out": (),
+        "shipped": SHIPPED,
+        "recovery": RECOVERY_METHODS,
+        "box": 2,
+        "upsamplers": None,
+    },
     "quick": {
         "leave_out": QUICK_LEAVE_OUT,
         "shipped": SHIPPED,
         # Jakob 2019 builds its coefficient table (36 s): the full report runs it
         "recovery": tuple(m for m in RECOVERY_METHODS if m != "Jakob 2019"),
+        "upsamplers": ("mallett2019", "regression"),  # jakob2019's tables: minutes, once
         "box": 8,
     },
     "tiny": {
@@ -65,6 +73,7 @@ SETTINGS = {
         "shipped": ("root_polynomial", 1),
         "recovery": ("Mallett 2019", "Otsu 2018", "Smits 1999"),
         "box": 32,
+        "upsamplers": ("mallett2019",),
     },
 }
 # Targets (erratum E44; ΔE94, held-out ColorChecker unless said otherwise).
@@ -168,7 +177,10 @@ def spectral_environments(
         ``results["losses"]``: ``[{loss, augmentation, augment_weight, ridge, spectral_weight,
         in_sample, held_out}]`` of the shipped features with each loss and augmentation
         (erratum E44);
-        ``results["recovery"]``: ``{method: figures on the ColorChecker}``; ``results["picks"]``:
+        ``results["recovery"]``: ``{method: figures on the ColorChecker}``;
+        ``results["upsamplers"]``: the render's upsamplers' time on the panorama and held-out
+        error (:func:`validation.studies.spectral_env.upsampling_speed_accuracy`);
+        ``results["picks"]``:
         spectra of picked panorama pixels; ``arrays["panorama"]``: the RGB and relit images.
     """
     s = settings or SETTINGS["quick" if ctx is not None and ctx.quick else "full"]
@@ -200,6 +212,8 @@ def spectral_environments(
             "spectralize_s": medians["spectralize"],
             "throughput_ratio": medians["baseline"] / medians["spectralize"],
         }
+    # speed against accuracy of the render's upsamplers, on the panorama and the held-out sets
+    data.results["upsamplers"] = upsampling_speed_accuracy(PANORAMA, methods=s["upsamplers"])
     panorama = _panorama(s["box"])
     data.results["nonnegative"] = nonnegative_study()
     data.results["every_set"] = every_set_study(*s["shipped"])
@@ -247,9 +261,42 @@ def present(ctx: ReportContext, data: SectionData) -> list:
                 f"(throughput ratio {speed['throughput_ratio']:.2f})."
             )
         )
+    if "upsamplers" in data.results:
+        blocks.append(_upsampler_chart(ctx, data.results["upsamplers"]))
     blocks.append(_every_set_table(data))
     blocks += _panorama_blocks(ctx, data)
     return blocks
+
+
+def _upsampler_chart(ctx: ReportContext, found: dict):
+    """The render's upsamplers: time to spectralize the panorama against held-out error under A."""
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 3.4), constrained_layout=True)
+    for i, (method, f) in enumerate(found.items()):
+        ax.errorbar(f["seconds"], f["A mean"], yerr=[[0], [f["A max"] - f["A mean"]]], fmt="o",
+                    color=f"C{i}", capsize=3, label=method)  # fmt: skip
+    ax.set_xscale("log")
+    ax.set_xlabel(f"seconds to spectralize {PANORAMA.name} (41 bands)")
+    ax.set_ylabel("held-out ΔE94 relit under A (mean, bar to max)")
+    ax.set_ylim(bottom=0)
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    fastest = min(found, key=lambda m: found[m]["seconds"])
+    best = min(found, key=lambda m: found[m]["A mean"])
+    caption = (
+        f"The render's RGB upsamplers: {fastest} is the fastest "
+        f"({found[fastest]['seconds']:.2g} s for {found[fastest]['megapixels']:.2g} MP)"
+    )
+    if best != fastest:
+        caption += (
+            f", {best} the most accurate relit under A (mean ΔE94 {found[best]['A mean']:.2f} "
+            f"against {found[fastest]['A mean']:.2f}) at {found[best]['seconds']:.2g} s"
+        )
+    else:
+        caption += f" and the most accurate relit under A ({found[best]['A mean']:.2f} mean ΔE94)"
+    caption += f" (held-out sets: {', '.join(HELD_OUT_SETS)})"
+    return ctx.figure("upsamplers", fig, caption)
 
 
 def _method_tables(ctx: ReportContext, data: SectionData) -> list:

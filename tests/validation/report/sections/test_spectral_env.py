@@ -83,7 +83,13 @@ def test_present_writes_every_image_and_table(tiny):
         "spectral-env-degree.png",
         "spectral-env-panorama.png",
         "spectral-env-picks.png",
+        "spectral-env-upsamplers.png",
     ]
     captions = " ".join(getattr(b, "caption", "") for b in blocks)
+    # the upsamplers' chart states its conclusion from the run
+    timed = data.results["upsamplers"]["mallett2019"]
+    assert timed["seconds"] > 0
+    assert timed["A mean"] > 0
+    assert f"mallett2019 is the fastest ({timed['seconds']:.2g} s" in captions
     assert "Root-polynomial 1 fitted with each loss" in captions
     assert "root_polynomial 2" in captions  # the left-out rows are named
