@@ -66,7 +66,7 @@ __all__ = [
 
 #: Default of ``options.sphere_light_tol``: two successive orders agree within this fraction of
 #: the pixel's value (or of a white diffuser's facing the light, if larger).
-DEFAULT_TOLERANCE = 1e-4
+DEFAULT_TOLERANCE = 1e-3
 #: Largest Gauss-Legendre order on each part of ``[cos σ, 1]`` (with twice as many azimuths):
 #: 4 × 32² directions per pixel.
 MAX_ORDER = 32

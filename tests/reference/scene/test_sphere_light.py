@@ -11,6 +11,7 @@ from reference.scene.loader import loads_scene
 from reference.scene.render import render_scene
 from reference.scene.shading import SHADERS, ShadingContext, Surface
 from reference.scene.sphere_light import (
+    DEFAULT_TOLERANCE,
     MAX_ORDER,
     sphere_light_irradiance_closed_form,
     sphere_light_quadrature,
@@ -153,7 +154,7 @@ def test_a_scene_file_names_a_sphere_light_and_its_metadata_says_what_was_done()
     assert (light.radius, light.intensity) == (0.5, 8.0)
     result = render_scene(scene)
     record = result.records["sphere_light"]["grey"]
-    assert record["largest_change"] <= 1e-4
+    assert record["largest_change"] <= DEFAULT_TOLERANCE
     # the light is to the right: the sphere's right side is lit, its far left side dark
     assert result.XYZ[12, 15, 1] > 0.05
     assert result.XYZ[12, 7, 1] == 0.0
