@@ -107,7 +107,7 @@ def render_mitsuba_folder(
 #: averaged over 4 × 4 blocks, near half the 1 % floor in Y or below (measured at 128 to 4096). The
 #: point-lit spheres and the broadband charts reach it at 256; FL11's narrow lines make Mitsuba's
 #: wavelength sampling noisier, and the studio map's small bright lamps its environment sampling;
-#: the sphere-lit spheres reach it at 512.
+#: the Lambertian sphere under a sphere light reaches it at 512.
 PROOF_SPP = 1024
 PROOF_SPP_OVERRIDE = {
     "lambert-point-d65": 256,
@@ -118,7 +118,6 @@ PROOF_SPP_OVERRIDE = {
     "colorchecker-fl11": 4096,
     "lambert-env-studio": 2048,
     "lambert-sphere-light-d65": 512,
-    "ggx-sphere-light-a": 512,
 }
 
 
