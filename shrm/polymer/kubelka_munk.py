@@ -51,6 +51,7 @@ __all__ = [
     "km_invert",
     "km_over_backing",
     "km_slab",
+    "km_tinted_K",
     "polymer_K_S",
     "polymer_constituents",
     "saunderson_constants",
@@ -277,6 +278,54 @@ def km_R_infinity(K, S) -> np.ndarray:
     K = _nonnegative(K, "km_R_infinity: K")
     S = _nonnegative(S, "km_R_infinity: S")
     return S / (K + S + np.sqrt(K * (K + 2.0 * S)))
+
+
+#: Smallest opaque reflectance a tint may ask for (a tint of 0 would need infinite absorption).
+TINT_MIN_R_INFINITY = 1e-6
+
+
+def km_tinted_K(K, S, tint) -> np.ndarray:
+    """Absorption of the slab with a dye: an opaque layer's reflectance times ``tint``.
+
+    Not in Herbert et al., whose ``Tint_polymer`` (Eq. (2), Herbert et al.) multiplies the
+    hybrid's diffuse term; the layered model needs the tint inside the slab (erratum E115). A dye
+    absorbs and does not scatter (Duncan's additive mixing keeps ``S``), and its amount is set
+    so that an opaque layer of the tinted polymer reflects ``tint`` times the untinted one:
+    ``R'_∞ = tint · R_∞(K, S)``, and from Kubelka & Munk's ``K/S = (1 − R_∞)² / (2 R_∞)``,
+
+        ``K' = S (1 − R'_∞)² / (2 R'_∞)``.
+
+    A thin or translucent chip then follows the slab's physics (its transmission is tinted as
+    well); ``tint = 1`` leaves ``K`` unchanged; ``R'_∞`` is held at least
+    :data:`TINT_MIN_R_INFINITY`; where ``S = 0`` there is no body to tint and ``K`` is kept.
+
+    Parameters
+    ----------
+    K, S : array_like, shape (..., n_bands)
+        The untinted slab, 1/mm.
+    tint : float or array_like, shape (n_bands,)
+        In [0, 1].
+
+    Returns
+    -------
+    ndarray, shape (..., n_bands)
+        ``K'``, 1/mm, >= ``K``.
+
+    Examples
+    --------
+    >>> K, S = np.array([0.1, 0.1]), np.array([20.0, 20.0])
+    >>> K2 = km_tinted_K(K, S, np.array([1.0, 0.5]))
+    >>> bool(K2[0] == K[0]), (km_R_infinity(K2, S) / km_R_infinity(K, S)).round(12)
+    (True, array([1. , 0.5]))
+    """
+    K = _nonnegative(K, "km_tinted_K: K")
+    S = _nonnegative(S, "km_tinted_K: S")
+    t = require_finite(tint, "km_tinted_K: tint")
+    require(bool(np.all((t >= 0) & (t <= 1))), f"km_tinted_K: tint: must be in [0, 1], got {t!r}")
+    # R'_∞ = tint · R_∞, then K/S = (1 − R'_∞)² / (2 R'_∞) (Kubelka & Munk 1931)
+    R = np.maximum(t * km_R_infinity(K, S), TINT_MIN_R_INFINITY)
+    K_tinted = S * (1.0 - R) ** 2 / (2.0 * R)
+    return np.where((t == 1.0) | (S == 0.0), K, np.maximum(K_tinted, K))
 
 
 def km_over_backing(R_0, T, R_g) -> np.ndarray:

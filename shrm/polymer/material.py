@@ -90,8 +90,9 @@ POLYMER_DEFAULTS = {
 #: The real-time models of ``type = "polymer"``: Herbert et al.'s hybrid (``shrm.polymer.hybrid``)
 #: and the layered model from prefiltered maps (``shrm.polymer.layered``, erratum E108).
 POLYMER_MODELS = ("herbert", "layered")
-#: Keys of the hybrid alone: the layered model refuses them (its slab is the constituents' KM).
-_HERBERT_ONLY = ("characterization", "tint", "gloss_exponent", "transparency", "mirror", "effect",
+#: Keys of the hybrid alone: the layered model refuses them (its slab is the constituents' KM;
+#: its transparency follows from the slab). It reads ``tint`` as a dye (erratum E115).
+_HERBERT_ONLY = ("characterization", "gloss_exponent", "transparency", "mirror", "effect",
                  "modulation")  # fmt: skip
 
 
@@ -125,7 +126,8 @@ class PolymerMaterial:
         Mod_effect, in [0, 1]: a constant or a greyscale image (row 0 at v = 0).
     model : str
         One of :data:`POLYMER_MODELS`: ``"herbert"`` (the hybrid) or ``"layered"`` (the layered
-        model from prefiltered maps, which reads the thickness, TiO2, gloss and index only).
+        model from prefiltered maps, which reads the thickness, TiO2, tint (as a dye in the slab,
+        erratum E115), gloss and index).
     name : str
     """
 
@@ -668,7 +670,7 @@ def shade_polymer_environment(
 def _shade_layered(surface: Surface, material: PolymerMaterial, light, ctx) -> np.ndarray:
     """Spectral radiance of the layered model (``shrm.polymer.layered``), maps cached per light."""
     from shrm.environment import _state
-    from shrm.polymer.kubelka_munk import polymer_constituents, polymer_K_S
+    from shrm.polymer.kubelka_munk import km_tinted_K, polymer_constituents, polymer_K_S
     from shrm.polymer.layered import layered_maps, layered_terms
 
     constituents = polymer_constituents(ctx.grid)
@@ -678,6 +680,8 @@ def _shade_layered(surface: Surface, material: PolymerMaterial, light, ctx) -> n
     if key not in state:
         state[key] = layered_maps(state["radiance"], n, material.gloss)
     K, S = polymer_K_S(constituents, material.tio2_pct)
+    # erratum E115: the tint as a dye in the slab
+    K = km_tinted_K(K, S, material.tint)
     terms = layered_terms(surface.normal, surface.view, state[key], K, S, material.thickness_mm)
     return terms["result"]
 
@@ -750,7 +754,7 @@ def _parse_polymer(reader, table: dict, key: str, name: str) -> PolymerMaterial:
                 reader.fail(
                     f"{key}.{k}",
                     'belongs to Herbert\'s hybrid; the layered model (model = "layered") reads '
-                    "thickness, tio2, gloss and index",
+                    "thickness, tio2, tint, gloss and index",
                 )
     path = None
     if "characterization" in table:

@@ -183,3 +183,33 @@ def test_shipped_constituents_look_like_hdpe_and_tio2():
     assert np.all(np.diff(c.K_base) < 0)  # absorption rising towards the blue: yellowish
     assert c.K_TiO2[wl == 380][0] > 100 * c.K_TiO2[wl == 450][0]  # the band gap below ~410 nm
     assert c.S_TiO2[wl == 560][0] > 10 * c.S_base[wl == 560][0]
+
+
+def test_a_tint_is_a_dye_that_scales_the_opaque_reflectance(rng):
+    # Source: Kubelka & Munk's closed forms. The dye keeps S and sets K so that R_∞ is tint times
+    # the untinted R_∞; then a thick slab (km_slab at d → ∞) reflects that, and a thin one
+    # transmits less than untinted (the dye absorbs on the way through).
+    from shrm.polymer.kubelka_munk import km_R_infinity, km_slab, km_tinted_K, polymer_K_S
+
+    K, S = polymer_K_S(polymer_constituents(), 0.5)
+    tint = rng.uniform(0.05, 1.0, K.shape)
+    K_t = km_tinted_K(K, S, tint)
+    np.testing.assert_allclose(km_R_infinity(K_t, S), tint * km_R_infinity(K, S), rtol=1e-12)
+    assert (K_t >= K).all()
+    np.testing.assert_array_equal(km_tinted_K(K, S, 1.0), K)
+    R_thick, _ = km_slab(K_t, S, 1e3)
+    np.testing.assert_allclose(R_thick, tint * km_R_infinity(K, S), rtol=1e-9)
+    _, T_thin = km_slab(K_t, S, 0.2)
+    _, T_clear = km_slab(K, S, 0.2)
+    assert (T_thin <= T_clear + 1e-15).all()
+    # no scattering: no body to tint; tint 0: held at the smallest opaque reflectance
+    np.testing.assert_array_equal(km_tinted_K([0.3], [0.0], [0.5]), [0.3])
+    assert np.isfinite(km_tinted_K(K, S, 0.0)).all()
+
+
+@pytest.mark.parametrize("tint", [-0.1, 1.5, np.nan])
+def test_a_tint_outside_0_1_is_refused(tint):
+    from shrm.polymer.kubelka_munk import km_tinted_K
+
+    with pytest.raises(SpecrefError, match="km_tinted_K: tint"):
+        km_tinted_K([0.1], [10.0], [tint])

@@ -201,3 +201,25 @@ def test_bad_pixels_are_refused():
     maps = layered_maps(np.ones((8, 16, 1)), 1.5, 0.8)
     with pytest.raises(SpecrefError, match="normal and view must be"):
         layered_pixel_parts(np.ones((4, 3)), np.ones((3, 3)), maps)
+
+
+def test_a_tinted_slab_agrees_with_the_oracle_as_an_untinted_one_does(maps32):
+    # The dye (erratum E115) enters both models as the same K', so the layered body stays within
+    # the untinted test's bound of the oracle's on venice, and the tint colours the body: its
+    # ratio to the untinted body follows the tint's shape (redder where the tint is higher)
+    from shrm.polymer.kubelka_munk import km_tinted_K
+    from shrm.polymer.tint import read_tint_library
+
+    N, V = _sphere(24)
+    env = maps32["venice_sunset_1k.hdr"]
+    K, S = polymer_K_S(HDPE, 0.5)
+    tint = read_tint_library(None).tint("pb-orange")
+    K_t = km_tinted_K(K, S, tint)
+    maps = layered_maps(env, HDPE.index, 1.0)
+    out = layered_terms(N, V, maps, K_t, S, 1.5)
+    body, trans = oracle_diffuse(N, V, env, K_t, S, 1.5, HDPE.index, 1.0)
+    total = (out["specular"] + body + trans).mean(axis=1)
+    assert (np.abs(out["body"] - body).mean(axis=1) / total).max() < 0.01
+    plain = layered_terms(N, V, maps, K, S, 1.5)["body"]
+    ratio = out["body"].sum(axis=0) / plain.sum(axis=0)
+    assert np.corrcoef(ratio, tint)[0, 1] > 0.9

@@ -152,6 +152,16 @@ def test_the_layered_model_is_selectable_and_shades_its_terms():
     shade_polymer_environment(surface, PolymerMaterial(2.0, 1.0, gloss=0.7, model="layered"),
                               light, ctx)  # fmt: skip
     assert cached_map_names(light).count("layered") == 1
+    # a tint is a dye in the slab (erratum E115): the same terms with K' for K, same maps
+    from shrm.polymer.kubelka_munk import km_tinted_K
+
+    tint = np.linspace(0.2, 1.0, GRID.n_bands)
+    tinted = dataclasses.replace(m, tint=tint)
+    got = shade_polymer_environment(surface, tinted, light, ctx)
+    K_t = km_tinted_K(K, S, tint)
+    want = layered_terms(surface.normal, surface.view, maps, K_t, S, 0.9)["result"]
+    np.testing.assert_allclose(got, want @ ctx.weights(None), rtol=1e-12)
+    assert cached_map_names(light).count("layered") == 1
 
 
 def test_effect_term_is_the_effect_pigment_through_its_shrm():
@@ -252,8 +262,9 @@ def test_modulation_image_is_looked_up_by_uv(sky, tmp_path):
         ("thicknes = 1.0", r"materials.p: unknown key 'thicknes'; allowed: "),
         ('model = "phong"', r"materials.p.model: unknown value 'phong'; allowed: herbert, layered"),
         (
-            'model = "layered"\ntint = 0.5',
-            r"materials.p.tint: belongs to Herbert's hybrid; the layered model .* reads thickness",
+            'model = "layered"\ntransparency = 0.5',
+            r"materials.p.transparency: belongs to Herbert's hybrid; the layered model .* reads "
+            "thickness, tio2, tint",
         ),
         (
             'model = "layered"\nmirror = "cosine"',
