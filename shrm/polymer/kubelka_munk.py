@@ -284,14 +284,17 @@ def km_R_infinity(K, S) -> np.ndarray:
 TINT_MIN_R_INFINITY = 1e-6
 
 
-def km_tinted_K(K, S, tint) -> np.ndarray:
-    """Absorption of the slab with a dye: an opaque layer's reflectance times ``tint``.
+def km_tinted_K(K, S, tint, r_t: float = 0.0) -> np.ndarray:
+    """Absorption of the slab with a dye: an opaque chip's diffuse reflectance times ``tint``.
 
     Not in Herbert et al., whose ``Tint_polymer`` (Eq. (2), Herbert et al.) multiplies the
     hybrid's diffuse term; the layered model needs the tint inside the slab (erratum E115). A dye
-    absorbs and does not scatter (Duncan's additive mixing keeps ``S``), and its amount is set
-    so that an opaque layer of the tinted polymer reflects ``tint`` times the untinted one:
-    ``R'_∞ = tint · R_∞(K, S)``, and from Kubelka & Munk's ``K/S = (1 − R_∞)² / (2 R_∞)``,
+    absorbs and does not scatter (Duncan's additive mixing keeps ``S``), and its amount is set so
+    that an opaque chip's diffuse reflectance seen from outside, ``ρ = (1 − r_t) R_∞ / (1 − r_t
+    R_∞)`` (Saunderson 1942, the front surface's internal reflectance ``r_t``), becomes ``tint``
+    times the untinted one, as the hybrid's tint makes it (a spot colour is measured from
+    outside). Inverting Saunderson, ``R'_∞ = ρ' / ((1 − r_t) + r_t ρ')`` with ``ρ' = tint · ρ``,
+    and from Kubelka & Munk's ``K/S = (1 − R_∞)² / (2 R_∞)``,
 
         ``K' = S (1 − R'_∞)² / (2 R'_∞)``.
 
@@ -305,6 +308,9 @@ def km_tinted_K(K, S, tint) -> np.ndarray:
         The untinted slab, 1/mm.
     tint : float or array_like, shape (n_bands,)
         In [0, 1].
+    r_t : float
+        Internal diffuse reflectance of the front surface (``Coupling.r_i`` of
+        ``shrm.polymer.oracle``), in [0, 1); 0 scales ``R_∞`` itself.
 
     Returns
     -------
@@ -322,9 +328,14 @@ def km_tinted_K(K, S, tint) -> np.ndarray:
     S = _nonnegative(S, "km_tinted_K: S")
     t = require_finite(tint, "km_tinted_K: tint")
     require(bool(np.all((t >= 0) & (t <= 1))), f"km_tinted_K: tint: must be in [0, 1], got {t!r}")
-    # R'_∞ = tint · R_∞, then K/S = (1 − R'_∞)² / (2 R'_∞) (Kubelka & Munk 1931)
-    R = np.maximum(t * km_R_infinity(K, S), TINT_MIN_R_INFINITY)
-    K_tinted = S * (1.0 - R) ** 2 / (2.0 * R)
+    r = float(r_t)
+    require(0.0 <= r < 1.0, f"km_tinted_K: r_t: must be in [0, 1), got {r_t!r}")
+    R = km_R_infinity(K, S)
+    # Saunderson (1942): the opaque chip seen from outside, tinted, then back inside
+    rho = t * (1.0 - r) * R / (1.0 - r * R)
+    R_tinted = np.maximum(rho / ((1.0 - r) + r * rho), TINT_MIN_R_INFINITY)
+    # Kubelka & Munk (1931): K/S = (1 − R_∞)² / (2 R_∞)
+    K_tinted = S * (1.0 - R_tinted) ** 2 / (2.0 * R_tinted)
     return np.where((t == 1.0) | (S == 0.0), K, np.maximum(K_tinted, K))
 
 

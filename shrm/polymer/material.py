@@ -672,6 +672,7 @@ def _shade_layered(surface: Surface, material: PolymerMaterial, light, ctx) -> n
     from shrm.environment import _state
     from shrm.polymer.kubelka_munk import km_tinted_K, polymer_constituents, polymer_K_S
     from shrm.polymer.layered import layered_maps, layered_terms
+    from shrm.polymer.oracle import interface_coupling
 
     constituents = polymer_constituents(ctx.grid)
     n = constituents.index if material.index is None else float(material.index)
@@ -680,8 +681,9 @@ def _shade_layered(surface: Surface, material: PolymerMaterial, light, ctx) -> n
     if key not in state:
         state[key] = layered_maps(state["radiance"], n, material.gloss)
     K, S = polymer_K_S(constituents, material.tio2_pct)
-    # erratum E115: the tint as a dye in the slab
-    K = km_tinted_K(K, S, material.tint)
+    # erratum E115: the tint as a dye in the slab, through the front surface's r_i
+    r_t = interface_coupling(state[key].n, state[key].alpha).r_i
+    K = km_tinted_K(K, S, material.tint, r_t)
     terms = layered_terms(surface.normal, surface.view, state[key], K, S, material.thickness_mm)
     return terms["result"]
 

@@ -202,6 +202,15 @@ def test_a_tint_is_a_dye_that_scales_the_opaque_reflectance(rng):
     _, T_thin = km_slab(K_t, S, 0.2)
     _, T_clear = km_slab(K, S, 0.2)
     assert (T_thin <= T_clear + 1e-15).all()
+    # with the front surface (Saunderson): the opaque chip's reflectance seen from outside is
+    # what the tint scales, as the hybrid's tint scales its diffuse term
+    r = 0.6
+
+    def outside(K_):
+        R = km_R_infinity(K_, S)
+        return (1 - r) * R / (1 - r * R)
+
+    np.testing.assert_allclose(outside(km_tinted_K(K, S, tint, r)), tint * outside(K), rtol=1e-12)
     # no scattering: no body to tint; tint 0: held at the smallest opaque reflectance
     np.testing.assert_array_equal(km_tinted_K([0.3], [0.0], [0.5]), [0.3])
     assert np.isfinite(km_tinted_K(K, S, 0.0)).all()

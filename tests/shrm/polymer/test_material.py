@@ -158,7 +158,9 @@ def test_the_layered_model_is_selectable_and_shades_its_terms():
     tint = np.linspace(0.2, 1.0, GRID.n_bands)
     tinted = dataclasses.replace(m, tint=tint)
     got = shade_polymer_environment(surface, tinted, light, ctx)
-    K_t = km_tinted_K(K, S, tint)
+    from shrm.polymer.oracle import interface_coupling
+
+    K_t = km_tinted_K(K, S, tint, interface_coupling(maps.n, maps.alpha).r_i)
     want = layered_terms(surface.normal, surface.view, maps, K_t, S, 0.9)["result"]
     np.testing.assert_allclose(got, want @ ctx.weights(None), rtol=1e-12)
     assert cached_map_names(light).count("layered") == 1

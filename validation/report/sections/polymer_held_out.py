@@ -3,7 +3,8 @@
 The hybrid's sweeps in ``polymer_oracle_study`` (the design cases) vary one parameter at a time
 around one chip under one synthetic environment. Here every chip is held out: drawn by a seeded
 generator (:data:`HELD_OUT_SEED`) from the ranges the sweeps span (thickness log-uniform, TiO2 and
-gloss uniform), none equal to a sweep value, and each is shaded under every environment map
+gloss uniform; the index and a spot-colour tint, which the sweeps never vary, from generators of
+their own), none equal to a sweep value, and each is shaded under every environment map
 specref ships (real captures: :data:`MAPS`). The measure is the one the sweeps use: ΔE00 of the
 hybrid (Eqs. (1)-(5), Herbert et al.; M_s = fresnel) against the oracle (``polymer_oracle``),
 relative to a white Lambertian surface facing the camera, over the sphere (mean, p95, max) and at
@@ -45,6 +46,7 @@ __all__ = [
     "held_out_study",
     "held_out_table",
     "map_environment",
+    "tint_spectrum",
 ]
 
 #: The environment maps specref ships (``reference/data/environments``), every one.
@@ -68,6 +70,11 @@ RANGES = {"thickness_mm": (0.381, 4.572), "tio2_pct": (0.0, 2.0), "gloss": (0.4,
 #: over common plastics (polypropylene 1.49 to polycarbonate 1.585 and polystyrene 1.59), from
 #: a generator of its own (seed + 1), so the other axes draw as before.
 INDEX_RANGE = (1.45, 1.65)
+#: The chance that a chip is tinted; its tint is a spot colour of the shipped library
+#: (``shrm.polymer.tint``) drawn uniformly, from a generator of its own (seed + 2). Herbert's hybrid
+#: multiplies its diffuse term by the tint (Eq. (2), Herbert et al.); the oracle and the layered
+#: model take it as a dye in the slab (erratum E115).
+TINT_CHANCE = 0.5
 
 
 @dataclass(frozen=True)
@@ -91,17 +98,21 @@ def held_out_chips(count: int, seed: int = HELD_OUT_SEED) -> list[dict]:
     """``count`` chips from :data:`RANGES`, none equal to a value of the design sweeps.
 
     Thickness is drawn log-uniform (mm), TiO2 (%), gloss and index (:data:`INDEX_RANGE`)
-    uniform; values rounded to 3 digits.
+    uniform; values rounded to 3 digits; ``tint`` is a spot colour's name or ``"none"``
+    (:data:`TINT_CHANCE`).
 
     Examples
     --------
     >>> chips = held_out_chips(3)
     >>> len(chips), sorted(chips[0])
-    (3, ['gloss', 'index', 'thickness_mm', 'tio2_pct'])
+    (3, ['gloss', 'index', 'thickness_mm', 'tint', 'tio2_pct'])
     >>> all(0.4 <= c["gloss"] <= 1.0 for c in chips)
     True
     """
+    from shrm.polymer.tint import read_tint_library
+
     rng, rng_index = np.random.default_rng(seed), np.random.default_rng(seed + 1)
+    rng_tint, names = np.random.default_rng(seed + 2), read_tint_library(None).names
     design = {
         axis: {round(v, 3) for s in SWEEPS.values() for v in getattr(s, axis)} for axis in RANGES
     }
@@ -114,7 +125,10 @@ def held_out_chips(count: int, seed: int = HELD_OUT_SEED) -> list[dict]:
             "gloss": round(float(rng.uniform(*gloss)), 3),
         }
         if all(chip[axis] not in design[axis] for axis in RANGES):
-            chips.append(chip | {"index": round(float(rng_index.uniform(*INDEX_RANGE)), 3)})
+            index = round(float(rng_index.uniform(*INDEX_RANGE)), 3)
+            tinted = rng_tint.uniform() < TINT_CHANCE
+            tint = str(names[rng_tint.integers(len(names))]) if tinted else "none"
+            chips.append(chip | {"index": index, "tint": tint})
     return chips
 
 
@@ -131,11 +145,29 @@ def map_environment(name: str, rows: int) -> np.ndarray:
     return environment_radiance(data_path(f"environments/{name}"), rows, DEFAULT_GRID)
 
 
+def tint_spectrum(chip: dict):
+    """The chip's tint on the 41-band grid: a spot colour's reflectance, or 1 for ``"none"``.
+
+    Examples
+    --------
+    >>> tint_spectrum({"tint": "none"}), tint_spectrum({"tint": "cc-cyan"}).shape
+    (1.0, (41,))
+    """
+    from shrm.polymer.tint import read_tint_library
+
+    name = chip.get("tint", "none")
+    return 1.0 if name == "none" else read_tint_library(None).tint(name)
+
+
 def _layered(N, V, env, chip: dict) -> np.ndarray:
     """The layered model's radiance for a chip (maps made per chip's gloss)."""
+    from shrm.polymer.kubelka_munk import km_tinted_K
+    from shrm.polymer.oracle import interface_coupling
+
     constituents = polymer_constituents()
     K, S = polymer_K_S(constituents, chip["tio2_pct"])
     maps = layered_maps(env, chip.get("index", constituents.index), chip["gloss"])
+    K = km_tinted_K(K, S, tint_spectrum(chip), interface_coupling(maps.n, maps.alpha).r_i)
     return layered_terms(N, V, maps, K, S, chip["thickness_mm"])["result"]
 
 
@@ -237,13 +269,17 @@ def held_out_table(study: dict) -> Table:
     >>> held_out_table({"rows": [row], "settings": {"seed": 1}}).rows[0][:5]
     ['the layered model', 'a.hdr', 1.0, 0.5, 0.8]
     """
-    keys = ("thickness_mm", "tio2_pct", "gloss", "index", "mean", "p95", "max", "centre", "rim")
-    head = ["model", "map", "thickness mm", "TiO2 %", "gloss", "index"]
+    keys = ("thickness_mm", "tio2_pct", "gloss", "index", "tint", "mean", "p95", "max", "centre",
+            "rim")  # fmt: skip
+    head = ["model", "map", "thickness mm", "TiO2 %", "gloss", "index", "tint"]
     return Table(
         [*head, "mean", "p95", "max", "centre", "rim"],
         [[MODELS[r["model"]], r["map"], *(r.get(k, "") for k in keys)] for r in study["rows"]],
         "Herbert's hybrid (M_s = fresnel) and the layered model against the layered oracle, "
         "ΔE00, on chips held out of the design (drawn with seed "
-        f"{study['settings']['seed']} from the sweeps' ranges) under every shipped environment map",
+        f"{study['settings']['seed']} from the sweeps' ranges) under every shipped environment "
+        "map. A tint is a spot colour: the hybrid multiplies its diffuse term by it (Eq. (2), "
+        "Herbert et al.), the oracle and the layered model take it as a dye in the slab (erratum "
+        "E115), so on a translucent chip they differ by design as well as by approximation",
         "{:.3g}",
     )

@@ -172,8 +172,9 @@ def hybrid_maps(env, gloss_values, size: int = 32) -> tuple[dict, float]:
 def chip_oracle(N, V, env, chip: dict, settings: OracleStudy, **kwargs):
     """The layered oracle (``shrm.polymer.oracle.polymer_oracle``) for one chip.
 
-    The chip's K and S from its TiO2 load (``shrm.polymer.kubelka_munk``), its thickness, index
-    (the constituents' when the chip has none) and gloss; the study's tolerance, seed 0;
+    The chip's K and S from its TiO2 load (``shrm.polymer.kubelka_munk``) with its ``tint`` (a
+    spot colour's name) as a dye (erratum E115), its thickness, index (the constituents' when the
+    chip has none) and gloss; the study's tolerance, seed 0;
     ``kwargs`` override the oracle's keywords.
 
     Examples
@@ -186,6 +187,14 @@ def chip_oracle(N, V, env, chip: dict, settings: OracleStudy, **kwargs):
     """
     constituents = polymer_constituents()
     K, S = polymer_K_S(constituents, chip["tio2_pct"])
+    if "tint" in chip and chip["tint"] != "none":  # a dye in the slab (erratum E115)
+        from shrm.polymer.kubelka_munk import km_tinted_K
+        from shrm.polymer.oracle import interface_coupling
+        from shrm.polymer.tint import read_tint_library
+
+        n = chip.get("index", constituents.index)
+        r_t = interface_coupling(n, gloss_alpha(chip["gloss"])).r_i
+        K = km_tinted_K(K, S, read_tint_library(None).tint(chip["tint"]), r_t)
     options = {"tol": settings.tol, "seed": 0, **kwargs}
     return polymer_oracle(
         N,
@@ -228,8 +237,9 @@ def chip_hybrid(N, V, maps, chips, chip: dict, mirror: str) -> dict:
     """Herbert's hybrid (Eq. (1), Herbert et al.) for one chip: its terms per pixel.
 
     The chip's look from the characterized model ``chips`` (``shrm.polymer.characterization``)
-    at its thickness, TiO2 load, gloss and index, shaded with the maps of its gloss
-    (:func:`hybrid_maps`); ``mirror`` is the specular map's Fresnel treatment.
+    at its thickness, TiO2 load, tint (a spot colour's name, Eq. (2)), gloss and index, shaded
+    with the maps of its gloss (:func:`hybrid_maps`); ``mirror`` is the specular map's Fresnel
+    treatment.
 
     Examples
     --------
@@ -242,7 +252,9 @@ def chip_hybrid(N, V, maps, chips, chip: dict, mirror: str) -> dict:
     (2, 41)
     """
     d, c = chip["thickness_mm"], chip["tio2_pct"]
-    look = polymer_look(chips, d, c, gloss=chip["gloss"], mirror=mirror, index=chip.get("index"))
+    tint = 1.0 if chip.get("tint", "none") == "none" else chip["tint"]  # a spot colour's name
+    look = polymer_look(chips, d, c, tint=tint, gloss=chip["gloss"], mirror=mirror,
+                        index=chip.get("index"))  # fmt: skip
     return polymer_terms(N, V, look, maps[chip["gloss"]])
 
 
