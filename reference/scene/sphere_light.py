@@ -224,8 +224,11 @@ def _tolerance(ctx) -> float:
     return float(tol)
 
 
+_SURFACE_FIELDS = ("position", "normal", "view", "uv")
+
+
 def _subset(surface: Surface, rows: np.ndarray) -> Surface:
-    return Surface(*(getattr(surface, k)[rows] for k in ("position", "normal", "view", "uv")))
+    return Surface(*(getattr(surface, k)[rows] for k in _SURFACE_FIELDS))
 
 
 def _white_diffuser(surface: Surface, light: SphereLight) -> np.ndarray:
@@ -250,15 +253,27 @@ def _record(ctx, material, order: int, relative: float) -> None:
     )
 
 
+#: Rows (pixels × directions) handed to a point shader at once: directions are batched so that
+#: few pixels (the ones still refining) are shaded in one call per batch, not one per direction.
+BATCH_ROWS = 1 << 15
+
+
 def _integrate(shade_point, surface: Surface, material, light: SphereLight, ctx, order: int):
     directions, weights = sphere_light_quadrature(
         light.position, light.radius, surface.position, surface.normal, order
     )
+    n_dir, n = weights.shape
+    batch = max(1, BATCH_ROWS // max(n, 1))
     total = 0.0
-    for omega, w in zip(directions, weights, strict=True):
-        probe = _DirectionLight(surface.position + omega, light.spectrum)
+    for start in range(0, n_dir, batch):
+        omega, w = directions[start : start + batch], weights[start : start + batch]
+        k = w.shape[0]
+        # every pixel repeated once per direction of the batch (rows: direction-major)
+        rows = Surface(*(np.tile(getattr(surface, a), (k, 1)) for a in _SURFACE_FIELDS))
+        probe = _DirectionLight(rows.position + omega.reshape(-1, 3), light.spectrum)
+        values = shade_point(rows, material, probe, ctx).reshape(k, n, -1)
         # L_o = (1/π) Σ_k w_k (π f cos θ_i)_k: the shader's value is π f cos θ_i
-        total = total + w[:, None] * shade_point(surface, material, probe, ctx)
+        total = total + np.einsum("kn,knc->nc", w, values)
     return light.intensity / np.pi * total
 
 
