@@ -12,9 +12,11 @@ A convex receiver cannot shadow itself in a direction above its horizon, so ``ma
 the whole of the visibility on a single convex object.
 
 **The quadrature.** With ``μ = cos θ`` about ``w`` and the azimuth ``φ``, ``dω = dμ dφ``;
-``μ ∈ [cos σ, 1]`` takes ``n`` Gauss-Legendre nodes and ``φ`` takes ``2n`` equally spaced nodes
-(the trapezoid rule, spectrally accurate for a periodic integrand); each direction is handed to the
-material's point-light shader as a point light one unit away with no fall-off, whose value is
+``μ ∈ [cos σ, 1]`` is split where the rings of the cone start to cross the horizon and each part
+takes ``n`` Gauss-Legendre nodes, and each ring takes ``2n`` Gauss-Legendre nodes over its part
+above the horizon (:func:`sphere_light_quadrature`); each direction is handed to the material's
+point-light shader (directions batched, :data:`BATCH_ROWS` rows a call) as a point light one unit
+away with no fall-off, whose value is
 ``π f cos θ_i`` in the scene's units (a white diffuser facing a unit point light has Y = 1), so
 
     ``Y = (intensity / π) Σ_k w_k · shade_point(x, ω_k)``,   ``Σ_k w_k = 2π (1 − cos σ)``.
@@ -55,6 +57,7 @@ from reference.scene.shading import (
 )
 
 __all__ = [
+    "BATCH_ROWS",
     "DEFAULT_TOLERANCE",
     "MAX_ORDER",
     "shade_lambert_sphere",
