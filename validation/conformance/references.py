@@ -209,7 +209,7 @@ def reference_folder() -> Path:
     Examples
     --------
     >>> reference_folder().name
-    'v1'
+    'v2'
     """
     from reference.files import default_cache_dir
 

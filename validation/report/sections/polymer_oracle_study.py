@@ -237,9 +237,9 @@ def chip_hybrid(N, V, maps, chips, chip: dict, mirror: str) -> dict:
     """Herbert's hybrid (Eq. (1), Herbert et al.) for one chip: its terms per pixel.
 
     The chip's look from the characterized model ``chips`` (``shrm.polymer.characterization``)
-    at its thickness, TiO2 load, tint (a spot colour's name, Eq. (2)), gloss and index, shaded
-    with the maps of its gloss (:func:`hybrid_maps`); ``mirror`` is the specular map's Fresnel
-    treatment.
+    at its thickness, TiO2 load, tint (a spot colour's name, Eq. (2), Herbert et al.), gloss
+    and index, shaded with the maps of its gloss (:func:`hybrid_maps`); ``mirror`` is the
+    specular map's Fresnel treatment.
 
     Examples
     --------
