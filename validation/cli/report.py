@@ -46,10 +46,10 @@ def add_parser(sub) -> None:
         "the settings its checks need (the full-resolution studies and long sweeps at their "
         "quick settings: --full runs them in full). index.html is rewritten after every "
         "section, so a stopped run leaves a readable page. Measured on a shared two-core "
-        "machine: 1 min 55 s – 2 min 32 s with the default two processes (3 min 26 s – 4 min "
-        "31 s of CPU, the later run with the editor's screenshot and every ImpastoR lighting "
-        "method timed); --full "
-        "54 min alone, 1 h 48 min beside other work.",
+        "machine: 1 min 55 s – 2 min 42 s with the default two processes (3 min 26 s – 4 min "
+        "48 s of CPU, the latest run with speed against accuracy for the SH order, the RGB "
+        "upsamplers and the channel count); --full 40 min (with make bench, 54-59 min), 1 h "
+        "48 min beside other work.",
     )
     p.add_argument("--out", default="report", help="output folder (default: report)")
     effort = p.add_mutually_exclusive_group()
