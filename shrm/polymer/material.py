@@ -73,6 +73,7 @@ __all__ = [
     "polymer_pixel_parts",
     "polymer_shade_parts",
     "shade_polymer_environment",
+    "shade_polymer_oracle",
 ]
 
 #: Defaults of the scene keys: a 0.06" (1.524 mm) chip with 0.5 % TiO2, untinted, fully glossy.
@@ -635,7 +636,9 @@ def shade_polymer_environment(
 
     The terms come from :func:`shrm.polymer.hybrid.polymer_terms` with the cached maps
     (:func:`polymer_environment_maps`) and the per-frame look (:func:`polymer_material_look`).
-    There is no brute-force path: ``ctx.options["environment"] == "bruteforce"`` is refused (E60).
+    With ``ctx.options["environment"] == "bruteforce"`` (``specref render --oracle``) both models
+    are shaded by the physics they approximate, the layered oracle (:func:`shade_polymer_oracle`,
+    erratum E60).
 
     Examples
     --------
@@ -648,13 +651,10 @@ def shade_polymer_environment(
     >>> XYZ.shape, bool(0.5 < XYZ[0, 1] < 1.0)
     ((1, 3), True)
     """
-    require(
-        ctx.options.get("environment") != "bruteforce",
-        f"{material.name}: polymer materials have no brute-force environment path (--oracle); "
-        "allowed: the frequency-space maps",
-    )
     if surface.normal.shape[0] == 0:
-        return np.zeros((0, 3))
+        return np.zeros((0, ctx.n_outputs))
+    if ctx.options.get("environment") == "bruteforce":
+        return shade_polymer_oracle(surface, material, light, ctx)
     if material.model == "layered":
         return _shade_layered(surface, material, light, ctx) @ ctx.weights(None)
     maps = polymer_environment_maps(light, ctx, material.gloss_exponent)
@@ -665,6 +665,62 @@ def shade_polymer_environment(
         E_effect = _effect_radiance(surface, material.effect, light, ctx)
     terms = polymer_terms(surface.normal, surface.view, look, maps, Mod, E_effect)
     return terms["I_result"] @ ctx.weights(None)
+
+
+def shade_polymer_oracle(
+    surface: Surface, material: PolymerMaterial, light: EnvironmentLight, ctx
+) -> np.ndarray:
+    """XYZ of a polymer material by the layered oracle (``shrm.polymer.oracle.polymer_oracle``).
+
+    The physical counterpart of Eq. (1), Herbert et al. (erratum E60): what both real-time
+    models approximate: a dielectric interface (GGX-rough below gloss 1, E65) over a
+    Kubelka–Munk slab of the constituents' K and S at the material's TiO2 load, its tint a dye
+    (E115), its thickness and index, integrated over every pixel of the map (the specular lobe
+    by seeded Monte Carlo to ``ctx.options["polymer_oracle_tol"]``, default 0.005 of the
+    radiance). The hybrid's heuristics (``transparency``, ``mirror``, ``gloss_exponent``) have
+    no physical counterpart and are not read; a characterization file or an effect pigment is
+    refused in one line (the oracle knows neither). The samples used are recorded in
+    ``ctx.records["polymer_oracle"]``.
+
+    Examples
+    --------
+    >>> from reference.scene.shading import ShadingContext
+    >>> from reference.colour.spectra import SpectralGrid
+    >>> ctx = ShadingContext(SpectralGrid(400.0, 700.0, 20.0))
+    >>> n = np.array([[0.0, 1.0, 0.0]])
+    >>> XYZ = shade_polymer_oracle(Surface(n * 0, n, n, np.zeros((1, 2))), PolymerMaterial(),
+    ...                            EnvironmentLight(np.ones((16, 32, 3))), ctx)
+    >>> XYZ.shape, bool(0.5 < XYZ[0, 1] < 1.0)
+    ((1, 3), True)
+    """
+    from shrm.environment import _state
+    from shrm.polymer.kubelka_munk import km_tinted_K, polymer_constituents, polymer_K_S
+    from shrm.polymer.oracle import gloss_alpha, interface_coupling, polymer_oracle
+
+    require(
+        material.characterization is None and material.effect is None,
+        f"{material.name}: --oracle shades the Kubelka-Munk slab of the constituents; a "
+        "characterization file or an effect pigment has no physical counterpart there",
+    )
+    constituents = polymer_constituents(ctx.grid)
+    n = constituents.index if material.index is None else float(material.index)
+    K, S = polymer_K_S(constituents, material.tio2_pct)
+    K = km_tinted_K(K, S, material.tint, interface_coupling(n, gloss_alpha(material.gloss)).r_i)
+    tol = ctx.options.get("polymer_oracle_tol", 0.005)
+    require(
+        isinstance(tol, (int, float)) and not isinstance(tol, bool) and 0 < tol < 1,
+        f"options.polymer_oracle_tol: must be a number in (0, 1), got {tol!r}",
+    )
+    radiance = _state(light, ctx)["radiance"]
+    out = polymer_oracle(surface.normal, surface.view, radiance, K, S, material.thickness_mm, n,
+                         material.gloss, tol=float(tol), seed=0)  # fmt: skip
+    before = ctx.records.get("polymer_oracle", {}).get(material.name, {})
+    ctx.record("polymer_oracle", material.name, {
+        "samples": max(out.samples, before.get("samples", 0)),
+        "relative_error": max(out.relative_error, before.get("relative_error", 0.0)),
+        "tol": float(tol),
+    })  # fmt: skip
+    return out.result @ ctx.weights(None)
 
 
 def _shade_layered(surface: Surface, material: PolymerMaterial, light, ctx) -> np.ndarray:

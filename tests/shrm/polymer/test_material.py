@@ -287,10 +287,34 @@ def test_unknown_tint_lists_the_closest_names(sky):
     assert "\n" not in str(error.value)
 
 
-def test_oracle_option_is_refused_in_one_line(sky):
-    scene = load(sky, "")
-    with pytest.raises(SpecrefError, match="polymer materials have no brute-force environment"):
-        render_scene(scene, options={"environment": "bruteforce"})
+def test_the_oracle_option_shades_the_layered_oracle(sky):
+    # --oracle (erratum E60): the render's pixels are shrm.polymer.oracle.polymer_oracle's for the
+    # material's slab (K, S at its TiO2, tint as a dye, E115), thickness, index and gloss; both
+    # models share it; a material with an effect pigment is refused in one line
+    from shrm.environment import cached_spectral_radiance
+    from shrm.polymer.kubelka_munk import km_tinted_K, polymer_constituents, polymer_K_S
+    from shrm.polymer.oracle import gloss_alpha, interface_coupling, polymer_oracle
+
+    scene = load(sky, 'tint = "pb-orange"\ngloss = 0.7')
+    oracle = render_scene(scene, width=6, height=6, options={"environment": "bruteforce"})
+    g, ctx, m = oracle.gbuffer, scene.shading_context(), scene.materials[0]
+    constituents = polymer_constituents(scene.grid)
+    K, S = polymer_K_S(constituents, m.tio2_pct)
+    r_t = interface_coupling(constituents.index, gloss_alpha(0.7)).r_i
+    K = km_tinted_K(K, S, m.tint, r_t)
+    radiance = cached_spectral_radiance(scene.lights[0], ctx)
+    want = polymer_oracle(g.normal[g.mask], g.view[g.mask], radiance, K, S, m.thickness_mm,
+                          constituents.index, 0.7, tol=0.005, seed=0).result  # fmt: skip
+    assert oracle.records["polymer_oracle"][m.name]["samples"] >= 64
+    assert scene.render.supersample == 1  # one sample per pixel: the pixel is the shaded point
+    np.testing.assert_allclose(oracle.XYZ[g.mask], want @ ctx.weights(None), rtol=1e-12)
+    layered = load(sky, 'model = "layered"\ntint = "pb-orange"\ngloss = 0.7')
+    again = render_scene(layered, width=6, height=6, options={"environment": "bruteforce"})
+    np.testing.assert_array_equal(again.XYZ, oracle.XYZ)
+    with pytest.raises(SpecrefError, match="--oracle shades the Kubelka-Munk slab") as error:
+        render_scene(load(sky, 'effect = "ggx"\nmodulation = 0.5'), width=4, height=4,
+                     options={"environment": "bruteforce"})  # fmt: skip
+    assert "\n" not in str(error.value)
 
 
 def test_obj_groups_render_with_their_own_polymers(sky, tmp_path):
