@@ -120,10 +120,38 @@ def _bsdf(material: dict, where: str) -> list[str]:
             f'      <spectrum name="reflectance" value="{_pairs(k_d)}"/>',
             "    </bsdf>",
         ]
+    if material["type"] == "polymer":  # the opaque smooth chip: Mitsuba's smooth plastic
+        return _plastic(material)
     # the GGX conductor of F = 1 (ConformanceScene.cannot_export lists the other BRDFs)
     return ['    <bsdf type="roughconductor">', '      <string name="distribution" value="ggx"/>',
             f'      <float name="alpha" value="{material["alpha"]}"/>',
             '      <string name="material" value="none"/>', "    </bsdf>"]  # fmt: skip
+
+
+def _plastic(material: dict) -> list[str]:
+    """A smooth opaque polymer chip as Mitsuba 3's ``plastic``.
+
+    ``nonlinear``: the internal reflections between the coat and the body (Saunderson's). The
+    diffuse reflectance is the slab's body reflectance ``R_0 + T² r_b / (1 − R_0 r_b)``
+    (Kubelka-Munk, the constituents' K and S at the chip's TiO2 load); ``T`` is below 1 % for the
+    suite's chip, so the light it passes is left out.
+    """
+    from reference.colour.spectra import SpectralGrid
+    from shrm.polymer.kubelka_munk import km_slab, polymer_constituents, polymer_K_S
+    from shrm.polymer.oracle import interface_coupling
+
+    wl = MITSUBA_WAVELENGTHS
+    constituents = polymer_constituents(SpectralGrid(float(wl[0]), float(wl[-1]), 5.0))
+    K, S = polymer_K_S(constituents, float(material["tio2"]))
+    R_0, T = km_slab(K, S, float(material["thickness"]))
+    r_b = interface_coupling(constituents.index, 0.0).r_i
+    body = R_0 + T**2 * r_b / (1.0 - R_0 * r_b)
+    return ['    <bsdf type="plastic">',
+            f'      <float name="int_ior" value="{constituents.index}"/>',
+            '      <float name="ext_ior" value="1.0"/>',
+            '      <boolean name="nonlinear" value="true"/>',
+            f'      <spectrum name="diffuse_reflectance" value="{_pairs(body, wl)}"/>',
+            "    </bsdf>"]  # fmt: skip
 
 
 def _chart_shapes() -> list[str]:

@@ -117,6 +117,7 @@ PROOF_SPP_OVERRIDE = {
     "colorchecker-a": 256,
     "colorchecker-fl11": 4096,
     "lambert-env-studio": 2048,
+    "polymer-smooth-env-studio": 2048,
     "lambert-sphere-light-d65": 512,
 }
 

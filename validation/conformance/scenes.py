@@ -190,8 +190,9 @@ def _chart(illuminant: str) -> Callable[[], str]:
 
 
 def _environment(material: list[str], map_key: str) -> Callable[[], str]:
-    # the brute force of a glossy BRDF costs 16 times a Lambertian's per pixel: 2 × 2 samples
-    supersample = 2 if "isotropic_brdf" in material[0] else 4
+    # the brute force of a glossy BRDF or a polymer costs 16 times a Lambertian's per pixel:
+    # 2 × 2 samples
+    supersample = 2 if any(k in material[0] for k in ("isotropic_brdf", "polymer")) else 4
 
     def body() -> str:
         return "\n".join([
@@ -329,6 +330,25 @@ CONFORMANCE_SCENES.register(ConformanceScene(
     _ENV_MISTAKES,
     _environment(['type = "isotropic_brdf"', 'brdf = "ggx"', "rho_d = 0", "F_0 = 1",
                   "alpha = 0.4"], "venice"),
+))  # fmt: skip
+CONFORMANCE_SCENES.register(ConformanceScene(
+    "polymer-smooth-env-studio",
+    "Herbert's polymer in its opaque smooth limit (a 4.572 mm chip, 2 % TiO2, gloss 1, index "
+    "1.54: a smooth dielectric coat over an opaque Kubelka-Munk body) under the studio map, the "
+    "case a physical renderer expresses as a smooth plastic; the reference is the layered oracle",
+    _ENV_MISTAKES,
+    _environment(['type = "polymer"', 'model = "layered"', "thickness = 4.572", "tio2 = 2.0",
+                  "gloss = 1.0"], "studio"),
+))  # fmt: skip
+CONFORMANCE_SCENES.register(ConformanceScene(
+    "polymer-rough-env-venice",
+    "Herbert's polymer in general (a translucent 0.762 mm chip, 0.2 % TiO2, tinted with the "
+    "measured orange as a dye, gloss 0.7: a rough coat over a scattering, absorbing, transmitting "
+    "body) under venice; the reference is specref's layered oracle",
+    _ENV_MISTAKES,
+    _environment(['type = "polymer"', 'model = "layered"', "thickness = 0.762", "tio2 = 0.2",
+                  'tint = "pb-orange"', "gloss = 0.7"], "venice"),
+    {"mitsuba": "Mitsuba 3 has no rough coat over a translucent, transmitting Kubelka-Munk body"},
 ))  # fmt: skip
 CONFORMANCE_SCENES.register(ConformanceScene(
     "ggx-plastic-env-fagans",
