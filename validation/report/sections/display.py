@@ -419,21 +419,30 @@ def _figures(ctx: ReportContext, data: SectionData) -> list:
 
     blocks = []
     fig, ax = plt.subplots(figsize=(5.5, 4))
+    gaps = {}
     for curve in FIG6_CURVES:
         G, Y = data.arrays[("fig6", curve)]
         ax.plot(255 * G, Y, lw=2, label=f"measured, {curve}")
         ax.plot(255 * G, curve_target(curve, G), "k:", lw=1)
+        gaps[curve] = float(np.max(np.abs(np.asarray(Y) - curve_target(curve, G))))
     ax.set_xlabel("gray value G (0-255)")
     ax.set_ylabel("Y / Y_max")
     ax.legend(frameon=False)
     blocks.append(
         ctx.figure(
-            "fig6", fig, "Fig. 6 reproduced: Y against G (dotted: Eqs. (6)-(7), Herbert et al.)"
+            "fig6",
+            fig,
+            "Fig. 6 reproduced: the calibrated Y follows each target curve (dotted: Eqs. (6)-(7), "
+            "Herbert et al.) within "
+            + ", ".join(f"{gap:.1e} of Y_max ({curve})" for curve, gap in gaps.items()),
         )
     )
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.8), sharex=True)
+    drift = {}
     for instrument in INSTRUMENTS.names():
         G, xy, white = data.arrays[("fig7", instrument)]
+        upper = np.asarray(G) >= 0.2  # near black, the gray's xy is the black level's
+        drift[instrument] = float(np.max(np.abs(np.asarray(xy)[upper] - np.asarray(white)[:2])))
         for k, ax in enumerate(axes):
             ax.plot(255 * G[1:], xy[1:, k], lw=1.5, label=f"calibrated with {instrument}")
             ax.axhline(white[k], color="k", lw=0.8)
@@ -443,7 +452,13 @@ def _figures(ctx: ReportContext, data: SectionData) -> list:
         ax.set_ylim(white[k] - 0.03, white[k] + 0.03)
     axes[0].legend(frameon=False, fontsize=8)
     blocks.append(
-        ctx.figure("fig7", fig, "Fig. 7 reproduced: x and y of gray against G, D65, L* curve")
+        ctx.figure(
+            "fig7",
+            fig,
+            "Fig. 7 reproduced (D65, L* curve): the gray's x and y stay within "
+            + ", ".join(f"{d:.4f} of the white's ({name})" for name, d in drift.items())
+            + " from G = 51 up (near black, xy is the black level's)",
+        )
     )
     return blocks
 

@@ -314,9 +314,19 @@ def _chip_figures(ctx: ReportContext, data: SectionData) -> list:
         ax.set_xlabel("TiO2 load (% by weight)")
         ax.set_ylabel("L* (D65)")
     axes[0].legend(frameon=False)
-    blocks.append(
-        ctx.figure("fig2", fig, "Fig. 2 reproduced: lightness of HDPE-like chips against TiO2")
+    curves = data.results["fig2"].values()
+    rises = all(np.all(np.diff(c["L_over_black"]) >= 0) for c in curves)
+    falls = all(np.all(np.diff(c["L_transmission"]) <= 0) for c in curves)
+    span = ", ".join(
+        f"{d} mm {min(c['L_over_black']):.0f}–{max(c['L_over_black']):.0f}"
+        for d, c in data.results["fig2"].items()
     )
+    trend = (
+        f"over black, L* rises with the TiO2 load ({span}) and the transmission falls"
+        if rises and falls
+        else f"over black, L* spans {span}; not monotone in the load on every chip"
+    )
+    blocks.append(ctx.figure("fig2", fig, f"Fig. 2 reproduced, HDPE-like chips: {trend}"))
     W, _ = _weights("D65")
     R, T = data.arrays["chips"]
     swatch = 24
