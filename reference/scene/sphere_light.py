@@ -47,6 +47,7 @@ import numpy as np
 
 from reference.colour.spectra import Spectrum
 from reference.errors import require
+from reference.materials.brdf import frame_from_normal
 from reference.registry import Method
 from reference.scene.lights import SphereLight
 from reference.scene.shading import (
@@ -163,16 +164,8 @@ def _horizon_frame(N: np.ndarray, w: np.ndarray, a: np.ndarray) -> tuple[np.ndar
     """``t`` along the normal's part across ``w`` (or any, if none), ``b = w × t``."""
     p = N - a[:, None] * w
     length = np.linalg.norm(p, axis=-1, keepdims=True)
-    fallback, _ = _orthonormal_frame(w)
+    fallback, _ = frame_from_normal(w)
     t = np.where(length > 1e-12, p / np.where(length > 1e-12, length, 1.0), fallback)
-    return t, np.cross(w, t)
-
-
-def _orthonormal_frame(w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Two unit vectors ``t, b`` with ``(t, b, w)`` right-handed and orthonormal, per row."""
-    helper = np.where(np.abs(w[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
-    t = np.cross(helper, w)
-    t /= np.linalg.norm(t, axis=-1, keepdims=True)
     return t, np.cross(w, t)
 
 

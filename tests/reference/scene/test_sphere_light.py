@@ -168,6 +168,10 @@ def test_a_scene_file_names_a_sphere_light_and_its_metadata_says_what_was_done()
         ("position = [0, 0, 3]\nradius = -1", "lights[0].radius: must be >= 0, got -1"),
         ('position = [0, 0, 3]\nradius = "big"', "lights[0].radius"),
         ("radius = 1", "lights[0]: missing key 'position'"),
+        ("position = [0, 0, 3]\nradius = nan", "lights[0].radius"),
+        ("position = [0, 0, 3]\nradius = inf", "lights[0].radius"),
+        ("position = [0, nan, 3]\nradius = 1", "lights[0].position"),
+        ("position = [0, 0, 3]\nradius = 1\nintensity = -2", "lights[0].intensity: must be >= 0"),
     ],
 )
 def test_bad_sphere_lights_are_refused_in_one_line(table, message):
@@ -176,7 +180,7 @@ def test_bad_sphere_lights_are_refused_in_one_line(table, message):
     assert "\n" not in str(error.value)
 
 
-@pytest.mark.parametrize("tol", [0, -1, 1.5, "tight", True])
+@pytest.mark.parametrize("tol", [0, -1, 1.5, float("nan"), "tight", True])
 def test_a_bad_tolerance_is_refused(tol):
     surface = _surface([[0.0, 0.0, 1.0]])
     ctx = ShadingContext(options={"sphere_light_tol": tol})

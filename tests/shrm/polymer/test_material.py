@@ -281,6 +281,15 @@ def test_bad_input_is_one_line_naming_the_key(sky, material, message):
     assert str(error.value).startswith("s.toml: ")
 
 
+@pytest.mark.parametrize("tol", [0, -0.1, 1.5, float("nan"), "tight", True])
+def test_a_bad_oracle_tolerance_is_refused_in_one_line(sky, tol):
+    scene = load(sky, "")
+    options = {"environment": "bruteforce", "polymer_oracle_tol": tol}
+    with pytest.raises(SpecrefError, match=r"options\.polymer_oracle_tol: must be a number") as e:
+        render_scene(scene, width=4, height=4, options=options)
+    assert "\n" not in str(e.value)
+
+
 def test_unknown_tint_lists_the_closest_names(sky):
     with pytest.raises(SpecrefError, match=r"closest: pb-lemon") as error:
         load(sky, 'tint = "lemon"')
