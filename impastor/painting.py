@@ -56,6 +56,7 @@ __all__ = [
     "PAINTING_LIGHTING_METHODS",
     "PAINT_SPECTRA",
     "PaintingScene",
+    "booth_in_canvas_frame",
     "booth_lamp_kind",
     "booth_light_spectrum",
     "booth_plane_light",
@@ -64,6 +65,7 @@ __all__ = [
     "canvas_materials",
     "canvas_pixels",
     "check_eye",
+    "check_pose",
     "impasto_painting",
     "lights_visibility",
     "load_paint_spectra",
@@ -72,6 +74,7 @@ __all__ = [
     "painting_specular_fis",
     "painting_specular_hybrid",
     "painting_specular_point_lights",
+    "posed_scene",
     "render_painting",
     "shade_canvas",
 ]
@@ -301,6 +304,109 @@ def check_eye(eye, where: str = "--observer") -> np.ndarray:
     return point
 
 
+def _tilt_rotation(tilt: float) -> np.ndarray:
+    """``R_x(tilt)``: the booth's frame into the frame of a canvas tilted by ``tilt`` radians."""
+    tilt = float(tilt)
+    require(
+        np.isfinite(tilt) and abs(tilt) <= np.pi / 2,
+        f"tilt: must be within ±90° of the booth's canvas, got {np.degrees(tilt):g}°",
+    )
+    c, s = np.cos(tilt), np.sin(tilt)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def booth_in_canvas_frame(
+    plane: PlaneLight, eye, tilt: float = 0.0
+) -> tuple[PlaneLight, np.ndarray]:
+    """The booth's light and viewer seen from a canvas turned by ``tilt`` about the booth's x axis.
+
+    ImpastoR's painting is the display (§3.4, Ferwerda): as the screen is tilted, the painting
+    turns with it under the booth's fixed light, in front of a viewer who stays where they are.
+    The canvas turns about its centre line from left to right by the rotation that tilts the
+    screen in :mod:`reference.display.pipeline`, ``R_x(−tilt)``: a positive tilt takes its normal
+    from +y towards −z, away from the viewer and towards the booth's light. The renderer keeps the
+    canvas in y = 0 facing +y, so the light plane and the viewer turn by the inverse, ``R_x(tilt)``.
+
+    Parameters
+    ----------
+    plane : PlaneLight
+        The booth's light in the booth's frame.
+    eye : (3,) array_like
+        The viewer in the booth's frame, m.
+    tilt : float
+        The canvas's tilt, radians, in [−π/2, π/2].
+
+    Returns
+    -------
+    (PlaneLight, ndarray of shape (3,))
+        The light and the viewer in the canvas's frame.
+
+    Examples
+    --------
+    >>> plane = booth_plane_light("fluorescent", 16, 8)
+    >>> turned, eye = booth_in_canvas_frame(plane, EYE, np.radians(90.0))
+    >>> np.round(eye, 12).tolist(), np.round(turned.n_light, 12).tolist()
+    ([0.0, -0.6, 0.45], [0.0, 0.0, -1.0])
+    >>> booth_in_canvas_frame(plane, EYE, 0.0)[0] is plane    # at rest: the booth as it is
+    True
+    """
+    R = _tilt_rotation(tilt)
+    if float(tilt) == 0.0:
+        return plane, np.asarray(eye, dtype=np.float64)
+    turned = replace(
+        plane,
+        origin=tuple(R @ np.asarray(plane.origin)),
+        A=tuple(R @ np.asarray(plane.A)),
+        B=tuple(R @ np.asarray(plane.B)),
+    )
+    return turned, R @ np.asarray(eye, dtype=np.float64)
+
+
+def check_pose(eye=EYE, tilt: float = 0.0) -> np.ndarray:
+    """The viewer (the booth's frame, m) in the frame of the canvas tilted by ``tilt`` radians.
+
+    One-line errors for a viewer that is not x, y, z, a tilt beyond ±90° and a viewer the tilted
+    canvas faces away from.
+
+    Examples
+    --------
+    >>> check_pose(EYE, np.radians(20.0)).round(3).tolist()
+    [0.0, 0.218, 0.718]
+    >>> check_pose(EYE, np.radians(45.0))
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: tilt: at 45° the canvas faces away from the viewer at (0, 0.45,
+    0.6) m
+    """
+    eye = np.asarray(check_eye(eye, "eye"), dtype=np.float64)
+    eye_canvas = _tilt_rotation(tilt) @ eye
+    require(
+        eye_canvas[1] > 1e-3,
+        f"tilt: at {np.degrees(tilt):g}° the canvas faces away from the viewer at "
+        f"({', '.join(f'{c:g}' for c in eye)}) m",
+    )
+    return eye_canvas
+
+
+def posed_scene(scene: PaintingScene, eye=EYE, tilt: float = 0.0) -> tuple:
+    """The scene and the viewer in the frame of the canvas tilted by ``tilt`` radians (a pose).
+
+    :func:`check_pose`, then :func:`booth_in_canvas_frame` applied to the scene's light.
+
+    Examples
+    --------
+    >>> scene = painting_scene("D65", "median_cut", impasto_painting(16), light_resolution=(16, 8))
+    >>> posed, eye = posed_scene(scene, EYE, np.radians(20.0))
+    >>> bool(posed.plane.origin[1] > scene.plane.origin[1]), bool(eye[1] < EYE[1])
+    (True, True)
+    >>> posed_scene(scene, EYE, 0.0)[0] is scene
+    True
+    """
+    eye_canvas = check_pose(eye, tilt)
+    plane, _ = booth_in_canvas_frame(scene.plane, eye, tilt)
+    return (scene if plane is scene.plane else scene._replace(plane=plane)), eye_canvas
+
+
 def _painting_gbuffer(size: int, width_m: float, eye=EYE):
     from reference.geometry.camera import Camera
     from reference.geometry.gbuffer import render_gbuffer
@@ -382,6 +488,7 @@ def render_painting(
     failsafe: bool = True,
     eye=EYE,
     n_channels: int = 6,
+    tilt: float = 0.0,
 ) -> dict:
     """Render a painting (the demo one by default) under a booth light through ImpastoR.
 
@@ -391,28 +498,25 @@ def render_painting(
 
     Parameters
     ----------
-    light : str
-        Illuminant key; A uses the incandescent booth image, others the fluorescent one.
-    size : int
-        Image side, pixels.
+    light, size
+        Illuminant key (A: the incandescent booth image, else the fluorescent one); image side, px.
     method : str
         A key of :data:`PAINTING_LIGHTING_METHODS`: the specular lighting, and the light sampling
         of the point lights that the diffuse term always uses.
     painting : dict, optional
         From :func:`impasto_painting` (default: one at ``size``).
-    design, light_resolution, shadows, spectra
-        Pipeline settings (``spectra``: :func:`load_paint_spectra`).
+    design, light_resolution, shadows, spectra, n_channels
+        Pipeline settings (``spectra``: :func:`load_paint_spectra`; ``n_channels``: 3-10).
     n_lights, n_samples, n_sectors, failsafe
         Point lights N, FIS samples K, horizon sectors S and the hybrid's fail-safe: fixed here
         (32, 32, 36, on); :func:`impastor.settings.render_painting_to_tolerance` chooses them.
-    backend : {"numba", "numpy"}
-        Kernels or their NumPy twins (no JIT warm-up: for small images).
-    progress : file-like, optional
-        Where to write a line per stage with its time (``specref impastor render``).
-    eye : (3,) array_like
-        The viewer (m; :data:`EYE` by default): the camera and the specular term follow it.
-    n_channels : int
-        Channels of the design (Ferwerda's six by default; 3-10 for the speed-accuracy study).
+    backend, progress
+        ``"numba"`` kernels or their ``"numpy"`` twins (no JIT warm-up: for small images); a stream
+        for a line per stage with its time (``specref impastor render``), optional.
+    eye, tilt
+        The pose: the viewer (m; :data:`EYE` by default) and the canvas's tilt (radians) under the
+        booth's fixed light, as the display showing it is tilted (:func:`booth_in_canvas_frame`;
+        the sRGB keeps the exposure at rest). The camera, shading and specular term follow both.
 
     Returns
     -------
@@ -420,7 +524,7 @@ def render_painting(
         ``XYZ`` (H, W, 3) in cd/m², ``sRGB`` encoded (H, W, 3) in [0, 1] (white = 1.2× the
         white diffuser's luminance), ``seconds`` per stage (``shadows`` is the horizon lookup,
         plus the horizon map the first time a height field is rendered: :func:`cached_horizon_map`),
-        ``settings`` (N, K, S and the fail-safe used).
+        ``settings`` (N, K, S, the fail-safe) and ``pose`` (``eye`` in m, ``tilt_deg``).
 
     Examples
     --------
@@ -429,12 +533,12 @@ def render_painting(
     ((32, 32, 3), ['diffuse', 'shadows', 'specular'], 32)
     """
     painting = painting or impasto_painting(size)
-    scene = painting_scene(light, method, painting, design, light_resolution, spectra, n_channels)
-    px = canvas_pixels(painting, size, check_eye(eye, "eye"))
+    rest = painting_scene(light, method, painting, design, light_resolution, spectra, n_channels)
+    scene, eye_canvas = posed_scene(rest, eye, tilt)
+    px = canvas_pixels(painting, size, eye_canvas)
     timer = StageTimer(progress, f"painting {size}×{size} under {light}")
-    settings = {"n_lights": n_lights, "n_samples": n_samples, "n_sectors": n_sectors} | {
-        "failsafe": bool(failsafe)
-    }
+    settings = {"n_lights": n_lights, "n_samples": n_samples, "n_sectors": n_sectors}
+    settings["failsafe"] = bool(failsafe)
 
     def horizon():
         # Once per height field, not per frame (§3.5.3, Ferwerda: a precomputed map).
@@ -442,8 +546,18 @@ def render_painting(
         return cached_horizon_map(height, pixel_size, n_sectors, 32, backend)[px.row, px.col]
 
     L, E = shade_canvas(scene, px, settings, horizon if shadows else None, backend, timer)
+    if scene.plane is not rest.plane:  # the exposure of the canvas at rest: the white it had
+        E = _rest_illuminance(rest, px, n_lights, horizon if shadows else None)
     XYZ, sRGB = _frame_images(px, L, E, scene.design)
-    return {"XYZ": XYZ, "sRGB": sRGB, "seconds": timer.seconds, "settings": settings}
+    pose = {"eye": np.asarray(eye, float).tolist(), "tilt_deg": float(np.degrees(tilt))}
+    return {"XYZ": XYZ, "sRGB": sRGB, "seconds": timer.seconds, "settings": settings, "pose": pose}
+
+
+def _rest_illuminance(rest: PaintingScene, px, n_lights: int, horizon) -> np.ndarray:
+    """Eq. (2), Ferwerda, at the pixels under the untilted booth: a tilted frame's exposure."""
+    lights = point_lights_from_plane(rest.plane, rest.lighting.sampling, n_lights)
+    visibility = None if horizon is None else lights_visibility(horizon(), px.P, lights)
+    return illuminance_point_lights(px.P, px.N, lights, visibility)
 
 
 def _frame_images(px, L, E, design) -> tuple[np.ndarray, np.ndarray]:

@@ -36,6 +36,7 @@ from impastor._kernels import diffuse_brute_force_kernel
 from impastor.horizon import horizon_at_texels
 from impastor.multispectral import channels_to_XYZ
 from impastor.painting import (
+    EYE,
     HORIZON_SECTORS,
     PaintingScene,
     canvas_frame,
@@ -44,6 +45,7 @@ from impastor.painting import (
     impasto_painting,
     lights_visibility,
     painting_scene,
+    posed_scene,
     render_painting,
     shade_canvas,
 )
@@ -266,6 +268,8 @@ class PaintingPilot:
     size : int
         The pilot's image side (its visible canvas pixels are the pilot's pixels).
     backend : {"numba", "numpy"}
+    eye : (3,) array_like
+        The viewer in the canvas's frame, m (:func:`impastor.painting.posed_scene`).
 
     Attributes
     ----------
@@ -276,10 +280,12 @@ class PaintingPilot:
         those settings on the pilot pixels (memoised).
     """
 
-    def __init__(self, scene: PaintingScene, size: int = PILOT_SIZE, backend: str = "numba"):
+    def __init__(
+        self, scene: PaintingScene, size: int = PILOT_SIZE, backend: str = "numba", eye=EYE
+    ):
         painting = scene.painting
         self.scene, self.backend = scene, backend
-        self.px = canvas_pixels(painting, size)
+        self.px = canvas_pixels(painting, size, eye)
         brute_force = painting_brute_force(scene, self.px, backend)
         self.reference = channels_to_XYZ(brute_force, scene.design)
         height, pixel_size, rows, cols = (
@@ -363,6 +369,7 @@ def settings_from_tolerance(
     pilot_size: int = PILOT_SIZE,
     backend: str = "numba",
     pilot: PaintingPilot | None = None,
+    eye=EYE,
 ) -> PaintingSettings:
     """The cheapest N, K, S and fail-safe whose pilot error is within ``tolerance`` (erratum E96).
 
@@ -380,6 +387,8 @@ def settings_from_tolerance(
     backend : {"numba", "numpy"}
     pilot : PaintingPilot, optional
         A pilot of this scene already made (several tolerances share one).
+    eye : (3,) array_like
+        The viewer in the canvas's frame, m: the pilot's pixels are the canvas as they see it.
 
     Returns
     -------
@@ -395,7 +404,7 @@ def settings_from_tolerance(
     (True, True, True)
     """
     check_tolerance(tolerance)
-    pilot = pilot or PaintingPilot(scene, pilot_size, backend)
+    pilot = pilot or PaintingPilot(scene, pilot_size, backend, eye)
     top = tuple(ladder[-1] for ladder in _LADDERS)
     base = pilot.error(*top)
     if base > PILOT_MARGIN * tolerance:
@@ -422,7 +431,8 @@ def render_painting_to_tolerance(
     tolerance : float
         Relative RMS error against brute force, > 0.
     **options
-        ``design``, ``light_resolution``, ``spectra``, ``backend`` of :func:`render_painting`.
+        ``design``, ``light_resolution``, ``spectra``, ``backend``, ``eye``, ``tilt`` of
+        :func:`render_painting` (the pilot is made in the frame's pose).
 
     Returns
     -------
@@ -443,12 +453,13 @@ def render_painting_to_tolerance(
     painting = painting or impasto_painting(size)
     keys = ("design", "light_resolution", "spectra")
     scene_options = {k: options[k] for k in keys if k in options}
-    scene = painting_scene(light, method, painting, **scene_options)
+    rest = painting_scene(light, method, painting, **scene_options)
+    # the pilot sees the canvas in the frame's pose
+    scene, eye = posed_scene(rest, options.get("eye", EYE), options.get("tilt", 0.0))
     timer = StageTimer(progress, f"settings for a tolerance of {tolerance:g}")
     with timer.stage("pilot"):
-        chosen = settings_from_tolerance(
-            scene, tolerance, min(PILOT_SIZE, size), options.get("backend", "numba")
-        )
+        backend = options.get("backend", "numba")
+        chosen = settings_from_tolerance(scene, tolerance, min(PILOT_SIZE, size), backend, eye=eye)
     out = render_painting(
         light, size, method, painting, progress=progress, **options, **chosen.render_options()
     )

@@ -2,6 +2,7 @@
 
 import imageio.v3 as iio
 import numpy as np
+import pytest
 
 from impastor import painting as imp
 from validation.cli import main
@@ -65,3 +66,94 @@ def test_the_path_command_writes_an_animation(tmp_path, capsys):
         assert len(err.splitlines()) == 1
         assert message in err
     assert not (tmp_path / "bad.png").exists()
+
+
+# --- the display's tilt turns the painting under the booth's light --------------------------------
+
+
+def _flat_matte(size=32):
+    painting = imp.impasto_painting(size, seed=5)
+    for key in ("height", "rho_s", "material"):
+        painting[key] = np.zeros_like(painting[key])
+    return painting
+
+
+def _booth_illuminance(tilt, resolution):
+    # Independent of the render's frame change: every pixel of the booth's ceiling, in the booth's
+    # own frame, seen from the canvas centre whose normal is turned instead, R_x(−tilt) (0, 1, 0)
+    plane = imp.booth_plane_light("fluorescent", *resolution)
+    x, L = plane.pixel_positions().reshape(-1, 3), plane.image.reshape(-1)
+    n = np.array([0.0, np.cos(tilt), -np.sin(tilt)])
+    r2 = (x * x).sum(axis=1)
+    w = x / np.sqrt(r2)[:, None]
+    cos_s, cos_l = np.maximum(w @ n, 0.0), np.maximum(-(w @ plane.n_light), 0.0)
+    return float((L * cos_s * cos_l * plane.pixel_area / r2).sum())
+
+
+def test_a_tilted_flat_canvas_follows_lamberts_law_under_the_booth_light():
+    # a flat matte canvas lit by every light pixel (N = the light's 128 pixels): the centre pixel's
+    # luminance over its value at rest is the booth's illuminance ratio for the turned normal
+    resolution, painting = (16, 8), _flat_matte()
+    options = {"light_resolution": resolution, "n_lights": 128, "backend": "numpy"}
+
+    def centre_Y(tilt):
+        out = imp.render_painting("D65", 33, "median_cut", painting, tilt=tilt, **options)
+        return out["XYZ"][16, 16, 1]
+
+    rest, rest_E = centre_Y(0.0), _booth_illuminance(0.0, resolution)
+    for degrees in (-40.0, -20.0, 20.0, 35.0):
+        t = np.radians(degrees)
+        ratio = centre_Y(t) / rest
+        assert abs(ratio / (_booth_illuminance(t, resolution) / rest_E) - 1) < 1e-4, degrees
+    # towards the light it brightens, away from it it darkens
+    assert centre_Y(np.radians(20.0)) > rest > centre_Y(np.radians(-20.0))
+
+
+def test_a_canvas_turned_from_the_whole_light_is_black_and_keeps_its_exposure():
+    painting = imp.impasto_painting(32, seed=5)
+    away = imp.render_painting("D65", 16, painting=painting, tilt=np.radians(-75.0), **OPTIONS)
+    assert away["pose"]["tilt_deg"] == -75.0
+    assert np.all(away["XYZ"] == 0)  # every light pixel is behind the canvas's plane
+    # the sRGB keeps the exposure of the canvas at rest: turned from the light, it darkens
+    rest = imp.render_painting("D65", 16, painting=painting, **OPTIONS)
+    less = imp.render_painting("D65", 16, painting=painting, tilt=np.radians(-30.0), **OPTIONS)
+    seen = lambda out: out["sRGB"][out["XYZ"][..., 1] > 0].mean()  # noqa: E731
+    assert seen(less) < seen(rest)
+
+
+def test_the_pose_is_checked_and_the_pilot_sees_the_tilted_canvas():
+    from impastor.settings import render_painting_to_tolerance
+    from reference.errors import SpecrefError
+
+    painting = imp.impasto_painting(32, seed=5)
+    out = render_painting_to_tolerance(
+        "A", 16, 0.05, painting=painting, light_resolution=(16, 8), backend="numpy",
+        tilt=np.radians(20.0),
+    )  # fmt: skip
+    assert out["pose"]["tilt_deg"] == 20.0
+    assert out["settings"]["met"]
+    assert out["settings"]["pilot_error"] <= 0.05
+    for tilt, message in ((np.radians(45.0), "faces away from the viewer"),
+                          (np.radians(95.0), "within ±90°"), (np.nan, "within ±90°")):  # fmt: skip
+        with pytest.raises(SpecrefError, match=message):
+            imp.render_painting("D65", 8, painting=painting, tilt=tilt, **OPTIONS)
+
+
+def test_the_commands_take_the_tilt(tmp_path, capsys):
+    out = tmp_path / "tilt.png"
+    command = ["impastor", "path", "--frames", "3", "--size", "16", "--method", "median_cut"]
+    assert main([*command, "--tilt-from", "-20", "--tilt-to", "20", "-o", str(out)]) == 0
+    frames = iio.imread(out, index=None)
+    assert frames.shape[:3] == (3, 16, 16)
+    assert not np.array_equal(frames[0], frames[2])
+    assert "tilt 20.0°" in capsys.readouterr().err
+    bad = ["--tilt-to", "60", "-o", str(tmp_path / "bad.png")]
+    assert main([*command, *bad]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "frame 3 of the path: tilt: at 60° the canvas faces away" in err
+    assert len(err.splitlines()) == 1
+    assert not (tmp_path / "bad.png").exists()
+    render = ["impastor", "render", "--size", "16", "--method", "median_cut", "--tilt", "50"]
+    assert main([*render, "--out", str(tmp_path / "r.png")]) == 2
+    assert "faces away from the viewer" in capsys.readouterr().err
+    assert not (tmp_path / "r.png").exists()

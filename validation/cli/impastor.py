@@ -75,6 +75,8 @@ def _cmd_impastor_path(args) -> int:
         painting=args.painting,
         fps=args.fps,
         progress=sys.stderr,
+        tilt_from=args.tilt_from,
+        tilt_to=args.tilt_to,
     )
     print(summary)
     return 0
@@ -147,6 +149,16 @@ def _add_path(isub) -> None:
     )
     a.add_argument("--frames", type=int, default=24, help="frames along the path (default 24)")
     a.add_argument("--fps", type=float, default=12.0, help="frames per second (default 12)")
+    a.add_argument(
+        "--tilt-from",
+        type=float,
+        default=0.0,
+        metavar="DEG",
+        help="the canvas's first tilt about x, degrees, as the display showing it (default 0)",
+    )
+    a.add_argument(
+        "--tilt-to", type=float, default=0.0, metavar="DEG", help="its last tilt (default 0)"
+    )
     a.add_argument("--painting", type=input_file, metavar="DIR", help="a painting folder")
     a.add_argument("--light", default="D65", help="illuminant key (D65, D50, A, FL2, ...)")
     a.add_argument("--size", type=int, default=256, help="image side in pixels (default 256)")
@@ -186,7 +198,13 @@ def _add_render(isub) -> None:
         default="0,0,0.6",
         help="eye position x,y,z in metres from the screen centre (default 0,0,0.6)",
     )
-    r.add_argument("--tilt", type=float, default=0.0, help="display tilt about x, degrees")
+    r.add_argument(
+        "--tilt",
+        type=float,
+        default=0.0,
+        help="display tilt about x, degrees: the painting turns with the display under the "
+        "booth's light, and the display's compensation follows it",
+    )
     r.add_argument(
         "--screen-lux", type=float, default=1000.0, help="booth illuminance on the screen, lux"
     )

@@ -150,7 +150,8 @@ def render_for_cli(
             np.isfinite(light_luminance) and light_luminance >= 0,
             f"--light-luminance: must be >= 0 cd/m², got {light_luminance!r}",
         )
-    result = _render(light, size, method, tolerance, painting, progress)
+    tilt = np.radians(tilt_deg)  # the display's tilt turns the painting it shows (§3.4)
+    result = _render(light, size, method, tolerance, painting, progress, tilt)
     write_png(out, result["sRGB"], {"specref": json.dumps(result["settings"])})
     seconds = sum(result["seconds"].values())
     summary = f"wrote {out} ({size}×{size}, {light}, {method}, shading {seconds:.2f} s"
@@ -161,19 +162,22 @@ def render_for_cli(
     return summary
 
 
-def _render(light, size, method, tolerance, painting, progress) -> dict:
+def _render(light, size, method, tolerance, painting, progress, tilt=0.0) -> dict:
     """The painting (read from its folder, else the demo) at fixed or tolerance-chosen settings."""
-    from impastor.painting import render_painting
+    from impastor.painting import check_pose, render_painting
 
+    check_pose(tilt=tilt)  # a canvas turned away from the viewer fails before any work
     if painting is not None:
         from impastor.painting_files import read_painting
 
         painting = read_painting(painting)
     if tolerance is None:
-        return render_painting(light, size, method, painting, progress=progress)
+        return render_painting(light, size, method, painting, progress=progress, tilt=tilt)
     from impastor.settings import render_painting_to_tolerance
 
-    return render_painting_to_tolerance(light, size, tolerance, method, painting, progress=progress)
+    return render_painting_to_tolerance(
+        light, size, tolerance, method, painting, progress=progress, tilt=tilt
+    )
 
 
 def render_path_for_cli(
@@ -187,13 +191,17 @@ def render_path_for_cli(
     painting=None,
     fps: float = 12.0,
     progress=None,
+    tilt_from: float = 0.0,
+    tilt_to: float = 0.0,
 ) -> str:
-    """Render the painting from a path of viewer positions; write an animated PNG (APNG).
+    """Render the painting from a path of poses; write an animated PNG (APNG).
 
     The viewer moves in a straight line from ``eye_from`` to ``eye_to`` (m, the booth's frame)
-    over ``frames`` frames; the camera and the specular term follow it, while the horizon map
-    (pose-independent, §3.5.3, Ferwerda) is computed once for all frames. Every input is
-    checked, and the output proved writable, before the first frame.
+    and the canvas turns from ``tilt_from`` to ``tilt_to`` (degrees, as the display that shows it;
+    :func:`impastor.painting.booth_in_canvas_frame`) over ``frames`` frames; the camera, the
+    shading and the specular term follow the pose, while the horizon map (pose-independent,
+    §3.5.3, Ferwerda) is computed once for all frames. Every pose is checked, and the output
+    proved writable, before the first frame.
 
     Examples
     --------
@@ -205,8 +213,8 @@ def render_path_for_cli(
     """
     import imageio.v3 as iio
 
-    from impastor.painting import PAINTING_LIGHTING_METHODS, check_eye
-    from reference.errors import require, require_positive_int
+    from impastor.painting import PAINTING_LIGHTING_METHODS, check_eye, check_pose
+    from reference.errors import SpecrefError, require, require_positive_int
     from reference.files import atomic_path, check_output_file
 
     PAINTING_LIGHTING_METHODS.lookup(method)
@@ -214,30 +222,39 @@ def render_path_for_cli(
     frames = require_positive_int(frames, "--frames", MAX_PATH_FRAMES)
     require(np.isfinite(fps) and 0 < fps <= 120, f"--fps: must be in (0, 120], got {fps!r}")
     start, end = check_eye(eye_from, "--from"), check_eye(eye_to, "--to")
+    tilts = np.radians(np.linspace(tilt_from, tilt_to, frames))
+    eyes = [start + (end - start) * (k / max(frames - 1, 1)) for k in range(frames)]
+    for k, (eye, tilt) in enumerate(zip(eyes, tilts, strict=True)):
+        try:
+            check_pose(eye, tilt)
+        except SpecrefError as error:
+            raise SpecrefError(f"frame {k + 1} of the path: {error}") from None
     check_output_file(out)
     if painting is not None:
         from impastor.painting_files import read_painting
 
         painting = read_painting(painting)
     images = []
-    for k in range(frames):
-        eye = start + (end - start) * (k / max(frames - 1, 1))
-        result = _render_pose(light, size, method, painting, eye)
+    for k, (eye, tilt) in enumerate(zip(eyes, tilts, strict=True)):
+        result = _render_pose(light, size, method, painting, eye, tilt)
         images.append(np.round(np.clip(result["sRGB"], 0, 1) * 255).astype(np.uint8))
         if progress is not None:
             seconds = sum(result["seconds"].values())
             eye_text = ", ".join(f"{c:.3f}" for c in eye)
-            progress.write(f"frame {k + 1}/{frames} from ({eye_text}) m: {seconds:.2f} s\n")
+            progress.write(
+                f"frame {k + 1}/{frames} from ({eye_text}) m, tilt {np.degrees(tilt):.1f}°: "
+                f"{seconds:.2f} s\n"
+            )
             progress.flush()
     with atomic_path(out, suffix=".png") as tmp:
         iio.imwrite(tmp, np.stack(images), extension=".png", duration=1000.0 / fps, loop=0)
     return f"wrote {out}: {frames} frames of {size}×{size} at {fps:g} frames per second (APNG)"
 
 
-def _render_pose(light, size, method, painting, eye) -> dict:
+def _render_pose(light, size, method, painting, eye, tilt=0.0) -> dict:
     from impastor.painting import render_painting
 
-    return render_painting(light, size, method, painting, eye=eye)
+    return render_painting(light, size, method, painting, eye=eye, tilt=tilt)
 
 
 def _check_before_render(tolerance, out, counts_out) -> None:
