@@ -46,7 +46,14 @@ from validation.studies.phong import (
 )
 from validation.studies.phong_table1 import target_checks
 
-__all__ = ["FULL", "QUICK", "PhongStudy", "phong_speed_accuracy"]
+__all__ = [
+    "FULL",
+    "QUICK",
+    "PhongStudy",
+    "phong_speed_accuracy",
+    "segments_caption",
+    "sweep_caption",
+]
 
 QUICK_NOTE = " with the NumPy references (quick mode: times not representative)"
 #: Image size of the in-run speed-up in full mode: Table 1's.
@@ -433,6 +440,52 @@ def _sweep_figure(sweep: dict, xlabel: str, m: int = 200):
     return fig
 
 
+def sweep_caption(sweep: dict, what: str, unit: str) -> str:
+    """A failure sweep's caption from its figures: where the lines end, and which fail.
+
+    ``sweep`` as the failure sweeps give it (``x``, and ``rms`` per "variant interpolation").
+
+    Examples
+    --------
+    >>> sweep = {"x": [1, 10, 100], "rms": {"uniform linear": [0.1, 1.0, 50.0],
+    ...                                     "error monotone": [0.01, 0.01, 0.02]}}
+    >>> print(sweep_caption(sweep, "the exponent scale", "n"))
+    Where methods fail, against the exponent scale (far view, m = 200): at n = 100 the worst is
+    uniform linear (RMS 50, 500× its value at n = 1), the best error monotone (RMS 0.02); 1 of 2
+    lines grow more than tenfold
+    """
+    x, rms = sweep["x"], sweep["rms"]
+    last = {name: ys[-1] for name, ys in rms.items()}
+    worst, best = max(last, key=last.get), min(last, key=last.get)
+    grows = sum(ys[-1] > 10 * ys[0] for ys in rms.values())
+    growth = rms[worst][-1] / max(rms[worst][0], 1e-12)
+    return (
+        f"Where methods fail, against {what} (far view, m = 200): at {unit} = {x[-1]:g} the worst "
+        f"is {worst} (RMS {last[worst]:.3g}, {growth:.3g}× its value at {unit} = {x[0]:g}), the "
+        f"best {best} (RMS {last[best]:.3g}); {grows} of {len(rms)} lines grow more than tenfold"
+    )
+
+
+def segments_caption(segments: dict) -> str:
+    """The segment chart's caption from its figures: the best p per scene against p = m.
+
+    Examples
+    --------
+    >>> print(segments_caption({"p": [1, 10, 200], "rms": {"R1": [5, 0.5, 2], "R2": [1, 2, 3]}}))
+    Importance tables (m = 200, t-parabola) against their segment count p: the best p is 10 for
+    R1 (RMS 0.5 against 2 at p = 200), 1 for R2 (RMS 1 against 3)
+    """
+    ps, parts = segments["p"], []
+    for k, (scene, ys) in enumerate(segments["rms"].items()):
+        i = int(np.argmin(ys))
+        at = f" at p = {ps[-1]:g}" if k == 0 else ""
+        parts.append(f"{ps[i]:g} for {scene} (RMS {ys[i]:.3g} against {ys[-1]:.3g}{at})")
+    return (
+        "Importance tables (m = 200, t-parabola) against their segment count p: the best p is "
+        + ", ".join(parts)
+    )
+
+
 def _segments_figure(segments: dict):
     """RMS of the importance table against its segment count p, one line per scene."""
     import matplotlib.pyplot as plt
@@ -484,17 +537,17 @@ def present(ctx: ReportContext, data: SectionData) -> list:
         ctx.figure(
             "exponent-scale",
             _sweep_figure(results["exponent-scale"], "exponent n (constant)"),
-            "Where methods fail: RMS against the exponent scale (far view)",
+            sweep_caption(results["exponent-scale"], "a constant exponent", "n"),
         ),
         ctx.figure(
             "exponent-spread",
             _sweep_figure(results["exponent-spread"], "n above 580 nm (n = 5 below)"),
-            "Where methods fail: RMS against the exponent spread of a bimodal n(λ) (far view)",
+            sweep_caption(
+                results["exponent-spread"], "the spread of a bimodal n(λ) (n = 5 below 580 nm)", "n"
+            ),
         ),
         ctx.figure(
-            "segments",
-            _segments_figure(results["segments"]),
-            "RMS against the importance table's segment count p",
+            "segments", _segments_figure(results["segments"]), segments_caption(results["segments"])
         ),
         _tolerance_table(data),
         Text(f"Non-finite RMS values in all sweeps: {results['nonfinite']} (must be 0)."),

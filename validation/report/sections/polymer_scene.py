@@ -284,7 +284,12 @@ def present(ctx: ReportContext, data: SectionData) -> list:
             "thin-film effect pigment at Mod_effect 0.7; cap: 3.048 mm, 2 % TiO2, tinted "
             "pb-orange, exponent 40 (the others 200)."
         ),
-        ctx.image("bottle", data.arrays["encoded"], "Three polymer groups on one mesh"),
+        ctx.image(
+            "bottle",
+            data.arrays["encoded"],
+            "Three polymer groups on one mesh, each shaded as its own material: "
+            + ", ".join(f"{g} {r['pixels'][g]:,} px" for g in r["groups"]),
+        ),
         Table(
             ["group", "pixels"],
             [[g, r["pixels"][g]] for g in r["groups"]],

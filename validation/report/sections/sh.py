@@ -65,6 +65,7 @@ __all__ = [
     "prefilter_agreement",
     "ringing_by_order",
     "sh_accuracy_and_speed",
+    "window_caption",
     "window_reconstructions",
 ]
 
@@ -442,11 +443,32 @@ def _ringing_blocks(ctx, data) -> list:
     ]
     for window, rec in data.arrays["windows"].items():
         encoded = linear_to_display(rec, "srgb", data.arrays["window_exposure"])
-        encoded[(rec < 0).any(axis=-1)] = (1.0, 0.0, 1.0)
-        blocks.append(
-            ctx.image(f"window-{window}", encoded, f"L = 100, window {window} (negative: magenta)")
-        )
+        negative = (rec < 0).any(axis=-1)
+        encoded[negative] = (1.0, 0.0, 1.0)
+        blocks.append(ctx.image(f"window-{window}", encoded, window_caption(window, rec)))
     return blocks
+
+
+def window_caption(window: str, reconstruction) -> str:
+    """The caption of a windowed reconstruction's picture, from its pixels (magenta: negative).
+
+    Examples
+    --------
+    >>> rec = np.ones((2, 4, 3)); rec[0, 0] = -0.5
+    >>> window_caption("none", rec)
+    'L = 100, window none: 12.5 % of pixels negative (magenta), down to -0.5 of the peak'
+    >>> window_caption("gaussian", np.ones((2, 4, 3)))
+    'L = 100, window gaussian: no pixel negative'
+    """
+    rec = np.asarray(reconstruction, dtype=np.float64)
+    negative = (rec < 0).any(axis=-1)
+    if not negative.any():
+        return f"L = 100, window {window}: no pixel negative"
+    share, low = 100 * float(negative.mean()), float(rec.min() / rec.max())
+    return (
+        f"L = 100, window {window}: {share:.3g} % of pixels negative (magenta), down to "
+        f"{low:.2g} of the peak"
+    )
 
 
 def _irradiance_blocks(ctx, maps) -> list:

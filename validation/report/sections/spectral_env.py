@@ -567,7 +567,12 @@ def _panorama_blocks(ctx: ReportContext, data: SectionData) -> list:
     ax.set_xlabel("wavelength (nm)")
     ax.set_ylabel("spectrum / its peak")
     ax.legend(fontsize=7)
-    blocks.append(ctx.figure("picks", fig, "Spectra of picked pixels of the panorama"))
+    peaks = [
+        f"{name} at {GRID_41.wavelengths_nm[int(np.argmax(spectrum))]:g} nm"
+        for name, spectrum in data.results["picks"].items()
+    ]
+    caption = "Spectra of picked pixels of the panorama, each over its peak: " + ", ".join(peaks)
+    blocks.append(ctx.figure("picks", fig, caption))
     return blocks
 
 

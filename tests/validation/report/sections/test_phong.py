@@ -172,6 +172,14 @@ def test_phong_section_compute_present_checks_on_tiny_settings(tiny):
         for name in ("pareto", "exponent-scale", "exponent-spread", "segments")
     ]
     assert all((ctx.out_dir / path).stat().st_size > 1000 for path in images)
+    # each failure chart's caption names the line that ends worst, with its RMS from the run
+    captions = {b.path: b.caption for b in blocks if isinstance(b, Image)}
+    for name in ("exponent-scale", "exponent-spread"):
+        ends = {k: ys[-1] for k, ys in data.results[name]["rms"].items()}
+        worst = max(ends, key=ends.get)
+        caption = captions[f"images/phong-{name}.png"]
+        assert f"the worst is {worst} (RMS {ends[worst]:.3g}" in caption
+    assert "the best p is" in captions["images/phong-segments.png"]
     # the targets are shown by the report around the section (folded), not again as a table
     tables = [b for b in blocks if isinstance(b, Table)]
     assert all(t.columns[:2] != ["target", "limit"] for t in tables)
