@@ -28,6 +28,7 @@ __all__ = [
     "PAPER_TABLE1",
     "TABLE1_METHODS",
     "NameWriter",
+    "curves_caption",
     "fig2_uniform",
     "fig3_cosine_powers",
     "fig4_nodes",
@@ -236,6 +237,26 @@ def fig4_nodes(writer, state: ViewState, entries: int = 20, divisor: int = 4) ->
     return writer.figure(f"fig4-nodes-{state.model.name}", fig, caption)
 
 
+def curves_caption(scene: str, model) -> str:
+    """Figs. 5-7 (g)-(j), Wang et al.: what makes the scene hard, read from its curves.
+
+    Examples
+    --------
+    >>> print(curves_caption("R1", _r1_states()["far"].model))
+    R1 (reconstruction, Erratum E24): light, k_d, k_s and n (log axis); n runs from ... at ...
+    nm to ... at ... nm (...×), k_s peaks at ... nm
+    """
+    wl, m = model.grid.wavelengths_nm, model.material
+    n = np.asarray(m.n, dtype=np.float64) * np.ones(wl.size)
+    k_s = np.asarray(m.k_s, dtype=np.float64) * np.ones(wl.size)
+    lo, hi = int(np.argmin(n)), int(np.argmax(n))
+    return (
+        f"{scene} (reconstruction, Erratum E24): light, k_d, k_s and n (log axis); n runs from "
+        f"{n[lo]:.4g} at {wl[lo]:g} nm to {n[hi]:.4g} at {wl[hi]:g} nm ({n[hi] / n[lo]:.3g}×), "
+        f"k_s peaks at {wl[int(np.argmax(k_s))]:g} nm"
+    )
+
+
 def _curves_figure(model):
     import matplotlib.pyplot as plt
 
@@ -278,7 +299,7 @@ def fig567_scene(writer, scene: str, states: dict, entries: int = TABLE1_ENTRIES
         writer.figure(
             f"fig567-{scene}-curves",
             _curves_figure(model),
-            f"{scene} (reconstruction, Erratum E24): light, k_d, k_s and n (log axis).",
+            curves_caption(scene, model),
         )
     ]
     for view, state in states.items():
