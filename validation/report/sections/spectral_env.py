@@ -36,7 +36,8 @@ CC = "ColorChecker N Ohta"
 SHIPPED = ("root_polynomial", 4)
 RELIGHT = ("D65", "A", "FL2")
 #: The panorama the section spectralizes (shipped with specref).
-PANORAMA = data_path("environments/venice_sunset_1k.hdr")
+PANORAMA_NAME = "environments/venice_sunset_1k.hdr"
+PANORAMA = data_path(PANORAMA_NAME)
 # Picked pixels of the panorama, as (row, column) fractions: sun, sky, water, shadowed building.
 PICKS = {"sun": (0.47, 0.52), "sky": (0.2, 0.3), "water": (0.8, 0.5), "building": (0.55, 0.1)}
 # Rows of the methods table that quick mode leaves out (features, degree).
@@ -125,16 +126,9 @@ def nonnegative_study() -> dict:
 
 
 def _panorama(box: int) -> dict:
-    from reference.colour.spectral_regression import model_XYZ_weights, project_nonnegative
-    from reference.colour.upsampling import default_regression
-    from reference.geometry.camera import downsample_box
-    from reference.images.formats import read_hdr
+    from validation.studies.herbert_fig1 import panorama_spectra
 
-    RGB = downsample_box(read_hdr(PANORAMA), box)
-    model = default_regression()
-    spectra = model.predict(RGB)
-    negative = (spectra < 0).any(axis=-1)  # erratum E106, as specref env spectralize does
-    spectra[negative] = project_nonnegative(spectra[negative], model_XYZ_weights(model))[0]
+    RGB, spectra = panorama_spectra(PANORAMA_NAME, box)  # negative values projected (E106)
     picks = {
         name: spectra[int(r * RGB.shape[0]), int(c * RGB.shape[1])].tolist()
         for name, (r, c) in PICKS.items()

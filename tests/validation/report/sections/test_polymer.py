@@ -49,7 +49,18 @@ def test_report_polymer_section_quick(tmp_path):
     assert all(rims[m] < hybrid_rims[m] for m in rims), (rims, hybrid_rims)
     rows = section["held_out"]["rows"]
     assert len(rows) == 2 * 4 * section["held_out"]["settings"]["chips"]
-    names = ("fig2", "chips", "terms-fresnel", "terms-cosine", "terms-none", "oracle-images")
+    names = (
+        "fig1",
+        "fig2",
+        "chips",
+        "terms-fresnel",
+        "terms-cosine",
+        "terms-none",
+        "oracle-images",
+    )
+    # Fig. 1 rebuilt: the reference light's shift is 0 and the others' are stated
+    assert section["fig1"]["delta_E00"]["D65"] == 0.0
+    assert section["fig1"]["delta_E00"]["FL2"] > 0.0
     for name in (*names, "oracle-sweeps", "oracle-speed"):
         assert (tmp_path / "images" / f"polymer-{name}.png").is_file()
     # Erratum E34: the printed model returns more than a passive surface can at grazing views
