@@ -52,28 +52,38 @@ def _chunks(cells: int, shared: int, workers: int) -> int:
 def sweep_scaling_model(
     serial_s: float, startup: dict, runs: dict, cells: int, shared: int
 ) -> dict:
-    """The sweep's time on N workers: start-up, the work divided, and a per-task overhead.
+    """The sweep's time on N workers: start-up, the work divided, its last chunk, Dask's tasks.
 
-    ``T(N) = s(N) + W/N + o·m(N)/N``, fitted to cold command-line runs (docs/scale-out.md):
+    ``T(N) = s(N) + κ·W/N + κ·W/(2·m(N)) + o·m(N)/N``, fitted to cold command-line runs
+    (docs/scale-out.md):
 
     - ``s(N) = s_0 + s_1·N``, the start-up, least squares through the one-cell sweeps on
       ``local:N`` (``startup[N]``; the process, the imports, the cluster, the kernels' loading);
     - ``W = T_serial − s_serial``, the cells' work: the serial sweep less the serial one-cell run;
-    - ``m(N)``, the Dask tasks (chunks of one shared key, and the shared builds), and ``o``, the
-      overhead per task (scheduling, the last chunk's wait, data moved), least squares through
-      what the measured ``T(N)`` leaves over, never below 0.
+    - ``κ``, the workers' slowdown on the cells against the serial process (cores shared with the
+      client, the scheduler and the nannies; 1 where each has its own);
+    - ``m(N)``, the Dask tasks (chunks of one shared key, and the shared builds): the last chunk
+      leaves the other workers idle for half a chunk on average (``κ·W/(2·m)``, from 2 workers),
+      and ``o`` is Dask's own cost per task;
+    - ``κ`` and ``o`` by non-negative least squares through the measured ``T(N)``.
 
-    The serial fraction is Amdahl's ``f = s(1)/T(1)``. Predictions assume one core per worker.
+    The serial fraction is Amdahl's ``f = s(1)/T(1)``. ``predicted_speedup`` assumes one core per
+    worker with the start-up's slope as measured here (on fewer cores it holds the workers'
+    imports competing for them: a lower bound); ``predicted_speedup_parallel_start`` takes
+    ``s_1 = 0`` (every worker starting on its own core: an upper bound).
 
     Examples
     --------
     >>> m = sweep_scaling_model(70.0, {0: 5.0, 1: 8.0, 2: 8.4}, {1: 74.0, 2: 41.5}, 3840, 8)
     >>> round(m["work_s"], 1), round(m["startup_s"][0], 1), round(m["startup_s"][1], 1)
     (65.0, 7.6, 0.4)
-    >>> round(m["speedup"][2], 2), m["predicted_speedup"][16] > m["predicted_speedup"][8]
-    (1.69, True)
+    >>> round(m["slowdown"], 2), round(m["speedup"][2], 2)
+    (1.01, 1.69)
+    >>> m["predicted_speedup"][16] < m["predicted_speedup_parallel_start"][16]
+    True
     """
     import numpy as np
+    from scipy.optimize import nnls
 
     counts = sorted(n for n in startup if n >= 1)
     A = np.vstack([np.ones(len(counts)), counts]).T
@@ -84,22 +94,31 @@ def sweep_scaling_model(
     )
     s0, s1 = float(s01[0]), max(float(s01[1]), 0.0)
     W = serial_s - startup[0]
-    # what the start-up and the work divided leave over, per Dask task per worker
-    x = np.array([_chunks(cells, shared, n) / n for n in sorted(runs)])
-    r = np.array([runs[n] - (s0 + s1 * n) - W / n for n in sorted(runs)])
-    o = max(float(x @ r / (x @ x)), 0.0)
 
-    def T(n):
-        return s0 + s1 * n + W / n + o * _chunks(cells, shared, n) / n
+    def terms(n):
+        # the work divided and the last chunk's wait (per unit κ), and the tasks per worker
+        m = _chunks(cells, shared, n)
+        return W / n + (W / (2 * m) if n > 1 else 0.0), m / n
+
+    ns = sorted(runs)
+    design = np.array([terms(n) for n in ns])
+    left = np.array([runs[n] - (s0 + s1 * n) for n in ns])
+    kappa, o = (float(v) for v in nnls(design, left)[0])
+
+    def T(n, slope=s1):
+        work, tasks = terms(n)
+        return s0 + slope * n + kappa * work + o * tasks
 
     return {
         "startup_s": (s0, s1),
         "work_s": W,
+        "slowdown": kappa,
         "overhead_s": o,
         "serial_fraction": (s0 + s1) / T(1),
         "speedup": {n: serial_s / t for n, t in sorted(runs.items())},
-        "fitted_speedup": {n: serial_s / T(n) for n in sorted(runs)},
+        "fitted_speedup": {n: serial_s / T(n) for n in ns},
         "predicted_speedup": {n: serial_s / T(n) for n in PREDICT_WORKERS},
+        "predicted_speedup_parallel_start": {n: serial_s / T(n, 0.0) for n in PREDICT_WORKERS},
     }
 
 
@@ -171,8 +190,12 @@ def _present_cli(cli: dict | None) -> list:
             f"{CLI_SWEEP_TARGET}×), the CSVs byte-identical. The model fitted to these runs: a "
             f"start-up of {s0:.1f} s + {s1:.2f} s per worker (one-cell sweeps; "
             f"{s['startup_serial_s']:.1f} s serially), {s['work_s']:.1f} s of cells' work divided "
-            f"among the workers, {1e3 * s['overhead_s']:.0f} ms per Dask task; serial fraction "
-            f"{100 * s['serial_fraction']:.0f} %."
+            f"among the workers and run {s.get('slowdown', 1.0):.2f}× as long as serially, half "
+            f"a chunk's wait at the end, {1e3 * s['overhead_s']:.0f} ms per Dask task; serial "
+            f"fraction {100 * s['serial_fraction']:.0f} %. At 16 workers it predicts "
+            f"{s['predicted_speedup'][16]:.1f}× with the start-up's slope measured here, "
+            f"{s.get('predicted_speedup_parallel_start', s['predicted_speedup'])[16]:.1f}× if "
+            "every worker started on its own core."
         )
         if "split_s" in s:
             ceiling = s["serial_s"] / s["split_s"]

@@ -161,19 +161,24 @@ def test_the_split_sweep_is_set_beside_the_cluster_as_the_machines_ceiling(tmp_p
 
 
 def test_the_scaling_model_recovers_its_own_parameters():
-    # runs made by the model itself (start-up 6 s + 0.5 s per worker, 64 s of work, 20 ms per
-    # task) give back those parameters and its speed-ups, also beyond the measured counts
+    # runs made by the model itself (start-up 6 s + 0.5 s per worker, 64 s of work run 1.15× as
+    # long on the workers, half a chunk's wait at the end, 20 ms per task) give back those
+    # parameters and its speed-ups, also beyond the measured counts
     from validation.report.sections.scaleout import _chunks, sweep_scaling_model
 
-    def T(n):
-        return 6.0 + 0.5 * n + 64.0 / n + 0.02 * _chunks(3840, 8, n) / n
+    def T(n, slope=0.5):
+        m = _chunks(3840, 8, n)
+        tail = 64.0 / (2 * m) if n > 1 else 0.0
+        return 6.0 + slope * n + 1.15 * (64.0 / n + tail) + 0.02 * m / n
 
     startup = {0: 3.0, 1: 6.5, 2: 7.0, 3: 7.5}
     model = sweep_scaling_model(67.0, startup, {n: T(n) for n in (1, 2, 3)}, 3840, 8)
     assert model["startup_s"] == (pytest.approx(6.0), pytest.approx(0.5))
     assert model["work_s"] == pytest.approx(64.0)
+    assert model["slowdown"] == pytest.approx(1.15)
     assert model["overhead_s"] == pytest.approx(0.02)
     assert model["predicted_speedup"][16] == pytest.approx(67.0 / T(16))
+    assert model["predicted_speedup_parallel_start"][16] == pytest.approx(67.0 / T(16, 0.0))
     assert model["predicted_speedup"][64] < model["predicted_speedup"][16]  # start-up per worker
     # an overhead the start-up and the work already explain is 0, not negative
     faster = sweep_scaling_model(67.0, startup, {1: 60.0, 2: 30.0}, 3840, 8)
