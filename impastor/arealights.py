@@ -35,6 +35,7 @@ __all__ = [
     "check_light_image",
     "light_plane_lookup",
     "light_plane_uv",
+    "plane_image_from_latlong",
 ]
 
 
@@ -207,6 +208,56 @@ def booth_light_image(kind: str = "fluorescent", width: int = 128, height: int =
             r2 = ((X - cx) / 0.09) ** 2 + ((Y - 0.5) / 0.18) ** 2
             image += 4000.0 * np.exp(-0.5 * r2)
     return image
+
+
+def plane_image_from_latlong(image, plane: PlaneLight, centre=(0.0, 0.0, 0.0), supersample=4):
+    """A captured room seen through a plane light: the lat-long map's radiance behind each pixel.
+
+    specref's own bridge from an HDR panorama to ImpastoR's booth (erratum E113): each pixel of
+    ``plane`` takes the mean of the map, looked up bilinearly
+    (:func:`reference.geometry.envmap.latlong_lookup_bilinear`), in the directions from ``centre``
+    (the canvas's centre) through ``supersample²`` points spread over the pixel. The plane then
+    sends the canvas's centre exactly the map's radiance in the solid angle it covers; light from
+    outside it (walls, a window to the side) is left out, and points away from the centre see the
+    plane's radiance at a slightly different angle than the room's.
+
+    Parameters
+    ----------
+    image : array_like, shape (H_map, W_map) or (H_map, W_map, C)
+        The lat-long map (``reference.geometry.envmap``'s orientation, y up), radiance.
+    plane : PlaneLight
+        Its geometry (the image it holds is ignored).
+    centre : (3,) array_like
+        The point the room is seen from, m.
+    supersample : int
+        Sub-pixel points per axis.
+
+    Returns
+    -------
+    ndarray, shape (H, W) or (H, W, C)
+        The plane's new image at its own resolution.
+
+    Examples
+    --------
+    >>> plane = PlaneLight(np.ones((2, 4)), (-0.6, 0.6, -1.0), (1, 0, 0), (0, 0, 1), 1.2, 0.8)
+    >>> plane_image_from_latlong(np.full((8, 16), 5.0), plane).round(12)
+    array([[5., 5., 5., 5.],
+           [5., 5., 5., 5.]])
+    """
+    from reference.geometry.envmap import latlong_lookup_bilinear
+
+    image = check_light_image(image, "light map")
+    n = require_positive_int(supersample, "supersample", 64)
+    H, W = plane.shape
+    offsets = (np.arange(n) + 0.5) / n
+    rows = (np.arange(H)[:, None] + offsets[None]).reshape(-1)
+    cols = (np.arange(W)[:, None] + offsets[None]).reshape(-1)
+    R, C = np.meshgrid(rows, cols, indexing="ij")
+    d = plane.pixel_positions(R, C) - np.asarray(centre, dtype=np.float64)
+    d /= np.linalg.norm(d, axis=-1, keepdims=True)
+    L = latlong_lookup_bilinear(image, d)  # (H n, W n, C)
+    L = L.reshape(H, n, W, n, -1).mean(axis=(1, 3))
+    return L[..., 0] if L.shape[-1] == 1 else L
 
 
 # --- the light-plane lookup: where a direction meets the light plane ----------------------------

@@ -60,10 +60,12 @@ __all__ = [
     "booth_lamp_kind",
     "booth_light_spectrum",
     "booth_plane_light",
+    "booth_plane_light_from_map",
     "cached_horizon_map",
     "canvas_frame",
     "canvas_materials",
     "canvas_pixels",
+    "centre_illuminance",
     "check_eye",
     "check_pose",
     "impasto_painting",
@@ -113,6 +115,71 @@ def booth_plane_light(kind: str = "fluorescent", width: int = 128, height: int =
     """
     image = booth_light_image(kind, width, height)
     return PlaneLight(image, (-0.6, 0.6, -1.0), (1.0, 0.0, 0.0), (0.0, 0.0, 1.0), 1.2, 0.8)
+
+
+def centre_illuminance(plane: PlaneLight) -> float:
+    """Eq. (2), Ferwerda, at the canvas's centre facing +y, every pixel of ``plane`` a light (lux).
+
+    Examples
+    --------
+    >>> plane = booth_plane_light("fluorescent", 16, 8)
+    >>> 500 < centre_illuminance(plane) < 1000
+    True
+    """
+    x = plane.pixel_positions().reshape(-1, 3)
+    L = plane.image.reshape(x.shape[0], -1)[:, 0]
+    r2 = (x * x).sum(axis=1)
+    w = x / np.sqrt(r2)[:, None]
+    # (N_surf·I)(−N_light·I) A/P / d², N_surf = +y
+    geometry = np.maximum(w[:, 1], 0.0) * np.maximum(-(w @ plane.n_light), 0.0) / r2
+    return float(L @ geometry * plane.pixel_area)
+
+
+def booth_plane_light_from_map(
+    path, width: int = 128, height: int = 64, lux: float | None = None
+) -> PlaneLight:
+    """The booth's ceiling showing a captured room: an HDR panorama seen through it (E113).
+
+    The map (Radiance ``.hdr`` or an RGB OpenEXR, linear sRGB primaries; y up) becomes luminance
+    and is projected onto the booth's ceiling from the canvas's centre
+    (:func:`impastor.arealights.plane_image_from_latlong`), then scaled so the canvas's centre gets
+    ``lux`` (default: what the procedural fluorescent booth gives it, so frames compare). The
+    lamp's spectrum stays ``light``'s.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> from reference.images.formats import write_exr
+    >>> path = write_exr(os.path.join(tempfile.mkdtemp(), "room.exr"), np.ones((16, 32, 3)))
+    >>> plane = booth_plane_light_from_map(path, 16, 8, lux=1500.0)
+    >>> round(centre_illuminance(plane), 6), float(np.ptp(plane.image))
+    (1500.0, 0.0)
+    """
+    from impastor.arealights import plane_image_from_latlong
+    from reference.colour.colorimetry import display_RGB_to_XYZ
+    from reference.images.spectral import read_environment_file
+
+    image, names = read_environment_file(path)
+    require(
+        names[:3] == ["R", "G", "B"],
+        f"{path}: the light map must be RGB (R, G, B channels, linear sRGB), got {names[:4]}",
+    )
+    Y = display_RGB_to_XYZ(np.asarray(image[..., :3], dtype=np.float64))[..., 1]
+    require(
+        bool(np.isfinite(Y).all()) and float(Y.min()) >= 0.0,
+        f"{path}: the light map must be finite and >= 0",
+    )
+    booth = booth_plane_light("fluorescent", width, height)
+    plane = replace(booth, image=plane_image_from_latlong(Y, booth))
+    E = centre_illuminance(plane)
+    require(
+        E > 0.0,
+        f"{path}: no light in the directions the booth's ceiling covers (above the canvas, behind "
+        "it); the map's y axis must point up",
+    )
+    target = centre_illuminance(booth) if lux is None else float(lux)
+    require(np.isfinite(target) and target > 0, f"lux: must be > 0, got {lux!r}")
+    return replace(plane, image=plane.image * (target / E))
 
 
 def booth_light_spectrum(light: str):
@@ -489,6 +556,7 @@ def render_painting(
     eye=EYE,
     n_channels: int = 6,
     tilt: float = 0.0,
+    light_map=None,
 ) -> dict:
     """Render a painting (the demo one by default) under a booth light through ImpastoR.
 
@@ -505,8 +573,9 @@ def render_painting(
         of the point lights that the diffuse term always uses.
     painting : dict, optional
         From :func:`impasto_painting` (default: one at ``size``).
-    design, light_resolution, shadows, spectra, n_channels
-        Pipeline settings (``spectra``: :func:`load_paint_spectra`; ``n_channels``: 3-10).
+    design, light_resolution, shadows, spectra, n_channels, light_map
+        Pipeline settings (``spectra``: :func:`load_paint_spectra`; ``n_channels``: 3-10;
+        ``light_map``: a captured room as the ceiling, :func:`booth_plane_light_from_map`).
     n_lights, n_samples, n_sectors, failsafe
         Point lights N, FIS samples K, horizon sectors S and the hybrid's fail-safe: fixed here
         (32, 32, 36, on); :func:`impastor.settings.render_painting_to_tolerance` chooses them.
@@ -533,24 +602,31 @@ def render_painting(
     ((32, 32, 3), ['diffuse', 'shadows', 'specular'], 32)
     """
     painting = painting or impasto_painting(size)
-    rest = painting_scene(light, method, painting, design, light_resolution, spectra, n_channels)
+    options = (design, light_resolution, spectra, n_channels, light_map)
+    rest = painting_scene(light, method, painting, *options)
     scene, eye_canvas = posed_scene(rest, eye, tilt)
     px = canvas_pixels(painting, size, eye_canvas)
     timer = StageTimer(progress, f"painting {size}×{size} under {light}")
     settings = {"n_lights": n_lights, "n_samples": n_samples, "n_sectors": n_sectors}
     settings["failsafe"] = bool(failsafe)
-
-    def horizon():
-        # Once per height field, not per frame (§3.5.3, Ferwerda: a precomputed map).
-        height, pixel_size = painting["height"], painting["pixel_size"]
-        return cached_horizon_map(height, pixel_size, n_sectors, 32, backend)[px.row, px.col]
-
-    L, E = shade_canvas(scene, px, settings, horizon if shadows else None, backend, timer)
+    # once per height field, not per frame (§3.5.3, Ferwerda: a precomputed map)
+    horizon = _horizon_at(painting, px, n_sectors, backend) if shadows else None
+    L, E = shade_canvas(scene, px, settings, horizon, backend, timer)
     if scene.plane is not rest.plane:  # the exposure of the canvas at rest: the white it had
-        E = _rest_illuminance(rest, px, n_lights, horizon if shadows else None)
+        E = _rest_illuminance(rest, px, n_lights, horizon)
     XYZ, sRGB = _frame_images(px, L, E, scene.design)
     pose = {"eye": np.asarray(eye, float).tolist(), "tilt_deg": float(np.degrees(tilt))}
     return {"XYZ": XYZ, "sRGB": sRGB, "seconds": timer.seconds, "settings": settings, "pose": pose}
+
+
+def _horizon_at(painting: dict, px, n_sectors: int, backend: str):
+    """The horizon angles at the pixels' texels, as a call (the map cached per height field)."""
+
+    def horizon():
+        height, pixel_size = painting["height"], painting["pixel_size"]
+        return cached_horizon_map(height, pixel_size, n_sectors, 32, backend)[px.row, px.col]
+
+    return horizon
 
 
 def _rest_illuminance(rest: PaintingScene, px, n_lights: int, horizon) -> np.ndarray:
@@ -593,8 +669,13 @@ def painting_scene(
     light_resolution: tuple = (128, 64),
     spectra=None,
     n_channels: int = 6,
+    light_map=None,
 ) -> PaintingScene:
     """The painting, its paints, the channel design and the booth light, ready to shade.
+
+    ``light`` gives the lamp's spectrum; the ceiling's image is the procedural booth's, or with
+    ``light_map`` (an HDR panorama's file) the room it captures
+    (:func:`booth_plane_light_from_map`).
 
     Examples
     --------
@@ -606,7 +687,10 @@ def painting_scene(
     painting = painting or impasto_painting(256)
     spectra = spectra or load_paint_spectra()
     d = MULTISPECTRAL_DESIGNS.lookup(design).reference(n_channels)
-    plane = booth_plane_light(booth_lamp_kind(light), *light_resolution)
+    if light_map is None:
+        plane = booth_plane_light(booth_lamp_kind(light), *light_resolution)
+    else:  # a captured room as the booth's ceiling (E113)
+        plane = booth_plane_light_from_map(light_map, *light_resolution)
     S6 = light_to_channels(booth_light_spectrum(light), d)
     return PaintingScene(painting, spectra, d, plane, S6, lighting)
 

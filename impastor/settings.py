@@ -431,8 +431,8 @@ def render_painting_to_tolerance(
     tolerance : float
         Relative RMS error against brute force, > 0.
     **options
-        ``design``, ``light_resolution``, ``spectra``, ``backend``, ``eye``, ``tilt`` of
-        :func:`render_painting` (the pilot is made in the frame's pose).
+        ``design``, ``light_resolution``, ``spectra``, ``light_map``, ``backend``, ``eye``,
+        ``tilt`` of :func:`render_painting` (the pilot is made in the frame's pose and light).
 
     Returns
     -------
@@ -451,7 +451,7 @@ def render_painting_to_tolerance(
 
     check_tolerance(tolerance)
     painting = painting or impasto_painting(size)
-    keys = ("design", "light_resolution", "spectra")
+    keys = ("design", "light_resolution", "spectra", "light_map")
     scene_options = {k: options[k] for k in keys if k in options}
     rest = painting_scene(light, method, painting, **scene_options)
     # the pilot sees the canvas in the frame's pose

@@ -56,6 +56,7 @@ def _cmd_impastor_render(args) -> int:
             progress=sys.stderr,
             tolerance=args.tolerance,
             painting=args.painting,
+            light_map=args.light_map,
         )
     )
     return 0
@@ -77,6 +78,7 @@ def _cmd_impastor_path(args) -> int:
         progress=sys.stderr,
         tilt_from=args.tilt_from,
         tilt_to=args.tilt_to,
+        light_map=args.light_map,
     )
     print(summary)
     return 0
@@ -128,6 +130,16 @@ def add_parser(sub) -> None:
     _add_render(isub)
 
 
+def _light_map_option(parser) -> None:
+    parser.add_argument(
+        "--light-map",
+        type=input_file,
+        metavar="HDR",
+        help="an HDR panorama of a room (.hdr or RGB .exr, y up), seen through the booth's ceiling "
+        "as its light; --light still gives the lamp's spectrum (docs/impastor.md)",
+    )
+
+
 def _add_path(isub) -> None:
     """``specref impastor path``: the painting from a moving viewer, as an animated PNG."""
     from impastor.painting import PAINTING_LIGHTING_METHODS
@@ -160,6 +172,7 @@ def _add_path(isub) -> None:
         "--tilt-to", type=float, default=0.0, metavar="DEG", help="its last tilt (default 0)"
     )
     a.add_argument("--painting", type=input_file, metavar="DIR", help="a painting folder")
+    _light_map_option(a)
     a.add_argument("--light", default="D65", help="illuminant key (D65, D50, A, FL2, ...)")
     a.add_argument("--size", type=int, default=256, help="image side in pixels (default 256)")
     registry_option(a, "--method", PAINTING_LIGHTING_METHODS, "specular lighting", default="hybrid")
@@ -178,6 +191,7 @@ def _add_render(isub) -> None:
         metavar="DIR",
         help="a painting folder or its painting.toml (docs/impastor.md); default the demo",
     )
+    _light_map_option(r)
     r.add_argument(
         "--light",
         default="D65",

@@ -96,11 +96,13 @@ def render_for_cli(
     progress=None,
     tolerance: float | None = None,
     painting=None,
+    light_map=None,
 ) -> str:
     """Render a painting (the demo one by default) and write it as a PNG; return a one-line summary.
 
     ``painting`` is a painting folder or its ``painting.toml`` (``docs/impastor.md``, "Painting
-    files"), read before any work.
+    files"), read before any work; ``light_map`` an HDR panorama of a room, shown through the
+    booth's ceiling (:func:`impastor.painting.booth_plane_light_from_map`).
 
     ``progress`` (a stream) gets a line per stage of the render with its time. With
     ``tolerance``, N, K, S and the fail-safe come from it (:mod:`impastor.settings`); the
@@ -151,7 +153,7 @@ def render_for_cli(
             f"--light-luminance: must be >= 0 cd/m², got {light_luminance!r}",
         )
     tilt = np.radians(tilt_deg)  # the display's tilt turns the painting it shows (§3.4)
-    result = _render(light, size, method, tolerance, painting, progress, tilt)
+    result = _render(light, size, method, tolerance, painting, progress, tilt, light_map)
     write_png(out, result["sRGB"], {"specref": json.dumps(result["settings"])})
     seconds = sum(result["seconds"].values())
     summary = f"wrote {out} ({size}×{size}, {light}, {method}, shading {seconds:.2f} s"
@@ -162,22 +164,31 @@ def render_for_cli(
     return summary
 
 
-def _render(light, size, method, tolerance, painting, progress, tilt=0.0) -> dict:
+def _render(light, size, method, tolerance, painting, progress, tilt=0.0, light_map=None) -> dict:
     """The painting (read from its folder, else the demo) at fixed or tolerance-chosen settings."""
-    from impastor.painting import check_pose, render_painting
+    from impastor.painting import render_painting
 
-    check_pose(tilt=tilt)  # a canvas turned away from the viewer fails before any work
+    painting = _check_pose_inputs(painting, tilt, light_map)
+    options = {"progress": progress, "tilt": tilt, "light_map": light_map}
+    if tolerance is None:
+        return render_painting(light, size, method, painting, **options)
+    from impastor.settings import render_painting_to_tolerance
+
+    return render_painting_to_tolerance(light, size, tolerance, method, painting, **options)
+
+
+def _check_pose_inputs(painting, tilt: float, light_map):
+    """The painting read, the tilt and the light map checked, before any work (one-line errors)."""
+    from impastor.painting import booth_plane_light_from_map, check_pose
+
+    check_pose(tilt=tilt)  # a canvas turned away from the viewer
+    if light_map is not None:
+        booth_plane_light_from_map(light_map, 16, 8)  # unreadable, not RGB, dark where it matters
     if painting is not None:
         from impastor.painting_files import read_painting
 
         painting = read_painting(painting)
-    if tolerance is None:
-        return render_painting(light, size, method, painting, progress=progress, tilt=tilt)
-    from impastor.settings import render_painting_to_tolerance
-
-    return render_painting_to_tolerance(
-        light, size, tolerance, method, painting, progress=progress, tilt=tilt
-    )
+    return painting
 
 
 def render_path_for_cli(
@@ -193,6 +204,7 @@ def render_path_for_cli(
     progress=None,
     tilt_from: float = 0.0,
     tilt_to: float = 0.0,
+    light_map=None,
 ) -> str:
     """Render the painting from a path of poses; write an animated PNG (APNG).
 
@@ -230,13 +242,10 @@ def render_path_for_cli(
         except SpecrefError as error:
             raise SpecrefError(f"frame {k + 1} of the path: {error}") from None
     check_output_file(out)
-    if painting is not None:
-        from impastor.painting_files import read_painting
-
-        painting = read_painting(painting)
+    painting = _check_pose_inputs(painting, 0.0, light_map)
     images = []
     for k, (eye, tilt) in enumerate(zip(eyes, tilts, strict=True)):
-        result = _render_pose(light, size, method, painting, eye, tilt)
+        result = _render_pose(light, size, method, painting, eye, tilt, light_map)
         images.append(np.round(np.clip(result["sRGB"], 0, 1) * 255).astype(np.uint8))
         if progress is not None:
             seconds = sum(result["seconds"].values())
@@ -251,10 +260,10 @@ def render_path_for_cli(
     return f"wrote {out}: {frames} frames of {size}×{size} at {fps:g} frames per second (APNG)"
 
 
-def _render_pose(light, size, method, painting, eye, tilt=0.0) -> dict:
+def _render_pose(light, size, method, painting, eye, tilt=0.0, light_map=None) -> dict:
     from impastor.painting import render_painting
 
-    return render_painting(light, size, method, painting, eye=eye, tilt=tilt)
+    return render_painting(light, size, method, painting, eye=eye, tilt=tilt, light_map=light_map)
 
 
 def _check_before_render(tolerance, out, counts_out) -> None:

@@ -131,6 +131,7 @@ def test_compute_returns_every_figure_of_results_json(tiny):
         "held_out_hybrid",
         "painting_D65_seconds",
         "painting_A_seconds",
+        "room_ceiling",
         *(f"frame_seconds_{m}" for m in frame_methods(every=False)),
         "channel_frame_seconds",
     ]
@@ -163,8 +164,11 @@ def test_present_draws_every_study_from_the_data(tiny, tmp_path):
             "metamers",
             "painting-A",
             "painting-D65",
+            "painting-room",
         )
     ] + ["impastor-shadows.png"]
+    # the captured room's ceiling is more concentrated than the booth's four tubes
+    assert tiny.results["room_ceiling"]["room"] > tiny.results["room_ceiling"]["booth"]
     frame_table, bench_table = blocks[-2:]
     assert [row[0] for row in frame_table.rows] == frame_methods(every=False)
     assert bench_table.rows == [["test_bench_specular[fis]", 1]]
