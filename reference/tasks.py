@@ -35,6 +35,8 @@ __all__ = [
     "PROFILE_SETTING",
     "SCHEDULER_ENV",
     "SERIAL",
+    "STREAMED_MMAP_BYTES",
+    "STREAMED_TRIM_BYTES",
     "TIMEOUT_ENV",
     "TRIM_SETTING",
     "WORKER_MMAP_BYTES",
@@ -620,12 +622,24 @@ MMAP_SETTING = "distributed.nanny.pre-spawn-environ.MALLOC_MMAP_THRESHOLD_"
 PROFILE_SETTING = "distributed.worker.profile.enabled"
 
 
-def set_malloc_trim(threshold: int = WORKER_TRIM_BYTES) -> bool:
+#: glibc's thresholds for streamed commands (``env convert``, ``env spectralize``, ...): a block of
+#: 8 MiB or more (a chunk's buffers at the default chunk size) is its own mapping, returned to the
+#: system when freed, while the reader's smaller windows reuse the heap; set explicitly, so a
+#: stream's resident memory stays a few chunks whatever the environment passed on (a parent that
+#: started a Dask cluster passes the workers' thresholds to its children; docs/scale-out.md).
+STREAMED_TRIM_BYTES, STREAMED_MMAP_BYTES = 128 << 10, 8 << 20
+
+
+def set_malloc_trim(threshold: int = WORKER_TRIM_BYTES, mmap: int = WORKER_MMAP_BYTES) -> bool:
     """Set glibc's trim and mmap thresholds in this process (``mallopt``); False without glibc.
 
     Examples
     --------
-    >>> set_malloc_trim()    # Linux with glibc
+    >>> set_malloc_trim()    # Linux with glibc: the workers' thresholds
+    True
+    >>> set_malloc_trim(STREAMED_TRIM_BYTES, STREAMED_MMAP_BYTES)   # a streamed command's
+    True
+    >>> set_malloc_trim()
     True
     """
     import ctypes
@@ -641,7 +655,7 @@ def set_malloc_trim(threshold: int = WORKER_TRIM_BYTES) -> bool:
     return bool(
         mallopt
         and mallopt(M_TRIM_THRESHOLD, int(threshold)) == 1
-        and mallopt(M_MMAP_THRESHOLD, WORKER_MMAP_BYTES) == 1
+        and mallopt(M_MMAP_THRESHOLD, int(mmap)) == 1
     )
 
 

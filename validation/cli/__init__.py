@@ -118,14 +118,17 @@ def main(argv: list[str] | None = None) -> int:
     """
     import shrm  # noqa: F401  (registers the environment-light shaders before any rendering)
     from reference.files import check_outputs
-    from reference.tasks import set_malloc_trim
+    from reference.tasks import STREAMED_MMAP_BYTES, STREAMED_TRIM_BYTES, set_malloc_trim
 
     parser = build_parser()
     args = parser.parse_args(argv)
     # glibc's default mmap threshold makes NumPy's large temporaries an mmap and a munmap each, in
     # system calls that slowed long sweeps (docs/scale-out.md); the workers set the same.
-    # Streamed commands keep the default, which returns each chunk's memory to the system.
-    if not getattr(args, "streamed", False):
+    # Streamed commands map each chunk on its own and return it to the system when freed,
+    # whatever thresholds the environment passed on.
+    if getattr(args, "streamed", False):
+        set_malloc_trim(STREAMED_TRIM_BYTES, STREAMED_MMAP_BYTES)
+    else:
         set_malloc_trim()
     return run_command(args, lambda: check_outputs(*command_paths(args)))
 

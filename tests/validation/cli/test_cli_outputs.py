@@ -279,9 +279,10 @@ def test_sprague_with_too_few_samples_is_refused():
         resample_spectrum(uneven, GRID_41, interpolation="sprague")
 
 
-def test_commands_set_the_allocator_thresholds_but_streamed_ones(tmp_path, monkeypatch):
-    # docs/scale-out.md: every command keeps NumPy's temporaries on the heap, except the streamed
-    # ones (env convert, env spectralize, sh project), which return each chunk's memory
+def test_commands_set_the_allocator_thresholds_streamed_ones_their_own(tmp_path, monkeypatch):
+    # docs/scale-out.md: every command keeps NumPy's temporaries on the heap; the streamed ones
+    # (env convert, env spectralize, sh project) map chunk-sized blocks on their own, set
+    # explicitly so that thresholds inherited through the environment do not apply
     import numpy as np
 
     import reference.tasks
@@ -289,9 +290,13 @@ def test_commands_set_the_allocator_thresholds_but_streamed_ones(tmp_path, monke
     from validation.cli import main
 
     calls = []
-    monkeypatch.setattr(reference.tasks, "set_malloc_trim", lambda: calls.append(1) or True)
+    monkeypatch.setattr(
+        reference.tasks, "set_malloc_trim", lambda *args: calls.append(args) or True
+    )
     sky = write_exr(tmp_path / "sky.exr", np.ones((8, 16, 3), np.float32))
     assert main(["env", "convert", str(sky), str(tmp_path / "sky.zarr")]) == 0
-    assert calls == []
+    streamed = (reference.tasks.STREAMED_TRIM_BYTES, reference.tasks.STREAMED_MMAP_BYTES)
+    assert calls == [streamed]
+    assert reference.tasks.STREAMED_MMAP_BYTES < reference.tasks.WORKER_MMAP_BYTES
     assert main(["sweep", str(tmp_path / "missing.toml"), "--scheduler", "serial"]) == 2
-    assert calls == [1]
+    assert calls == [streamed, ()]
