@@ -369,6 +369,7 @@ def dask_client(
 
     workers = n_workers or os.cpu_count() or 1
     with (
+        _environ_kept(),
         dask.config.set(
             {
                 TRIM_SETTING: WORKER_TRIM_BYTES,
@@ -388,6 +389,23 @@ def dask_client(
         Client(cluster) as client,
     ):
         yield client
+
+
+@contextlib.contextmanager
+def _environ_kept():
+    """The client's environment as it was before a local cluster's nannies wrote to it.
+
+    The nannies write the workers' ``pre-spawn-environ`` (the allocator thresholds above, one
+    thread per library) and their own bookkeeping (``PYTHONHASHSEED``, the parent's pid) into the
+    client's ``os.environ``, where every process the client starts afterwards would inherit them.
+    """
+    saved = dict(os.environ)
+    try:
+        yield
+    finally:
+        for key in set(os.environ) - set(saved):
+            del os.environ[key]
+        os.environ.update(saved)
 
 
 def specref_identity() -> dict:

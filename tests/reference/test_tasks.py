@@ -433,10 +433,16 @@ def process_id(_task):
     return os.getpid()
 
 
-def test_local_n_starts_a_cluster_of_n_workers():
+def test_local_n_starts_a_cluster_of_n_workers(monkeypatch):
+    # and leaves this process's environment as it was: Dask's nannies write the workers'
+    # allocator thresholds into it, which every process started later would inherit
+    for key in ("MALLOC_TRIM_THRESHOLD_", "MALLOC_MMAP_THRESHOLD_"):
+        monkeypatch.delenv(key, raising=False)
+    before = dict(os.environ)
     pids = run_tasks(process_id, range(6), scheduler="local:1", progress=False, grain=1)
     assert len(set(pids)) == 1
     assert pids[0] != os.getpid()
+    assert dict(os.environ) == before
     with pytest.raises(SpecrefError, match=r"^--scheduler local:0: allowed: local:N, N workers"):
         run_tasks(process_id, [1], scheduler="local:0", progress=False)
 
