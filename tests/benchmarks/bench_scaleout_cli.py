@@ -16,6 +16,8 @@ Scale-out section fits its model to these figures):
   ``specref sweep`` in its own process, all started at once; the parts' rows are the serial
   sweep's, in order. A cluster can only approach it (it pays its start and its scheduling), so
   the report sets the cluster's speed-up beside it;
+- ``cli-task-overhead``: Dask's own cost per task, from 2,000 empty tasks on a warm local cluster
+  (the model's ``o``, measured rather than fitted);
 - ``convert-memory``: ``specref env convert`` of a 4096 × 8192 RGB EXR in a new process, its peak
   resident set (``VmHWM``), beside the same command's on a 16 × 32 map (what the process holds
   without the map) and the size of one float32 chunk (target: at most four chunks above it, three
@@ -160,6 +162,34 @@ def test_cli_startup(benchmark, grid, workers):
     scheduler = f"local:{workers}" if workers else "serial"
     benchmark.extra_info.update({"role": "cli-startup", "workers": workers})
     benchmark.pedantic(_sweep, args=(grid, scheduler, "one"), rounds=1, iterations=1)
+
+
+#: Empty tasks for Dask's own cost per task (the model's ``o``, measured rather than fitted).
+EMPTY_TASKS = 2000
+
+
+@pytest.mark.benchmark(group="scaleout-cli")
+def test_cli_task_overhead(benchmark):
+    # a local cluster of the cores present, warmed up; then EMPTY_TASKS tasks one per Dask task
+    # (``abs`` of the task: nothing to compute). Each worker runs its share one after another, so
+    # one task costs the time × workers / tasks (the scheduler's part included).
+    from reference.tasks import dask_client, run_tasks
+
+    workers = min(CORES, 2)
+    with dask_client(f"local:{workers}") as client:
+        run_tasks(abs, range(50), client=client, progress=False, grain=1)
+        result = benchmark.pedantic(
+            run_tasks,
+            args=(abs, range(EMPTY_TASKS)),
+            kwargs={"client": client, "progress": False, "grain": 1},
+            rounds=3,
+            iterations=1,
+        )
+    assert result == list(range(EMPTY_TASKS))
+    task_s = benchmark.stats.stats.min * workers / EMPTY_TASKS
+    benchmark.extra_info.update(
+        {"role": "cli-task-overhead", "workers": workers, "tasks": EMPTY_TASKS, "task_s": task_s}
+    )
 
 
 def _convert_peak(source: Path, out: Path) -> int:

@@ -50,7 +50,7 @@ def _chunks(cells: int, shared: int, workers: int) -> int:
 
 
 def sweep_scaling_model(
-    serial_s: float, startup: dict, runs: dict, cells: int, shared: int
+    serial_s: float, startup: dict, runs: dict, cells: int, shared: int, task_s: float | None = None
 ) -> dict:
     """The sweep's time on N workers: start-up, the work divided, its last chunk, Dask's tasks.
 
@@ -65,7 +65,9 @@ def sweep_scaling_model(
     - ``m(N)``, the Dask tasks (chunks of one shared key, and the shared builds): the last chunk
       leaves the other workers idle for half a chunk on average (``κ·W/(2·m)``, from 2 workers),
       and ``o`` is Dask's own cost per task;
-    - ``κ`` and ``o`` by non-negative least squares through the measured ``T(N)``.
+    - ``κ`` and ``o`` by non-negative least squares through the measured ``T(N)``; with ``task_s``
+      (Dask's cost per task measured on its own, with empty tasks) ``o`` is that and ``κ`` alone is
+      fitted, so two worker counts no longer determine both exactly.
 
     The serial fraction is Amdahl's ``f = s(1)/T(1)``. ``predicted_speedup`` assumes one core per
     worker with the start-up's slope as measured here (on fewer cores it holds the workers'
@@ -103,7 +105,12 @@ def sweep_scaling_model(
     ns = sorted(runs)
     design = np.array([terms(n) for n in ns])
     left = np.array([runs[n] - (s0 + s1 * n) for n in ns])
-    kappa, o = (float(v) for v in nnls(design, left)[0])
+    if task_s is None:
+        kappa, o = (float(v) for v in nnls(design, left)[0])
+    else:
+        o = max(float(task_s), 0.0)
+        rest = left - o * design[:, 1]
+        kappa = max(float(design[:, 0] @ rest / (design[:, 0] @ design[:, 0])), 0.0)
 
     def T(n, slope=s1):
         work, tasks = terms(n)
@@ -131,7 +138,9 @@ def _cli_sweep(cli: dict) -> dict | None:
         return None
     e = serial[0]["extra_info"]
     serial_s = serial[0]["stats"]["min"]
-    model = sweep_scaling_model(serial_s, startup, runs, e["cells"], e["shared"])
+    overhead = cli.get("cli-task-overhead", [])
+    task_s = overhead[0]["extra_info"]["task_s"] if overhead else None
+    model = sweep_scaling_model(serial_s, startup, runs, e["cells"], e["shared"], task_s)
     best = max(runs)
     split = cli.get("cli-split", [])
     return {
@@ -140,6 +149,7 @@ def _cli_sweep(cli: dict) -> dict | None:
         "serial_s": serial_s,
         "runs_s": dict(sorted(runs.items())),
         "startup_serial_s": startup[0],
+        "task_measured": task_s is not None,
         "workers": best,
         "local_s": runs[best],
         # the machine's ceiling without a scheduler: the sweep cut into serial processes at once
@@ -191,7 +201,8 @@ def _present_cli(cli: dict | None) -> list:
             f"start-up of {s0:.1f} s + {s1:.2f} s per worker (one-cell sweeps; "
             f"{s['startup_serial_s']:.1f} s serially), {s['work_s']:.1f} s of cells' work divided "
             f"among the workers and run {s.get('slowdown', 1.0):.2f}× as long as serially, half "
-            f"a chunk's wait at the end, {1e3 * s['overhead_s']:.0f} ms per Dask task; serial "
+            f"a chunk's wait at the end, {1e3 * s['overhead_s']:.0f} ms per Dask task"
+            f"{' (measured with empty tasks)' if s.get('task_measured') else ' (fitted)'}; serial "
             f"fraction {100 * s['serial_fraction']:.0f} %. At 16 workers it predicts "
             f"{s['predicted_speedup'][16]:.1f}× with the start-up's slope measured here, "
             f"{s.get('predicted_speedup_parallel_start', s['predicted_speedup'])[16]:.1f}× if "

@@ -180,6 +180,9 @@ def test_the_scaling_model_recovers_its_own_parameters():
     assert model["predicted_speedup"][16] == pytest.approx(67.0 / T(16))
     assert model["predicted_speedup_parallel_start"][16] == pytest.approx(67.0 / T(16, 0.0))
     assert model["predicted_speedup"][64] < model["predicted_speedup"][16]  # start-up per worker
+    # Dask's cost per task measured on its own: o is that, and κ alone is fitted
+    measured = sweep_scaling_model(67.0, startup, {n: T(n) for n in (1, 2)}, 3840, 8, task_s=0.02)
+    assert (measured["slowdown"], measured["overhead_s"]) == (pytest.approx(1.15), 0.02)
     # an overhead the start-up and the work already explain is 0, not negative
     faster = sweep_scaling_model(67.0, startup, {1: 60.0, 2: 30.0}, 3840, 8)
     assert faster["overhead_s"] == 0.0
