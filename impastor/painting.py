@@ -39,7 +39,11 @@ from impastor.multispectral import (
     light_to_channels,
     spectra_to_channels,
 )
-from impastor.point_lights import illuminance_point_lights, point_lights_from_plane
+from impastor.point_lights import (
+    illuminance_point_lights,
+    point_lights_every_pixel,
+    point_lights_from_plane,
+)
 from impastor.specular_hybrid import specular_hybrid
 from impastor.specular_lighting import specular_fis, specular_point_lights
 from reference.colour.colorimetry import XYZ_to_display_RGB
@@ -126,13 +130,8 @@ def centre_illuminance(plane: PlaneLight) -> float:
     >>> 500 < centre_illuminance(plane) < 1000
     True
     """
-    x = plane.pixel_positions().reshape(-1, 3)
-    L = plane.image.reshape(x.shape[0], -1)[:, 0]
-    r2 = (x * x).sum(axis=1)
-    w = x / np.sqrt(r2)[:, None]
-    # (N_surf·I)(−N_light·I) A/P / d², N_surf = +y
-    geometry = np.maximum(w[:, 1], 0.0) * np.maximum(-(w @ plane.n_light), 0.0) / r2
-    return float(L @ geometry * plane.pixel_area)
+    lights = point_lights_every_pixel(plane)
+    return float(illuminance_point_lights([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], lights)[0])
 
 
 def booth_plane_light_from_map(

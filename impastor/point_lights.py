@@ -38,6 +38,7 @@ __all__ = [
     "diffuse_radiance",
     "illuminance_point_lights",
     "median_cut",
+    "point_lights_every_pixel",
     "point_lights_from_latlong",
     "point_lights_from_plane",
     "region_sums",
@@ -307,6 +308,27 @@ class PointLights:
     pixel_area: float
     spread: np.ndarray
     method: str = "median_cut"
+
+
+def point_lights_every_pixel(light: PlaneLight) -> PointLights:
+    """Every pixel of a plane light a point light at its centre: Eq. (2), Ferwerda, unreduced.
+
+    The brute force the sampled lights are measured against.
+
+    Examples
+    --------
+    >>> plane = PlaneLight(np.full((2, 3), 10.0), (-0.5, 1, -0.5), (1, 0, 0), (0, 0, 1), 1.0, 1.0)
+    >>> lights = point_lights_every_pixel(plane)
+    >>> lights.position.shape, float(lights.L.sum())
+    ((6, 3), 60.0)
+    """
+    H, W = light.shape
+    rows, cols = np.meshgrid(np.arange(H) + 0.5, np.arange(W) + 0.5, indexing="ij")
+    position = light.pixel_positions(rows.ravel(), cols.ravel())
+    L = np.asarray(light.image, dtype=np.float64).reshape(H * W, -1)
+    regions = [(i, i + 1, j, j + 1) for i in range(H) for j in range(W)]
+    spread = np.zeros(H * W)
+    return PointLights(position, L, regions, False, light.n_light, light.pixel_area, spread, "all")
 
 
 def point_lights_from_plane(light: PlaneLight, method: str = "median_cut", n_lights: int = 32):

@@ -49,7 +49,11 @@ from impastor.painting import (
     render_painting,
     shade_canvas,
 )
-from impastor.point_lights import PointLights, illuminance_point_lights
+from impastor.point_lights import (
+    PointLights,
+    illuminance_point_lights,
+    point_lights_every_pixel,
+)
 from impastor.specular_lighting import specular_brute_force
 from reference.errors import require
 from reference.registry import Method, Registry
@@ -146,14 +150,7 @@ def relative_rms_error(XYZ, XYZ_reference) -> float:
 
 def _every_pixel_lights(scene: PaintingScene) -> PointLights:
     """Every pixel of the booth light a point light at its centre (the diffuse brute force)."""
-    plane = scene.plane
-    H, W = plane.shape
-    rows, cols = np.meshgrid(np.arange(H) + 0.5, np.arange(W) + 0.5, indexing="ij")
-    position = plane.pixel_positions(rows.ravel(), cols.ravel())
-    L = np.asarray(plane.image, dtype=np.float64).reshape(H * W, -1)
-    regions = [(i, i + 1, j, j + 1) for i in range(H) for j in range(W)]
-    spread = np.zeros(H * W)
-    return PointLights(position, L, regions, False, plane.n_light, plane.pixel_area, spread, "all")
+    return point_lights_every_pixel(scene.plane)
 
 
 def diffuse_brute_force(scene: PaintingScene, px, horizon, backend: str = "numba", chunk=128):

@@ -81,6 +81,12 @@ def test_bad_light_maps_are_one_line(tmp_path, capsys):
         assert len(err.splitlines()) == 1
         assert message in err
         assert not out.exists()
+    missing = ["impastor", "render", "--size", "16", "--light-map", str(tmp_path / "none.hdr")]
+    assert main([*missing, "--out", str(tmp_path / "m.png")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert "none.hdr" in err
+    assert not (tmp_path / "m.png").exists()
     good = write_exr(tmp_path / "room.exr", np.ones((16, 32, 3)))
     out = tmp_path / "path.png"
     path_command = ["impastor", "path", "--frames", "2", "--size", "16", "--method", "median_cut"]

@@ -157,3 +157,21 @@ def test_the_commands_take_the_tilt(tmp_path, capsys):
     assert main([*render, "--out", str(tmp_path / "r.png")]) == 2
     assert "faces away from the viewer" in capsys.readouterr().err
     assert not (tmp_path / "r.png").exists()
+
+
+def test_non_finite_and_huge_tilts_are_one_line(tmp_path, capsys):
+    render = ["impastor", "render", "--size", "16", "--method", "median_cut"]
+    path = ["impastor", "path", "--frames", "2", "--size", "16", "--method", "median_cut"]
+    for command, bad in (
+        (render, ["--tilt", "nan"]),
+        (render, ["--tilt=-1e300"]),
+        (path, ["--tilt-from", "inf"]),  # "--tilt-from: must be a finite angle"
+        (path, ["--tilt-to=-95"]),
+    ):
+        out = tmp_path / "bad.png"
+        flag = "--out" if command is render else "-o"
+        assert main([*command, *bad, flag, str(out)]) == 2, bad
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1, err
+        assert "tilt" in err
+        assert not out.exists()

@@ -103,7 +103,7 @@ def relit_environment(spectra, illuminant: str) -> tuple[np.ndarray, np.ndarray]
 
     W_E = band_weights(GRID_41, None)
     # each band's value of the light from its folded weights (erratum E7), not a point sample:
-    # FL2's mercury lines sampled at 10 nm would move its white by 0.017 in xy. The folded weights
+    # FL2's mercury lines sampled at 10 nm would move its white off its chromaticity. The weights
     # can dip below 0 in a band where the CMFs are tiny (FL2 at 390 nm): held at 0 (radiance)
     W_S = band_weights(GRID_41, spectrum_from_dataset("illuminant", illuminant))
     s = np.maximum(W_S.sum(axis=1) / np.maximum(W_E.sum(axis=1), 1e-300), 0.0)

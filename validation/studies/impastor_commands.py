@@ -234,6 +234,8 @@ def render_path_for_cli(
     frames = require_positive_int(frames, "--frames", MAX_PATH_FRAMES)
     require(np.isfinite(fps) and 0 < fps <= 120, f"--fps: must be in (0, 120], got {fps!r}")
     start, end = check_eye(eye_from, "--from"), check_eye(eye_to, "--to")
+    for option, value in (("--tilt-from", tilt_from), ("--tilt-to", tilt_to)):
+        require(np.isfinite(value), f"{option}: must be a finite angle in degrees, got {value!r}")
     tilts = np.radians(np.linspace(tilt_from, tilt_to, frames))
     eyes = [start + (end - start) * (k / max(frames - 1, 1)) for k in range(frames)]
     for k, (eye, tilt) in enumerate(zip(eyes, tilts, strict=True)):
