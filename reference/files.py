@@ -595,34 +595,46 @@ def check_output_folder(folder) -> Path:
 
 
 @contextlib.contextmanager
-def folder_lock(folder):
-    """Hold an exclusive lock on ``folder`` (its ``.lock`` file) while the block runs.
+def folder_lock(folder, item: str = "", wait: bool = True):
+    """Hold an exclusive lock on ``folder`` (its ``.lock`` file) while the block runs; yields True.
 
     Processes that fill one cache folder at once (two commands, the workers of a test run) take
     turns: the second finds what the first wrote instead of writing it again, and no manifest
     update is lost. An advisory ``flock`` (released when the process ends, even killed); where
     the platform has none (Windows), no lock.
 
+    ``item`` names a lock of its own within the folder (``.lock-<item>``), so processes working on
+    different items of one folder do not wait for each other. With ``wait=False`` the block runs
+    at once and gets False when another process holds the lock (it must then leave the item alone).
+
     Examples
     --------
     >>> import tempfile, os
     >>> with tempfile.TemporaryDirectory() as d:
-    ...     with folder_lock(d):
-    ...         sorted(os.listdir(d))
-    ['.lock']
+    ...     with folder_lock(d) as held, folder_lock(d, "scene", wait=False) as other:
+    ...         held, other, sorted(os.listdir(d))
+    (True, True, ['.lock', '.lock-scene'])
     """
     folder = Path(folder)
+    require(
+        "/" not in item and "\\" not in item and item not in (".", ".."),
+        f"folder_lock: {item!r} is not a lock name",
+    )
     try:
         import fcntl
     except ImportError:  # no flock: one process at a time is the user's business
-        yield folder
+        yield True
         return
     with _write_errors(folder):
         folder.mkdir(parents=True, exist_ok=True)
-        handle = open(folder / ".lock", "a+b")  # noqa: SIM115 (closed below)
+        handle = open(folder / (f".lock-{item}" if item else ".lock"), "a+b")  # noqa: SIM115
     try:
-        fcntl.flock(handle.fileno(), fcntl.LOCK_EX)
-        yield folder
+        try:
+            fcntl.flock(handle.fileno(), fcntl.LOCK_EX | (0 if wait else fcntl.LOCK_NB))
+        except BlockingIOError:
+            yield False
+            return
+        yield True
     finally:
         handle.close()  # releases the lock
 

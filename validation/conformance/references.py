@@ -270,30 +270,55 @@ def ensure_references(names=None, folder=None, progress=None, force: bool = Fals
     >>> sorted(manifest["scenes"]["colorchecker-d65"]["files"])
     ['colorchecker-d65.spectral.exr', 'colorchecker-d65.xyz.exr']
     """
-    import time
-
-    from reference.files import check_output_folder, folder_lock, write_text_atomic
+    from reference.files import check_output_folder, folder_lock
     from validation.conformance.scenes import CONFORMANCE_SCENES
 
     folder = check_output_folder(folder if folder is not None else reference_folder())
     names = list(CONFORMANCE_SCENES.names() if names is None else names)
     for name in names:
         CONFORMANCE_SCENES.lookup(name)
-    for i, name in enumerate(names, 1):
-        # one process renders a scene; the others wait and find it (the manifest read again)
-        with folder_lock(folder):
-            manifest = _read_manifest(folder)
-            if not force and _intact(folder, manifest["scenes"].get(name)):
-                continue
-            start = time.perf_counter()
-            if progress is not None:
-                progress(f"[{i}/{len(names)}] {name}: rendering the reference")
-            manifest["scenes"][name] = write_reference(render_reference(name), folder)
-            write_text_atomic(folder / "manifest.json", json.dumps(manifest, indent=1) + "\n")
-        if progress is not None:
-            progress(f"[{i}/{len(names)}] {name}: {time.perf_counter() - start:.1f} s")
+    with folder_lock(folder):
+        before = _read_manifest(folder)["scenes"]
+    # Each scene under a lock of its own: processes filling one folder render different scenes side
+    # by side, a process passing over the scenes another holds; then it waits for those, and
+    # renders any that the other left undone (it stopped, or it was killed)
+    pending = list(enumerate(names, 1))
+    for wait in (False, True):
+        busy = []
+        for i, name in pending:
+            with folder_lock(folder, name, wait=wait) as held:
+                if not held:
+                    busy.append((i, name))
+                    continue
+                label = f"[{i}/{len(names)}] {name}"
+                _render_if_missing(folder, name, before.get(name), force, label, progress)
+        pending = busy
     with folder_lock(folder):
         return _read_manifest(folder)
+
+
+def _render_if_missing(folder: Path, name, before, force: bool, label: str, progress) -> None:
+    # one scene of ensure_references, under the scene's lock: the manifest read and written under
+    # the folder's (brief), the render outside it
+    import time
+
+    from reference.files import folder_lock, write_text_atomic
+
+    with folder_lock(folder):
+        entry = _read_manifest(folder)["scenes"].get(name)
+    done = force and entry is not None and entry != before  # rendered anew by another process
+    if (done or not force) and _intact(folder, entry):
+        return
+    start = time.perf_counter()
+    if progress is not None:
+        progress(f"{label}: rendering the reference")
+    entry = write_reference(render_reference(name), folder)
+    with folder_lock(folder):
+        manifest = _read_manifest(folder)
+        manifest["scenes"][name] = entry
+        write_text_atomic(folder / "manifest.json", json.dumps(manifest, indent=1) + "\n")
+    if progress is not None:
+        progress(f"{label}: {time.perf_counter() - start:.1f} s")
 
 
 def load_reference(name: str, folder=None, progress=None) -> Reference:

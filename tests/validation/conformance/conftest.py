@@ -10,8 +10,9 @@ def conformance_references(tmp_path_factory, request):
     """A folder the references are rendered into where missing (``load_reference`` does it).
 
     With pytest-xdist, the run's workers share it (the base folder's parent is the run's): each
-    reference is rendered once, by whichever worker needs it first, under the folder's lock
-    (``reference.files.folder_lock``), and the others read it.
+    reference is rendered once, by whichever worker comes to it first, under the scene's lock
+    (``reference.files.folder_lock``); a worker passes over the scenes another is rendering, so
+    two workers that need the references at once render them side by side.
     """
     worker = getattr(request.config, "workerinput", {}).get("workerid")
     if worker is None:

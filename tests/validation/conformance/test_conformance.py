@@ -343,8 +343,8 @@ def _ensure_and_report(folder, names, queue):
 
 
 def test_processes_filling_one_folder_render_each_reference_once(tmp_path):
-    # two commands (or the suite's workers) at once on one cache: the folder's lock makes the
-    # second wait and find each reference, and no scene is lost from the manifest
+    # two commands (or the suite's workers) at once on one cache: each scene's lock lets one of
+    # them render it and the other find it, and no scene is lost from the manifest
     import multiprocessing
 
     from validation.conformance.references import _read_manifest
@@ -362,3 +362,32 @@ def test_processes_filling_one_folder_render_each_reference_once(tmp_path):
     assert [p.exitcode for p in procs] == [0, 0]
     assert queue.get(timeout=5) + queue.get(timeout=5) == len(names)
     assert sorted(_read_manifest(tmp_path)["scenes"]) == names
+
+
+def test_a_scene_another_process_holds_is_passed_over_then_done_if_it_stops(tmp_path):
+    # This process holds colorchecker-d65's lock, as another command rendering it would: the child
+    # renders colorchecker-a meanwhile (its manifest entry appears while the lock is held), then
+    # waits, and renders colorchecker-d65 itself once the lock goes without the scene being done
+    import multiprocessing
+    import time
+
+    from reference.files import folder_lock
+    from validation.conformance.references import _read_manifest
+
+    names = ["colorchecker-d65", "colorchecker-a"]
+    context = multiprocessing.get_context("spawn")
+    queue = context.Queue()
+    child = context.Process(target=_ensure_and_report, args=(tmp_path, names, queue))
+    with folder_lock(tmp_path, "colorchecker-d65"):
+        child.start()
+        deadline = time.monotonic() + 120
+        while "colorchecker-a" not in _read_manifest(tmp_path)["scenes"]:
+            assert child.is_alive(), "the child stopped before rendering colorchecker-a"
+            assert time.monotonic() < deadline, "the child did not pass over colorchecker-d65"
+            time.sleep(0.1)
+        assert "colorchecker-d65" not in _read_manifest(tmp_path)["scenes"]
+        assert child.is_alive()  # waiting for the scene this process holds
+    child.join(timeout=120)
+    assert child.exitcode == 0
+    assert queue.get(timeout=5) == 2
+    assert sorted(_read_manifest(tmp_path)["scenes"]) == sorted(names)
