@@ -38,6 +38,8 @@ __all__ = [
     "check_latlong_shape",
     "direction_to_latlong_uv",
     "latlong_lookup_bilinear",
+    "latlong_lookup_trilinear",
+    "latlong_mip_pyramid",
     "latlong_pixel_directions",
     "latlong_pixel_solid_angles",
     "latlong_rows_centred",
@@ -203,6 +205,85 @@ def latlong_lookup_bilinear(image, d) -> np.ndarray:
     top = image[y0, x0] * (1 - fx) + image[y0, x1] * fx
     bottom = image[y1, x0] * (1 - fx) + image[y1, x1] * fx
     return top * (1 - fy) + bottom * fy
+
+
+def latlong_mip_pyramid(image) -> list[np.ndarray]:
+    """The lat-long map and its successive 2 × 2 reductions, each texel the solid-angle mean.
+
+    Level ``k + 1`` averages the 2 × 2 texels of level ``k`` weighted by their exact solid angles
+    (:func:`latlong_pixel_solid_angles`), so every level keeps the map's integral over the sphere.
+    The pyramid stops at a level whose height is odd (or 1); a 2:1 map of ``2^m`` rows goes down
+    to 1 × 2 texels. Filtered importance sampling reads it (Colbert & Křivánek 2007, GPU Gems 3,
+    ch. 20).
+
+    Parameters
+    ----------
+    image : array_like, shape (H, W, C)
+        Lat-long map (W = 2H).
+
+    Returns
+    -------
+    list of ndarray
+        Level 0 (the map, float64) first; level k of shape (H / 2^k, W / 2^k, C).
+
+    Examples
+    --------
+    >>> levels = latlong_mip_pyramid(np.ones((8, 16, 2)))
+    >>> [lv.shape[:2] for lv in levels], bool(np.allclose(levels[-1], 1.0))
+    ([(8, 16), (4, 8), (2, 4), (1, 2)], True)
+    """
+    levels = [np.asarray(image, dtype=np.float64)]
+    check_latlong_shape(levels[0].shape, "mip pyramid")
+    while levels[-1].shape[0] > 1 and levels[-1].shape[0] % 2 == 0:
+        top = levels[-1]
+        H, W, C = top.shape
+        omega = latlong_pixel_solid_angles(H, W)[..., None]
+        # Σ Ω L / Σ Ω over each 2 × 2 block
+        weighted = (top * omega).reshape(H // 2, 2, W // 2, 2, C).sum(axis=(1, 3))
+        total = omega.reshape(H // 2, 2, W // 2, 2, 1).sum(axis=(1, 3))
+        levels.append(weighted / total)
+    return levels
+
+
+def latlong_lookup_trilinear(levels, d, level) -> np.ndarray:
+    """Look-ups of a mip pyramid between levels: bilinear in each, linear across (GPU trilinear).
+
+    Parameters
+    ----------
+    levels : list of ndarray
+        From :func:`latlong_mip_pyramid`.
+    d : array_like, shape (..., 3)
+        Unit directions, y up.
+    level : array_like, shape (...,)
+        Fractional levels, clamped to ``[0, len(levels) − 1]``.
+
+    Returns
+    -------
+    ndarray, shape (..., C)
+
+    Examples
+    --------
+    >>> levels = latlong_mip_pyramid(np.arange(32.0).reshape(4, 8, 1))
+    >>> up = [[0.0, 1.0, 0.0]]
+    >>> bool(np.allclose(latlong_lookup_trilinear(levels, up, [0.0]),
+    ...                  latlong_lookup_bilinear(levels[0], up)))
+    True
+    >>> a, b = (latlong_lookup_bilinear(levels[k], up) for k in (1, 2))
+    >>> bool(np.allclose(latlong_lookup_trilinear(levels, up, [1.25]), 0.75 * a + 0.25 * b))
+    True
+    """
+    d = np.asarray(d, dtype=np.float64)
+    level = np.clip(np.asarray(level, dtype=np.float64), 0.0, len(levels) - 1.0)
+    lo = np.minimum(np.floor(level).astype(np.int64), len(levels) - 1)
+    t = (level - lo)[..., None]
+    out = np.zeros((*d.shape[:-1], levels[0].shape[-1]))
+    for k in np.unique(lo):
+        at = lo == k
+        above = levels[min(k + 1, len(levels) - 1)]
+        out[at] = (1.0 - t[at]) * latlong_lookup_bilinear(levels[k], d[at]) + t[
+            at
+        ] * latlong_lookup_bilinear(above, d[at])
+    return out
 
 
 def latlong_rows_centred(image) -> np.ndarray:

@@ -3,7 +3,8 @@
 Twins of ``shrm.polymer.oracle.rough_specular_samples`` and ``rough_reflection_albedo``, of
 ``shrm.polymer.material.polymer_shade_parts``, of its baseline
 ``shrm.polymer.material.lambert_phong_shade_parts`` and of the layered model's re-shade
-``shrm.polymer.layered.layered_reshade_XYZ``. Each kernel keeps the names and equation
+``shrm.polymer.layered.layered_reshade_XYZ`` and of its filtered importance sampling
+``shrm.polymer.layered.fis_specular_latlong``. Each kernel keeps the names and equation
 comments of its NumPy reference, never validates, never prints, and writes into an output array
 that the public entry point allocated. The equality tests live in ``tests/shrm/polymer``.
 """
@@ -18,6 +19,7 @@ from reference.jit import njit
 
 __all__ = [
     "lambert_phong_shade_parts_kernel",
+    "layered_fis_kernel",
     "layered_reshade_kernel",
     "polymer_shade_parts_kernel",
     "rough_reflection_albedo_kernel",
@@ -117,6 +119,107 @@ def rough_specular_samples_kernel(N, V, radiance, alpha, n, u, total, total_sq):
             for band in range(nb):
                 total[p, band] += x[band]
                 total_sq[p, band] += x[band] * x[band]
+
+
+@njit
+def _pyramid_bilinear_add(flat, offset, H, dx, dy, dz, weight, x_out):
+    """x_out[b] += weight × bilinear look-up of one packed pyramid level (W = 2H)."""
+    W = 2 * H
+    u = math.atan2(dx, -dz) / (2.0 * math.pi)
+    if u < 0.0:
+        u += 1.0
+    if u >= 1.0:
+        u = 0.0
+    v = math.acos(min(max(dy, -1.0), 1.0)) / math.pi
+    x = u * W - 0.5
+    y = min(max(v * H - 0.5, 0.0), H - 1.0)
+    x0 = math.floor(x)
+    y0 = min(math.floor(y), H - 1)
+    fx, fy = x - x0, y - y0
+    x1, y1 = (x0 + 1) % W, min(y0 + 1, H - 1)
+    x0 = x0 % W
+    for b in range(flat.shape[1]):
+        top = flat[offset + y0 * W + x0, b] * (1 - fx) + flat[offset + y0 * W + x1, b] * fx
+        bottom = flat[offset + y1 * W + x0, b] * (1 - fx) + flat[offset + y1 * W + x1, b] * fx
+        x_out[b] += weight * (top * (1 - fy) + bottom * fy)
+
+
+@njit
+def layered_fis_kernel(N, V, flat, heights, offsets, alpha, n, u, bias, out):
+    """Twin of ``shrm.polymer.layered.fis_specular_latlong``: Σ w L̃(i, λ) / Σ w, w = F G_1."""
+    K, top = u.shape[0], heights.shape[0] - 1
+    nb = flat.shape[1]
+    x = np.zeros(nb)
+    H = heights[0]
+    texel = (math.pi / H) * (2.0 * math.pi / (2 * H))
+    sin_pole = math.sin(0.5 * math.pi / H)
+    a2 = alpha * alpha
+    for p in range(N.shape[0]):
+        nx, ny, nz = N[p, 0], N[p, 1], N[p, 2]
+        # Duff et al. 2017: the tangent frame (T, B, N)
+        sign = math.copysign(1.0, nz)
+        a = -1.0 / (sign + nz)
+        b = nx * ny * a
+        tx, ty, tz = 1.0 + sign * nx * nx * a, sign * b, -sign * nx
+        bx, by, bz = b, sign + ny * ny * a, -ny
+        ox = V[p, 0] * tx + V[p, 1] * ty + V[p, 2] * tz
+        oy = V[p, 0] * bx + V[p, 1] * by + V[p, 2] * bz
+        oz = max(V[p, 0] * nx + V[p, 1] * ny + V[p, 2] * nz, 1e-6)
+        norm = math.sqrt(ox * ox + oy * oy + oz * oz)
+        ox, oy, oz = ox / norm, oy / norm, oz / norm
+        c2 = max(oz * oz, 1e-300)
+        G1_o = 2.0 / (1.0 + math.sqrt(1.0 + a2 * (1.0 - c2) / c2))
+        # Heitz 2018, listing 1: the view in the stretched configuration
+        vx, vy, vz = alpha * ox, alpha * oy, oz
+        norm = math.sqrt(vx * vx + vy * vy + vz * vz)
+        vx, vy, vz = vx / norm, vy / norm, vz / norm
+        lensq = vx * vx + vy * vy
+        if lensq > 0:
+            inv = 1.0 / math.sqrt(lensq)
+            t1x, t1y, t1z = -vy * inv, vx * inv, 0.0
+        else:
+            t1x, t1y, t1z = 1.0, 0.0, 0.0
+        t2x, t2y, t2z = vy * t1z - vz * t1y, vz * t1x - vx * t1z, vx * t1y - vy * t1x
+        s = 0.5 * (1.0 + vz)
+        x[:] = 0.0
+        total = 0.0
+        for m in range(K):
+            r = math.sqrt(u[m, 0])
+            phi = 2.0 * math.pi * u[m, 1]
+            q1 = r * math.cos(phi)
+            q2 = (1.0 - s) * math.sqrt(1.0 - q1 * q1) + s * r * math.sin(phi)
+            q3 = math.sqrt(max(0.0, 1.0 - q1 * q1 - q2 * q2))
+            hx = alpha * (q1 * t1x + q2 * t2x + q3 * vx)
+            hy = alpha * (q1 * t1y + q2 * t2y + q3 * vy)
+            hz = max(0.0, q1 * t1z + q2 * t2z + q3 * vz)
+            norm = math.sqrt(hx * hx + hy * hy + hz * hz)
+            hx, hy, hz = hx / norm, hy / norm, hz / norm
+            # i = 2 (o·h) h − o; weight F(o·h) G_1(i) (Eq. (34), Walter et al. 2007)
+            oh = ox * hx + oy * hy + oz * hz
+            ix, iy, iz = 2.0 * oh * hx - ox, 2.0 * oh * hy - oy, 2.0 * oh * hz - oz
+            if iz <= 0.0:
+                continue
+            ci2 = max(iz * iz, 1e-300)
+            G = 2.0 / (1.0 + math.sqrt(1.0 + a2 * (1.0 - ci2) / ci2))
+            weight = _fresnel_dielectric(oh, n) * G
+            total += weight
+            dx = ix * tx + iy * bx + iz * nx
+            dy = ix * ty + iy * by + iz * ny
+            dz = ix * tz + iy * bz + iz * nz
+            # pdf(i) = G_1(o) D(h) / (4 cos θ_o); the level of Ω_s = 1/(K pdf) over a texel's Ω_p
+            D = a2 / (math.pi * (hz * hz * (a2 - 1.0) + 1.0) ** 2)
+            pdf = G1_o * D / (4.0 * oz)
+            omega_p = texel * max(math.sqrt(max(1.0 - dy * dy, 0.0)), sin_pole)
+            level = max(0.5 * math.log2(1.0 / (K * pdf * omega_p)) + bias, 0.0)
+            level = min(level, float(top))
+            lo = min(math.floor(level), top)
+            t = level - lo
+            hi = min(lo + 1, top)
+            _pyramid_bilinear_add(flat, offsets[lo], heights[lo], dx, dy, dz, weight * (1 - t), x)
+            _pyramid_bilinear_add(flat, offsets[hi], heights[hi], dx, dy, dz, weight * t, x)
+        if total > 0.0:
+            for band in range(nb):
+                out[p, band] = x[band] / total
 
 
 @njit

@@ -13,10 +13,12 @@ three terms from maps prefiltered once per environment, index and gloss, with th
   truncation and interpolation;
 - **transmission**: ``exit(θ_o) τ E_b(−n)`` with the smooth back surface's kernel
   ``(1 − F(cos γ)) cos γ``, the same way;
-- **specular**: smooth interface: ``F(θ_o) L(r)``, the oracle's mirror look-up. Rough: the split
-  sum of Karis 2013, ``E_ρ(θ_o) L_α(r)``: the interface's directional albedo (the oracle's table)
-  times the environment prefiltered by the GGX lobe about the mirror direction ``r``, which
-  assumes ``n = v = r`` for the lobe's shape (its only approximation; erratum E108).
+- **specular**: smooth interface: ``F(θ_o) L(r)``, the oracle's mirror look-up. Rough:
+  ``E_ρ(θ_o) L̄``, the interface's directional albedo (the oracle's table) times the environment
+  averaged over the pixel's own lobe by filtered importance sampling (Colbert & Křivánek 2007) of
+  the oracle's estimator, read from the map's mip pyramid (:func:`fis_specular_latlong`); or, with
+  ``specular="split_sum_Karis"``, Karis 2013's split sum, the environment prefiltered by the GGX
+  lobe about the mirror direction ``r`` for ``n = v = r`` (erratum E108).
 
 ``exit(θ_o) = (1 − E_ρ(θ_o)) / (π (1 − k_e))`` and the slab's ``ρ_out`` and ``τ`` are the
 oracle's (:func:`shrm.polymer.oracle.body_factors`). Thickness and TiO2 (the slab) change only
@@ -26,6 +28,8 @@ and the index choose the maps.
 
 References
 ----------
+Colbert, M., Křivánek, J. (2007). GPU-based importance sampling. GPU Gems 3, ch. 20.
+Heitz, E. (2018). Sampling the GGX distribution of visible normals. JCGT 7(4).
 Karis, B. (2013). Real shading in Unreal Engine 4. SIGGRAPH course notes (the split sum).
 Ramamoorthi, R., Hanrahan, P. (2001). An efficient representation for irradiance environment
     maps. SIGGRAPH 2001.
@@ -39,10 +43,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reference.errors import require, require_finite
+from reference.errors import require, require_choice, require_finite, require_positive_int
 from reference.geometry.envmap import (
     check_latlong_shape,
     latlong_lookup_bilinear,
+    latlong_lookup_trilinear,
+    latlong_mip_pyramid,
     latlong_pixel_directions,
     latlong_pixel_solid_angles,
 )
@@ -50,6 +56,10 @@ from reference.materials.fresnel import fresnel_dielectric
 from reference.registry import Method, Registry
 from shrm.polymer.oracle import (
     Coupling,
+    _frame,
+    _reflect_weight,
+    _sample_visible_normal,
+    _smith_G1,
     body_factors,
     coupled_irradiance,
     gloss_alpha,
@@ -57,11 +67,16 @@ from shrm.polymer.oracle import (
 )
 
 __all__ = [
+    "FIS_BIAS",
+    "FIS_SAMPLES",
     "LAYERED_KERNELS",
+    "LAYERED_SPECULAR",
     "PREFILTER_MAX_ROWS",
     "LayeredMaps",
     "coupled_irradiance_latlong",
+    "fis_specular_latlong",
     "ggx_prefiltered_latlong",
+    "hammersley_points",
     "layered_maps",
     "layered_pixel_parts",
     "layered_reshade_XYZ",
@@ -72,6 +87,14 @@ __all__ = [
 #: Rows of the map the prefilters sum over: larger maps are box-filtered to this first, which
 #: bounds their cost to (64 · 128)² weights per map (erratum E108).
 PREFILTER_MAX_ROWS = 64
+#: The rough interface's reflection, by method (:func:`layered_maps`): filtered importance
+#: sampling of the true lobe (:func:`fis_specular_latlong`, the default) or Karis's split sum
+#: (:func:`ggx_prefiltered_latlong`; erratum E108).
+LAYERED_SPECULAR = ("fis_Colbert", "split_sum_Karis")
+#: Filtered importance sampling: Hammersley samples of the lobe per pixel, and the bias added to
+#: the pyramid level (Colbert & Křivánek 2007 add 1; 0 reads a sharper level). Chosen on the first
+#: draw of held-out chips (erratum E108), which the report no longer uses.
+FIS_SAMPLES, FIS_BIAS = 128, 0.0
 
 
 def _box_rows(radiance: np.ndarray, rows: int) -> np.ndarray:
@@ -196,9 +219,15 @@ class LayeredMaps:
     E_front, E_back : ndarray, shape (H_e, W_e, n_bands)
         Irradiance through the front coupling and through the smooth back surface, lat-long.
     specular : ndarray or None, shape (H_s, W_s, n_bands)
-        The GGX-prefiltered environment (None for a smooth interface).
+        The GGX-prefiltered environment (the split sum's; None otherwise).
     n, gloss, alpha : float
         Index, gloss and the interface's GGX width.
+    method : str
+        The rough interface's reflection, one of :data:`LAYERED_SPECULAR`.
+    levels : tuple of ndarray
+        The environment's mip pyramid (filtered importance sampling's; empty otherwise).
+    samples : int
+        Samples per pixel of filtered importance sampling.
     """
 
     radiance: np.ndarray
@@ -208,9 +237,18 @@ class LayeredMaps:
     n: float
     gloss: float
     alpha: float
+    method: str = "split_sum_Karis"
+    levels: tuple = ()
+    samples: int = FIS_SAMPLES
 
 
-def layered_maps(radiance, n: float = 1.54, gloss: float = 1.0) -> LayeredMaps:
+def layered_maps(
+    radiance,
+    n: float = 1.54,
+    gloss: float = 1.0,
+    specular: str = "fis_Colbert",
+    samples: int = FIS_SAMPLES,
+) -> LayeredMaps:
     """Prefilter an environment for the layered model (once per map, index and gloss).
 
     Parameters
@@ -221,6 +259,11 @@ def layered_maps(radiance, n: float = 1.54, gloss: float = 1.0) -> LayeredMaps:
         Index of the polymer, > 1.
     gloss : float
         In [0, 1] (``gloss_alpha``, erratum E65).
+    specular : str
+        The rough interface's reflection, one of :data:`LAYERED_SPECULAR`: ``"fis_Colbert"``
+        keeps the map's mip pyramid, ``"split_sum_Karis"`` prefilters it by the GGX lobe.
+    samples : int
+        Samples per pixel of ``"fis_Colbert"``.
 
     Returns
     -------
@@ -228,25 +271,140 @@ def layered_maps(radiance, n: float = 1.54, gloss: float = 1.0) -> LayeredMaps:
 
     Examples
     --------
-    >>> maps = layered_maps(np.ones((16, 32, 2)), 1.5, 0.8)
+    >>> maps = layered_maps(np.ones((16, 32, 2)), 1.5, 0.8, "split_sum_Karis")
     >>> maps.E_front.shape, maps.specular.shape, round(maps.alpha, 3)
     ((16, 32, 2), (16, 32, 2), 0.1)
+    >>> [level.shape[0] for level in layered_maps(np.ones((16, 32, 2)), 1.5, 0.8).levels]
+    [16, 8, 4, 2, 1]
     """
     radiance = np.asarray(require_finite(radiance, "layered polymer: radiance"), dtype=np.float64)
     check_latlong_shape(radiance.shape, "layered polymer: radiance")
     require((radiance >= 0).all(), "layered polymer: radiance must be >= 0")
     require(float(n) > 1.0, f"layered polymer: n: refractive index must be > 1, got {n!r}")
+    require_choice(specular, LAYERED_SPECULAR, "layered polymer: specular")
+    require_positive_int(samples, "layered polymer: samples")
     alpha = gloss_alpha(gloss)
     front, back = interface_coupling(float(n), alpha), interface_coupling(float(n), 0.0)
+    rough = alpha > 0.0
     return LayeredMaps(
         radiance,
         coupled_irradiance_latlong(radiance, front),
         coupled_irradiance_latlong(radiance, back),
-        ggx_prefiltered_latlong(radiance, alpha) if alpha > 0.0 else None,
+        ggx_prefiltered_latlong(radiance, alpha) if rough and specular != "fis_Colbert" else None,
         float(n),
         float(gloss),
         alpha,
+        specular,
+        tuple(latlong_mip_pyramid(radiance)) if rough and specular == "fis_Colbert" else (),
+        int(samples),
     )
+
+
+def hammersley_points(samples: int) -> np.ndarray:
+    """``samples`` Hammersley points in [0, 1)²: ``((k + ½)/K, radical inverse of k in base 2)``.
+
+    Examples
+    --------
+    >>> hammersley_points(4).tolist()
+    [[0.125, 0.0], [0.375, 0.5], [0.625, 0.25], [0.875, 0.75]]
+    """
+    k = np.arange(samples, dtype=np.uint64)
+    bits = np.zeros(samples, dtype=np.float64)
+    scale = 0.5
+    for _ in range(max(1, int(samples - 1).bit_length())):
+        bits += (k & np.uint64(1)) * scale
+        k >>= np.uint64(1)
+        scale *= 0.5
+    return np.stack([(np.arange(samples) + 0.5) / samples, bits], axis=-1)
+
+
+def fis_specular_latlong(
+    normal, view, levels, alpha: float, n: float, samples: int = FIS_SAMPLES, bias=FIS_BIAS
+) -> np.ndarray:
+    """The environment averaged over the rough interface's lobe, by filtered importance sampling.
+
+    ``L̄ = Σ_k w_k L̃(i_k, λ_k) / Σ_k w_k`` with ``w_k = F(o·h_k) G_1(i_k)``: the oracle's
+    estimator (``oracle.rough_specular_samples``: GGX visible normals ``h_k``, Heitz 2018,
+    ``i_k = 2 (o·h_k) h_k − o``, the weight of Eq. (20), Walter et al. 2007, with Eq. (34),
+    Walter et al. 2007) at the K Hammersley points of :func:`hammersley_points`, normalized by
+    its own sum of weights, so that ``E_ρ(θ_o) L̄`` is the reflection with the interface's
+    tabulated albedo (exact under a uniform sky, as the body's ``1 − E_ρ`` needs). Each sample
+    reads the map's mip pyramid at the level of its solid angle (Colbert & Křivánek 2007),
+    ``λ_k = max(½ log₂(Ω_s / Ω_p) + bias, 0)`` with ``Ω_s = 1 / (K pdf(i_k))``,
+    ``pdf(i) = G_1(o) D(h) / (4 cos θ_o)`` and ``Ω_p`` a level-0 texel's solid angle at ``i_k``,
+    ``(π/H)(2π/W) sin θ``. The true lobe for the pixel's own ``n`` and ``v`` (stretched and off the
+    mirror direction at grazing views, cut by the horizon), filtered instead of noisy; 0 where
+    every sample falls below the horizon.
+
+    Parameters
+    ----------
+    normal, view : array_like, shape (P, 3)
+        Unit normals and unit vectors towards the eye.
+    levels : sequence of ndarray
+        The environment's pyramid (``reference.geometry.envmap.latlong_mip_pyramid``).
+    alpha, n : float
+        GGX width (> 0) and index.
+    samples : int
+        K.
+    bias : float
+        Added to every level.
+
+    Returns
+    -------
+    ndarray, shape (P, n_bands)
+
+    Examples
+    --------
+    >>> up, side = np.array([[0.0, 1.0, 0.0]]), np.array([[0.0, 0.0, 1.0]])
+    >>> fis_specular_latlong(up, up, latlong_mip_pyramid(np.ones((16, 32, 1))), 0.2, 1.5)
+    array([[1.]])
+    >>> sky = np.concatenate([np.ones((8, 32, 1)), np.zeros((8, 32, 1))])   # bright above
+    >>> levels = latlong_mip_pyramid(sky)
+    >>> print(fis_specular_latlong(side, side, levels, 0.3, 1.5).round(3))  # half the lobe's sky
+    [[0.5]]
+    """
+    N = np.asarray(normal, dtype=np.float64)
+    V = np.asarray(view, dtype=np.float64)
+    H, W = levels[0].shape[:2]
+    u = hammersley_points(samples)
+    out = np.zeros((N.shape[0], levels[0].shape[2]))
+    for s in range(0, N.shape[0], 1024):
+        T, B = _frame(N[s : s + 1024])
+        n_s = N[s : s + 1024]
+        o = np.stack([np.einsum("ij,ij->i", V[s : s + 1024], A) for A in (T, B, n_s)], axis=-1)
+        o[:, 2] = np.maximum(o[:, 2], 1e-6)
+        o = np.broadcast_to(
+            (o / np.linalg.norm(o, axis=-1, keepdims=True))[:, None], (len(o), samples, 3)
+        )
+        h = _sample_visible_normal(o, alpha, *np.broadcast_to(u.T[:, None], (2, len(o), samples)))
+        weight, i = _reflect_weight(o, h, alpha, n)
+        wi = i[..., 0:1] * T[:, None] + i[..., 1:2] * B[:, None] + i[..., 2:3] * n_s[:, None]
+        # pdf(i) = G_1(o) D(h) / (4 cos θ_o), D of Eq. (33), Walter et al. 2007
+        D = alpha**2 / (np.pi * (h[..., 2] ** 2 * (alpha**2 - 1.0) + 1.0) ** 2)
+        pdf = _smith_G1(o[..., 2], alpha) * D / (4.0 * o[..., 2])
+        sin_theta = np.sqrt(np.maximum(1.0 - wi[..., 1] ** 2, 0.0))
+        omega_p = (np.pi / H) * (2.0 * np.pi / W) * np.maximum(sin_theta, np.sin(0.5 * np.pi / H))
+        level = np.maximum(0.5 * np.log2(1.0 / (samples * pdf * omega_p)) + bias, 0.0)
+        L = latlong_lookup_trilinear(levels, wi, level)
+        total = weight.sum(axis=1)[:, None]
+        lit = total[:, 0] > 0.0
+        out[s : s + 1024][lit] = (weight[..., None] * L).sum(axis=1)[lit] / total[lit]
+    return out
+
+
+def _fis_compiled(normal, view, levels, alpha, n, samples=FIS_SAMPLES, bias=FIS_BIAS):
+    """:func:`fis_specular_latlong` by its numba twin (the pyramid packed in one array)."""
+    from shrm.polymer._kernels import layered_fis_kernel
+
+    N = np.ascontiguousarray(normal, dtype=np.float64)
+    V = np.ascontiguousarray(view, dtype=np.float64)
+    heights = np.array([level.shape[0] for level in levels], dtype=np.int64)
+    offsets = np.concatenate([[0], np.cumsum(2 * heights**2)[:-1]]).astype(np.int64)
+    flat = np.concatenate([level.reshape(-1, level.shape[2]) for level in levels])
+    out = np.zeros((N.shape[0], levels[0].shape[2]))
+    u = hammersley_points(samples)
+    layered_fis_kernel(N, V, flat, heights, offsets, float(alpha), float(n), u, float(bias), out)
+    return out
 
 
 def layered_pixel_parts(normal, view, maps: LayeredMaps) -> dict:
@@ -282,11 +440,16 @@ def layered_pixel_parts(normal, view, maps: LayeredMaps) -> dict:
     # exit(θ_o) = (1 − E_ρ(θ_o)) / (π (1 − k_e)), the oracle's exit distribution
     exit_ = (front.lookup(cos_o) / (np.pi * (1.0 - front.k_e)))[:, None]
     r = 2.0 * cos_o[:, None] * N - V
-    if maps.specular is None:
+    if maps.alpha == 0.0:
         # smooth: F(θ_o) L(r), the oracle's own term
         specular = fresnel_dielectric(cos_o, maps.n)[:, None] * latlong_lookup_bilinear(
             maps.radiance, r
         )
+    elif maps.method == "fis_Colbert":
+        # E_ρ(θ_o) times the environment averaged over the pixel's own lobe (filtered sampling)
+        E_rho = 1.0 - front.lookup(np.maximum(cos_o, 1e-6))
+        lobe = _fis_compiled(N, V, maps.levels, maps.alpha, maps.n, maps.samples)
+        specular = E_rho[:, None] * lobe
     else:
         # Karis 2013's split sum: E_ρ(θ_o) L_α(r), with E_ρ = 1 − the oracle's coupling table
         E_rho = 1.0 - front.lookup(np.maximum(cos_o, 1e-6))
@@ -407,9 +570,28 @@ def _reshade_example(rng):
     return parts, K, S, 1.3, maps, rng.uniform(0, 1, (16, 3))
 
 
-def _register():
-    from shrm.polymer._kernels import layered_reshade_kernel
+def _fis_example(rng):
+    N = rng.normal(size=(6, 3))
+    N /= np.linalg.norm(N, axis=1, keepdims=True)
+    V = N + rng.normal(scale=0.6, size=(6, 3))
+    V /= np.linalg.norm(V, axis=1, keepdims=True)
+    levels = latlong_mip_pyramid(rng.uniform(0.0, 2.0, (8, 16, 3)))
+    return N, V, levels, 0.3, 1.5, 16, 0.5
 
+
+def _register():
+    from shrm.polymer._kernels import layered_fis_kernel, layered_reshade_kernel
+
+    LAYERED_KERNELS.register(
+        Method(
+            "fis",
+            fis_specular_latlong,
+            layered_fis_kernel,
+            "Colbert & Křivánek 2007 (filtered importance sampling); Heitz 2018",
+            _fis_example,
+            compiled=_fis_compiled,
+        )
+    )
     LAYERED_KERNELS.register(
         Method(
             "reshade",
@@ -422,7 +604,7 @@ def _register():
     )
 
 
-#: The layered model's re-shade and its numba twin (tests check the pair).
+#: The layered model's kernels beside their NumPy references (tests check each pair).
 LAYERED_KERNELS = Registry("layered polymer kernel")
 _register()
 

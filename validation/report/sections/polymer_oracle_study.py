@@ -341,6 +341,9 @@ def speed_accuracy(env, settings: OracleStudy, maps: dict, references: dict) -> 
         dE = colour.delta_E(terms["I_result"], reference.result)
         out["hybrid"][mirror] = {"seconds": seconds, **object_delta_E_stats(dE, N[:, 2])}
     out["layered"] = _layered_speed(N, V, env, colour, reference.result)
+    out["layered_split_sum"] = _layered_speed(
+        N, V, env, colour, reference.result, "split_sum_Karis"
+    )
     for m in settings.samples:
         run = chip_oracle(N, V, env, BASE, settings, tol=0.0, samples=m, max_samples=m, seed=1)
         dE = colour.delta_E(run.result, reference.result)
@@ -350,8 +353,12 @@ def speed_accuracy(env, settings: OracleStudy, maps: dict, references: dict) -> 
     return out
 
 
-def _layered_speed(N, V, env, colour: Colour, reference: np.ndarray) -> dict:
+def _layered_speed(
+    N, V, env, colour: Colour, reference: np.ndarray, specular: str = "fis_Colbert"
+) -> dict:
     """The layered model on the base chip: seconds for its maps, a frame and a re-shade; ΔE00.
+
+    ``specular``: the interface's reflection (``shrm.polymer.layered.LAYERED_SPECULAR``).
 
     The maps' time includes the interface's coupling tables, built uncached as a cold process
     builds them.
@@ -363,7 +370,7 @@ def _layered_speed(N, V, env, colour: Colour, reference: np.ndarray) -> dict:
     t0 = time.perf_counter()
     for alpha in (gloss_alpha(BASE["gloss"]), 0.0):
         interface_coupling.__wrapped__(float(constituents.index), alpha)
-    maps = layered_maps(env, constituents.index, BASE["gloss"])
+    maps = layered_maps(env, constituents.index, BASE["gloss"], specular)
     maps_seconds = time.perf_counter() - t0
     result = layered_terms(N, V, maps, K, S, d)["result"]
     parts = layered_pixel_parts(N, V, maps)
