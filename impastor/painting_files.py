@@ -252,7 +252,7 @@ def write_painting(folder, painting: dict, name: str = "painting", spectra=None)
     from reference.files import atomic_path, check_output_folder, write_text_atomic
     from reference.images.spectral import write_spectral_blocks
 
-    folder = check_output_folder(folder)
+    folder = check_output_folder(folder, marker="painting.toml")
     reflectance = painting_reflectance(painting, spectra).astype(np.float32)
     size = reflectance.shape[0]
     write_spectral_blocks(folder / "reflectance.tif", size, size, MS_GRID.wavelengths_nm,

@@ -19,6 +19,7 @@ from pathlib import Path
 from reference.errors import SpecrefError, require
 
 __all__ = [
+    "MAX_FOLDER_FILES",
     "WRITE_ERRORS",
     "atomic_path",
     "atomic_write",
@@ -292,6 +293,33 @@ def _existing_inputs(inputs) -> list[Path]:
     return found
 
 
+#: Files of an input folder that the write policy looks at (a painting folder, a data folder):
+#: enough for any folder a command reads as a whole, few enough to stay instant.
+MAX_FOLDER_FILES = 10_000
+
+
+def _inode(path) -> tuple | None:
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return (st.st_dev, st.st_ino)
+
+
+def _files_in_folders(inputs) -> dict:
+    """(device, inode) of the files below the input folders, to the folder each was found in."""
+    found: dict = {}
+    for folder in (i for i in inputs if i.is_dir()):
+        for root, _, files in os.walk(folder):
+            for name in files:
+                if len(found) >= MAX_FOLDER_FILES:
+                    return found
+                key = _inode(os.path.join(root, name))
+                if key is not None:
+                    found.setdefault(key, folder)
+    return found
+
+
 def check_outputs(outputs, inputs=(), stores=()) -> list[Path]:
     """The write policy: refuse, before any work, outputs that cannot or must not be written.
 
@@ -303,8 +331,9 @@ def check_outputs(outputs, inputs=(), stores=()) -> list[Path]:
     - a folder, a device, a FIFO or a socket (a rename onto ``/dev/null`` would replace the
       device node; specref never writes to special files: give a regular file name);
     - below a file, or has a name longer than the file system holds;
-    - the same file as an input (inodes compared: hard and symbolic links count), or as another
-      output of the same command.
+    - the same file as an input (inodes compared: hard and symbolic links count), or as a file
+      below an input folder (a painting folder, a data folder), or as another output of the same
+      command.
 
     An input whose name is too long for the file system, or a loop of symbolic links, is refused
     too (a missing input is left to the command, which says so in its own words).
@@ -347,6 +376,7 @@ def check_outputs(outputs, inputs=(), stores=()) -> list[Path]:
     """
     outputs = [Path(o) for o in outputs if o is not None]
     inputs = _existing_inputs(Path(i) for i in inputs if i is not None)
+    inside = _files_in_folders(inputs)
     for k, out in enumerate(outputs):
         with _write_errors(out):
             _require_file_target(out)
@@ -355,6 +385,12 @@ def check_outputs(outputs, inputs=(), stores=()) -> list[Path]:
                 not same_file(out, source),
                 f"{out}: is also an input of this command ({source}); give another output name",
             )
+        folder = inside.get(_inode(out) or _inode(os.path.realpath(out)))
+        require(
+            folder is None,
+            f"{out}: is also an input of this command (a file of the folder {folder}); give "
+            "another output name",
+        )
         for other in outputs[:k]:
             require(not same_file(out, other), f"{out}: the command would write it twice ({other})")
     for store in (Path(s) for s in stores):
@@ -566,12 +602,15 @@ def check_output_file(path) -> Path:
     return path
 
 
-def check_output_folder(folder) -> Path:
+def check_output_folder(folder, marker: str | None = None) -> Path:
     """Create ``folder`` if needed and prove that a file can be written in it; return it.
 
     Commands that write many files into a folder call this before any work, so an unwritable
     folder (a file of that name, a read-only file system, a full disk) is refused in one line
-    before the first frame rather than after it.
+    before the first frame rather than after it. With ``marker``, the file a command writes into
+    every folder it fills (a painting's ``painting.toml``, an export's ``scenes.json``), a folder
+    that holds other files but not that one is refused too: its files could be overwritten by the
+    command's (an empty folder, or one the command wrote before, is fine).
 
     Raises
     ------
@@ -583,11 +622,24 @@ def check_output_folder(folder) -> Path:
     >>> import tempfile, os
     >>> with tempfile.TemporaryDirectory() as d:
     ...     check_output_folder(os.path.join(d, "frames")).is_dir()
-    True
+    ...     _ = open(os.path.join(d, "holiday.jpg"), "w").close()
+    ...     check_output_folder(d, marker="painting.toml")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: ...: cannot write here: the folder holds other files ...
     """
     folder = Path(folder)
+    require(str(folder).strip() != "", "an empty folder name (give a folder)")
     with _write_errors(folder):
         require(not folder.is_file(), f"{folder}: cannot write ({WRITE_ERRORS[errno.ENOTDIR]})")
+        if marker is not None and folder.is_dir() and not (folder / marker).exists():
+            others = [p.name for p in folder.iterdir() if not p.name.startswith(".")]
+            if others:
+                raise SpecrefError(
+                    f"{folder}: cannot write here: the folder holds other files ({others[0]}, "
+                    f"...) and no {marker} of an earlier run, and the command's files could "
+                    "replace them; give a new or empty folder"
+                )
         folder.mkdir(parents=True, exist_ok=True)
     probe = write_bytes_atomic(folder / ".specref-write-probe", b"specref")
     probe.unlink()

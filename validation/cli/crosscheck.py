@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 
-from validation.cli.parser import output_file
+from validation.cli.parser import input_file, output_file
 
 
 def _cmd_crosscheck(args) -> int:
@@ -60,6 +60,7 @@ def add_parser(sub) -> None:
     p.add_argument("--quick", action="store_true", help="tiny renders (seconds), for tests")
     p.add_argument(
         "--data",
+        type=input_file,
         metavar="FOLDER",
         help="a folder laid out as the shipped data (environments/, spectra/); default the data "
         "shipped with specref",

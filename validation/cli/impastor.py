@@ -5,7 +5,13 @@ from __future__ import annotations
 import sys
 
 from reference.tasks import SERIAL, add_scheduler_option
-from validation.cli.parser import Parser, input_file, output_file, registry_option
+from validation.cli.parser import (
+    Parser,
+    input_file,
+    key_or_input_file,
+    output_file,
+    registry_option,
+)
 
 
 def _cmd_impastor_table1(args) -> int:
@@ -92,7 +98,7 @@ def _cmd_impastor_painting(args) -> int:
 
     size = require_positive_int(args.size, "--size", 4096)
     require(args.seed >= 0, f"--seed: must be an integer >= 0, got {args.seed}")
-    check_output_folder(args.out)  # before the painting is made
+    check_output_folder(args.out, marker="painting.toml")  # before the painting is made
     written = write_painting(args.out, impasto_painting(size, seed=args.seed), f"demo-{args.seed}")
     print(f"wrote {written} and its images: the demo painting, {size}×{size}, seed {args.seed}")
     return 0
@@ -173,7 +179,12 @@ def _add_path(isub) -> None:
     )
     a.add_argument("--painting", type=input_file, metavar="DIR", help="a painting folder")
     _light_map_option(a)
-    a.add_argument("--light", default="D65", help="illuminant key (D65, D50, A, FL2, ...)")
+    a.add_argument(
+        "--light",
+        type=key_or_input_file,
+        default="D65",
+        help="illuminant key (D65, D50, A, FL2, ...) or a measured lamp's spectrum file",
+    )
     a.add_argument("--size", type=int, default=256, help="image side in pixels (default 256)")
     registry_option(a, "--method", PAINTING_LIGHTING_METHODS, "specular lighting", default="hybrid")
     a.add_argument("-o", "--out", type=output_file, required=True, help="the animated PNG")
@@ -194,6 +205,7 @@ def _add_render(isub) -> None:
     _light_map_option(r)
     r.add_argument(
         "--light",
+        type=key_or_input_file,
         default="D65",
         help="illuminant key (D65, D50, A, FL2, ...) or a measured lamp's spectrum file "
         "(wavelength and power per line; docs/impastor.md)",

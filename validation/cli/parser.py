@@ -13,6 +13,7 @@ __all__ = [
     "Parser",
     "command_paths",
     "input_file",
+    "key_or_input_file",
     "nonnegative_int",
     "output_file",
     "port_number",
@@ -66,6 +67,24 @@ def input_file(value: str) -> InputPath:
         return InputPath(data_path(value))
     except SpecrefError as error:
         raise argparse.ArgumentTypeError(str(error)) from None
+
+
+def key_or_input_file(value: str) -> str:
+    """A name (an illuminant key) or, where it names a file, an input file (:func:`input_file`).
+
+    A value with a folder separator, a suffix or an existing file of that name is a file, so the
+    write policy keeps the command's outputs off it.
+
+    Examples
+    --------
+    >>> type(key_or_input_file("D65")).__name__, type(key_or_input_file("lamp.csv")).__name__
+    ('str', 'InputPath')
+    """
+    import os
+
+    if os.sep in value or "." in value or value.startswith("data:") or os.path.exists(value):
+        return input_file(value)
+    return value
 
 
 def nonnegative_int(value: str) -> int:

@@ -299,7 +299,7 @@ def export_scenes(folder, fmt: str = "specref", spp: int = 64) -> dict:
         isinstance(spp, int) and 1 <= spp <= MAX_SPP,
         f"spp: samples per pixel must be an integer in 1-{MAX_SPP}, got {spp!r}",
     )
-    out = check_output_folder(folder)
+    out = check_output_folder(folder, marker="scenes.json")
     check_output_folder(out / "maps")
     for path in sorted(data_path("conformance/maps").iterdir()):
         if path.suffix == ".exr" and fmt == "mitsuba":

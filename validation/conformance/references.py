@@ -273,7 +273,9 @@ def ensure_references(names=None, folder=None, progress=None, force: bool = Fals
     from reference.files import check_output_folder, folder_lock
     from validation.conformance.scenes import CONFORMANCE_SCENES
 
-    folder = check_output_folder(folder if folder is not None else reference_folder())
+    folder = check_output_folder(
+        folder if folder is not None else reference_folder(), marker="manifest.json"
+    )
     names = list(CONFORMANCE_SCENES.names() if names is None else names)
     for name in names:
         CONFORMANCE_SCENES.lookup(name)

@@ -63,6 +63,13 @@ SAME_AS_INPUT = [
     (["display", "calibrate", "--display", "{d}/d.json", "-o", "{d}/d.cal"], "d.json"),
     (["render", "{d}/c.toml", "-o", "{d}/c.toml"], "c.toml"),
     (["phong", "table1", "--material", "{d}/c.toml", "--json", "{d}/c.toml"], "c.toml"),
+    # a lamp's spectrum file given where an illuminant key may go
+    (["impastor", "render", "--size", "8", "--light", "{d}/t.csv", "--out", "{d}/t.csv"], "t.csv"),
+    (["impastor", "path", "--size", "8", "--light", "{d}/t.csv", "-o", "{d}/t.csv"], "t.csv"),
+    # a file of an input folder (a painting folder, crosscheck's data folder)
+    (["impastor", "render", "--painting", "{d}", "--out", "{d}/c.toml"], "c.toml"),
+    (["impastor", "path", "--painting", "{d}", "-o", "{d}/sub/../c.toml"], "c.toml"),
+    (["crosscheck", "--quick", "--data", "{d}", "--json", "{d}/d.json"], "d.json"),
 ]
 
 
@@ -180,3 +187,30 @@ def test_every_output_argument_is_under_the_policy():
     assert isinstance(output_file("x.exr"), OutputPath)
     assert isinstance(output_file("x.zarr"), OutputStore)
     assert type(input_file("x.exr")).__name__ == "InputPath"
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["conformance", "export", "{d}"],
+        ["conformance", "export", "{d}", "--format", "mitsuba"],
+        ["impastor", "painting", "{d}"],
+        ["conformance", "references", "--out", "{d}", "--scene", "colorchecker-d65"],
+    ],
+    ids=lambda a: " ".join(a[:2]),
+)
+def test_a_folder_of_other_files_is_not_filled(argv, tmp_path, capsys):
+    # The commands that fill a folder write files of their own names into it: a folder holding a
+    # user's files (here one of the same name as the command's) is refused, nothing is written
+    (tmp_path / "lambert-point-d65.toml").write_text("mine\n")
+    (tmp_path / "holiday.jpg").write_bytes(b"jpeg")
+    before = sorted(p.name for p in tmp_path.iterdir())
+    _refused([a.format(d=tmp_path) for a in argv], capsys, "the folder holds other files")
+    assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith(".")) == before
+    assert (tmp_path / "lambert-point-d65.toml").read_text() == "mine\n"
+
+
+def test_a_folder_the_command_filled_before_is_filled_again(tmp_path, capsys):
+    assert main(["impastor", "painting", str(tmp_path / "p"), "--size", "16"]) == 0
+    assert main(["impastor", "painting", str(tmp_path / "p"), "--size", "16", "--seed", "2"]) == 0
+    assert "seed 2" in capsys.readouterr().out
