@@ -27,7 +27,6 @@ paint indices); :func:`write_painting` writes any such dictionary, the demo pain
 
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -35,7 +34,13 @@ import numpy as np
 from impastor.multispectral import MS_GRID
 from reference.errors import SpecrefError, require
 
-__all__ = ["PAINTING_FILE", "painting_reflectance", "read_painting", "write_painting"]
+__all__ = [
+    "MAX_PAINTING_SIDE",
+    "PAINTING_FILE",
+    "painting_reflectance",
+    "read_painting",
+    "write_painting",
+]
 
 #: The file a painting folder holds.
 PAINTING_FILE = "painting.toml"
@@ -65,6 +70,19 @@ def painting_reflectance(painting: dict, spectra: dict | None = None) -> np.ndar
     return table[np.where(material < 0, len(PAINT_SPECTRA), material)]
 
 
+#: The largest painting side, pixels: its 81-band reflectance is then 10 GiB in float64, what the
+#: renderer holds at once; a larger image is refused before it is converted.
+MAX_PAINTING_SIDE = 4096
+
+
+def _check_side(shape, path: Path, where: str) -> None:
+    require(
+        len(shape) >= 2 and max(shape[:2]) <= MAX_PAINTING_SIDE,
+        f"{where}: {path}: {' × '.join(str(n) for n in shape[:2])} pixels; a painting is at most "
+        f"{MAX_PAINTING_SIDE} pixels a side (scale the image down)",
+    )
+
+
 def _image(path: Path, where: str) -> np.ndarray:
     """An image file as float ``(H, W, C)``: 8/16-bit PNG and JPEG normalised, floats as stored."""
     from reference.images.formats import read_image
@@ -72,20 +90,21 @@ def _image(path: Path, where: str) -> np.ndarray:
     require(path.is_file(), f"{where}: {path}: file not found")
     suffix = path.suffix.lower()
     try:
-        if suffix in (".png", ".jpg", ".jpeg"):
-            import imageio.v3 as iio
+        if suffix in (".png", ".jpg", ".jpeg", ".tif", ".tiff"):
+            if suffix in (".tif", ".tiff"):
+                import tifffile
 
-            raw = np.asarray(iio.imread(path))
-            scale = np.iinfo(raw.dtype).max if raw.dtype.kind in "ui" else 1.0
-            image = raw.astype(np.float64) / scale
-        elif suffix in (".tif", ".tiff"):
-            import tifffile
+                raw = np.asarray(tifffile.imread(path))
+            else:
+                import imageio.v3 as iio
 
-            raw = np.asarray(tifffile.imread(path))
+                raw = np.asarray(iio.imread(path))
+            _check_side(raw.shape, path, where)
             scale = np.iinfo(raw.dtype).max if raw.dtype.kind in "ui" else 1.0
             image = raw.astype(np.float64) / scale
         else:
             image = read_image(path)
+            _check_side(image.shape, path, where)
     except SpecrefError as error:
         raise SpecrefError(f"{where}: {error}") from None
     except (OSError, ValueError) as error:
@@ -165,10 +184,9 @@ def _read_doc(path) -> tuple[dict, Path, str]:
     path = Path(path)
     path = path if path.suffix.lower() == ".toml" else path / PAINTING_FILE
     require(path.is_file(), f"{path}: painting file not found")
-    try:
-        doc = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as error:
-        raise SpecrefError(f"{path}: cannot read the painting ({error})") from None
+    from reference.scene.loader import read_toml_file
+
+    doc = read_toml_file(path)  # one line for unreadable text, bad TOML and deep nesting
     _check_keys(doc, str(path))
     return doc, path.parent, str(path)
 
@@ -186,8 +204,9 @@ def read_painting(path) -> dict:
     ------
     SpecrefError
         One line naming the file and the key: a missing or unreadable file, an unknown key, a
-        colour that is not square, maps of another size, NaN, negative reflectance, a gloss
-        outside Ward–Dür's range (ρ_s in [0, 1], α > 0).
+        colour that is not square or more than :data:`MAX_PAINTING_SIDE` pixels a side, maps of
+        another size, NaN, negative reflectance, a relief ``scale_m`` outside (0, 1] m, a gloss
+        outside Ward–Dür's range (ρ_s in [0, 1], α in (0, 1]).
 
     Examples
     --------
@@ -212,14 +231,27 @@ def read_painting(path) -> dict:
     height_doc = doc["height"]
     require(isinstance(height_doc, dict), f'{where}: height: needs file = "..." and scale_m')
     scale = height_doc.get("scale_m", 1.0)
-    require(isinstance(scale, int | float) and scale > 0, f"{where}: height.scale_m: must be > 0")
+    require(
+        isinstance(scale, int | float) and not isinstance(scale, bool) and 0 < scale <= 1,
+        f"{where}: height.scale_m: the relief of a height of 1, in metres, in (0, 1]; "
+        f"got {scale!r}",
+    )
     height = _map({"file": height_doc.get("file")}, folder, shape, f"{where}: height") * scale
+    relief = float(height.max() - height.min())
+    require(
+        relief <= width,
+        f"{where}: height: a relief of {relief:.3g} m on a canvas {width:g} m wide; heights are "
+        "in metres (scale_m scales the file's values)",
+    )
     gloss = doc.get("gloss", {})
     require(isinstance(gloss, dict), f"{where}: gloss: must be a table with rho_s and alpha")
     rho_s = _map(gloss.get("rho_s", 0.04), folder, shape, f"{where}: gloss.rho_s")
     alpha = _map(gloss.get("alpha", 0.2), folder, shape, f"{where}: gloss.alpha")
     require(bool(((rho_s >= 0) & (rho_s <= 1)).all()), f"{where}: gloss.rho_s: must be in [0, 1]")
-    require(bool((alpha > 0).all()), f"{where}: gloss.alpha: must be > 0")
+    require(
+        bool(((alpha > 0) & (alpha <= 1)).all()),
+        f"{where}: gloss.alpha: Ward–Dür's roughness must be in (0, 1]",
+    )
     return {
         "name": str(doc.get("name", folder.name)),
         "width_m": float(width),

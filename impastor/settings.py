@@ -342,7 +342,7 @@ def _descend(pilot: PaintingPilot, start: tuple, limit: float) -> tuple:
 
 
 def check_tolerance(tolerance) -> float:
-    """``tolerance`` as a float after checking it is a relative error > 0 (one-line error).
+    """``tolerance`` as a float after checking it is a relative error in (0, 1) (one-line error).
 
     Examples
     --------
@@ -351,11 +351,12 @@ def check_tolerance(tolerance) -> float:
     >>> check_tolerance(float("nan"))
     Traceback (most recent call last):
     ...
-    reference.errors.SpecrefError: --tolerance: must be a relative error > 0 (0.02 is 2 %), got nan
+    reference.errors.SpecrefError: --tolerance: must be a relative error in (0, 1) (0.02 is 2 %),
+    got nan
     """
     require(
-        isinstance(tolerance, int | float) and np.isfinite(tolerance) and tolerance > 0,
-        f"--tolerance: must be a relative error > 0 (0.02 is 2 %), got {tolerance!r}",
+        isinstance(tolerance, int | float) and np.isfinite(tolerance) and 0 < tolerance < 1,
+        f"--tolerance: must be a relative error in (0, 1) (0.02 is 2 %), got {tolerance!r}",
     )
     return float(tolerance)
 

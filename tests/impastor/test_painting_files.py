@@ -81,8 +81,12 @@ def _edit(folder, tmp_path, text_change=None, files=None):
     ("width_m = 0.3", "width_m = -1", "width_m: must be a width in metres"),
     ('file = "height.tif"', 'file = "missing.tif"', "missing.tif: file not found"),
     ('rho_s = { file = "rho_s.tif" }', "rho_s = 2", "gloss.rho_s: must be in [0, 1]"),
-    ('alpha = { file = "alpha.tif" }', "alpha = 0", "gloss.alpha: must be > 0"),
+    ('alpha = { file = "alpha.tif" }', "alpha = 0", "gloss.alpha: Ward–Dür's roughness must be"),
+    ('alpha = { file = "alpha.tif" }', "alpha = 1e308", "gloss.alpha: Ward–Dür's roughness must"),
+    ("scale_m = 1.0", "scale_m = 1e300", "height.scale_m: the relief of a height of 1"),
+    ("width_m = 0.3", "width_m = 1e-6", "height: a relief of"),  # taller than the canvas is wide
     ("[height]", "[heigh]", "unknown key 'heigh'"),
+    ("width_m = 0.3", "width_m = 0.3\nx = " + "[" * 100_000, "nested deeper than"),
 ])  # fmt: skip
 def test_bad_painting_files_are_one_line(demo_folder, tmp_path, old, new, message):
     with pytest.raises(SpecrefError) as error:
@@ -109,6 +113,19 @@ def test_maps_of_another_size_or_with_nan_are_refused(demo_folder, tmp_path):
     (tmp_path / "x" / "copy").rename(broken)
     with pytest.raises(SpecrefError, match=r"gloss.alpha: .*NaN or infinite values"):
         read_painting(broken)
+
+
+def test_an_image_larger_than_a_painting_is_refused_before_it_is_converted(demo_folder, tmp_path):
+    import imageio.v3 as iio
+
+    from impastor.painting_files import MAX_PAINTING_SIDE
+
+    side = MAX_PAINTING_SIDE + 1
+    image = np.zeros((side, 8, 3), np.uint8)
+    big = _edit(demo_folder, tmp_path, lambda t: t.replace("reflectance.tif", "big.png"),
+                files={"big.png": lambda p: iio.imwrite(p, image)})  # fmt: skip
+    with pytest.raises(SpecrefError, match=f"{side} × 8 pixels; a painting is at most"):
+        read_painting(big)
 
 
 def test_the_commands_write_and_render_a_painting(tmp_path, capsys):

@@ -32,13 +32,19 @@ def _cmd_impastor_table1(args) -> int:
 
 
 def _vector(text: str, option: str) -> tuple:
+    import math
+
     from reference.errors import require
 
     try:
         values = tuple(float(v) for v in text.split(","))
     except ValueError:
         values = ()
-    require(len(values) == 3, f"{option}: must be x,y,z in metres, got {text!r}")
+    # a booth is a room: positions within 100 m (validation.studies.impastor_commands)
+    require(
+        len(values) == 3 and all(math.isfinite(v) and abs(v) <= 100.0 for v in values),
+        f"{option}: must be x,y,z in metres, finite and within 100 m, got {text!r}",
+    )
     return values
 
 

@@ -109,6 +109,11 @@ def crosscheck_cases(data_folder=None) -> list[dict]:
     ['ColorChecker D65', 'ColorChecker A']
     """
     data_folder = Path(data_folder) if data_folder is not None else data_root()
+    for sub in ("environments", "spectra"):
+        require(
+            (data_folder / sub).is_dir(),
+            f"--data: {data_folder}: not a folder laid out as specref's data (no {sub}/ folder)",
+        )
     maps = sorted(
         p for p in (data_folder / "environments").iterdir() if p.suffix in (".hdr", ".exr")
     )

@@ -131,6 +131,7 @@ def render_for_cli(
     PAINTING_LIGHTING_METHODS.lookup(method)
     size = require_positive_int(size, "--size", 4096)
     _check_before_render(tolerance, out, counts_out)
+    _check_flare_options(observer, light_position, screen_lux, light_luminance)
     booth_light_spectrum(light)  # an unknown key or a bad lamp file fails before any work
     if counts_out is not None:
         from reference.display.pipeline import ScreenGeometry, screen_view_angles
@@ -232,7 +233,8 @@ def render_path_for_cli(
     PAINTING_LIGHTING_METHODS.lookup(method)
     size = require_positive_int(size, "--size", 4096)
     frames = require_positive_int(frames, "--frames", MAX_PATH_FRAMES)
-    require(np.isfinite(fps) and 0 < fps <= 120, f"--fps: must be in (0, 120], got {fps!r}")
+    # APNG stores a frame's delay as a 16-bit fraction of a second: at most 65 s a frame
+    require(np.isfinite(fps) and 0.1 <= fps <= 120, f"--fps: must be in [0.1, 120], got {fps!r}")
     start, end = check_eye(eye_from, "--from"), check_eye(eye_to, "--to")
     for option, value in (("--tilt-from", tilt_from), ("--tilt-to", tilt_to)):
         require(np.isfinite(value), f"{option}: must be a finite angle in degrees, got {value!r}")
@@ -266,6 +268,33 @@ def _render_pose(light, size, method, painting, eye, tilt=0.0, light_map=None) -
     from impastor.painting import render_painting
 
     return render_painting(light, size, method, painting, eye=eye, tilt=tilt, light_map=light_map)
+
+
+#: Bounds of the display options, whether or not --counts uses them: the booth is a room (positions
+#: within 100 m), a screen's illuminance at most bright sunlight's, a lamp's luminance at most the
+#: sun's.
+MAX_POSITION_M, MAX_SCREEN_LUX, MAX_LUMINANCE = 100.0, 2e5, 2e9
+
+
+def _check_flare_options(observer, light_position, screen_lux, light_luminance) -> None:
+    """The display and flare options, finite and within :data:`MAX_POSITION_M` etc. (one line)."""
+    for flag, point in (("--observer", observer), ("--light-position", light_position)):
+        point = np.asarray(point, dtype=np.float64)
+        require(
+            point.shape == (3,) and bool(np.isfinite(point).all())
+            and float(np.abs(point).max()) <= MAX_POSITION_M,
+            f"{flag}: must be x,y,z in metres, finite and within {MAX_POSITION_M:g} m, got "
+            f"{', '.join(f'{c:g}' for c in np.ravel(point))}",
+        )  # fmt: skip
+    require(
+        np.isfinite(screen_lux) and 0 <= screen_lux <= MAX_SCREEN_LUX,
+        f"--screen-lux: must be in [0, {MAX_SCREEN_LUX:g}] lux, got {screen_lux!r}",
+    )
+    require(
+        light_luminance is None
+        or (np.isfinite(light_luminance) and 0 <= light_luminance <= MAX_LUMINANCE),
+        f"--light-luminance: must be in [0, {MAX_LUMINANCE:g}] cd/m², got {light_luminance!r}",
+    )
 
 
 def _check_before_render(tolerance, out, counts_out) -> None:

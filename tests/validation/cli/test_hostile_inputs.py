@@ -35,7 +35,7 @@ def _make(tmp_path: Path, name: str) -> Path:
         path.write_text("[" * 100_000 + "]" * 100_000)
     elif name == "sweep.toml":
         path.write_text('kind = "phong"\n')
-    elif name == "d.cube":
+    elif name in ("d.cube", "empty"):
         path.mkdir()
     elif name in ("nan.exr", "inf.exr", "fine.exr"):
         image = np.full((4, 4, 3), 0.5)
@@ -81,6 +81,10 @@ CASES = [
      "patch 2: reflectances must be finite and in [-0.05, 1.5]"),
     (["env", "fit", "--target", "{percent.csv}", "-o", "{out.json}"],
      "patch 2: reflectances must be finite and in [-0.05, 1.5]"),
+    # crosscheck's data folder: a file or an empty folder was a traceback (Mitsuba 3 is a test
+    # dependency: without it the line says how to install it)
+    (["crosscheck", "--quick", "--data", "{sweep.toml}"], "not a folder laid out as specref's"),
+    (["crosscheck", "--quick", "--data", "{empty}"], "(no environments/ folder)"),
 ]  # fmt: skip
 
 
