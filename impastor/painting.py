@@ -163,6 +163,11 @@ def booth_plane_light_from_map(
         names[:3] == ["R", "G", "B"],
         f"{path}: the light map must be RGB (R, G, B channels, linear sRGB), got {names[:4]}",
     )
+    require(
+        image.shape[1] == 2 * image.shape[0],
+        f"{path}: the light map must be a lat-long panorama (2:1), got "
+        f"{image.shape[1]} × {image.shape[0]} pixels",
+    )
     Y = display_RGB_to_XYZ(np.asarray(image[..., :3], dtype=np.float64))[..., 1]
     require(
         bool(np.isfinite(Y).all()) and float(Y.min()) >= 0.0,

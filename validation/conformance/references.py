@@ -232,7 +232,34 @@ def _read_manifest(folder: Path) -> dict:
         f"{path}: version: references of version {manifest.get('version')!r}; this specref "
         f"makes version {REFERENCE_VERSION} (render them again: specref conformance references)",
     )
+    for name, entry in manifest["scenes"].items():
+        _check_entry(entry, f"{path}: scenes.{name}")
     return manifest
+
+
+def _check_entry(entry, where: str) -> None:
+    # a manifest entry as write_reference makes it: files of the folder itself, sizes and means
+    # that a render could have (a changed manifest is refused, never read outside its folder)
+    require(isinstance(entry, dict), f"{where}: not a table")
+    files = entry.get("files")
+    require(
+        isinstance(files, dict)
+        and all(isinstance(f, str) and f == Path(f).name and f.endswith(".exr") for f in files),
+        f"{where}.files: must name .exr files of the manifest's own folder",
+    )
+    for key in ("width", "height"):
+        size = entry.get(key)
+        require(
+            isinstance(size, int) and not isinstance(size, bool) and 1 <= size <= 4096,
+            f"{where}.{key}: must be a size in pixels (1-4096), got {size!r}",
+        )
+    for key in ("mean_XYZ", "stderr_mean_XYZ"):
+        values = entry.get(key)
+        require(
+            isinstance(values, list) and len(values) == 3
+            and all(isinstance(v, int | float) and np.isfinite(v) and v >= 0 for v in values),
+            f"{where}.{key}: must be three finite values >= 0",
+        )  # fmt: skip
 
 
 def _intact(folder: Path, entry: dict | None) -> bool:
@@ -273,12 +300,12 @@ def ensure_references(names=None, folder=None, progress=None, force: bool = Fals
     from reference.files import check_output_folder, folder_lock
     from validation.conformance.scenes import CONFORMANCE_SCENES
 
+    names = list(CONFORMANCE_SCENES.names() if names is None else names)
+    for name in names:  # before the folder is made
+        CONFORMANCE_SCENES.lookup(name)
     folder = check_output_folder(
         folder if folder is not None else reference_folder(), marker="manifest.json"
     )
-    names = list(CONFORMANCE_SCENES.names() if names is None else names)
-    for name in names:
-        CONFORMANCE_SCENES.lookup(name)
     with folder_lock(folder):
         before = _read_manifest(folder)["scenes"]
     # Each scene under a lock of its own: processes filling one folder render different scenes side

@@ -10,6 +10,7 @@ from impastor.multispectral import MIN_CHANNELS, MULTISPECTRAL_DESIGNS
 from reference.errors import require
 
 __all__ = [
+    "MAX_PATH_BYTES",
     "MAX_PATH_FRAMES",
     "format_table1",
     "render_for_cli",
@@ -19,6 +20,9 @@ __all__ = [
 
 #: Frames a path may have (a 20 s animation at 30 frames per second).
 MAX_PATH_FRAMES = 600
+#: The animation's frames are held until the APNG is written: at most 2 GiB of them (600 frames
+#: of 1024², or 40 of 4096²).
+MAX_PATH_BYTES = 2 << 30
 
 
 def table1_for_cli(
@@ -233,6 +237,12 @@ def render_path_for_cli(
     PAINTING_LIGHTING_METHODS.lookup(method)
     size = require_positive_int(size, "--size", 4096)
     frames = require_positive_int(frames, "--frames", MAX_PATH_FRAMES)
+    held = frames * size * size * 3  # the frames are held until the APNG is written
+    require(
+        held <= MAX_PATH_BYTES,
+        f"--frames {frames} at --size {size}: the animation holds {held / 2**30:.1f} GiB of "
+        f"frames, more than {MAX_PATH_BYTES / 2**30:g} GiB; lower --size or --frames",
+    )
     # APNG stores a frame's delay as a 16-bit fraction of a second: at most 65 s a frame
     require(np.isfinite(fps) and 0.1 <= fps <= 120, f"--fps: must be in [0.1, 120], got {fps!r}")
     start, end = check_eye(eye_from, "--from"), check_eye(eye_to, "--to")

@@ -122,6 +122,37 @@ def test_a_changed_reference_file_is_refused_in_one_line(references, tmp_path):
         load_reference("colorchecker-a", folder)
 
 
+@pytest.mark.parametrize(
+    ("key", "value", "message"),
+    [
+        ("files", {"../lamp.csv": "0" * 64}, "must name .exr files of the manifest's own folder"),
+        ("width", 10**9, "width: must be a size in pixels"),
+        ("height", float("nan"), "height: must be a size in pixels"),
+        ("mean_XYZ", [float("nan"), 1.0, 1.0], "mean_XYZ: must be three finite values"),
+    ],
+)
+def test_a_tampered_manifest_entry_is_refused_in_one_line(
+    references, tmp_path, key, value, message
+):
+    # a manifest is read only as write_reference makes it: nothing outside its folder is read
+    import shutil
+
+    folder = tmp_path / "refs"
+    shutil.copytree(references, folder)
+    manifest = json.loads((folder / "manifest.json").read_text())
+    manifest["scenes"]["colorchecker-a"][key] = value
+    (folder / "manifest.json").write_text(json.dumps(manifest))
+    with pytest.raises(SpecrefError, match=message) as error:
+        load_reference("colorchecker-a", folder)
+    assert "\n" not in str(error.value)
+
+
+def test_an_unknown_scene_is_refused_before_the_folder_is_made(tmp_path, capsys):
+    code = main(["conformance", "references", "--out", str(tmp_path / "new"), "--scene", "nope"])
+    assert code == 2
+    assert not (tmp_path / "new").exists()
+
+
 def test_every_reference_passes_its_own_check_from_the_command_line(references, tmp_path, capsys):
     renders = tmp_path / "renders"
     renders.mkdir()

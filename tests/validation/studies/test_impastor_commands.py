@@ -110,6 +110,10 @@ def test_cli_table1_writes_json(tmp_path, capsys):
         (["impastor", "render", "--light-luminance", "nan"], "--light-luminance: must be in"),
         (["impastor", "render", "--light-position", "0,1e308,1e308"], "finite and within 100 m"),
         (["impastor", "path", "-o", "p.png", "--fps", "1e-5"], "--fps: must be in [0.1, 120]"),
+        (
+            ["impastor", "path", "-o", "p.png", "--size", "4096", "--frames", "600"],
+            "the animation holds 28.1 GiB of frames, more than 2 GiB",
+        ),
         (["impastor", "path", "-o", "p.png", "--from", "0,1e308,0.6"], "--from: must be x,y,z"),
     ],
 )
