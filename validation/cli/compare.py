@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from validation.cli.parser import input_file, output_file
+from validation.cli.parser import input_file, output_file, output_file_or_stdout
 
 
 def _cmd_compare(args) -> int:
@@ -32,7 +32,7 @@ def add_parser(sub) -> None:
     )
     p.add_argument(
         "--json",
-        type=output_file,
+        type=output_file_or_stdout,
         metavar="OUT.json",
         help="write the summary as JSON ('-' prints it)",
     )

@@ -16,6 +16,7 @@ __all__ = [
     "key_or_input_file",
     "nonnegative_int",
     "output_file",
+    "output_file_or_stdout",
     "port_number",
     "registry_option",
     "write_json",
@@ -132,16 +133,34 @@ def port_number(value: str) -> int:
 def output_file(value: str) -> str:
     """An output file argument, for argparse's ``type=``: marked for the write policy.
 
-    ``-`` (standard output, where a command offers it) is left as it is.
+    ``-`` is refused: a file of that name is not what a user means (the outputs that print
+    instead take :func:`output_file_or_stdout`).
 
     Examples
     --------
-    >>> type(output_file("out.exr")).__name__, output_file("-")
-    ('OutputPath', '-')
+    >>> type(output_file("out.exr")).__name__
+    'OutputPath'
+    >>> output_file("-")
+    Traceback (most recent call last):
+    ...
+    argparse.ArgumentTypeError: '-' (standard output) is not offered here; give a file name
     """
     if value == "-":
-        return value
+        raise argparse.ArgumentTypeError(
+            "'-' (standard output) is not offered here; give a file name"
+        )
     return (OutputStore if value.rstrip("/\\").endswith(".zarr") else OutputPath)(value)
+
+
+def output_file_or_stdout(value: str) -> str:
+    """:func:`output_file`, or ``-`` for standard output (where a command prints instead).
+
+    Examples
+    --------
+    >>> output_file_or_stdout("-"), type(output_file_or_stdout("a.json")).__name__
+    ('-', 'OutputPath')
+    """
+    return value if value == "-" else output_file(value)
 
 
 def command_paths(args) -> tuple[list[str], list[str], list[str]]:

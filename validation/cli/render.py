@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from reference.geometry.envmap import TEXEL_PLACEMENTS
-from validation.cli.parser import input_file, output_file, registry_option
+from validation.cli.parser import input_file, output_file, output_file_or_stdout, registry_option
 
 
 def _cmd_render(args) -> int:
@@ -92,7 +92,7 @@ def add_parser(sub) -> None:
     )
     p.add_argument(
         "--json",
-        type=output_file,
+        type=output_file_or_stdout,
         metavar="OUT.json",
         help="write the render's metadata (orders chosen, bounds promised, units) as JSON; "
         "'-' prints it",

@@ -109,4 +109,7 @@ def test_impastor_render_observer_behind_the_screen(tmp_path, capsys):
 def test_impastor_render_bad_observer(tmp_path, capsys):
     code = main(["impastor", "render", "--out", str(tmp_path / "p.png"), "--observer", "1,2"])
     assert code == 2
-    assert "--observer: must be x,y,z in metres, got '1,2'" in capsys.readouterr().err
+    assert (
+        "--observer: must be x,y,z in metres, finite and within 100 m, got '1,2'"
+        in capsys.readouterr().err
+    )

@@ -21,7 +21,13 @@ import pytest
 from reference.data import data_path
 from reference.images.formats import write_exr
 from validation.cli import build_parser, main
-from validation.cli.parser import OutputPath, OutputStore, input_file, output_file
+from validation.cli.parser import (
+    OutputPath,
+    OutputStore,
+    input_file,
+    output_file,
+    output_file_or_stdout,
+)
 
 VENICE = str(data_path("environments/venice_sunset_1k.hdr"))
 SCENE = str(data_path("examples/phong-sphere.toml"))
@@ -181,7 +187,9 @@ def test_every_output_argument_is_under_the_policy():
     found = 0
     for command, action in _actions(build_parser()):
         if action.dest in OUTPUT_DESTS and (command, action.dest) not in FOLDER_OUTPUTS:
-            assert action.type is output_file, f"specref {command} {action.option_strings}"
+            assert action.type in (output_file, output_file_or_stdout), (
+                f"specref {command} {action.option_strings}"
+            )
             found += 1
     assert found >= 20
     assert isinstance(output_file("x.exr"), OutputPath)
@@ -214,3 +222,24 @@ def test_a_folder_the_command_filled_before_is_filled_again(tmp_path, capsys):
     assert main(["impastor", "painting", str(tmp_path / "p"), "--size", "16"]) == 0
     assert main(["impastor", "painting", str(tmp_path / "p"), "--size", "16", "--seed", "2"]) == 0
     assert "seed 2" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["impastor", "render", "--size", "8", "--out", "-"],
+        ["conformance", "check", "{d}", "--json", "-"],
+        ["sh", "project", VENICE, "-o", "-"],
+    ],
+    ids=lambda a: " ".join(a[:2]),
+)
+def test_a_dash_is_standard_output_only_where_offered(argv, files, capsys):
+    # '-' prints where a command offers it (compare --json -, render --json -); elsewhere it was
+    # written as a file named '-'
+    with pytest.raises(SystemExit) as usage:
+        main([a.format(d=files) for a in argv])
+    assert usage.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert "'-' (standard output) is not offered here" in err
+    assert len(err.splitlines()) == 1
+    assert not (Path.cwd() / "-").exists()
