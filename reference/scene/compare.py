@@ -164,13 +164,15 @@ def pixel_differences(XYZ_a, XYZ_b, mask=None, stderr_b=None) -> tuple[dict, dic
             lit, np.linalg.norm(XYZ_to_uv_prime(a) - XYZ_to_uv_prime(b), axis=-1), 0.0
         ),
     }
+    where = {name: lit for name in maps}
     if stderr_b is not None:
         sigma = np.asarray(stderr_b, dtype=np.float64)
-        lit = lit & (sigma > 0)
-        maps["z"] = np.where(lit, (a[..., 1] - Y_b) / np.where(lit, sigma, 1.0), 0.0)
+        # z where the reference states a noise; a pixel of zero stderr still counts elsewhere
+        where["z"] = lit & (sigma > 0)
+        maps["z"] = np.where(where["z"], (a[..., 1] - Y_b) / np.where(where["z"], sigma, 1.0), 0.0)
     summary = {"pixels": int(lit.sum())}
     for name, values in maps.items():
-        v = np.abs(values[lit])
+        v = np.abs(values[where[name]])
         stats = (
             {"mean": float(v.mean()), "p95": float(np.percentile(v, 95)), "max": float(v.max())}
             if v.size
@@ -226,6 +228,10 @@ def compare_images(path_a, path_b, mask=None) -> tuple[dict, np.ndarray, list[st
         f"{path_a}: size {XYZ_a.shape[1]}×{XYZ_a.shape[0]} differs from {path_b}'s "
         f"{XYZ_b.shape[1]}×{XYZ_b.shape[0]}",
     )
+    stderr = info_b.get("stderr")
+    if stderr is not None:
+        bad = int((~(np.isfinite(stderr) & (stderr >= 0))).sum())
+        require(bad == 0, f"{path_b}: Y.stderr: {bad} pixels hold NaN, infinite or negative values")
     selected = None
     if mask is not None:
         image = read_image(mask)
@@ -234,8 +240,15 @@ def compare_images(path_a, path_b, mask=None) -> tuple[dict, np.ndarray, list[st
             f"{mask}: mask size {image.shape[1]}×{image.shape[0]} differs from the images' "
             f"{XYZ_b.shape[1]}×{XYZ_b.shape[0]}",
         )
+        require(bool(np.isfinite(image[..., 0]).all()), f"{mask}: the mask holds NaN or infinities")
         selected = image[..., 0] > 0.5
-    summary, maps = pixel_differences(XYZ_a, XYZ_b, selected, info_b.get("stderr"))
+    summary, maps = pixel_differences(XYZ_a, XYZ_b, selected, stderr)
+    require(
+        summary["pixels"] > 0,
+        f"{path_b}: nothing to compare: no pixel of the reference "
+        + ("within the mask " if mask is not None else "")
+        + f"is lit (Y > 0 and at least {LIT_FRACTION:g} of its peak)",
+    )
     summary = {
         "a": str(path_a),
         "b": str(path_b),

@@ -41,6 +41,14 @@ def _make(tmp_path: Path, name: str) -> Path:
         image = np.full((4, 4, 3), 0.5)
         image[1, 2, 1] = {"nan.exr": np.nan, "inf.exr": np.inf, "fine.exr": 0.5}[name]
         write_exr(path, image, ["X", "Y", "Z"])
+    elif name in ("nan-stderr.exr", "black.exr"):
+        image = np.zeros((4, 4, 4)) if name == "black.exr" else np.full((4, 4, 4), 0.5)
+        image[0, 0, 3] = np.nan if name == "nan-stderr.exr" else 0.0
+        write_exr(path, image, ["X", "Y", "Z", "Y.stderr"])
+    elif name in ("zero-mask.exr", "nan-mask.exr"):
+        mask = np.zeros((4, 4, 1))
+        mask[1, 1, 0] = np.nan if name == "nan-mask.exr" else 0.0
+        write_exr(path, mask, ["Y"])
     elif name == "gamma0.json":
         path.write_text('{"gamma": [0, 0, 0]}')
     elif name == "bright.json":
@@ -81,6 +89,11 @@ CASES = [
      "patch 2: reflectances must be finite and in [-0.05, 1.5]"),
     (["env", "fit", "--target", "{percent.csv}", "-o", "{out.json}"],
      "patch 2: reflectances must be finite and in [-0.05, 1.5]"),
+    # compare against nothing: a black reference or an empty mask was "no lit pixels", exit 0
+    (["compare", "{fine.exr}", "{nan-stderr.exr}"], "Y.stderr: 1 pixels hold NaN, infinite or"),
+    (["compare", "{fine.exr}", "{black.exr}"], "nothing to compare: no pixel of the reference"),
+    (["compare", "{fine.exr}", "{fine.exr}", "--mask", "{zero-mask.exr}"], "within the mask is"),
+    (["compare", "{fine.exr}", "{fine.exr}", "--mask", "{nan-mask.exr}"], "holds NaN or infin"),
     # crosscheck's data folder: a file or an empty folder was a traceback (Mitsuba 3 is a test
     # dependency: without it the line says how to install it)
     (["crosscheck", "--quick", "--data", "{sweep.toml}"], "not a folder laid out as specref's"),
