@@ -37,6 +37,7 @@ from reference.errors import SpecrefError, require
 __all__ = [
     "MAX_PAINTING_SIDE",
     "PAINTING_FILE",
+    "painting_file_paths",
     "painting_reflectance",
     "read_painting",
     "write_painting",
@@ -189,6 +190,32 @@ def _read_doc(path) -> tuple[dict, Path, str]:
     doc = read_toml_file(path)  # one line for unreadable text, bad TOML and deep nesting
     _check_keys(doc, str(path))
     return doc, path.parent, str(path)
+
+
+def painting_file_paths(path) -> list[Path]:
+    """The files a painting folder's ``painting.toml`` names, and the toml itself.
+
+    What a command reads from the folder, for the write policy (``reference.files.
+    check_outputs``): other files there may be replaced (a render written into the painting's own
+    folder, again). A folder that cannot be read gives what could be found; the command that
+    reads it says what is wrong.
+
+    Examples
+    --------
+    >>> [p.name for p in painting_file_paths("/nonexistent")]
+    ['painting.toml']
+    """
+    path = Path(path)
+    toml = path if path.suffix.lower() == ".toml" else path / PAINTING_FILE
+    found = [toml]
+    try:
+        doc, folder, _ = _read_doc(toml)
+    except SpecrefError:
+        return found
+    tables = [doc.get("colour"), doc.get("height")]
+    if isinstance(doc.get("gloss"), dict):
+        tables += [doc["gloss"].get("rho_s"), doc["gloss"].get("alpha")]
+    return found + [folder / str(t["file"]) for t in tables if isinstance(t, dict) and "file" in t]
 
 
 def read_painting(path) -> dict:

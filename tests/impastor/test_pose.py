@@ -58,7 +58,7 @@ def test_the_path_command_writes_an_animation(tmp_path, capsys):
         (["--from", "0,-0.2,0.6"], "--from: (0, -0.2, 0.6) m is behind the canvas"),
         (["--frames", "0"], "--frames"),
         (["--frames", "601"], "--frames"),
-        (["--fps", "0"], "--fps: must be in (0, 120]"),
+        (["--fps", "0"], "--fps: must be in [0.1, 120]"),
         (["--to", "1,2"], "--to: must be x,y,z in metres"),
     ):
         assert main([*command, *bad, "-o", str(tmp_path / "bad.png")]) == 2, bad

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 
-from validation.cli.parser import output_file
+from validation.cli.parser import folder_name, input_file, output_file
 
 
 def _say(line: str) -> None:
@@ -73,12 +73,17 @@ def add_parser(sub) -> None:
     q = cmd.add_parser("list", help="the scenes, what each tests and the mistakes it catches")
     q.set_defaults(func=_cmd_list)
     q = cmd.add_parser("references", help="render the references (into the cache by default)")
-    q.add_argument("--out", metavar="DIR", help="the folder (default <cache>/conformance/v<N>)")
+    q.add_argument(
+        "--out",
+        type=folder_name,
+        metavar="DIR",
+        help="the folder (default <cache>/conformance/v<N>)",
+    )
     q.add_argument("--scene", action="append", metavar="NAME", help="only this scene (repeat)")
     q.add_argument("--force", action="store_true", help="render even the references present")
     q.set_defaults(func=_cmd_references)
     q = cmd.add_parser("export", help="write the scenes in specref's or Mitsuba 3's format")
-    q.add_argument("out", metavar="DIR")
+    q.add_argument("out", type=folder_name, metavar="DIR")
     q.add_argument("--format", choices=EXPORT_FORMATS, default="specref")
     q.add_argument("--spp", type=int, default=256, help="Mitsuba's samples per pixel (256)")
     q.set_defaults(func=_cmd_export)
@@ -87,8 +92,13 @@ def add_parser(sub) -> None:
         help="check a folder of renders (<scene>.exr) against the references",
         description="Exit code 0 when every render passes, 1 when one fails, 2 on bad input.",
     )
-    q.add_argument("renders", metavar="RENDERS_DIR")
-    q.add_argument("--references", metavar="DIR", help="the references' folder (default cache)")
+    q.add_argument("renders", type=input_file, metavar="RENDERS_DIR")
+    q.add_argument(
+        "--references",
+        type=input_file,
+        metavar="DIR",
+        help="the references' folder (default cache)",
+    )
     q.add_argument("--colourspace", help="of renders with R, G, B channels (default: the file's "
                    "specref metadata, else sRGB)")  # fmt: skip
     q.add_argument(

@@ -10,6 +10,7 @@ from validation.cli.parser import (
     input_file,
     key_or_input_file,
     output_file,
+    painting_input,
     registry_option,
 )
 
@@ -183,7 +184,7 @@ def _add_path(isub) -> None:
     a.add_argument(
         "--tilt-to", type=float, default=0.0, metavar="DEG", help="its last tilt (default 0)"
     )
-    a.add_argument("--painting", type=input_file, metavar="DIR", help="a painting folder")
+    a.add_argument("--painting", type=painting_input, metavar="DIR", help="a painting folder")
     _light_map_option(a)
     a.add_argument(
         "--light",
@@ -204,7 +205,7 @@ def _add_render(isub) -> None:
     r = isub.add_parser("render", help="render a painting (the demo one by default) to a PNG")
     r.add_argument(
         "--painting",
-        type=input_file,
+        type=painting_input,
         metavar="DIR",
         help="a painting folder or its painting.toml (docs/impastor.md); default the demo",
     )

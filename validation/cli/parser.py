@@ -10,13 +10,16 @@ from reference.registry import ParametricMethod
 __all__ = [
     "InputPath",
     "OutputPath",
+    "PaintingPath",
     "Parser",
     "command_paths",
+    "folder_name",
     "input_file",
     "key_or_input_file",
     "nonnegative_int",
     "output_file",
     "output_file_or_stdout",
+    "painting_input",
     "port_number",
     "registry_option",
     "write_json",
@@ -33,6 +36,10 @@ class Parser(argparse.ArgumentParser):
 
 class InputPath(str):
     """An argument that names a file the command reads (:func:`input_file`)."""
+
+
+class PaintingPath(str):
+    """A painting folder (or its ``painting.toml``) the command reads (:func:`painting_input`)."""
 
 
 class OutputPath(str):
@@ -70,6 +77,19 @@ def input_file(value: str) -> InputPath:
         raise argparse.ArgumentTypeError(str(error)) from None
 
 
+def painting_input(value: str) -> PaintingPath:
+    """A painting folder argument: its ``painting.toml`` and the files it names are inputs.
+
+    Other files of the folder are not: a render may be written there, and written again.
+
+    Examples
+    --------
+    >>> type(painting_input("my/painting")).__name__
+    'PaintingPath'
+    """
+    return PaintingPath(input_file(value))
+
+
 def key_or_input_file(value: str) -> str:
     """A name (an illuminant key) or, where it names a file, an input file (:func:`input_file`).
 
@@ -85,6 +105,23 @@ def key_or_input_file(value: str) -> str:
 
     if os.sep in value or "." in value or value.startswith("data:") or os.path.exists(value):
         return input_file(value)
+    return value
+
+
+def folder_name(value: str) -> str:
+    """A folder the command writes into, for argparse's ``type=``: not an empty name.
+
+    Examples
+    --------
+    >>> folder_name("out")
+    'out'
+    >>> folder_name("")
+    Traceback (most recent call last):
+    ...
+    argparse.ArgumentTypeError: an empty folder name
+    """
+    if not value.strip():  # Path("") is the current folder
+        raise argparse.ArgumentTypeError("an empty folder name")
     return value
 
 
@@ -187,6 +224,10 @@ def command_paths(args) -> tuple[list[str], list[str], list[str]]:
     if siblings is not None:
         outputs += [str(s) for s in siblings(args)]
     inputs = [v for v in values if isinstance(v, InputPath)]
+    for painting in (v for v in values if isinstance(v, PaintingPath)):
+        from impastor.painting_files import painting_file_paths
+
+        inputs += [str(p) for p in painting_file_paths(painting)]
     return outputs, inputs, [v for v in values if isinstance(v, OutputStore)]
 
 

@@ -307,6 +307,11 @@ def check_folder(folder, references=None, colourspace=None, progress=None) -> di
             raise SpecrefError(f"colourspace: {error}") from None
     for name, path in files.items():  # bad input is refused before the references are rendered
         _check_size(name, path, read_render(path, colourspace))
+    if references is not None and Path(references).exists():  # its manifest, before any line
+        from validation.conformance.references import _read_manifest
+
+        require(Path(references).is_dir(), f"--references: {references}: not a folder")
+        _read_manifest(Path(references))
     results = []
     for name, path in files.items():
         if progress is not None:

@@ -72,10 +72,9 @@ SAME_AS_INPUT = [
     # a lamp's spectrum file given where an illuminant key may go
     (["impastor", "render", "--size", "8", "--light", "{d}/t.csv", "--out", "{d}/t.csv"], "t.csv"),
     (["impastor", "path", "--size", "8", "--light", "{d}/t.csv", "-o", "{d}/t.csv"], "t.csv"),
-    # a file of an input folder (a painting folder, crosscheck's data folder)
-    (["impastor", "render", "--painting", "{d}", "--out", "{d}/c.toml"], "c.toml"),
-    (["impastor", "path", "--painting", "{d}", "-o", "{d}/sub/../c.toml"], "c.toml"),
-    (["crosscheck", "--quick", "--data", "{d}", "--json", "{d}/d.json"], "d.json"),
+    # a file of an input folder (crosscheck's data folder, a renders folder to check)
+    (["crosscheck", "--quick", "--data", "{d}", "--json", "{d}/sub/../d.json"], "d.json"),
+    (["conformance", "check", "{d}", "--json", "{d}/d.json"], "d.json"),
 ]
 
 
@@ -243,3 +242,20 @@ def test_a_dash_is_standard_output_only_where_offered(argv, files, capsys):
     assert "'-' (standard output) is not offered here" in err
     assert len(err.splitlines()) == 1
     assert not (Path.cwd() / "-").exists()
+
+
+def test_a_paintings_files_are_inputs_and_its_folder_takes_renders(tmp_path, capsys):
+    # painting.toml and the files it names are inputs; a render written into the painting's
+    # folder is not one, so it may be written there again
+    folder = tmp_path / "p"
+    assert main(["impastor", "painting", str(folder), "--size", "16"]) == 0
+    before = {name: _digest(folder / name) for name in ("painting.toml", "reflectance.tif")}
+    render = ["impastor", "render", "--size", "8", "--method", "median_cut", "--painting"]
+    for name in before:
+        _refused([*render, folder, "--out", folder / name], capsys, "is also an input")
+    path = ["impastor", "path", "--size", "8", "--frames", "2", "--method", "median_cut"]
+    _refused([*path, "--painting", folder, "-o", folder / "sub" / ".." / "painting.toml"],
+             capsys, "is also an input")  # fmt: skip
+    assert {name: _digest(folder / name) for name in before} == before
+    for _ in range(2):
+        assert main([str(a) for a in (*render, folder, "--out", folder / "render.png")]) == 0

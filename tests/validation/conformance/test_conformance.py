@@ -327,8 +327,8 @@ def test_check_folder_reports_missing_scenes(references, tmp_path):
 @pytest.mark.parametrize(
     ("command", "message"),
     [
-        (["check", "{renders}", "--json", "{renders}/colorchecker-a.exr"], "is an input"),
-        (["check", "{renders}", "--html", "{refs}/manifest.json"], "is an input"),
+        (["check", "{renders}", "--json", "{renders}/colorchecker-a.exr"], "an input"),
+        (["check", "{renders}", "--html", "{refs}/manifest.json"], "an input"),
         (["check", "{renders}", "--json", "{tmp}"], "is a folder"),
         (["check", "{renders}", "--json", "/dev/null"], "a device"),
         (["check", "{renders}", "--json", "{tmp}/afile/out.json"], "a part of the path is a file"),
