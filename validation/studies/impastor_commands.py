@@ -46,6 +46,12 @@ def table1_for_cli(
         f"--channels: channel count must be >= {MIN_CHANNELS}, got {n_channels}",
     )
     display = load_display_measurements(display_file) if display_file else virtual_display()
+    peak = float(display.white_XYZ[1])
+    require(
+        np.isfinite(white_luminance) and 0 < white_luminance <= peak,
+        f"--white-luminance: the white diffuser's luminance must be in (0, {peak:.4g}] cd/m², "
+        f"what the display's white reaches; got {white_luminance!r}",
+    )
     return table1(design, n_channels, white_luminance, display, scheduler=scheduler)
 
 

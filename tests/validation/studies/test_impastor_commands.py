@@ -97,6 +97,8 @@ def test_cli_table1_writes_json(tmp_path, capsys):
     [
         (["impastor", "table1", "--channels", "2"], "channel count must be >= 3"),
         (["impastor", "table1", "--design", "gauss"], "unknown multispectral design"),
+        (["impastor", "table1", "--white-luminance", "1e6"], "--white-luminance: the white"),
+        (["impastor", "table1", "--white-luminance", "nan"], "must be in (0, 320"),
         (["impastor", "table1", "--display", "/no/such.json"], "file not found"),
         (["impastor", "render", "--method", "nearest"], "unknown lighting method"),
         (["impastor", "render", "--light", "D66"], "unknown illuminant 'D66'"),
