@@ -132,6 +132,12 @@ def _small_map(path: Path, height: int, folder: Path) -> Path:
 
     image = read_hdr(path) if path.suffix == ".hdr" else read_exr(path)[0][..., :3]
     H, W = image.shape[:2]
+    # the user's map named, not the small copy: a lat-long panorama taller than the copy, finite
+    require(
+        W == 2 * H and height <= H,
+        f"{path}: a lat-long map (2:1) of at least {height} rows is needed, got {W} × {H}",
+    )
+    require(bool(np.isfinite(image).all()), f"{path}: NaN or infinite values")
     rows = np.array_split(np.arange(H), height)
     cols = np.array_split(np.arange(W), 2 * height)
     small = np.array([[image[r][:, c].mean(axis=(0, 1)) for c in cols] for r in rows])
@@ -325,11 +331,16 @@ def run_crosscheck(
     require(cases, f"crosscheck: no case matches {only!r}; cases: {names}")
     results = []
     with tempfile.TemporaryDirectory() as tmp:
+        small = {  # every map read and checked before the first case starts
+            c["env"]: _small_map(c["env"], settings.env_height, Path(tmp))
+            for c in cases
+            if c["kind"] == "sphere"
+        }
         for case in cases:
             if progress is not None:
                 progress(case["name"])
             if case["kind"] == "sphere":
-                env = _small_map(case["env"], settings.env_height, Path(tmp))
+                env = small[case["env"]]
                 ours = _sphere_specref(case, env, settings)
                 runs = _mitsuba_runs(_sphere_mitsuba(case, env, settings), settings, False)
             else:

@@ -37,6 +37,10 @@ def _make(tmp_path: Path, name: str) -> Path:
         path.write_text('kind = "phong"\n')
     elif name in ("d.cube", "empty"):
         path.mkdir()
+    elif name == "square-data":  # a data folder whose map is square
+        (path / "spectra").mkdir(parents=True)
+        (path / "environments").mkdir()
+        write_exr(path / "environments" / "square.exr", np.ones((8, 8, 3)))
     elif name in ("nan.exr", "inf.exr", "fine.exr"):
         image = np.full((4, 4, 3), 0.5)
         image[1, 2, 1] = {"nan.exr": np.nan, "inf.exr": np.inf, "fine.exr": 0.5}[name]
@@ -98,6 +102,8 @@ CASES = [
     # dependency: without it the line says how to install it)
     (["crosscheck", "--quick", "--data", "{sweep.toml}"], "not a folder laid out as specref's"),
     (["crosscheck", "--quick", "--data", "{empty}"], "(no environments/ folder)"),
+    (["crosscheck", "--quick", "--data", "{square-data}"],
+     "square.exr: a lat-long map (2:1) of at least"),  # the user's map named, before any case
 ]  # fmt: skip
 
 
