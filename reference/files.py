@@ -13,6 +13,7 @@ import errno
 import os
 import re
 import shutil
+import stat
 import tempfile
 from pathlib import Path
 
@@ -272,7 +273,30 @@ def check_output_store(path) -> Path:
             f"{path}: cannot write a Zarr store: a folder that is not a Zarr store is there "
             "(its files would be lost); give another name or remove it",
         )
+        foreign = [p.name for p in path.iterdir() if not _store_entry(p)]
+        require(
+            not foreign,
+            f"{path}: cannot write a Zarr store: the earlier store there also holds other files "
+            f"({', '.join(sorted(foreign)[:3])}), which would be lost; give another name or "
+            "move them",
+        )
     return path
+
+
+#: What the top of a Zarr store holds besides its arrays and groups (folders with a marker).
+STORE_FILES = (*STORE_MARKERS, ".zattrs", ".zmetadata")
+
+
+def _store_entry(entry: Path) -> bool:
+    """Whether a top-level entry of a folder belongs to a Zarr store.
+
+    Its metadata, an array or group below it (a folder with a marker), or the chunks of an array
+    at its root: Zarr 3's ``c/`` folder, Zarr 2's keys such as ``0.0.0``.
+    """
+    if entry.is_dir():
+        return entry.name == "c" or any((entry / m).is_file() for m in STORE_MARKERS)
+    chunk_key = re.fullmatch(r"\d+([./]\d+)*", entry.name) is not None
+    return chunk_key or entry.name in STORE_FILES or entry.name.startswith(".")
 
 
 def _existing_inputs(inputs) -> list[Path]:
@@ -280,7 +304,7 @@ def _existing_inputs(inputs) -> list[Path]:
     found = []
     for source in inputs:
         try:
-            os.stat(source)
+            mode = os.stat(source).st_mode
         except FileNotFoundError:
             continue  # the command says "file not found" in its own words
         except OSError as error:
@@ -289,6 +313,11 @@ def _existing_inputs(inputs) -> list[Path]:
             if reason is None:
                 raise
             raise SpecrefError(f"{source}: cannot read ({reason})") from None
+        # a device, a FIFO or a socket: /dev/zero never ends, a FIFO waits for a writer
+        require(
+            stat.S_ISREG(mode) or stat.S_ISDIR(mode),
+            f"{source}: cannot read (a device or special file, not a regular file or folder)",
+        )
         found.append(source)
     return found
 
@@ -380,27 +409,34 @@ def check_outputs(outputs, inputs=(), stores=()) -> list[Path]:
     for k, out in enumerate(outputs):
         with _write_errors(out):
             _require_file_target(out)
-        for source in inputs:
-            require(
-                not same_file(out, source),
-                f"{out}: is also an input of this command ({source}); give another output name",
-            )
-        folder = inside.get(_inode(out) or _inode(os.path.realpath(out)))
-        require(
-            folder is None,
-            f"{out}: is also an input of this command (a file of the folder {folder}); give "
-            "another output name",
-        )
+        _require_not_an_input(out, inputs, inside)
         for other in outputs[:k]:
             require(not same_file(out, other), f"{out}: the command would write it twice ({other})")
     for store in (Path(s) for s in stores):
         check_output_store(store)
-        for source in inputs:
+        _require_not_an_input(store, inputs, {})
+        for source in inputs:  # a store replaces its folder: an input inside it would go too
+            below = os.path.realpath(source).startswith(os.path.realpath(store) + os.sep)
             require(
-                not same_file(store, source),
-                f"{store}: is also an input of this command ({source}); give another output name",
+                not below,
+                f"{store}: the store would replace the folder that holds an input ({source}); "
+                "give another output name",
             )
     return outputs
+
+
+def _require_not_an_input(out: Path, inputs, inside: dict) -> None:
+    for source in inputs:
+        require(
+            not same_file(out, source),
+            f"{out}: is also an input of this command ({source}); give another output name",
+        )
+    folder = inside.get(_inode(out) or _inode(os.path.realpath(out)))
+    require(
+        folder is None,
+        f"{out}: is also an input of this command (a file of the folder {folder}); give "
+        "another output name",
+    )
 
 
 @contextlib.contextmanager

@@ -12,6 +12,7 @@ __all__ = [
     "OutputPath",
     "PaintingPath",
     "Parser",
+    "TomlPath",
     "command_paths",
     "folder_name",
     "input_file",
@@ -22,6 +23,8 @@ __all__ = [
     "painting_input",
     "port_number",
     "registry_option",
+    "toml_input",
+    "toml_named_files",
     "write_json",
 ]
 
@@ -36,6 +39,10 @@ class Parser(argparse.ArgumentParser):
 
 class InputPath(str):
     """An argument that names a file the command reads (:func:`input_file`)."""
+
+
+class TomlPath(InputPath):
+    """A TOML input (a scene, a sweep) whose strings may name other inputs (:func:`toml_input`)."""
 
 
 class PaintingPath(str):
@@ -75,6 +82,60 @@ def input_file(value: str) -> InputPath:
         return InputPath(data_path(value))
     except SpecrefError as error:
         raise argparse.ArgumentTypeError(str(error)) from None
+
+
+def toml_input(value: str) -> TomlPath:
+    """A TOML input file argument; the files its strings name are inputs too.
+
+    An environment map, a mesh, a material file of a sweep's grid (:func:`toml_named_files`).
+
+    Examples
+    --------
+    >>> type(toml_input("scene.toml")).__name__
+    'TomlPath'
+    """
+    return TomlPath(input_file(value))
+
+
+def toml_named_files(path, limit: int = 10_000) -> list[str]:
+    r"""The existing files that the strings of a TOML file name, relative to its folder.
+
+    Unreadable or malformed files give none (the command says what is wrong with them).
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> d = tempfile.mkdtemp(); _ = open(os.path.join(d, "env.exr"), "w").close()
+    >>> _ = open(os.path.join(d, "s.toml"), "w").write('file = "env.exr"\nname = "x"\n')
+    >>> [os.path.basename(p) for p in toml_named_files(os.path.join(d, "s.toml"))]
+    ['env.exr']
+    """
+    import tomllib
+    from pathlib import Path
+
+    path = Path(path)
+    try:
+        doc = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError, RecursionError):
+        return []
+    strings, stack = [], [doc]
+    while stack and len(strings) < limit:
+        item = stack.pop()
+        if isinstance(item, dict):
+            stack.extend(item.values())
+        elif isinstance(item, list):
+            stack.extend(item)
+        elif isinstance(item, str) and 0 < len(item) < 4096 and "\n" not in item:
+            strings.append(item)
+    found = []
+    for text in strings:
+        candidate = Path(text) if Path(text).is_absolute() else path.parent / text
+        try:
+            if candidate.is_file():
+                found.append(str(candidate))
+        except OSError:  # a name too long, a loop: not a file the command reads
+            continue
+    return found
 
 
 def painting_input(value: str) -> PaintingPath:
@@ -224,6 +285,11 @@ def command_paths(args) -> tuple[list[str], list[str], list[str]]:
     if siblings is not None:
         outputs += [str(s) for s in siblings(args)]
     inputs = [v for v in values if isinstance(v, InputPath)]
+    for toml in (v for v in values if isinstance(v, TomlPath)):
+        inputs += toml_named_files(toml)
+    sibling_inputs = getattr(args, "sibling_inputs", None)
+    if sibling_inputs is not None:
+        inputs += [str(s) for s in sibling_inputs(args)]
     for painting in (v for v in values if isinstance(v, PaintingPath)):
         from impastor.painting_files import painting_file_paths
 

@@ -3,7 +3,12 @@
 from __future__ import annotations
 
 from reference.geometry.envmap import TEXEL_PLACEMENTS
-from validation.cli.parser import input_file, output_file, output_file_or_stdout, registry_option
+from validation.cli.parser import (
+    output_file,
+    output_file_or_stdout,
+    registry_option,
+    toml_input,
+)
 
 
 def _cmd_render(args) -> int:
@@ -60,7 +65,7 @@ def add_parser(sub) -> None:
     p.add_argument(
         "scene",
         metavar="SCENE.toml",
-        type=input_file,
+        type=toml_input,
         help="the scene file, or data:examples/<name>.toml",
     )
     p.add_argument(

@@ -13,6 +13,12 @@ def _cmd_sh_project(args) -> int:
     return 0
 
 
+def _kernel_table(args) -> list[str]:
+    """A ``table:FILE`` kernel's file, an input of ``sh prefilter`` (the write policy)."""
+    kernel = str(args.kernel)
+    return [kernel.split(":", 1)[1]] if kernel.startswith("table:") else []
+
+
 def _cmd_sh_prefilter(args) -> int:
     from shrm.files import prefilter_file
 
@@ -49,4 +55,4 @@ def add_parser(sub) -> None:
     r.add_argument("--format", choices=("cube", "latlong"), default="cube")
     r.add_argument("--size", type=int, default=64, help="cube face size")
     r.add_argument("--bands", choices=("spectral", "rgb"), default=None, help="convert first")
-    r.set_defaults(func=_cmd_sh_prefilter)
+    r.set_defaults(func=_cmd_sh_prefilter, sibling_inputs=_kernel_table)

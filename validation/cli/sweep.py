@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from validation.cli.parser import input_file, output_file
+from validation.cli.parser import output_file, toml_input
 
 
 def _cmd_sweep(args) -> int:
@@ -29,7 +29,7 @@ def add_parser(sub) -> None:
     kinds = ", ".join(SWEEP_KINDS.names())
     file = p.add_argument(
         "file",
-        type=input_file,
+        type=toml_input,
         metavar="SWEEP.toml",
         help=f"the sweep file (docs/scale-out.md); kind: {kinds}",
     )

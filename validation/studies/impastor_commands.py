@@ -144,24 +144,8 @@ def render_for_cli(
     _check_flare_options(observer, light_position, screen_lux, light_luminance)
     booth_light_spectrum(light)  # an unknown key or a bad lamp file fails before any work
     if counts_out is not None:
-        from reference.display.pipeline import ScreenGeometry, screen_view_angles
-        from reference.errors import require_finite
-
-        geometry = ScreenGeometry(tilt=np.radians(tilt_deg))
-        screen_view_angles(geometry, observer, 2, 2)  # an observer behind the screen fails first
-        lamp = require_finite(light_position, "--light-position")
-        require(
-            lamp.shape == (3,) and lamp @ geometry.normal > 0,
-            f"--light-position: ({', '.join(f'{c:g}' for c in np.ravel(lamp))}) m must be x,y,z "
-            "in front of the screen (the side it faces), or it is not mirrored by it",
-        )
-        if light_luminance is None:
-            from impastor.painting import booth_lamp_kind, booth_light_image
-
-            light_luminance = float(booth_light_image(booth_lamp_kind(light)).mean())
-        require(
-            np.isfinite(light_luminance) and light_luminance >= 0,
-            f"--light-luminance: must be >= 0 cd/m², got {light_luminance!r}",
+        geometry, lamp, light_luminance = _counts_setup(
+            light, tilt_deg, observer, light_position, light_luminance
         )
     tilt = np.radians(tilt_deg)  # the display's tilt turns the painting it shows (§3.4)
     result = _render(light, size, method, tolerance, painting, progress, tilt, light_map)
@@ -311,6 +295,26 @@ def _check_flare_options(observer, light_position, screen_lux, light_luminance) 
         or (np.isfinite(light_luminance) and 0 <= light_luminance <= MAX_LUMINANCE),
         f"--light-luminance: must be in [0, {MAX_LUMINANCE:g}] cd/m², got {light_luminance!r}",
     )
+
+
+def _counts_setup(light, tilt_deg, observer, light_position, light_luminance):
+    """The display's geometry, the lamp and its luminance for --counts, checked before work."""
+    from reference.display.pipeline import ScreenGeometry, screen_view_angles
+    from reference.errors import require_finite
+
+    geometry = ScreenGeometry(tilt=np.radians(tilt_deg))
+    screen_view_angles(geometry, observer, 2, 2)  # an observer behind the screen fails first
+    lamp = require_finite(light_position, "--light-position")
+    require(
+        lamp.shape == (3,) and lamp @ geometry.normal > 0,
+        f"--light-position: ({', '.join(f'{c:g}' for c in np.ravel(lamp))}) m must be x,y,z "
+        "in front of the screen (the side it faces), or it is not mirrored by it",
+    )
+    if light_luminance is None:
+        from impastor.painting import booth_lamp_kind, booth_light_image
+
+        light_luminance = float(booth_light_image(booth_lamp_kind(light)).mean())
+    return geometry, lamp, light_luminance
 
 
 def _check_before_render(tolerance, out, counts_out) -> None:

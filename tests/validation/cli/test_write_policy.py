@@ -56,6 +56,8 @@ def files(tmp_path):
     (tmp_path / "t.csv").write_text("R,G,B\n0.1,0.2,0.3\n")
     (tmp_path / "s.toml").write_text('kind = "phong"\n')
     (tmp_path / "d.json").write_text("{}\n")
+    (tmp_path / "e.toml").write_text('[[lights]]\ntype = "environment"\nfile = "A.exr"\n')
+    (tmp_path / "g.toml").write_text('kind = "phong"\n[grid]\nmaterials = ["c.toml"]\n')
     return tmp_path
 
 
@@ -72,6 +74,11 @@ SAME_AS_INPUT = [
     # a lamp's spectrum file given where an illuminant key may go
     (["impastor", "render", "--size", "8", "--light", "{d}/t.csv", "--out", "{d}/t.csv"], "t.csv"),
     (["impastor", "path", "--size", "8", "--light", "{d}/t.csv", "-o", "{d}/t.csv"], "t.csv"),
+    # a file a scene or a sweep names (its environment map; a material file of the grid), a
+    # prefilter kernel's table
+    (["render", "{d}/e.toml", "-o", "{d}/x.png", "--exr", "{d}/A.exr"], "A.exr"),
+    (["sweep", "{d}/g.toml", "--scheduler", "serial", "-o", "{d}/c.toml"], "c.toml"),
+    (["sh", "prefilter", VENICE, "--kernel", "table:{d}/t.csv", "-o", "{d}/t.csv"], "t.csv"),
     # a file of an input folder (crosscheck's data folder, a renders folder to check)
     (["crosscheck", "--quick", "--data", "{d}", "--json", "{d}/sub/../d.json"], "d.json"),
     (["conformance", "check", "{d}", "--json", "{d}/d.json"], "d.json"),
@@ -139,8 +146,8 @@ def test_two_outputs_that_are_one_file_are_refused(files, capsys):
 def test_a_name_too_long_for_the_file_system_is_refused(files, capsys):
     long = files / ("x" * 250 + ".exr")
     _refused(["compare", files / "A.exr", files / "A.exr", "--diff", long], capsys, "longer than")
-    assert sorted(p.name for p in files.iterdir()) == ["A.exr", "c.toml", "d.json", "s.toml",
-                                                       "t.csv"]  # fmt: skip
+    assert sorted(p.name for p in files.iterdir()) == ["A.exr", "c.toml", "d.json", "e.toml",
+                                                       "g.toml", "s.toml", "t.csv"]  # fmt: skip
 
 
 def test_a_zarr_store_never_replaces_a_folder_of_other_files(tmp_path, capsys):
@@ -259,3 +266,28 @@ def test_a_paintings_files_are_inputs_and_its_folder_takes_renders(tmp_path, cap
     assert {name: _digest(folder / name) for name in before} == before
     for _ in range(2):
         assert main([str(a) for a in (*render, folder, "--out", folder / "render.png")]) == 0
+
+
+def test_a_store_never_takes_files_that_are_not_its_own(tmp_path, capsys):
+    # an earlier store with a user's files in it, or an input inside the store, is not replaced
+    store = tmp_path / "e.zarr"
+    assert main(["env", "convert", VENICE, str(store), "--rows", "16"]) == 0
+    (store / "notes.txt").write_text("mine\n")
+    _refused(["env", "convert", VENICE, store, "--rows", "16"], capsys, "also holds other files")
+    assert (store / "notes.txt").read_text() == "mine\n"
+    (store / "notes.txt").unlink()
+    inside = store / "precious.hdr"
+    inside.write_bytes(Path(VENICE).read_bytes())
+    _refused(["env", "convert", inside, store, "--rows", "16"], capsys, "precious.hdr")
+    assert inside.is_file()
+
+
+@pytest.mark.parametrize("kind", ["fifo", "device"])
+def test_a_special_file_is_never_read(kind, tmp_path, capsys):
+    # /dev/zero never ends (brdf check was killed at 24 GB); a FIFO waits for a writer
+    path = tmp_path / "in.toml"
+    if kind == "fifo":
+        os.mkfifo(path)
+    else:
+        path = Path("/dev/zero")
+    _refused(["brdf", "check", path], capsys, "a device or special file")
