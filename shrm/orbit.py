@@ -305,8 +305,12 @@ def shade_isotropic_brdf_environment(
         spectra = angular_sum(env, *_full_brdf(material), surface.normal, surface.view)
         ctx.records.setdefault("shrm", {})["method"] = "bruteforce"
         return spectra @ ctx.weights(None)
-    tol = float(ctx.options.get("shrm_tol", DEFAULT_SHRM_TOL))
-    require(0.0 < tol < 1.0, f"render.options.shrm_tol: must be in (0, 1), got {tol!r}")
+    tol = ctx.options.get("shrm_tol", DEFAULT_SHRM_TOL)
+    require(
+        isinstance(tol, int | float) and not isinstance(tol, bool) and 0.0 < tol < 1.0,
+        f"render.options.shrm_tol: must be a number in (0, 1), got {tol!r}",
+    )
+    tol = float(tol)
     renderer = _renderer(surface, material, light, ctx, tol)
     spectra, clamped = split_shade(renderer, surface.normal, surface.view)
     meta = ctx.records.setdefault("shrm", {})

@@ -707,13 +707,22 @@ def _unit_rms_features(RGB, kind: str, degree: int) -> tuple[np.ndarray, np.ndar
     return X / scale, scale
 
 
+#: The largest spectral weight β of the colorimetric loss (:func:`fit_regression`).
+MAX_SPECTRAL_WEIGHT = 1e6
+
+
 def _check_loss_options(loss: str, spectral_weight, augment, augment_weight) -> None:
     """Check the loss key, β (colorimetric loss only) and a (with an augmentation only)."""
     REGRESSION_LOSSES.lookup(loss)
     if spectral_weight is not None:
+        # β weighs the spectral misfit against ΔE's: beyond 1e6 either term is lost in the other,
+        # and at 1e308 the normal equations overflow
         require(
-            loss == "colorimetric" and np.isfinite(spectral_weight) and spectral_weight > 0,
-            f"spectral weight (colorimetric loss only) must be > 0, got {spectral_weight!r}",
+            loss == "colorimetric"
+            and np.isfinite(spectral_weight)
+            and 0 < spectral_weight <= MAX_SPECTRAL_WEIGHT,
+            f"--spectral-weight: β (colorimetric loss only) must be in (0, "
+            f"{MAX_SPECTRAL_WEIGHT:g}], got {spectral_weight!r}",
         )
     require(
         augment_weight is None

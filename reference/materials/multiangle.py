@@ -221,12 +221,18 @@ def read_five_angle_csv(path, aspecular_deg=FIVE_ASPECULAR_DEG) -> MultiAngleMea
         angles.append(_number(fields[0], f"{where}: aspecular_deg"))
         row = [_number(v, f"{where}: value") for v in fields[1:]]
         require(min(row) >= 0, f"{where}: reflectance factors must be >= 0, got {min(row):g}")
+        # a reflectance factor of 1000 is beyond any paint's flop (1e308 overflowed the fit)
+        require(max(row) <= 1e3, f"{where}: reflectance factors must be <= 1000, got {max(row):g}")
         values.append(row)
     expected = sorted(float(a) for a in aspecular_deg)
     require(
         sorted(angles) == expected,
         f"{path}: readings at {', '.join(f'{a:g}' for a in angles) or 'no angle'}°; a five-angle "
         f"file needs exactly one row at each of {', '.join(f'{a:g}' for a in expected)}°",
+    )
+    require(
+        max(max(r) for r in values) >= 1e-4,
+        f"{path}: every reading is below 1e-4: nothing to fit (all zero ended in an SVD failure)",
     )
     order = np.argsort(angles)
     return MultiAngleMeasurement(

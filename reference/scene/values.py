@@ -47,10 +47,13 @@ from reference.data import resolve_path
 from reference.errors import SpecrefError, format_allowed
 from reference.registry import Registry
 
-__all__ = ["SPECTRUM_FORMS", "SceneReader", "SpectrumForm", "SpectrumSpec"]
+__all__ = ["MAX_SCENE_NUMBER", "SPECTRUM_FORMS", "SceneReader", "SpectrumForm", "SpectrumSpec"]
 
 #: Keys every spectrum table may carry besides its form key.
 RESAMPLING_KEYS = ("extrapolation", "interpolation")
+#: The largest magnitude of any number in a scene file: far beyond any scene's (metres, relative
+#: intensities, radiance), small enough that products and squares stay finite in float32 outputs.
+MAX_SCENE_NUMBER = 1e12
 
 
 def _shown(value) -> str:
@@ -176,6 +179,9 @@ class SceneReader:
     ) -> float:
         """A finite number (TOML integer or float, not a boolean) within optional bounds.
 
+        Every number is within :data:`MAX_SCENE_NUMBER` of zero: an intensity of 1e308 or a
+        position of 1e300 wrote infinities and NaN into the image.
+
         Examples
         --------
         >>> SceneReader("s.toml").number(0, "render.exposure", minimum=0, exclusive_minimum=True)
@@ -191,6 +197,12 @@ class SceneReader:
             number = math.inf
         if not math.isfinite(number):
             self.fail(key, f"must be finite, got {_shown(value)}")
+        if abs(number) > MAX_SCENE_NUMBER:
+            self.fail(
+                key,
+                f"must be within ±{MAX_SCENE_NUMBER:g} (larger values overflow the render's "
+                f"arithmetic), got {value!r}",
+            )
         if minimum is not None:
             low = number <= minimum if exclusive_minimum else number < minimum
             if low:

@@ -163,12 +163,21 @@ def test_loads_scene_reads_spectral_parameters(tmp_path):
     assert m.params["rho_s"] == 0.6  # the default, a number
 
 
-def _square_map(tmp_path):
+def _maps(tmp_path) -> dict:
+    import imageio.v3 as iio
+
     from reference.images.formats import write_exr
 
-    path = tmp_path / "square.exr"
-    write_exr(path, np.ones((16, 16, 3), dtype=np.float32))
-    return path
+    nan = np.ones((16, 32, 3), dtype=np.float32)
+    nan[2, 3, 1] = np.nan
+    iio.imwrite(tmp_path / "grey16.png", np.zeros((16, 32), np.uint16))
+    iio.imwrite(tmp_path / "png8.png", np.zeros((16, 32, 3), np.uint8))
+    return {
+        "square": write_exr(tmp_path / "square.exr", np.ones((16, 16, 3), dtype=np.float32)),
+        "nan": write_exr(tmp_path / "nan.exr", nan),
+        "grey16": tmp_path / "grey16.png",
+        "png8": tmp_path / "png8.png",
+    }
 
 
 #: bad arguments of the built-in orbit -> what the one line says; none needs the BRDF's coefficients
@@ -179,16 +188,22 @@ BAD_ARGUMENTS = {
     "negative tol": (["--tol", "-1"], "shrm orbit: --tol: must be in (0, 1)"),
     "NaN tol": (["--tol", "nan"], "shrm orbit: --tol: must be in (0, 1)"),
     "tol above 1": (["--tol", "5"], "shrm orbit: --tol: must be in (0, 1)"),
-    "square map": (["--env", "{square}"], "square.exr: a lat-long map must be 2:1"),
+    "square map": (["--env", "{square}"], "square.exr: --env: a lat-long map is 2:1"),
+    # a NaN map was refused after two progress lines, naming no file; PNGs were a traceback
+    # (16-bit grey) or taken as HDR (8-bit)
+    "NaN map": (["--env", "{nan}"], "nan.exr: --env: radiance must be finite and >= 0"),
+    "16-bit grey PNG": (["--env", "{grey16}"], "grey16.png: an 8-bit image is not HDR"),
+    "8-bit PNG": (["--env", "{png8}"], "png8.png: an 8-bit image is not HDR"),
 }
 
 
 @pytest.mark.parametrize("case", BAD_ARGUMENTS, ids=list(BAD_ARGUMENTS))
 def test_orbit_arguments_are_refused_before_any_work(case, tmp_path, capsys):
     extra, message = BAD_ARGUMENTS[case]
-    extra = [a.format(square=_square_map(tmp_path)) for a in extra]
+    extra = [a.format(**_maps(tmp_path)) for a in extra]
     argv = ["shrm", "orbit", "--quick", "--frames", "2", "--no-cache", *extra]
     assert main([*argv, "-o", str(tmp_path / "o")]) == 2
+    assert not (tmp_path / "o").exists()  # refused before the output folder is made
     captured = capsys.readouterr()
     err = captured.err.strip().splitlines()
     # one line, and no progress bar (or anything else) before it

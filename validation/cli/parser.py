@@ -247,6 +247,8 @@ def output_file(value: str) -> str:
         raise argparse.ArgumentTypeError(
             "'-' (standard output) is not offered here; give a file name"
         )
+    if not value.strip():  # Path("") is the current folder: ".: cannot write (is a folder)"
+        raise argparse.ArgumentTypeError("an empty file name")
     return (OutputStore if value.rstrip("/\\").endswith(".zarr") else OutputPath)(value)
 
 

@@ -31,7 +31,30 @@ def _check_arguments(args) -> None:
         require(args.F >= 0, f"shrm orbit: --F: must be >= 0, got {args.F}")
     if args.env is not None:  # before the output folder is made: a refusal leaves nothing behind
         require(Path(args.env).is_file(), f"{args.env}: environment file not found (--env)")
+        _check_orbit_environment(args.env)
     check_output_folder(args.out)
+
+
+def _check_orbit_environment(path) -> None:
+    """An HDR lat-long map of at least three channels, finite and >= 0 (one line, before work)."""
+    import numpy as np
+
+    from reference.errors import require
+    from reference.images.spectral import read_environment_file
+
+    image, names = read_environment_file(path)  # refuses 8-bit images
+    require(
+        image.ndim == 3 and image.shape[2] >= 3,
+        f"{path}: --env: an RGB or spectral map is needed, got channels {names}",
+    )
+    require(
+        image.shape[1] == 2 * image.shape[0],
+        f"{path}: --env: a lat-long map is 2:1, got {image.shape[1]} × {image.shape[0]} pixels",
+    )
+    require(
+        bool(np.isfinite(image).all()) and float(image.min()) >= 0.0,
+        f"{path}: --env: radiance must be finite and >= 0",
+    )
 
 
 def _cmd_shrm_orbit(args) -> int:

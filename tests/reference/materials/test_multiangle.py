@@ -121,6 +121,8 @@ def test_the_fit_is_a_scene_material_that_renders(tmp_path):
     ("aspecular_deg,400,500\n15,0.1\n", "line 2: 2 columns, the header has 3"),
     ("aspecular_deg,400,500\n15,0.1,-0.2\n", "line 2: reflectance factors must be >= 0"),
     ("aspecular_deg,400,500\n15,0.1,nan\n", "line 2: value: must be finite"),
+    ("aspecular_deg,400,500\n15,0.1,1e308\n", "line 2: reflectance factors must be <= 1000"),
+    ("aspecular_deg,400\n15,0\n25,0\n45,0\n75,0\n110,0\n", "every reading is below 1e-4"),
     ("aspecular_deg,500,400\n", "line 1: wavelengths must increase"),
     ("angle,400\n", "line 1: the first column must be aspecular_deg"),
     ("# illumination_deg: 95\naspecular_deg,400\n", "illumination_deg: must be in (0, 90)"),

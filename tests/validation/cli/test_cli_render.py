@@ -50,6 +50,13 @@ BAD_INPUT = {
         [],
         "scene.toml: materials.m.k_d: values must be finite, got nan at 380 nm",
     ),
+    # huge values used to write infinities and NaN into the image, or end in OverflowError
+    "huge k_d": (GOOD.replace("{k_d}", "1e200"), [], "materials.m.k_d: must be within ±1e+12"),
+    "huge light position": (
+        GOOD.replace("{k_d}", "0.5").replace("[0, 0, 5]\n", "[0, 0, 1e300]\n"),
+        [],
+        "must be within ±1e+12",
+    ),
     "inf spectrum": (
         GOOD.replace("{k_d}", "inf"),
         [],
