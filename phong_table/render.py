@@ -32,13 +32,13 @@ from phong_table.scenes import SPHERE, view_camera
 from phong_table.table import SpecularTable, build_table, check_interpolation, tabulate
 from reference.display.encodings import linear_to_display
 from reference.errors import require, require_choice
-from reference.geometry.camera import MAX_RESOLUTION
 from reference.geometry.gbuffer import GBuffer, render_gbuffer
 from reference.registry import Method, Registry
 from reference.scene.lights import attenuation_Wang, point_light_vectors
 from reference.scene.shading import phong_cosines
 
 __all__ = [
+    "MAX_STUDY_RESOLUTION",
     "RENDER_METHODS",
     "SHADING_PATHS",
     "ShadingBuffer",
@@ -95,6 +95,10 @@ class SphereGeometry:
         return image
 
 
+#: The largest image side of the Phong study's sphere (:func:`render_sphere_gbuffer`).
+MAX_STUDY_RESOLUTION = 2048
+
+
 def render_sphere_gbuffer(view: str, resolution: int = 512) -> SphereGeometry:
     """Ray-cast the sphere's G-buffer for a view (uncached: the full-frame timing calls this).
 
@@ -103,9 +107,12 @@ def render_sphere_gbuffer(view: str, resolution: int = 512) -> SphereGeometry:
     >>> render_sphere_gbuffer("far", 16).position.shape
     (148, 3)
     """
+    # the study's spectral images hold resolution² × 41 bands several times over: 4096² ran out
+    # of 8 GB; 2048² is 1.4 GB an image
     require(
-        isinstance(resolution, int) and 1 <= resolution <= MAX_RESOLUTION,
-        f"render: resolution: must be an integer in [1, {MAX_RESOLUTION}], got {resolution!r}",
+        isinstance(resolution, int) and 1 <= resolution <= MAX_STUDY_RESOLUTION,
+        f"render: resolution: must be an integer in [1, {MAX_STUDY_RESOLUTION}], got "
+        f"{resolution!r}",
     )
     camera = view_camera(view)
     return SphereGeometry.from_gbuffer(render_gbuffer([SPHERE], camera, resolution, resolution))

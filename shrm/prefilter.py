@@ -58,6 +58,7 @@ from shrm.transform import project_latlong, synthesize_latlong
 
 __all__ = [
     "BRUTEFORCE_METHODS",
+    "MAX_PREFILTER_FACE",
     "PrefilterResult",
     "prefilter_bruteforce",
     "prefilter_coefficients",
@@ -120,6 +121,10 @@ class PrefilterResult:
     tail: float
 
 
+#: The largest cube face of a prefiltered map, texels (:func:`prefilter_environment`).
+MAX_PREFILTER_FACE = 2048
+
+
 def prefilter_environment(
     image,
     kernel,
@@ -175,6 +180,12 @@ def prefilter_environment(
     )
     require((image >= 0).all(), f"{where}: radiance must be >= 0, found {image.min():g}")
     require_choice(output, ("cube", "latlong"), "prefilter output format")
+    # a prefiltered map holds no detail beyond its order (at most a few hundred): a larger face
+    # only costs memory (4096² faces ran out of 8 GB)
+    require(
+        isinstance(size, int) and 1 <= size <= MAX_PREFILTER_FACE,
+        f"{where}: --size: a cube face of 1 to {MAX_PREFILTER_FACE} texels, got {size!r}",
+    )
     k = parse_kernel(kernel)
     L = adaptive_order(k, tol) if order is None else check_order(order, f"{where}: order")
     L = min(L, image.shape[1] // 2 - 1, SH_MAX_ORDER)

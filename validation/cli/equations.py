@@ -9,7 +9,7 @@ from validation.cli.parser import output_file
 
 
 def _cmd_equations(args) -> int:
-    from reference.errors import require
+    from reference.errors import SpecrefError, require
     from reference.files import check_output_file, write_text_atomic
     from validation.report.equations import (
         REGENERATE,
@@ -27,11 +27,18 @@ def _cmd_equations(args) -> int:
         f"{path}: not found; --check compares a checkout's docs/equations.md (run it in the "
         "repository, or give -o FILE)",
     )
+    if args.check:  # the file compared, read before the index's seconds of parsing
+        try:
+            current = path.read_text(encoding="utf-8")
+        except UnicodeDecodeError:
+            raise SpecrefError(
+                f"{path}: not UTF-8 text; --check compares an equation index"
+            ) from None
     citations = collect_citations()
     text = render_equation_index(citations=citations)
     if args.check:
         problems = equation_problems(citations)
-        if path.read_text(encoding="utf-8") != text:
+        if current != text:
             problems.append(f"{path} is out of date; regenerate it with `{REGENERATE}`")
         for problem in problems:
             print(f"specref equations: {problem}", file=sys.stderr)

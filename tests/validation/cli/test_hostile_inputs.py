@@ -33,6 +33,8 @@ def _make(tmp_path: Path, name: str) -> Path:
         path.write_bytes(b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 0 +X 16\n")
     elif name == "deep.json":
         path.write_text("[" * 100_000 + "]" * 100_000)
+    elif name == "mat.toml":
+        path.write_text('name = "brick"\n[material]\nk_d = 0.4\nk_s = 0.4\nn = 50\n')
     elif name == "sweep.toml":
         path.write_text('kind = "phong"\n')
     elif name in ("d.cube", "empty"):
@@ -98,6 +100,11 @@ CASES = [
     (["compare", "{fine.exr}", "{black.exr}"], "nothing to compare: no pixel of the reference"),
     (["compare", "{fine.exr}", "{fine.exr}", "--mask", "{zero-mask.exr}"], "within the mask is"),
     (["compare", "{fine.exr}", "{fine.exr}", "--mask", "{nan-mask.exr}"], "holds NaN or infin"),
+    # sizes bounded by the memory they need (4096 ended in a MemoryError traceback under 8 GB)
+    (["sh", "prefilter", VENICE, "--kernel", "lambert", "--size", "4096", "-o", "{out.exr}"],
+     "--size: a cube face of 1 to 2048 texels, got 4096"),
+    (["phong", "--material", "{mat.toml}", "--resolution", "4096", "--repeats", "1"],
+     "resolution: must be an integer in [1, 2048], got 4096"),
     # crosscheck's data folder: a file or an empty folder was a traceback (Mitsuba 3 is a test
     # dependency: without it the line says how to install it)
     (["crosscheck", "--quick", "--data", "{sweep.toml}"], "not a folder laid out as specref's"),

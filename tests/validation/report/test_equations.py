@@ -308,6 +308,11 @@ def test_cli_writes_and_checks(tmp_path, capsys):
     out.write_text("stale\n", encoding="utf-8")
     assert main(["equations", "--check", "-o", str(out)]) == 1
     assert f"regenerate it with `{REGENERATE}`" in capsys.readouterr().err
+    out.write_bytes(b"\xff\xfe\x00 binary")  # was a UnicodeDecodeError traceback
+    assert main(["equations", "--check", "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "not UTF-8 text" in err
+    assert len(err.splitlines()) == 1
 
 
 #: Where each paper's text prints its equation numbers (docs/equations.md, "Numbering").
