@@ -150,6 +150,10 @@ def image_preview(path, out, width: int = 2048, exposure_ev=None, progress=None)
         exposure_ev is None or (np.isfinite(exposure_ev) and abs(exposure_ev) <= 64),
         f"--exposure: must be a finite number of stops in [-64, 64], got {exposure_ev!r}",
     )
+    require(
+        str(out).lower().endswith(".png"),
+        f"{out}: the preview is an sRGB PNG; give a name ending in .png",
+    )
     with open_panorama_rows(path) as rows:
         to_XYZ, kind = channels_to_XYZ_function(rows.names, str(path))
         XYZ, factor = _box_filtered_XYZ(rows, to_XYZ, width, progress)

@@ -43,7 +43,7 @@ from reference.colour.colorimetry import (
 from reference.colour.spectra import DEFAULT_GRID, GRIDS, SpectralGrid, Spectrum
 from reference.data import DATA_SCHEME, resolve_path
 from reference.display.encodings import ENCODINGS
-from reference.errors import SpecrefError, format_allowed
+from reference.errors import SpecrefError, format_allowed, require
 from reference.geometry.camera import MAX_RESOLUTION, PROJECTIONS, Camera
 from reference.materials.types import MATERIAL_TYPES, MaterialType, make_material
 from reference.registry import Registry
@@ -666,7 +666,10 @@ def load_scene(path) -> Scene:
     """
     file = str(path)
     path = resolve_path(path, Path.cwd()) if file.startswith(DATA_SCHEME) else Path(path)
-    return scene_from_dict(read_toml_file(path), file, path.parent, path)
+    doc = read_toml_file(path)
+    # an empty file rendered a black 256² image: it is a mistake, not a scene
+    require(doc, f"{file}: an empty scene file (docs/scene-format.md: objects, lights, camera)")
+    return scene_from_dict(doc, file, path.parent, path)
 
 
 def read_toml_file(path) -> dict:

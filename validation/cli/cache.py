@@ -2,10 +2,18 @@
 
 from __future__ import annotations
 
+from validation.cli.parser import folder_name
+
 
 def _cmd_cache(args) -> int:
+    from pathlib import Path
+
+    from reference.errors import require
     from shrm.cache import Cache
 
+    if args.cache_dir is not None:  # a file or a device has no entries to show or clear
+        folder = Path(args.cache_dir)
+        require(not folder.exists() or folder.is_dir(), f"--cache-dir: {folder}: not a folder")
     cache = Cache(args.cache_dir)
     if args.action == "clear":
         count = cache.clear()
@@ -28,6 +36,7 @@ def add_parser(sub) -> None:
     p.add_argument("action", choices=["info", "clear"], help="show the cache or delete its entries")
     p.add_argument(
         "--cache-dir",
+        type=folder_name,
         metavar="DIR",
         help="cache folder (default: $SPECREF_CACHE_DIR, else $XDG_CACHE_HOME/specref, else "
         "~/.cache/specref)",

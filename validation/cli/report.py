@@ -2,16 +2,19 @@
 
 from __future__ import annotations
 
-from validation.cli.parser import input_file, output_file, registry_option
+from validation.cli.parser import folder_name, input_file, output_file, registry_option
 
 
 def _cmd_report(args) -> int:
     import os
 
     from reference.errors import require_positive_int
+    from reference.files import check_output_folder
     from validation.report.runner import run_report
 
     jobs = min(2, os.cpu_count() or 1) if args.jobs is None else args.jobs
+    check_output_folder(args.out)  # a file in the way is refused before minutes of sections
+    check_output_folder(os.path.join(args.out, "images"))
 
     effort = "quick" if args.quick else "full" if args.full else "default"
     results = run_report(
@@ -51,7 +54,9 @@ def add_parser(sub) -> None:
         "upsamplers and the channel count); --full 40 min (with make bench, 54-59 min), 1 h "
         "48 min beside other work.",
     )
-    p.add_argument("--out", default="report", help="output folder (default: report)")
+    p.add_argument(
+        "--out", type=folder_name, default="report", help="output folder (default: report)"
+    )
     effort = p.add_mutually_exclusive_group()
     effort.add_argument(
         "--quick",

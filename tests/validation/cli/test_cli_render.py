@@ -32,6 +32,7 @@ position = [0, 0, 5]
 
 #: name -> (scene text or None for no file, extra arguments, a piece of the expected message)
 BAD_INPUT = {
+    "empty scene": ("", [], "scene.toml: an empty scene file"),
     "malformed TOML": ("[camera\neye = [0, 0, 5]", [], "scene.toml: malformed TOML: Expected ']'"),
     "unknown key": ("[camera]\nfov = 30", [], "scene.toml: camera: unknown key 'fov'; allowed:"),
     "missing scene": (None, [], "scene.toml: file not found"),

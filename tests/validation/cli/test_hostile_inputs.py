@@ -100,6 +100,9 @@ CASES = [
     (["compare", "{fine.exr}", "{black.exr}"], "nothing to compare: no pixel of the reference"),
     (["compare", "{fine.exr}", "{fine.exr}", "--mask", "{zero-mask.exr}"], "within the mask is"),
     (["compare", "{fine.exr}", "{fine.exr}", "--mask", "{nan-mask.exr}"], "holds NaN or infin"),
+    (["env", "preview", VENICE, "-o", "{out.exr}"], "the preview is an sRGB PNG"),
+    (["cache", "info", "--cache-dir", "{sweep.toml}"], "sweep.toml: not a folder"),
+    (["cache", "info", "--cache-dir", ""], "an empty folder name"),
     # sizes bounded by the memory they need (4096 ended in a MemoryError traceback under 8 GB)
     (["sh", "prefilter", VENICE, "--kernel", "lambert", "--size", "4096", "-o", "{out.exr}"],
      "--size: a cube face of 1 to 2048 texels, got 4096"),
