@@ -103,6 +103,7 @@ CASES = [
     (["env", "preview", VENICE, "-o", "{out.exr}"], "the preview is an sRGB PNG"),
     (["cache", "info", "--cache-dir", "{sweep.toml}"], "sweep.toml: not a folder"),
     (["cache", "info", "--cache-dir", ""], "an empty folder name"),
+    (["report", "--out", "{sweep.toml}", "--only", "phong"], "sweep.toml: cannot write"),
     # sizes bounded by the memory they need (4096 ended in a MemoryError traceback under 8 GB)
     (["sh", "prefilter", VENICE, "--kernel", "lambert", "--size", "4096", "-o", "{out.exr}"],
      "--size: a cube face of 1 to 2048 texels, got 4096"),
