@@ -90,7 +90,7 @@ class SpectralGrid:
         )
         count = (self.end_nm - self.start_nm) / self.step_nm
         require(
-            abs(count - round(count)) < 1e-9,
+            round(count) >= 1 and abs(count - round(count)) < 1e-9,
             f"grid: step_nm: {self.step_nm} must divide end_nm - start_nm = "
             f"{self.end_nm - self.start_nm}",
         )

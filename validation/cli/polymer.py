@@ -15,9 +15,11 @@ def _numbers(text: str, name: str) -> list[float]:
 
 
 def _cmd_polymer_characterize(args) -> int:
+    import math
     import sys
 
     from reference.colour.spectra import GRIDS
+    from reference.errors import require
     from shrm.polymer.characterization import (
         characterize_model,
         check_chip_count,
@@ -26,6 +28,15 @@ def _cmd_polymer_characterize(args) -> int:
     from shrm.polymer.kubelka_munk import polymer_constituents
 
     thickness, tio2 = _numbers(args.thickness, "thickness"), _numbers(args.tio2, "tio2")
+    # a chip is a sheet of plastic: TiO2 a share by weight, the thickness in millimetres
+    require(
+        all(math.isfinite(t) and 0 <= t <= 1000 for t in thickness),
+        f"--thickness: each thickness must be in [0, 1000] mm, got {args.thickness!r}",
+    )
+    require(
+        all(math.isfinite(c) and 0 <= c <= 100 for c in tio2),
+        f"--tio2: each TiO2 load must be in [0, 100] % by weight, got {args.tio2!r}",
+    )
     # the grid's size before any work (docs/bad-input.md, bounded work)
     check_chip_count(len(thickness), len(tio2), GRIDS[args.grid].n_bands, args.yes)
     constituents = polymer_constituents(GRIDS[args.grid], args.constituents)

@@ -35,6 +35,7 @@ def test_builtin_grids_values():
         ((400, 705, 10), "must divide"),
         ((400, float("nan"), 10), "end_nm: must be a finite number"),
         ((0, 10000, 0.1), "at most 4096 bands"),
+        ((380, 780, 1e308), "must divide"),  # was a grid of one band (brdf convert --step-nm)
     ],
 )
 def test_grid_bad_input(args, match):

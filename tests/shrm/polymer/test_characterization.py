@@ -159,8 +159,8 @@ def test_a_backing_that_is_no_reflectance_and_a_partial_range_are_refused(tmp_pa
     ("flags", "message"),
     [
         (["--thickness", "2,1"], "thickness_mm: the grid is not monotonic"),
-        (["--thickness=-1,1"], "thickness_mm: must be >= 0"),
-        (["--tio2", "0,nan"], "tio2_pct: must be finite"),
+        (["--thickness=-1,1"], "--thickness: each thickness must be in [0, 1000] mm"),
+        (["--tio2", "0,nan"], "--tio2: each TiO2 load must be in [0, 100] %"),
         (["--tio2", "a,b"], "--tio2: must be comma-separated numbers"),
     ],
 )

@@ -104,6 +104,10 @@ CASES = [
     (["cache", "info", "--cache-dir", "{sweep.toml}"], "sweep.toml: not a folder"),
     (["cache", "info", "--cache-dir", ""], "an empty folder name"),
     (["report", "--out", "{sweep.toml}", "--only", "phong"], "sweep.toml: cannot write"),
+    (["polymer", "characterize", "-o", "{out.csv}", "--thickness", "1,2", "--tio2", "0,101"],
+     "--tio2: each TiO2 load must be in [0, 100] % by weight"),
+    (["polymer", "characterize", "-o", "{out.csv}", "--thickness", "1,1e308", "--tio2", "0,1"],
+     "--thickness: each thickness must be in [0, 1000] mm"),
     # sizes bounded by the memory they need (4096 ended in a MemoryError traceback under 8 GB)
     (["sh", "prefilter", VENICE, "--kernel", "lambert", "--size", "4096", "-o", "{out.exr}"],
      "--size: a cube face of 1 to 2048 texels, got 4096"),
