@@ -647,6 +647,12 @@ def convert_to_zarr(
                         np.isfinite(window).all(),
                         f"{source}: radiance must be finite, found NaN or inf (rows {a}-{b - 1})",
                     )
+                    # as scenes and sh project do: a store of radiance holds none below zero
+                    require(
+                        bool((window >= 0).all()),
+                        f"{source}: radiance must be >= 0, found {float(window.min()):g} "
+                        f"(rows {a}-{b - 1})",
+                    )
                 yield buffer[: row1 - row0]
 
         write_zarr_blocks(

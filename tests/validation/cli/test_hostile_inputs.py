@@ -47,6 +47,10 @@ def _make(tmp_path: Path, name: str) -> Path:
         image = np.full((4, 4, 3), 0.5)
         image[1, 2, 1] = {"nan.exr": np.nan, "inf.exr": np.inf, "fine.exr": 0.5}[name]
         write_exr(path, image, ["X", "Y", "Z"])
+    elif name == "negative.exr":
+        image = np.ones((8, 16, 3))
+        image[3, 4, 1] = -1.0
+        write_exr(path, image)
     elif name in ("nan-stderr.exr", "black.exr"):
         image = np.zeros((4, 4, 4)) if name == "black.exr" else np.full((4, 4, 4), 0.5)
         image[0, 0, 3] = np.nan if name == "nan-stderr.exr" else 0.0
@@ -101,6 +105,7 @@ CASES = [
     (["compare", "{fine.exr}", "{fine.exr}", "--mask", "{zero-mask.exr}"], "within the mask is"),
     (["compare", "{fine.exr}", "{fine.exr}", "--mask", "{nan-mask.exr}"], "holds NaN or infin"),
     (["env", "preview", VENICE, "-o", "{out.exr}"], "the preview is an sRGB PNG"),
+    (["env", "convert", "{negative.exr}", "{out.zarr}"], "radiance must be >= 0, found -1"),
     (["cache", "info", "--cache-dir", "{sweep.toml}"], "sweep.toml: not a folder"),
     (["cache", "info", "--cache-dir", ""], "an empty folder name"),
     (["report", "--out", "{sweep.toml}", "--only", "phong"], "sweep.toml: cannot write"),
