@@ -40,9 +40,8 @@ def _fresnel_dielectric(cos_i, n):
 
 
 @njit
-def _latlong_bilinear_add(image, dx, dy, dz, weight, x_out):
-    """x_out[b] = weight × bilinear look-up of the lat-long map (``latlong_lookup_bilinear``)."""
-    H, W = image.shape[0], image.shape[1]
+def _latlong_bilinear_taps(H, W, dx, dy, dz):
+    """The texels and weights of a bilinear look-up at a direction (``latlong_lookup_bilinear``)."""
     u = math.atan2(dx, -dz) / (2.0 * math.pi)
     if u < 0.0:
         u += 1.0
@@ -54,12 +53,67 @@ def _latlong_bilinear_add(image, dx, dy, dz, weight, x_out):
     x0 = math.floor(x)
     y0 = min(math.floor(y), H - 1)
     fx, fy = x - x0, y - y0
-    x1, y1 = (x0 + 1) % W, min(y0 + 1, H - 1)
-    x0 = x0 % W
+    return x0 % W, (x0 + 1) % W, y0, min(y0 + 1, H - 1), fx, fy
+
+
+@njit
+def _latlong_bilinear_add(image, dx, dy, dz, weight, x_out):
+    """x_out[b] = weight × bilinear look-up of the lat-long map (``latlong_lookup_bilinear``)."""
+    x0, x1, y0, y1, fx, fy = _latlong_bilinear_taps(image.shape[0], image.shape[1], dx, dy, dz)
     for b in range(image.shape[2]):
         top = image[y0, x0, b] * (1 - fx) + image[y0, x1, b] * fx
         bottom = image[y1, x0, b] * (1 - fx) + image[y1, x1, b] * fx
         x_out[b] = weight * (top * (1 - fy) + bottom * fy)
+
+
+@njit
+def _frame_and_view(N, V, p):
+    """Duff et al. 2017's tangent frame (T, B) of normal p and the unit view in it, above it."""
+    nx, ny, nz = N[p, 0], N[p, 1], N[p, 2]
+    sign = math.copysign(1.0, nz)
+    a = -1.0 / (sign + nz)
+    b = nx * ny * a
+    tx, ty, tz = 1.0 + sign * nx * nx * a, sign * b, -sign * nx
+    bx, by, bz = b, sign + ny * ny * a, -ny
+    ox = V[p, 0] * tx + V[p, 1] * ty + V[p, 2] * tz
+    oy = V[p, 0] * bx + V[p, 1] * by + V[p, 2] * bz
+    oz = max(V[p, 0] * nx + V[p, 1] * ny + V[p, 2] * nz, 1e-6)
+    norm = math.sqrt(ox * ox + oy * oy + oz * oz)
+    return tx, ty, tz, bx, by, bz, ox / norm, oy / norm, oz / norm
+
+
+@njit
+def _stretched_view(ox, oy, oz, alpha):
+    """Heitz 2018, listing 1: the view in the stretched configuration and its frame (T1, T2)."""
+    vx, vy, vz = alpha * ox, alpha * oy, oz
+    norm = math.sqrt(vx * vx + vy * vy + vz * vz)
+    vx, vy, vz = vx / norm, vy / norm, vz / norm
+    lensq = vx * vx + vy * vy
+    if lensq > 0:
+        inv = 1.0 / math.sqrt(lensq)
+        t1x, t1y, t1z = -vy * inv, vx * inv, 0.0
+    else:
+        t1x, t1y, t1z = 1.0, 0.0, 0.0
+    t2x, t2y, t2z = vy * t1z - vz * t1y, vz * t1x - vx * t1z, vx * t1y - vy * t1x
+    return vx, vy, vz, t1x, t1y, t1z, t2x, t2y, t2z, 0.5 * (1.0 + vz)
+
+
+@njit
+def _reflected_sample(ox, oy, oz, alpha, view, u1, u2):
+    """A GGX visible normal h (Heitz 2018, listing 1) from two uniforms: o·h, i = 2 (o·h) h − o."""
+    vx, vy, vz, t1x, t1y, t1z, t2x, t2y, t2z, s = view
+    r = math.sqrt(u1)
+    phi = 2.0 * math.pi * u2
+    q1 = r * math.cos(phi)
+    q2 = (1.0 - s) * math.sqrt(1.0 - q1 * q1) + s * r * math.sin(phi)
+    q3 = math.sqrt(max(0.0, 1.0 - q1 * q1 - q2 * q2))
+    hx = alpha * (q1 * t1x + q2 * t2x + q3 * vx)
+    hy = alpha * (q1 * t1y + q2 * t2y + q3 * vy)
+    hz = max(0.0, q1 * t1z + q2 * t2z + q3 * vz)
+    norm = math.sqrt(hx * hx + hy * hy + hz * hz)
+    hx, hy, hz = hx / norm, hy / norm, hz / norm
+    oh = ox * hx + oy * hy + oz * hz
+    return oh, 2.0 * oh * hx - ox, 2.0 * oh * hy - oy, 2.0 * oh * hz - oz, hz
 
 
 @njit
@@ -69,43 +123,11 @@ def rough_specular_samples_kernel(N, V, radiance, alpha, n, u, total, total_sq):
     x = np.empty(nb)
     for p in range(N.shape[0]):
         nx, ny, nz = N[p, 0], N[p, 1], N[p, 2]
-        # Duff et al. 2017: the tangent frame (T, B, N)
-        sign = math.copysign(1.0, nz)
-        a = -1.0 / (sign + nz)
-        b = nx * ny * a
-        tx, ty, tz = 1.0 + sign * nx * nx * a, sign * b, -sign * nx
-        bx, by, bz = b, sign + ny * ny * a, -ny
-        ox = V[p, 0] * tx + V[p, 1] * ty + V[p, 2] * tz
-        oy = V[p, 0] * bx + V[p, 1] * by + V[p, 2] * bz
-        oz = max(V[p, 0] * nx + V[p, 1] * ny + V[p, 2] * nz, 1e-6)
-        norm = math.sqrt(ox * ox + oy * oy + oz * oz)
-        ox, oy, oz = ox / norm, oy / norm, oz / norm
-        # Heitz 2018, listing 1: the view in the stretched configuration
-        vx, vy, vz = alpha * ox, alpha * oy, oz
-        norm = math.sqrt(vx * vx + vy * vy + vz * vz)
-        vx, vy, vz = vx / norm, vy / norm, vz / norm
-        lensq = vx * vx + vy * vy
-        if lensq > 0:
-            inv = 1.0 / math.sqrt(lensq)
-            t1x, t1y, t1z = -vy * inv, vx * inv, 0.0
-        else:
-            t1x, t1y, t1z = 1.0, 0.0, 0.0
-        t2x, t2y, t2z = vy * t1z - vz * t1y, vz * t1x - vx * t1z, vx * t1y - vy * t1x
-        s = 0.5 * (1.0 + vz)
+        tx, ty, tz, bx, by, bz, ox, oy, oz = _frame_and_view(N, V, p)
+        view = _stretched_view(ox, oy, oz, alpha)
         for m in range(u.shape[1]):
-            r = math.sqrt(u[p, m, 0])
-            phi = 2.0 * math.pi * u[p, m, 1]
-            q1 = r * math.cos(phi)
-            q2 = (1.0 - s) * math.sqrt(1.0 - q1 * q1) + s * r * math.sin(phi)
-            q3 = math.sqrt(max(0.0, 1.0 - q1 * q1 - q2 * q2))
-            hx = alpha * (q1 * t1x + q2 * t2x + q3 * vx)
-            hy = alpha * (q1 * t1y + q2 * t2y + q3 * vy)
-            hz = max(0.0, q1 * t1z + q2 * t2z + q3 * vz)
-            norm = math.sqrt(hx * hx + hy * hy + hz * hz)
-            hx, hy, hz = hx / norm, hy / norm, hz / norm
-            # i = 2 (o·h) h − o; weight F(o·h) G_1(i) (Eq. (34), Walter et al. 2007)
-            oh = ox * hx + oy * hy + oz * hz
-            ix, iy, iz = 2.0 * oh * hx - ox, 2.0 * oh * hy - oy, 2.0 * oh * hz - oz
+            oh, ix, iy, iz, _ = _reflected_sample(ox, oy, oz, alpha, view, u[p, m, 0], u[p, m, 1])
+            # weight F(o·h) G_1(i) (Eq. (34), Walter et al. 2007)
             if iz > 0.0:
                 c2 = max(iz * iz, 1e-300)
                 G = 2.0 / (1.0 + math.sqrt(1.0 + alpha * alpha * (1.0 - c2) / c2))
@@ -125,19 +147,7 @@ def rough_specular_samples_kernel(N, V, radiance, alpha, n, u, total, total_sq):
 def _pyramid_bilinear_add(flat, offset, H, dx, dy, dz, weight, x_out):
     """x_out[b] += weight × bilinear look-up of one packed pyramid level (W = 2H)."""
     W = 2 * H
-    u = math.atan2(dx, -dz) / (2.0 * math.pi)
-    if u < 0.0:
-        u += 1.0
-    if u >= 1.0:
-        u = 0.0
-    v = math.acos(min(max(dy, -1.0), 1.0)) / math.pi
-    x = u * W - 0.5
-    y = min(max(v * H - 0.5, 0.0), H - 1.0)
-    x0 = math.floor(x)
-    y0 = min(math.floor(y), H - 1)
-    fx, fy = x - x0, y - y0
-    x1, y1 = (x0 + 1) % W, min(y0 + 1, H - 1)
-    x0 = x0 % W
+    x0, x1, y0, y1, fx, fy = _latlong_bilinear_taps(H, W, dx, dy, dz)
     for b in range(flat.shape[1]):
         top = flat[offset + y0 * W + x0, b] * (1 - fx) + flat[offset + y0 * W + x1, b] * fx
         bottom = flat[offset + y1 * W + x0, b] * (1 - fx) + flat[offset + y1 * W + x1, b] * fx
@@ -156,49 +166,17 @@ def layered_fis_kernel(N, V, flat, heights, offsets, alpha, n, u, bias, out):
     a2 = alpha * alpha
     for p in range(N.shape[0]):
         nx, ny, nz = N[p, 0], N[p, 1], N[p, 2]
-        # Duff et al. 2017: the tangent frame (T, B, N)
-        sign = math.copysign(1.0, nz)
-        a = -1.0 / (sign + nz)
-        b = nx * ny * a
-        tx, ty, tz = 1.0 + sign * nx * nx * a, sign * b, -sign * nx
-        bx, by, bz = b, sign + ny * ny * a, -ny
-        ox = V[p, 0] * tx + V[p, 1] * ty + V[p, 2] * tz
-        oy = V[p, 0] * bx + V[p, 1] * by + V[p, 2] * bz
-        oz = max(V[p, 0] * nx + V[p, 1] * ny + V[p, 2] * nz, 1e-6)
-        norm = math.sqrt(ox * ox + oy * oy + oz * oz)
-        ox, oy, oz = ox / norm, oy / norm, oz / norm
+        tx, ty, tz, bx, by, bz, ox, oy, oz = _frame_and_view(N, V, p)
         c2 = max(oz * oz, 1e-300)
         G1_o = 2.0 / (1.0 + math.sqrt(1.0 + a2 * (1.0 - c2) / c2))
-        # Heitz 2018, listing 1: the view in the stretched configuration
-        vx, vy, vz = alpha * ox, alpha * oy, oz
-        norm = math.sqrt(vx * vx + vy * vy + vz * vz)
-        vx, vy, vz = vx / norm, vy / norm, vz / norm
-        lensq = vx * vx + vy * vy
-        if lensq > 0:
-            inv = 1.0 / math.sqrt(lensq)
-            t1x, t1y, t1z = -vy * inv, vx * inv, 0.0
-        else:
-            t1x, t1y, t1z = 1.0, 0.0, 0.0
-        t2x, t2y, t2z = vy * t1z - vz * t1y, vz * t1x - vx * t1z, vx * t1y - vy * t1x
-        s = 0.5 * (1.0 + vz)
+        view = _stretched_view(ox, oy, oz, alpha)
         x[:] = 0.0
         total = 0.0
         for m in range(K):
-            r = math.sqrt(u[m, 0])
-            phi = 2.0 * math.pi * u[m, 1]
-            q1 = r * math.cos(phi)
-            q2 = (1.0 - s) * math.sqrt(1.0 - q1 * q1) + s * r * math.sin(phi)
-            q3 = math.sqrt(max(0.0, 1.0 - q1 * q1 - q2 * q2))
-            hx = alpha * (q1 * t1x + q2 * t2x + q3 * vx)
-            hy = alpha * (q1 * t1y + q2 * t2y + q3 * vy)
-            hz = max(0.0, q1 * t1z + q2 * t2z + q3 * vz)
-            norm = math.sqrt(hx * hx + hy * hy + hz * hz)
-            hx, hy, hz = hx / norm, hy / norm, hz / norm
-            # i = 2 (o·h) h − o; weight F(o·h) G_1(i) (Eq. (34), Walter et al. 2007)
-            oh = ox * hx + oy * hy + oz * hz
-            ix, iy, iz = 2.0 * oh * hx - ox, 2.0 * oh * hy - oy, 2.0 * oh * hz - oz
+            oh, ix, iy, iz, hz = _reflected_sample(ox, oy, oz, alpha, view, u[m, 0], u[m, 1])
             if iz <= 0.0:
                 continue
+            # weight F(o·h) G_1(i) (Eq. (34), Walter et al. 2007)
             ci2 = max(iz * iz, 1e-300)
             G = 2.0 / (1.0 + math.sqrt(1.0 + a2 * (1.0 - ci2) / ci2))
             weight = _fresnel_dielectric(oh, n) * G
