@@ -264,6 +264,13 @@ class Scene:
         (50, 25)
         """
         r = self.render
+        # the sizes as given first, so a bad --height is named as such (not as the width from it)
+        check_render_size(
+            r.width if width is None else width,
+            r.height if height is None else height,
+            r.supersample if supersample is None else supersample,
+            where,
+        )
         if width is not None and height is None:
             height = max(1, round(width * r.height / r.width)) if _is_count(width) else width
         if height is not None and width is None:

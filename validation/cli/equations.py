@@ -34,7 +34,10 @@ def _cmd_equations(args) -> int:
             raise SpecrefError(
                 f"{path}: not UTF-8 text; --check compares an equation index"
             ) from None
+    # seconds of parsing: a line per stage on stderr (stdout may be the index itself)
+    print("specref equations: reading the code, its tests and the errata", file=sys.stderr)
     citations = collect_citations()
+    print("specref equations: writing the index", file=sys.stderr)
     text = render_equation_index(citations=citations)
     if args.check:
         problems = equation_problems(citations)

@@ -355,6 +355,10 @@ def test_resolution_limits():
     scene = scene_with("")
     with raises("command line: render.width: must be an integer in [1, 16384], got 0"):
         scene.with_render(width=0, where="command line: render")
+    # a lone --height is named as such, with the value given (it was reported as the width from it)
+    for height, shown in ((0, "0"), (-5, "-5"), (20000, "20000")):
+        with raises(f"command line: render.height: must be an integer in [1, 16384], got {shown}"):
+            scene.with_render(height=height, where="command line: render")
 
 
 def test_malformed_and_missing_scene_files(tmp_path):
