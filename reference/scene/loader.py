@@ -700,6 +700,8 @@ def read_toml_file(path) -> dict:
     """
     file = str(path)
     path = Path(path)
+    if path.is_dir():  # it was reported as "file not found"
+        raise SpecrefError(f"{file}: is a folder, not a TOML file")
     if not path.is_file():
         raise SpecrefError(f"{file}: file not found")
     try:

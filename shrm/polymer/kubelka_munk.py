@@ -142,6 +142,19 @@ def polymer_constituents(
     data = read_toml_file(path)
     for table in ("base", "tio2"):
         require(isinstance(data.get(table), dict), f"{path}: missing table [{table}]")
+    allowed = {
+        "": {"base", "tio2"},
+        "base": {"name", "index", "K_0", "K_blue", "K_tau_nm", "S_560", "S_exponent"},
+        "tio2": {"name", "S_560", "S_exponent", "K_edge", "edge_nm", "edge_width_nm", "K_floor"},
+    }
+    for table, keys in allowed.items():  # a misspelt key would be ignored and its default used
+        extra = sorted(set(data[table] if table else data) - keys)
+        where = f"{table}." if table else ""
+        require(
+            not extra,
+            f"{path}: {where}{extra[0] if extra else ''}: unknown key; allowed: "
+            f"{', '.join(sorted(keys))}",
+        )
     base = data["base"]
     num = {
         (t, k): _number(data[t], k, f"{path}: {t}")

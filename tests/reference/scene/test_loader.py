@@ -373,7 +373,7 @@ def test_malformed_and_missing_scene_files(tmp_path):
     binary.write_bytes(b"\xff\xfe\x00[camera]")
     with raises(f"{binary}: not UTF-8 text"):
         load_scene(binary)
-    with raises(f"{tmp_path}: file not found"):
+    with raises(f"{tmp_path}: is a folder, not a TOML file"):
         load_scene(tmp_path)
 
 

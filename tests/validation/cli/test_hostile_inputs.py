@@ -33,6 +33,10 @@ def _make(tmp_path: Path, name: str) -> Path:
         path.write_bytes(b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 0 +X 16\n")
     elif name == "deep.json":
         path.write_text("[" * 100_000 + "]" * 100_000)
+    elif name == "extra-key.toml":
+        from shrm.polymer.kubelka_munk import DEFAULT_CONSTITUENTS
+
+        path.write_text(Path(DEFAULT_CONSTITUENTS).read_text().replace("[base]", "[base]\nfoo = 1"))
     elif name == "mat.toml":
         path.write_text('name = "brick"\n[material]\nk_d = 0.4\nk_s = 0.4\nn = 50\n')
     elif name == "sweep.toml":
@@ -109,6 +113,9 @@ CASES = [
     (["cache", "info", "--cache-dir", "{sweep.toml}"], "sweep.toml: not a folder"),
     (["cache", "info", "--cache-dir", ""], "an empty folder name"),
     (["report", "--out", "{sweep.toml}", "--only", "phong"], "sweep.toml: cannot write"),
+    (["render", "{empty}", "-o", "{out.png}"], "empty: is a folder, not a TOML file"),
+    (["polymer", "characterize", "-o", "{out.csv}", "--constituents", "{extra-key.toml}"],
+     "extra-key.toml: base.foo: unknown key; allowed:"),
     (["polymer", "characterize", "-o", "{out.csv}", "--thickness", "1,2", "--tio2", "0,101"],
      "--tio2: each TiO2 load must be in [0, 100] % by weight"),
     (["polymer", "characterize", "-o", "{out.csv}", "--thickness", "1,1e308", "--tio2", "0,1"],
