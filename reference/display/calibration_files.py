@@ -17,8 +17,6 @@ References
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -34,7 +32,7 @@ from reference.display.cgats import write_cal, write_ti3
 from reference.display.instruments import INSTRUMENTS, ReferenceMeter
 from reference.display.spectral import SpectralDisplay
 from reference.errors import SpecrefError, require
-from reference.files import remove_stale_temporaries, temporary_prefix, write_text_atomic
+from reference.files import write_text_atomic
 
 __all__ = [
     "CalibratedDisplay",
@@ -156,17 +154,14 @@ def write_cube(path, lut, title: str = "specref calibration") -> Path:
     """
     import colour
 
+    from reference.files import atomic_path
+
     path = Path(path)
     table = colour.LUT3x1D(np.asarray(lut, dtype=np.float64).T, name=title)
-    remove_stale_temporaries(path)
-    handle, tmp = tempfile.mkstemp(dir=path.parent, prefix=temporary_prefix(path), suffix=".cube")
-    os.close(handle)
-    try:
-        colour.io.write_LUT(table, tmp)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+    # the one atomic writer: synced, renamed, and with an ordinary file's permissions (mkstemp's
+    # 0600 had stayed on the .cube while its sibling files were 0644)
+    with atomic_path(path, suffix=".cube") as tmp:
+        colour.io.write_LUT(table, str(tmp))
     return path
 
 

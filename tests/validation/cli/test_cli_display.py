@@ -34,6 +34,9 @@ def test_calibrate_writes_outputs(tmp_path, capsys):
     assert "max Δu′v′ above 5 % of white" in printed
     for suffix in (".cal", ".cube", ".ti3", ".json"):
         assert out.with_suffix(suffix).exists()
+    # every file with an ordinary new file's permissions (the .cube had kept mkstemp's 0600)
+    modes = {out.with_suffix(s).stat().st_mode & 0o777 for s in (".cal", ".cube", ".ti3", ".json")}
+    assert len(modes) == 1, modes
     assert json.loads(out.with_suffix(".json").read_text())["curve"] == "lstar"
 
 
