@@ -48,6 +48,7 @@ from impastor._kernels import (
 from impastor.arealights import PlaneLight, light_plane_uv
 from impastor.point_lights import PointLights
 from reference.errors import require, require_choice, require_nonnegative, require_positive_int
+from reference.geometry.sampling import hammersley
 from reference.materials.brdf import (
     brdf_ward_duer_specular,
     frame_from_normal,
@@ -57,7 +58,6 @@ from reference.materials.brdf import (
 
 __all__ = [
     "BACKENDS",
-    "hammersley",
     "mip_lookup",
     "mip_pyramid",
     "specular_brute_force",
@@ -80,28 +80,6 @@ def _flat(points, normals, views, alpha):
     a = np.broadcast_to(alpha, shape)
     as_c = lambda x, k: np.ascontiguousarray(x.reshape(-1, k) if k else x.reshape(-1))  # noqa: E731
     return as_c(p, 3), as_c(n, 3), as_c(v, 3), as_c(a, 0), shape
-
-
-def hammersley(n_samples: int) -> np.ndarray:
-    """The 2-D Hammersley point set: ``((k + ½)/K, radical inverse base 2 of k)``.
-
-    Examples
-    --------
-    >>> hammersley(4)
-    array([[0.125, 0.   ],
-           [0.375, 0.5  ],
-           [0.625, 0.25 ],
-           [0.875, 0.75 ]])
-    """
-    K = require_positive_int(n_samples, "fis: n_samples", 1 << 20)
-    k = np.arange(K, dtype=np.uint64)
-    inverse = np.zeros(K)
-    scale = 0.5
-    while (k > 0).any():
-        inverse += scale * (k & np.uint64(1)).astype(np.float64)
-        k = k >> np.uint64(1)
-        scale /= 2.0
-    return np.stack([(np.arange(K) + 0.5) / K, inverse], axis=-1)
 
 
 def mip_pyramid(image) -> list[np.ndarray]:

@@ -7,17 +7,19 @@
   the rasterizer (numba twin in ``_raster_kernels``).
 - :mod:`~reference.geometry.cubemap` — cube maps from lat-long maps and their lookups (numba twins
   in ``_cubemap_kernels``).
+- :mod:`~reference.geometry.sampling` — low-discrepancy (Hammersley) sample points.
 """
 
 from __future__ import annotations
 
-from reference.geometry import camera, cubemap, envmap, gbuffer, mesh, raster, shapes
+from reference.geometry import camera, cubemap, envmap, gbuffer, mesh, raster, sampling, shapes
 from reference.geometry.camera import *  # noqa: F403
 from reference.geometry.cubemap import *  # noqa: F403
 from reference.geometry.envmap import *  # noqa: F403
 from reference.geometry.gbuffer import *  # noqa: F403
 from reference.geometry.mesh import *  # noqa: F403
 from reference.geometry.raster import *  # noqa: F403
+from reference.geometry.sampling import *  # noqa: F403
 from reference.geometry.shapes import *  # noqa: F403
 
 __all__ = sorted(
@@ -28,6 +30,7 @@ __all__ = sorted(
         *gbuffer.__all__,
         *mesh.__all__,
         *raster.__all__,
+        *sampling.__all__,
         *cubemap.__all__,
     }
 )

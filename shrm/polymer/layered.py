@@ -52,6 +52,7 @@ from reference.geometry.envmap import (
     latlong_pixel_directions,
     latlong_pixel_solid_angles,
 )
+from reference.geometry.sampling import hammersley
 from reference.materials.fresnel import fresnel_dielectric
 from reference.registry import Method, Registry
 from shrm.polymer.oracle import (
@@ -76,7 +77,6 @@ __all__ = [
     "coupled_irradiance_latlong",
     "fis_specular_latlong",
     "ggx_prefiltered_latlong",
-    "hammersley_points",
     "layered_maps",
     "layered_pixel_parts",
     "layered_reshade_XYZ",
@@ -300,24 +300,6 @@ def layered_maps(
     )
 
 
-def hammersley_points(samples: int) -> np.ndarray:
-    """``samples`` Hammersley points in [0, 1)²: ``((k + ½)/K, radical inverse of k in base 2)``.
-
-    Examples
-    --------
-    >>> hammersley_points(4).tolist()
-    [[0.125, 0.0], [0.375, 0.5], [0.625, 0.25], [0.875, 0.75]]
-    """
-    k = np.arange(samples, dtype=np.uint64)
-    bits = np.zeros(samples, dtype=np.float64)
-    scale = 0.5
-    for _ in range(max(1, int(samples - 1).bit_length())):
-        bits += (k & np.uint64(1)) * scale
-        k >>= np.uint64(1)
-        scale *= 0.5
-    return np.stack([(np.arange(samples) + 0.5) / samples, bits], axis=-1)
-
-
 def fis_specular_latlong(
     normal, view, levels, alpha: float, n: float, samples: int = FIS_SAMPLES, bias=FIS_BIAS
 ) -> np.ndarray:
@@ -326,9 +308,10 @@ def fis_specular_latlong(
     ``L̄ = Σ_k w_k L̃(i_k, λ_k) / Σ_k w_k`` with ``w_k = F(o·h_k) G_1(i_k)``: the oracle's
     estimator (``oracle.rough_specular_samples``: GGX visible normals ``h_k``, Heitz 2018,
     ``i_k = 2 (o·h_k) h_k − o``, the weight of Eq. (20), Walter et al. 2007, with Eq. (34),
-    Walter et al. 2007) at the K Hammersley points of :func:`hammersley_points`, normalized by
-    its own sum of weights, so that ``E_ρ(θ_o) L̄`` is the reflection with the interface's
-    tabulated albedo (exact under a uniform sky, as the body's ``1 − E_ρ`` needs). Each sample
+    Walter et al. 2007) at the K Hammersley points (``reference.geometry.sampling.hammersley``),
+    normalized by its own sum of weights, so that ``E_ρ(θ_o) L̄`` is the reflection with the
+    interface's tabulated albedo (exact under a uniform sky, as the body's ``1 − E_ρ`` needs). Each
+    sample
     reads the map's mip pyramid at the level of its solid angle (Colbert & Křivánek 2007),
     ``λ_k = max(½ log₂(Ω_s / Ω_p) + bias, 0)`` with ``Ω_s = 1 / (K pdf(i_k))``,
     ``pdf(i) = G_1(o) D(h) / (4 cos θ_o)`` and ``Ω_p`` a level-0 texel's solid angle at ``i_k``,
@@ -366,7 +349,7 @@ def fis_specular_latlong(
     N = np.asarray(normal, dtype=np.float64)
     V = np.asarray(view, dtype=np.float64)
     H, W = levels[0].shape[:2]
-    u = hammersley_points(samples)
+    u = hammersley(samples)
     out = np.zeros((N.shape[0], levels[0].shape[2]))
     for s in range(0, N.shape[0], 1024):
         T, B = _frame(N[s : s + 1024])
@@ -402,7 +385,7 @@ def _fis_compiled(normal, view, levels, alpha, n, samples=FIS_SAMPLES, bias=FIS_
     offsets = np.concatenate([[0], np.cumsum(2 * heights**2)[:-1]]).astype(np.int64)
     flat = np.concatenate([level.reshape(-1, level.shape[2]) for level in levels])
     out = np.zeros((N.shape[0], levels[0].shape[2]))
-    u = hammersley_points(samples)
+    u = hammersley(samples)
     layered_fis_kernel(N, V, flat, heights, offsets, float(alpha), float(n), u, float(bias), out)
     return out
 

@@ -11,7 +11,6 @@ from impastor.arealights import PlaneLight
 from impastor.point_lights import point_lights_from_plane
 from impastor.specular_hybrid import SPECULAR_METHODS
 from impastor.specular_lighting import (
-    hammersley,
     mip_lookup,
     mip_pyramid,
     specular_brute_force,
@@ -19,6 +18,7 @@ from impastor.specular_lighting import (
     specular_point_lights,
 )
 from reference.errors import SpecrefError
+from reference.geometry.sampling import hammersley
 
 UP = np.array([0.0, 1.0, 0.0])
 
