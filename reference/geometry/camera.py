@@ -153,17 +153,19 @@ class Camera:
         p_y = (1.0 - 2.0 * np.asarray(y, dtype=np.float64) / height) * h
         return p_x, p_y
 
-    def rays(self, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+    def rays(self, width: int, height: int, rows=None) -> tuple[np.ndarray, np.ndarray]:
         """Primary rays through the pixel centres.
 
         Parameters
         ----------
         width, height : int
             Image size in pixels, each in [1, MAX_RESOLUTION].
+        rows : (int, int), optional
+            Only the rows ``start ≤ y < stop`` of that image (a band, for work in pieces).
 
         Returns
         -------
-        origins, directions : ndarray, shape (height, width, 3)
+        origins, directions : ndarray, shape (height, width, 3) or (stop − start, width, 3)
             World-space origins and unit directions.
 
         Examples
@@ -171,10 +173,13 @@ class Camera:
         >>> o, d = Camera(projection="orthographic", eye=(0, 0, 5), target=(0, 0, 0)).rays(2, 2)
         >>> o[0, 0], d[0, 0] + 0.0
         (array([-0.5,  0.5,  5. ]), array([ 0.,  0., -1.]))
+        >>> bool((Camera().rays(4, 6, rows=(2, 5))[1] == Camera().rays(4, 6)[1][2:5]).all())
+        True
         """
         _check_resolution(width, height)
+        start, stop = (0, height) if rows is None else rows
         x = np.arange(width) + 0.5
-        y = np.arange(height) + 0.5
+        y = np.arange(start, stop) + 0.5
         p_x, p_y = self.raster_to_ndc(x[None, :], y[:, None], width, height)
         p_x, p_y = np.broadcast_arrays(p_x, p_y)
         right, up, back = self.basis()

@@ -18,16 +18,25 @@ with ``reference.geometry.camera.downsample_box``.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
 from reference.errors import require
 from reference.geometry.camera import Camera, _check_resolution
 from reference.geometry.shapes import Hit, Plane, Sphere, intersect_plane, intersect_sphere
+from reference.progress import Progress
 from reference.registry import Registry
 
-__all__ = ["PRIMITIVES", "GBuffer", "empty_gbuffer", "gbuffer_from_hit", "render_gbuffer"]
+__all__ = [
+    "GBUFFER_BAND_SAMPLES",
+    "PRIMITIVES",
+    "RAY_CAST_PRIMITIVES",
+    "GBuffer",
+    "empty_gbuffer",
+    "gbuffer_from_hit",
+    "render_gbuffer",
+]
 
 
 @dataclass
@@ -69,6 +78,19 @@ class GBuffer:
         """``(H, W)``."""
         return self.depth.shape
 
+    def clear(self) -> None:
+        """Nothing visible (in place): NaN attributes, infinite depth, ids −1, no coverage."""
+        for name in ("position", "normal", "uv", "view"):
+            getattr(self, name).fill(np.nan)
+        self.depth.fill(np.inf)
+        self.material_id.fill(-1)
+        self.object_id.fill(-1)
+        self.mask.fill(False)
+
+    def rows(self, start: int, stop: int) -> GBuffer:
+        """Rows ``start:stop`` (views, no copies: writing to them writes to this G-buffer)."""
+        return GBuffer(**{f.name: getattr(self, f.name)[start:stop] for f in fields(GBuffer)})
+
     def composite(self, other: GBuffer) -> None:
         """Keep, per pixel, the nearer of ``self`` and ``other`` (in place): the z-buffer test."""
         nearer = other.depth < self.depth
@@ -87,16 +109,22 @@ def empty_gbuffer(height: int, width: int) -> GBuffer:
     >>> g.shape, bool(g.mask.any())
     ((2, 3), False)
     """
-    nan3 = np.full((height, width, 3), np.nan)
+    g = _allocated_gbuffer(height, width)
+    g.clear()
+    return g
+
+
+def _allocated_gbuffer(height: int, width: int) -> GBuffer:
+    """A G-buffer's arrays, not yet written (:meth:`GBuffer.clear` them)."""
     return GBuffer(
-        position=nan3.copy(),
-        normal=nan3.copy(),
-        uv=np.full((height, width, 2), np.nan),
-        depth=np.full((height, width), np.inf),
-        material_id=np.full((height, width), -1, dtype=np.int32),
-        object_id=np.full((height, width), -1, dtype=np.int32),
-        mask=np.zeros((height, width), dtype=bool),
-        view=nan3.copy(),
+        position=np.empty((height, width, 3)),
+        normal=np.empty((height, width, 3)),
+        uv=np.empty((height, width, 2)),
+        depth=np.empty((height, width)),
+        material_id=np.empty((height, width), dtype=np.int32),
+        object_id=np.empty((height, width), dtype=np.int32),
+        mask=np.empty((height, width), dtype=bool),
+        view=np.empty((height, width, 3)),
     )
 
 
@@ -146,16 +174,18 @@ def gbuffer_from_hit(
 
 
 def _gbuffer_sphere(
-    obj: Sphere, camera: Camera, width: int, height: int, object_id: int
+    obj: Sphere, camera: Camera, width: int, height: int, object_id: int, rows=None
 ) -> GBuffer:
-    origins, directions = camera.rays(width, height)
+    origins, directions = camera.rays(width, height, rows)
     return gbuffer_from_hit(
         intersect_sphere(obj, origins, directions), camera, directions, obj.material, object_id
     )
 
 
-def _gbuffer_plane(obj: Plane, camera: Camera, width: int, height: int, object_id: int) -> GBuffer:
-    origins, directions = camera.rays(width, height)
+def _gbuffer_plane(
+    obj: Plane, camera: Camera, width: int, height: int, object_id: int, rows=None
+) -> GBuffer:
+    origins, directions = camera.rays(width, height, rows)
     return gbuffer_from_hit(
         intersect_plane(obj, origins, directions), camera, directions, obj.material, object_id
     )
@@ -165,10 +195,23 @@ def _gbuffer_plane(obj: Plane, camera: Camera, width: int, height: int, object_i
 PRIMITIVES = Registry("primitive", Callable)
 PRIMITIVES.register(_gbuffer_sphere, "Sphere")
 PRIMITIVES.register(_gbuffer_plane, "Plane")
+#: The writers that cast one ray per sample and so can write a band of rows at a time:
+#: ``f(obj, camera, width, height, object_id, rows=(start, stop))``.
+RAY_CAST_PRIMITIVES = Registry("ray-cast primitive", Callable)
+RAY_CAST_PRIMITIVES.register(_gbuffer_sphere, "Sphere")
+RAY_CAST_PRIMITIVES.register(_gbuffer_plane, "Plane")
+#: Samples per band of a ray-cast G-buffer: the rays' temporaries stay within tens of MB and a
+#: long G-buffer reports its progress.
+GBUFFER_BAND_SAMPLES = 1 << 18
 
 
 def render_gbuffer(
-    objects: Sequence, camera: Camera, width: int, height: int, supersample: int = 1
+    objects: Sequence,
+    camera: Camera,
+    width: int,
+    height: int,
+    supersample: int = 1,
+    progress=None,
 ) -> GBuffer:
     """Resolve visibility for a list of primitives: the nearest surface per pixel (sub-sample).
 
@@ -184,6 +227,10 @@ def render_gbuffer(
     supersample : int
         Sub-samples per pixel per axis, in [1, 16]; the G-buffer is ``(supersample·height,
         supersample·width)``.
+    progress : file-like, optional
+        Where to report progress (:class:`reference.progress.Progress`, by rows of each
+        object); ray-cast primitives (:data:`RAY_CAST_PRIMITIVES`) are written in bands of
+        :data:`GBUFFER_BAND_SAMPLES` samples.
 
     Returns
     -------
@@ -202,8 +249,25 @@ def render_gbuffer(
     )
     _check_resolution(width, height)
     H, W = height * supersample, width * supersample
-    g = empty_gbuffer(H, W)
-    for object_id, obj in enumerate(objects):
-        writer: Callable = PRIMITIVES.lookup(type(obj).__name__)
-        g.composite(writer(obj, camera, W, H, object_id))
+    names = [type(obj).__name__ for obj in objects]
+    # rasterized meshes cover the whole image at once, ray-cast primitives a band at a time
+    whole = {
+        i: PRIMITIVES.lookup(name)(objects[i], camera, W, H, i)
+        for i, name in enumerate(names)
+        if name not in RAY_CAST_PRIMITIVES
+    }
+    g = _allocated_gbuffer(H, W)  # each band is cleared as it is reached
+    band = max(1, GBUFFER_BAND_SAMPLES // W)
+    with Progress("G-buffer", H, progress) as bar:
+        for start in range(0, H, band):
+            stop = min(start + band, H)
+            rows = g.rows(start, stop)
+            rows.clear()
+            for i, obj in enumerate(objects):  # in order: the nearer wins, the first on a tie
+                if i in whole:
+                    rows.composite(whole[i].rows(start, stop))
+                else:
+                    writer: Callable = RAY_CAST_PRIMITIVES.lookup(names[i])
+                    rows.composite(writer(obj, camera, W, H, i, (start, stop)))
+            bar.update(stop - start)
     return g

@@ -147,8 +147,8 @@ def check_shaders(scene: Scene) -> None:
                 )
 
 
-def scene_gbuffer(scene: Scene) -> GBuffer:
-    """The scene's G-buffer at ``supersample ×`` its resolution.
+def scene_gbuffer(scene: Scene, progress=None) -> GBuffer:
+    """The scene's G-buffer at ``supersample ×`` its resolution (progress to a stream, optional).
 
     Examples
     --------
@@ -159,14 +159,7 @@ def scene_gbuffer(scene: Scene) -> GBuffer:
     (6, 12)
     """
     r = scene.render
-    return render_gbuffer(scene.objects, scene.camera, r.width, r.height, r.supersample)
-
-
-def _gbuffer_rows(gbuffer: GBuffer, start: int, stop: int) -> GBuffer:
-    """Rows ``start:stop`` of a G-buffer (views, no copies)."""
-    return GBuffer(
-        **{f.name: getattr(gbuffer, f.name)[start:stop] for f in dataclasses.fields(GBuffer)}
-    )
+    return render_gbuffer(scene.objects, scene.camera, r.width, r.height, r.supersample, progress)
 
 
 def _adaptation_white(scene: Scene):
@@ -317,7 +310,7 @@ def shade_scene(
     covered = gbuffer.mask.sum(axis=1)
     with Progress("shading", int(covered.sum()), progress, unit="covered samples") as bar:
         for start in range(0, H, rows):
-            tile = _gbuffer_rows(gbuffer, start, min(start + rows, H))
+            tile = gbuffer.rows(start, min(start + rows, H))
             XYZ[start : start + rows] = shade_gbuffer(tile, scene.materials, scene.lights, ctx)
             bar.update(int(covered[start : start + rows].sum()))
     if records is not None:
@@ -438,7 +431,7 @@ def render_scene(
         scene = scene.with_render(width, height, supersample)
     r = scene.render
     check_shaders(scene)
-    gbuffer = _render_gbuffer(scene, gbuffer)
+    gbuffer = _render_gbuffer(scene, gbuffer, progress)
     t_gbuffer = time.perf_counter()
     records: dict = {}
     XYZ, spectral_image = _shade_and_resolve(scene, gbuffer, options, spectral, records, progress)
@@ -451,10 +444,10 @@ def render_scene(
     )
 
 
-def _render_gbuffer(scene: Scene, gbuffer: GBuffer | None) -> GBuffer:
+def _render_gbuffer(scene: Scene, gbuffer: GBuffer | None, progress=None) -> GBuffer:
     """Stage 1: the scene's supersampled G-buffer, or the one given once its shape is checked."""
     if gbuffer is None:
-        return scene_gbuffer(scene)
+        return scene_gbuffer(scene, progress)
     r = scene.render
     expected = (r.height * r.supersample, r.width * r.supersample)
     require(

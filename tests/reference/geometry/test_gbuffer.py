@@ -60,3 +60,43 @@ def test_registry_and_empty():
     g = empty_gbuffer(3, 2)
     assert g.shape == (3, 2)
     assert np.isinf(g.depth).all()
+
+
+def _whole_image_gbuffer(objects, camera, W, H):
+    """The reference: every primitive written over the whole image, composited in order."""
+    g = empty_gbuffer(H, W)
+    for i, obj in enumerate(objects):
+        g.composite(PRIMITIVES.lookup(type(obj).__name__)(obj, camera, W, H, i))
+    return g
+
+
+def test_bands_equal_the_whole_image_and_report_progress(monkeypatch):
+    import dataclasses
+    import functools
+    import io
+
+    import reference.geometry.gbuffer as gbuffer
+    from reference.geometry.mesh import uv_sphere_mesh
+    from reference.progress import Progress
+
+    camera = Camera(eye=(0, 0, 5), target=(0, 0, 0), fov_deg=40)
+    mesh = uv_sphere_mesh(12, 24)
+    objects = [
+        Plane((0, 0, -1), (0, 0, 1), (1, 0, 0), material=2),
+        Sphere((1.2, 0, 0.3), 0.5, material=1),
+        mesh,
+        Sphere((1.2, 0, 0.3), 0.5, material=3),  # the same surface: the first one keeps the pixel
+    ]
+    expected = _whole_image_gbuffer(objects, camera, 37, 29)
+    monkeypatch.setattr(gbuffer, "GBUFFER_BAND_SAMPLES", 37 * 3)  # bands of 3 rows, one of 2
+    stream = io.StringIO()
+    # a progress that estimates at once: the test's G-buffer takes milliseconds
+    monkeypatch.setattr(gbuffer, "Progress", functools.partial(Progress, estimate_after=0.0))
+    g = render_gbuffer(objects, camera, 37, 29, progress=stream)
+    for f in dataclasses.fields(g):
+        np.testing.assert_array_equal(getattr(g, f.name), getattr(expected, f.name), f.name)
+    assert (g.material_id == 3).sum() == 0
+    assert (g.material_id == 1).any()
+    lines = stream.getvalue().splitlines()
+    assert lines[0].startswith("G-buffer: 29 rows, about")
+    assert lines[-1].startswith("G-buffer: done")
