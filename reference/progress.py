@@ -14,10 +14,15 @@ nothing); the command line passes ``sys.stderr``.
 from __future__ import annotations
 
 import contextlib
+import threading
 import time
 from typing import TextIO
 
-__all__ = ["Progress", "StageTimer", "format_seconds"]
+__all__ = ["ANNOUNCE_AFTER", "Progress", "StageTimer", "format_seconds"]
+
+#: Seconds after which a command's stage is announced (``StageTimer(after=...)``): quick stages,
+#: and a refusal of bad input in its one line, print nothing else.
+ANNOUNCE_AFTER = 1.0
 
 
 def format_seconds(seconds: float) -> str:
@@ -101,6 +106,8 @@ class Progress:
         elapsed = time.perf_counter() - self._start
         if self.stream is not None and not self._estimated and elapsed >= self.estimate_after:
             self._estimated = True
+            if self.done >= self.total:  # nothing left to estimate: only the closing line
+                return
             expected = elapsed * self.total / max(self.done, 1)
             self._write(
                 f"{self.total} {self.unit}, about {format_seconds(expected)} in all "
@@ -130,21 +137,55 @@ class StageTimer:
     ...     pass
     >>> sorted(timer.seconds), out.getvalue().startswith("painting: shadows ...")
     (['shadows'], True)
+    >>> quiet = StageTimer(out, "painting", after=5.0)   # announced only after 5 s
+    >>> with quiet.stage("quick"):
+    ...     pass
+    >>> "quick" in out.getvalue(), sorted(quiet.seconds)
+    (False, ['quick'])
+    >>> with StageTimer(out, "painting", after=0.05).stage("slow"):
+    ...     time.sleep(0.5)
+    >>> out.getvalue().splitlines()[-1].startswith("painting: slow ... 0.5 s")
+    True
     """
 
-    def __init__(self, stream: TextIO | None = None, prefix: str = ""):
-        self.stream, self.prefix = stream, prefix
+    def __init__(self, stream: TextIO | None = None, prefix: str = "", after: float | None = None):
+        self.stream, self.prefix, self.after = stream, prefix, after
         self.seconds: dict[str, float] = {}
 
     @contextlib.contextmanager
     def stage(self, name: str):
-        """Time the block as stage ``name``."""
-        if self.stream is not None:
-            self.stream.write(f"{self.prefix}: {name} ...")
-            self.stream.flush()
+        """Time the block as stage ``name``.
+
+        With ``after`` (seconds), a stage is announced only once it has run that long (by a
+        timer thread; a kernel that holds the GIL delays it), so quick stages and the one-line
+        refusal of bad input stay alone on stderr.
+        """
+        shown, lock = [False], threading.Lock()
+
+        def announce():
+            with lock:
+                if shown[0] is None:  # the stage ended first
+                    return
+                shown[0] = True
+                self.stream.write(f"{self.prefix}: {name} ...")
+                self.stream.flush()
+
+        timer = None
+        if self.stream is not None and (self.after is None or self.after <= 0):
+            announce()
+        elif self.stream is not None:
+            timer = threading.Timer(self.after, announce)
+            timer.daemon = True
+            timer.start()
         start = time.perf_counter()
-        yield
-        self.seconds[name] = time.perf_counter() - start
-        if self.stream is not None:
-            self.stream.write(f" {format_seconds(self.seconds[name])}\n")
-            self.stream.flush()
+        try:
+            yield
+        finally:
+            self.seconds[name] = time.perf_counter() - start
+            if timer is not None:
+                timer.cancel()
+            with lock:
+                if shown[0]:
+                    self.stream.write(f" {format_seconds(self.seconds[name])}\n")
+                    self.stream.flush()
+                shown[0] = None

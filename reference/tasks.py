@@ -528,19 +528,25 @@ class Shared:
     build: Callable[[Hashable], object]
 
 
-def _shared_serial(function, tasks, shared: Shared, bar) -> list:
-    # each key built at its first task and dropped after its last one
+def _shared_serial(function, tasks, shared: Shared, bar, timer) -> list:
+    # each key built at its first task and dropped after its last one (a line each: it is long)
     keys = [shared.key(task) for task in tasks]
     last = {key: i for i, key in enumerate(keys)}
     built, results = {}, []
     for i, (task, key) in enumerate(zip(tasks, keys, strict=True)):
         if key not in built:
-            built[key] = shared.build(key)
+            with timer.stage(f"shared work {key!r}"):
+                built[key] = shared.build(key)
         results.append(function(task, built[key]))
         if last[key] == i:
             del built[key]
         bar.update(1)
     return results
+
+
+def _done(result, bar):
+    bar.update(1)
+    return result
 
 
 #: Workers :func:`usable_workers` kept, per client, for :func:`run_tasks` (gone with the client).
@@ -602,7 +608,7 @@ def run_tasks(
     >>> run_tasks(abs, [-1, 2, -3], scheduler="serial", progress=False)
     [1, 2, 3]
     """
-    from tqdm import tqdm
+    from reference.progress import ANNOUNCE_AFTER, Progress, StageTimer
 
     tasks = list(tasks)
     show = progress and not os.environ.get("CI") and sys.stderr.isatty()
@@ -610,10 +616,13 @@ def run_tasks(
     if grain is not None:
         require_positive_int(grain, "grain")
     if client is None and address == SERIAL:
-        if shared is not None:
-            with tqdm(total=len(tasks), desc=desc, disable=not show, leave=False) as bar:
-                return _shared_serial(function, tasks, shared, bar)
-        return [function(task) for task in tqdm(tasks, desc=desc, disable=not show, leave=False)]
+        # a bar on a terminal; else, for work of more than a couple of seconds, lines
+        stream = sys.stderr if progress and not os.environ.get("CI") else None
+        with Progress(desc, len(tasks), stream, unit="tasks") as bar:
+            if shared is not None:
+                timer = StageTimer(stream, desc, ANNOUNCE_AFTER)
+                return _shared_serial(function, tasks, shared, bar, timer)
+            return [_done(function(task), bar) for task in tasks]
     with contextlib.ExitStack() as stack:
         if client is None:
             client = stack.enter_context(dask_client(address or LOCAL))

@@ -61,10 +61,13 @@ def read_environment(path, bands: str | None = None) -> tuple[np.ndarray, list[s
     return image, names
 
 
-def project_file(path, order: int, out, window=None, bands=None, backend: str = "ducc0") -> dict:
+def project_file(
+    path, order: int, out, window=None, bands=None, backend: str = "ducc0", progress=None
+) -> dict:
     """Project a map file onto SH and save ``coeffs (C, (L+1)²)`` and metadata as ``.npz``.
 
-    §5.3, Herbert et al.; Eq. (4), Ramamoorthi & Hanrahan 2001.
+    §5.3, Herbert et al.; Eq. (4), Ramamoorthi & Hanrahan 2001. ``progress``: a stream for a line
+    per stage with its time (reading, projecting, writing), optional.
 
     Examples
     --------
@@ -76,8 +79,10 @@ def project_file(path, order: int, out, window=None, bands=None, backend: str = 
     import io
 
     from reference.files import write_bytes_atomic
+    from reference.progress import ANNOUNCE_AFTER, StageTimer
     from shrm.transform import project_latlong
 
+    timer = StageTimer(progress, f"sh project {Path(path).name}", ANNOUNCE_AFTER)
     if Path(path).suffix.lower() == ".zarr" and bands is None:
         # a chunked store is projected block by block, never read whole (shrm.streamed)
         from reference.images.zarr_store import open_zarr_image
@@ -85,34 +90,46 @@ def project_file(path, order: int, out, window=None, bands=None, backend: str = 
         from shrm.windows import apply_window
 
         names = open_zarr_image(path).channels
-        # a progress bar of rows on a terminal (none under CI or in a pipe)
-        coeffs = project_zarr(path, order, backend, progress=None)
-        if window is not None and window != "none":
-            coeffs = apply_window(coeffs, window)
+        with timer.stage(f"projecting {len(names)} channels to order {order} ({backend})"):
+            # a progress bar of rows on a terminal (none under CI or in a pipe)
+            coeffs = project_zarr(path, order, backend, progress=None)
+            if window is not None and window != "none":
+                coeffs = apply_window(coeffs, window)
     else:
-        image, names = read_environment(path, bands)
-        coeffs = project_latlong(image, order, window=window, backend=backend, where=str(path))
-    buffer = io.BytesIO()
-    np.savez(
-        buffer,
-        coeffs=coeffs,
-        order=order,
-        channels=np.array(names),
-        window=str(window or "none"),
-        source=str(path),
-        layout="real SH, Condon-Shortley phase, index l*l+l+m (docs/conventions.md)",
-    )
-    write_bytes_atomic(out, buffer.getvalue())
+        with timer.stage("reading"):
+            image, names = read_environment(path, bands)
+        with timer.stage(f"projecting {len(names)} channels to order {order} ({backend})"):
+            coeffs = project_latlong(image, order, window=window, backend=backend, where=str(path))
+    with timer.stage("writing"):
+        buffer = io.BytesIO()
+        np.savez(
+            buffer,
+            coeffs=coeffs,
+            order=order,
+            channels=np.array(names),
+            window=str(window or "none"),
+            source=str(path),
+            layout="real SH, Condon-Shortley phase, index l*l+l+m (docs/conventions.md)",
+        )
+        write_bytes_atomic(out, buffer.getvalue())
     return {"order": order, "channels": len(names), "out": str(out)}
 
 
 def prefilter_file(
-    path, kernel: str, out, tol: float = 1e-2, output: str = "cube", size: int = 64, bands=None
+    path,
+    kernel: str,
+    out,
+    tol: float = 1e-2,
+    output: str = "cube",
+    size: int = 64,
+    bands=None,
+    progress=None,
 ) -> dict:
     """Prefilter a map file and write the result as EXR (cube: faces stacked vertically).
 
     §5.4, Herbert et al. The cube layout is ``(6·S, S)``: faces +x, −x, +y, −y, +z, −z from top to
-    bottom, each in the orientation of ``reference.geometry.cubemap``.
+    bottom, each in the orientation of ``reference.geometry.cubemap``. ``progress``: a stream for
+    a line per stage with its time (reading, prefiltering, writing), optional.
 
     Examples
     --------
@@ -121,6 +138,7 @@ def prefilter_file(
     ...
     reference.errors.SpecrefError: /nonexistent.hdr: file not found
     """
+    from reference.progress import ANNOUNCE_AFTER, StageTimer
     from shrm.prefilter import prefilter_environment
 
     require(
@@ -128,12 +146,17 @@ def prefilter_file(
         f"--out: the prefiltered map is linear HDR, written as OpenEXR: the name must end in "
         f".exr, got {str(out)!r}",
     )
-    image, names = read_environment(path, bands)
-    result = prefilter_environment(
-        image, kernel, tol=tol, output=output, size=size, where=str(path)
-    )
+    timer = StageTimer(progress, f"sh prefilter {Path(path).name}", ANNOUNCE_AFTER)
+    with timer.stage("reading"):
+        image, names = read_environment(path, bands)
+    shape = f"6 faces of {size}²" if output == "cube" else "a lat-long map"
+    with timer.stage(f"prefiltering {len(names)} channels with {kernel} to {shape}"):
+        result = prefilter_environment(
+            image, kernel, tol=tol, output=output, size=size, where=str(path)
+        )
     values = result.values
     if output == "cube":
         values = values.reshape(6 * size, size, -1)
-    write_exr(out, values, channels=names if len(names) != 3 else None)
+    with timer.stage("writing"):
+        write_exr(out, values, channels=names if len(names) != 3 else None)
     return {"order": result.order, "tail": result.tail, "kernel": result.kernel, "out": str(out)}

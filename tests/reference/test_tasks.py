@@ -12,7 +12,7 @@ import time
 import pytest
 
 from reference.errors import SpecrefError
-from reference.tasks import dask_client, run_tasks
+from reference.tasks import Shared, dask_client, run_tasks
 
 
 def seeded_sum(task):
@@ -468,3 +468,22 @@ def test_a_bad_local_worker_count_is_one_line(tmp_path, capsys, count):
     assert err.count("\n") == 1
     assert f"--scheduler: local:{count}: allowed: local:N, N workers from 1 to 256" in err
     assert out.read_text() == "earlier"
+
+
+def test_serial_tasks_say_what_they_do(capsys, monkeypatch):
+    """Each shared build has a line (it is the long part); a run under CI or silenced has none."""
+    monkeypatch.delenv("CI", raising=False)
+    monkeypatch.setattr("reference.progress.ANNOUNCE_AFTER", 0.0)  # every build, however quick
+    shared = Shared(key=lambda task: task % 2, build=lambda key: 10 * key)
+    found = run_tasks(lambda task, built: task + built, [1, 2, 3], "serial", shared=shared,
+                      desc="study")  # fmt: skip
+    assert found == [11, 2, 13]
+    lines = capsys.readouterr().err.splitlines()
+    assert [line.split(" ...")[0] for line in lines] == [
+        "study: shared work 1",
+        "study: shared work 0",
+    ]
+    run_tasks(lambda task, built: task, [1], "serial", shared=shared, progress=False)
+    monkeypatch.setenv("CI", "true")
+    run_tasks(lambda task, built: task, [1], "serial", shared=shared)
+    assert capsys.readouterr().err == ""

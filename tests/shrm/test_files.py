@@ -82,3 +82,24 @@ def test_read_environment_bad_input(tmp_path, image, names, bands, match):
     write_exr(tmp_path / "map.exr", image, channels=names)
     with pytest.raises(SpecrefError, match=match):
         read_environment(tmp_path / "map.exr", bands)
+
+
+def test_project_and_prefilter_say_what_they_do(tmp_path, monkeypatch):
+    import io
+
+    monkeypatch.setattr("reference.progress.ANNOUNCE_AFTER", 0.0)  # every stage, however quick
+
+    write_exr(tmp_path / "sky.exr", np.ones((8, 16, 3)))
+    stream = io.StringIO()
+    project_file(tmp_path / "sky.exr", 2, tmp_path / "sky.npz", progress=stream)
+    prefilter_file(tmp_path / "sky.exr", "lambert", tmp_path / "cube.exr", size=4, progress=stream)
+    lines = stream.getvalue().splitlines()
+    assert [line.split(": ", 1)[1].split(" ...")[0] for line in lines] == [
+        "reading",
+        "projecting 3 channels to order 2 (ducc0)",
+        "writing",
+        "reading",
+        "prefiltering 3 channels with lambert to 6 faces of 4²",
+        "writing",
+    ]
+    assert lines[0].startswith("sh project sky.exr: reading ... ")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 from validation.cli.parser import Parser, input_file, output_file, registry_option
@@ -9,9 +10,13 @@ from validation.cli.parser import Parser, input_file, output_file, registry_opti
 
 def _cmd_brdf_tabulate(args) -> int:
     from reference.materials.table import tabulate_registered_brdf, write_brdf_table
+    from reference.progress import ANNOUNCE_AFTER, StageTimer
 
-    table = tabulate_registered_brdf(args.model, args.theta_step, args.phi_step)
-    write_brdf_table(args.out, table, {"source": f"specref brdf tabulate {args.model}"})
+    timer = StageTimer(sys.stderr, f"brdf tabulate {args.model}", ANNOUNCE_AFTER)
+    with timer.stage(f"tabulating at {args.theta_step:g}° × {args.phi_step:g}°"):
+        table = tabulate_registered_brdf(args.model, args.theta_step, args.phi_step)
+    with timer.stage(f"writing {table.values.size} values"):
+        write_brdf_table(args.out, table, {"source": f"specref brdf tabulate {args.model}"})
     print(f"wrote {args.out}: {table.values.shape[:3]} angles x {table.n_bands} bands")
     return 0
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from functools import partial
 
 from reference.tasks import SERIAL, add_scheduler_option
@@ -57,6 +58,7 @@ def _cmd_phong(args) -> int:
             args.tolerance,
             args.resolution,
             args.repeats,
+            progress=sys.stderr,
         )
         print(phong_table1.format_rows(result["rows"]))
         if result["tolerance"] is not None:

@@ -2,13 +2,17 @@
 
 from __future__ import annotations
 
+import sys
+
 from validation.cli.parser import Parser, input_file, output_file, registry_option
 
 
 def _cmd_sh_project(args) -> int:
     from shrm.files import project_file
 
-    info = project_file(args.env, args.order, args.out, args.window, args.bands, args.backend)
+    info = project_file(
+        args.env, args.order, args.out, args.window, args.bands, args.backend, sys.stderr
+    )
     print(f"wrote {info['out']}: {info['channels']} channels to order {info['order']}")
     return 0
 
@@ -23,7 +27,7 @@ def _cmd_sh_prefilter(args) -> int:
     from shrm.files import prefilter_file
 
     info = prefilter_file(
-        args.env, args.kernel, args.out, args.tol, args.format, args.size, args.bands
+        args.env, args.kernel, args.out, args.tol, args.format, args.size, args.bands, sys.stderr
     )
     print(
         f"wrote {info['out']}: {info['kernel']} at order {info['order']} (tail {info['tail']:.2g})"

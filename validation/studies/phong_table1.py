@@ -18,6 +18,7 @@ from phong_table.model import SpectralPhong
 from phong_table.scenes import SCENES, VIEWS
 from phong_table.table import check_interpolation
 from reference.errors import require_positive_int
+from reference.progress import ANNOUNCE_AFTER, StageTimer
 from reference.tasks import SERIAL, run_tasks
 from validation.report import Check
 from validation.studies.phong import (
@@ -77,6 +78,7 @@ def material_rows(
     repeats: int = 9,
     name: str | None = None,
     compiled: bool = True,
+    progress=None,
 ) -> tuple[list[dict], ViewState]:
     """Table 1 rows of one material in one view: the exact baseline, then each table variant.
 
@@ -94,6 +96,8 @@ def material_rows(
         The ``scene`` key of the records (default the material's name).
     compiled : bool
         numba kernels (timings) or NumPy references.
+    progress : file-like, optional
+        A line per stage (the exact render, each table) with its time.
 
     Returns
     -------
@@ -109,15 +113,18 @@ def material_rows(
     >>> [r["placement"] for r in rows], rows[1]["overshoot"]
     (['exact', 'error'], 0.0)
     """
-    state = view_state(model, view, resolution, compiled)
     name = name or model.name
-    exact_s = time_shading(state, None, repeats=repeats)
-    shared_s = shared_frame_time(state, resolution, max(1, min(repeats, 3)))
+    timer = StageTimer(progress, f"phong {name} {view}", ANNOUNCE_AFTER)
+    with timer.stage(f"exact render at {resolution}², timed"):
+        state = view_state(model, view, resolution, compiled)
+        exact_s = time_shading(state, None, repeats=repeats)
+        shared_s = shared_frame_time(state, resolution, max(1, min(repeats, 3)))
     rows = [_exact_row(state, name, exact_s, shared_s)]
     for placement, interpolation, entries, segments in variants:
-        row = table_error_row(state, placement, interpolation, entries, segments)
-        row = {"scene": name, "view": view, **row}
-        rows.append(time_row(state, row, exact_s, shared_s, repeats))
+        with timer.stage(f"{placement} table of {entries} entries, {interpolation}"):
+            row = table_error_row(state, placement, interpolation, entries, segments)
+            row = {"scene": name, "view": view, **row}
+            rows.append(time_row(state, row, exact_s, shared_s, repeats))
     return rows, state
 
 
@@ -566,8 +573,11 @@ def run_material(
     tolerance: float | None = None,
     resolution: int = 512,
     repeats: int = 9,
+    progress=None,
 ) -> dict:
     """``specref phong --material FILE.toml``: one table of a material against the exact render.
+
+    ``progress``: a stream for a line per stage with its time (:func:`material_rows`), optional.
 
     Returns
     -------
@@ -597,8 +607,9 @@ def run_material(
     check_entries(entries, segments, f"{placement} table")
     check_interpolation(interpolation, entries)
     rows, state = material_rows(
-        model, view, [(placement, interpolation, entries, segments)], resolution, repeats
-    )
+        model, view, [(placement, interpolation, entries, segments)], resolution, repeats,
+        progress=progress,
+    )  # fmt: skip
     result = {"material": str(path), "resolution": resolution, "rows": rows, "tolerance": None}
     if tolerance is not None:
         result["tolerance"] = tolerance_search(state, tolerance, interpolation)
