@@ -19,14 +19,22 @@ from __future__ import annotations
 import numpy as np
 
 from phong_table import _kernels
+from phong_table.interpolation import INTERPOLATION_METHODS
 from phong_table.model import SpectralPhong
+from phong_table.placement import MAX_ENTRIES, PLACEMENT_METHODS, check_entries
 from phong_table.render import ShadingBuffer, compiled_shader
 from phong_table.table import build_table, check_interpolation
 from reference.errors import require
 from reference.registry import Method
+from reference.scene.options import (
+    check_choice,
+    check_int_range,
+    check_table,
+    register_render_option,
+)
 from reference.scene.shading import PHONG_POINT_METHODS
 
-__all__ = ["OPTION_KEYS", "shade_phong_point_table"]
+__all__ = ["OPTION_KEYS", "check_phong_options", "shade_phong_point_table"]
 
 #: The keys of ``options["phong"]`` and their defaults.
 OPTION_KEYS = {
@@ -102,3 +110,32 @@ def shade_phong_point_table(surface, material, light, ctx) -> np.ndarray:
 PHONG_POINT_METHODS.register(
     Method("table", shade_phong_point_table, None, "Eq. (11), Wang et al.")
 )
+
+
+def check_phong_options(value) -> dict:
+    """``[render.options.phong]`` checked where the scene is loaded (keys of :data:`OPTION_KEYS`).
+
+    Examples
+    --------
+    >>> check_phong_options({"method": "table", "entries": 64})
+    {'method': 'table', 'entries': 64}
+    >>> check_phong_options({"method": "table", "placement": "errror"})
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: placement: unknown value 'errror'; allowed: error, importance,
+    uniform
+    """
+    options = check_table(value, {
+        "method": lambda v: check_choice(v, PHONG_POINT_METHODS),
+        "placement": lambda v: check_choice(v, PLACEMENT_METHODS),
+        "interpolation": lambda v: check_choice(v, INTERPOLATION_METHODS),
+        "entries": lambda v: check_entries(v, None, "table")[0],
+        "segments": lambda v: check_int_range(v, 1, MAX_ENTRIES),
+    })  # fmt: skip
+    settings = {**OPTION_KEYS, **options}
+    check_entries(settings["entries"], settings["segments"], "table")
+    check_interpolation(settings["interpolation"], settings["entries"])
+    return options
+
+
+register_render_option("phong", check_phong_options, "Phong materials through a table")

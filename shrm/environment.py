@@ -48,10 +48,11 @@ from reference.materials.types import LambertMaterial, PhongMaterial
 from reference.registry import Method
 from reference.scene.lights import EnvironmentLight
 from reference.scene.metadata import DEFAULT_ACCURACY, check_accuracy
+from reference.scene.options import check_fraction, check_int_range, register_render_option
 from reference.scene.shading import SHADERS, Surface
 from shrm.accuracy import accuracy_order, bright_texels, sparse_convolution
 from shrm.lobes import adaptive_order, kernel_phong, parse_kernel
-from shrm.prefilter import prefilter_bruteforce, prefilter_coefficients
+from shrm.prefilter import MAX_PREFILTER_FACE, prefilter_bruteforce, prefilter_coefficients
 from shrm.sh import sh_evaluate
 from shrm.transform import project_latlong
 
@@ -347,4 +348,28 @@ SHADERS.register(
         None,
         "Eq. (2), Wang et al.",
     )
+)
+
+
+def _check_environment_accuracy(value) -> float:
+    """``[render.options] environment_accuracy``: a number, as ``--accuracy`` takes it."""
+    number = isinstance(value, int | float) and not isinstance(value, bool)
+    require(
+        number and bool(np.isfinite(value)) and 0 < value <= 0.25,
+        f"must be a relative error in (0, 0.25], got {value!r}",
+    )
+    return float(value)
+
+
+register_render_option(
+    "environment_accuracy", _check_environment_accuracy,
+    f"environment lights' tolerance on Y (default {DEFAULT_ACCURACY}; specref render --accuracy)",
+)  # fmt: skip
+register_render_option(
+    "environment_tol", check_fraction, "environment lights' kernel-only tolerance (erratum E76)"
+)
+register_render_option(
+    "environment_size",
+    lambda value: check_int_range(value, 4, MAX_PREFILTER_FACE),
+    "environment lights' prefiltered cube face, texels (default min(256, max(64, 2L)))",
 )

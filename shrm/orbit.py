@@ -25,6 +25,7 @@ from reference.errors import require
 from reference.materials.types import MATERIAL_TYPES, MaterialType
 from reference.registry import Method
 from reference.scene.lights import EnvironmentLight, PointLight
+from reference.scene.options import check_fraction, register_render_option
 from reference.scene.shading import SHADERS, Surface
 from reference.scene.sphere_light import sphere_light_shader
 
@@ -705,3 +706,10 @@ def render_orbit(session, frames: int, out_dir=None, progress: bool = True):
             lines.append(f"{f}," + ",".join(cells) + f",{sum(times.values()):.6f}")
         write_text_atomic(Path(out_dir) / "timings.csv", "\n".join(lines) + "\n")
     return rows
+
+
+register_render_option(
+    "shrm_tol",
+    check_fraction,
+    f"SHRMs' per-pixel tolerance, of the peak (default {DEFAULT_SHRM_TOL})",
+)

@@ -418,8 +418,24 @@ def _parse_render(reader: SceneReader, data: dict, lights: tuple) -> RenderSetti
             f"{background!r:.60}",
         )
     options = dict(reader.table(table.get("options", {}), f"{key}.options"))
+    _check_options(reader, options, f"{key}.options")
     _parse_upsampling(reader, options, f"{key}.options")
     return RenderSettings(width, height, supersample, background, options)
+
+
+def _check_options(reader: SceneReader, options: dict, key: str) -> None:
+    """Each key registered (``reference.scene.options.RENDER_OPTIONS``) and its value checked."""
+    from reference.scene.options import RENDER_OPTIONS
+
+    for name in list(options):
+        if name not in RENDER_OPTIONS:
+            reader.fail(
+                key,
+                f"unknown key {name!r}; allowed: {format_allowed(RENDER_OPTIONS)} (keys of "
+                f"packages not imported are unknown: specref render imports them all)",
+            )
+        with reader.context(f"{key}.{name}"):
+            options[name] = RENDER_OPTIONS.lookup(name).check(options[name])
 
 
 def _parse_upsampling(reader: SceneReader, options: dict, key: str) -> None:

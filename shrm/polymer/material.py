@@ -44,6 +44,7 @@ from reference.errors import SpecrefError, require, require_nonnegative
 from reference.materials.types import MATERIAL_TYPES, MaterialType
 from reference.registry import Method, Registry
 from reference.scene.lights import EnvironmentLight
+from reference.scene.options import check_fraction, register_render_option
 from reference.scene.shading import SHADERS, Surface
 from shrm.orbit import IsotropicBRDFMaterial, _parse_isotropic_brdf
 from shrm.polymer.characterization import (
@@ -884,4 +885,10 @@ MATERIAL_TYPES.register(
         "Eq. (1), Herbert et al. (the hybrid polymer model)",
         parse=_parse_polymer,
     )
+)
+
+register_render_option(
+    "polymer_oracle_tol",
+    check_fraction,
+    "the polymer oracle's Monte Carlo tolerance (default 0.005)",
 )
