@@ -1,6 +1,7 @@
 """numba twins of the polymer family: the oracle's rough specular sum, the shading of the hybrid.
 
-Twins of ``shrm.polymer.oracle.rough_specular_samples`` and ``rough_reflection_albedo``, of
+Twins of ``shrm.polymer.oracle.rough_specular_samples``, ``rough_specular_samples_mis`` and
+``rough_reflection_albedo``, of
 ``shrm.polymer.material.polymer_shade_parts``, of its baseline
 ``shrm.polymer.material.lambert_phong_shade_parts`` and of the layered model's re-shade
 ``shrm.polymer.layered.layered_reshade_XYZ`` and of its filtered importance sampling
@@ -23,6 +24,7 @@ __all__ = [
     "layered_reshade_kernel",
     "polymer_shade_parts_kernel",
     "rough_reflection_albedo_kernel",
+    "rough_specular_mis_kernel",
     "rough_specular_samples_kernel",
 ]
 
@@ -141,6 +143,89 @@ def rough_specular_samples_kernel(N, V, radiance, alpha, n, u, total, total_sq):
             for band in range(nb):
                 total[p, band] += x[band]
                 total_sq[p, band] += x[band] * x[band]
+
+
+@njit
+def _vndf_pdf_local(ox, oy, oz, ix, iy, iz, alpha):
+    """G_1(o) D(h) / (4 cos θ_o) of a reflected local direction, and o·h (``_vndf_pdf``)."""
+    hx, hy, hz = ox + ix, oy + iy, oz + iz
+    norm = max(math.sqrt(hx * hx + hy * hy + hz * hz), 1e-300)
+    hx, hy, hz = hx / norm, hy / norm, hz / norm
+    oh = ox * hx + oy * hy + oz * hz
+    if oh <= 0.0 or hz <= 0.0:
+        return 0.0, oh
+    a2 = alpha * alpha
+    # D of Eq. (33), Walter et al. 2007
+    t = hz * hz * (a2 - 1.0) + 1.0
+    D = a2 / (math.pi * t * t)
+    c2 = max(oz * oz, 1e-300)
+    G1_o = 2.0 / (1.0 + math.sqrt(1.0 + a2 * (1.0 - c2) / c2))
+    return G1_o * D / (4.0 * oz), oh
+
+
+@njit
+def _texel_of_direction(H, W, dx, dy, dz):
+    """The row-major texel whose solid angle holds a unit direction (``_texel_of``)."""
+    u = math.atan2(dx, -dz) / (2.0 * math.pi)
+    if u < 0.0:
+        u += 1.0
+    if u >= 1.0:
+        u = 0.0
+    v = math.acos(min(max(dy, -1.0), 1.0)) / math.pi
+    return min(math.floor(v * H), H - 1) * W + min(math.floor(u * W), W - 1)
+
+
+@njit
+def _mis_add(radiance, ox, oy, oz, ix, iy, iz, d, alpha, n, p_e, x, pair):
+    """pair[b] += F(o·h) G_1(i) L(i) p_v / (p_v + p_e) for one direction (local i, world d)."""
+    p_v, oh = _vndf_pdf_local(ox, oy, oz, ix, iy, iz, alpha)
+    if p_v <= 0.0 or iz <= 0.0:
+        return
+    c2 = max(iz * iz, 1e-300)
+    G = 2.0 / (1.0 + math.sqrt(1.0 + alpha * alpha * (1.0 - c2) / c2))
+    # the balance heuristic's weight on the estimator F(o·h) G_1(i)
+    weight = _fresnel_dielectric(oh, n) * G * p_v / max(p_v + p_e, 1e-300)
+    _latlong_bilinear_add(radiance, d[0], d[1], d[2], weight, x)
+    for b in range(radiance.shape[2]):
+        pair[b] += x[b]
+
+
+@njit
+def rough_specular_mis_kernel(N, V, radiance, alpha, n, u, cdf, pdf, total, total_sq):
+    """Twin of ``shrm.polymer.oracle.rough_specular_samples_mis``: visible normals and the map."""
+    H, W, nb = radiance.shape[0], radiance.shape[1], radiance.shape[2]
+    x, pair, d = np.empty(nb), np.empty(nb), np.empty(3)
+    for p in range(N.shape[0]):
+        nx, ny, nz = N[p, 0], N[p, 1], N[p, 2]
+        tx, ty, tz, bx, by, bz, ox, oy, oz = _frame_and_view(N, V, p)
+        view = _stretched_view(ox, oy, oz, alpha)
+        for m in range(u.shape[1]):
+            pair[:] = 0.0
+            # a visible normal, reflected
+            _, ix, iy, iz, _ = _reflected_sample(ox, oy, oz, alpha, view, u[p, m, 0], u[p, m, 1])
+            d[0] = ix * tx + iy * bx + iz * nx
+            d[1] = ix * ty + iy * by + iz * ny
+            d[2] = ix * tz + iy * bz + iz * nz
+            p_e = pdf[_texel_of_direction(H, W, d[0], d[1], d[2])]
+            _mis_add(radiance, ox, oy, oz, ix, iy, iz, d, alpha, n, p_e, x, pair)
+            # a direction of the map: a texel by its share, then uniformly in its solid angle
+            u1, u2 = u[p, m, 2], u[p, m, 3]
+            k = min(np.searchsorted(cdf, u1, side="right"), H * W - 1)
+            low = cdf[k - 1] if k > 0 else 0.0
+            frac = min(max((u1 - low) / max(cdf[k] - low, 1e-300), 0.0), 1.0)
+            row, col = k // W, k % W
+            cos0, cos1 = math.cos(math.pi * row / H), math.cos(math.pi * (row + 1) / H)
+            cos_t = cos0 + u2 * (cos1 - cos0)
+            phi = 2.0 * math.pi * (col + frac) / W
+            sin_t = math.sqrt(max(1.0 - cos_t * cos_t, 0.0))
+            d[0], d[1], d[2] = sin_t * math.sin(phi), cos_t, -sin_t * math.cos(phi)
+            ix = d[0] * tx + d[1] * ty + d[2] * tz
+            iy = d[0] * bx + d[1] * by + d[2] * bz
+            iz = d[0] * nx + d[1] * ny + d[2] * nz
+            _mis_add(radiance, ox, oy, oz, ix, iy, iz, d, alpha, n, pdf[k], x, pair)
+            for b in range(nb):
+                total[p, b] += pair[b]
+                total_sq[p, b] += pair[b] * pair[b]
 
 
 @njit

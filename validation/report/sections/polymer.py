@@ -470,6 +470,18 @@ def _held_out_text(study: dict) -> str:
         f"{study['settings']['rows']} rows, spectralized), a {study['settings']['size']}² sphere. "
         f"Targets for a real-time polymer model: worst object mean ΔE00 <= {TARGETS['mean']:g} "
         f"and rim mean <= {TARGETS['rim']:g} per map. {found[0].upper()}{found[1:]}."
+        + _noise_text(study)
+    )
+
+
+def _noise_text(study: dict) -> str:
+    """The judge's own noise: the oracle against itself at another seed, worst map."""
+    if not study.get("noise"):
+        return ""
+    name, noise = max(study["noise"].items(), key=lambda item: item[1]["mean"])
+    return (
+        f" The oracle against itself at another seed (its own noise, erratum E117) differs by at "
+        f"most {noise['mean']:.2f} object mean and {noise['rim']:.2f} rim mean, under {name}."
     )
 
 

@@ -41,6 +41,7 @@ __all__ = [
     "HELD_OUT",
     "MAPS",
     "MODELS",
+    "NOISE_LIMIT",
     "TARGETS",
     "held_out_checks",
     "held_out_chips",
@@ -61,6 +62,9 @@ MAPS = (
 #: worst chip's object mean and rim mean (cos θ_v < 0.3) per map. Herbert's hybrid is measured
 #: against them; a model beyond it is to meet them (docs/herbert-polymer.md).
 TARGETS = {"mean": 1.0, "rim": 2.0}
+#: The judge's own noise that the study allows, ΔE00 between two seeds of the oracle (object mean,
+#: worst chip per map): a quarter of the models' target, so a miss is the model's (erratum E117).
+NOISE_LIMIT = TARGETS["mean"] / 4
 #: The real-time models measured, by key: their names in the checks and tables.
 MODELS = {
     "hybrid": "Herbert's hybrid",
@@ -191,13 +195,17 @@ def held_out_study(name: str) -> dict:
         for the layered model ``swap_mean`` and ``swap_rim``: the same with the oracle's specular
         term in place of the model's (what remains is the body and transmission's error);
         ``worst``: per model (a key of :data:`MODELS`) and map, the largest object and rim
-        means over its chips.
+        means over its chips; ``noise``: per map, the largest object and rim means between the
+        oracle and the oracle at another seed (``noise_mean``, ``noise_rim`` in every row): the
+        judge's own uncertainty.
 
     Examples
     --------
     >>> study = held_out_study("tiny")
     >>> sorted(study["worst"]) == sorted(MODELS), sorted(study["worst"]["layered"]) == sorted(MAPS)
     (True, True)
+    >>> sorted(study["noise"]) == sorted(MAPS)
+    True
     """
     s = HELD_OUT[name]
     chips = held_out_chips(s.chips)
@@ -211,6 +219,9 @@ def held_out_study(name: str) -> dict:
         colour = Colour(env)
         for chip in chips:
             oracle = chip_oracle(N, V, env, chip, oracle_settings)
+            # the judge's own noise: the oracle again with another seed (erratum E117)
+            again = chip_oracle(N, V, env, chip, oracle_settings, seed=1)
+            noise = object_delta_E_stats(colour.delta_E(again.result, oracle.result), N[:, 2])
             layered = _layered(N, V, env, chip)
             # where the layered model's error lies: its result with the oracle's specular term
             swapped = layered["result"] - layered["specular"] + oracle.specular
@@ -225,9 +236,10 @@ def held_out_study(name: str) -> dict:
                 for key, radiance in shaded.items()
             }
             swap = {"swap_mean": stats["swap"]["mean"], "swap_rim": stats["swap"]["rim"]}
+            judge = {"noise_mean": noise["mean"], "noise_rim": noise["rim"]}
             for key in MODELS:
                 extra = swap if key == "layered" else {}
-                rows.append({"model": key, "map": map_name, **chip, **stats[key], **extra})
+                rows.append({"model": key, "map": map_name, **chip, **stats[key], **extra, **judge})
     worst = {
         key: {
             m: {
@@ -239,10 +251,15 @@ def held_out_study(name: str) -> dict:
         for key in MODELS
     }
     settings = {"name": name, "chips": s.chips, "size": s.size, "rows": s.env_height}
+    noise = {
+        m: {part: max(r[f"noise_{part}"] for r in rows if r["map"] == m) for part in TARGETS}
+        for m in MAPS
+    }
     return {
         "settings": settings | {"tol": s.tol, "seed": HELD_OUT_SEED},
         "rows": rows,
         "worst": worst,
+        "noise": noise,
     }
 
 
@@ -258,6 +275,17 @@ def held_out_checks(study: dict) -> list:
     """
     found = []
     chips = study["settings"]["chips"]
+    for name, noise in study.get("noise", {}).items():
+        found.append(
+            Check(
+                f"the layered oracle's own noise, {name}: worst object mean ΔE00 between two "
+                f"seeds over {chips} held-out chips (a quarter of the models' target)",
+                f"<= {NOISE_LIMIT:g}",
+                noise["mean"],
+                noise["mean"] <= NOISE_LIMIT,
+                "held out",
+            )
+        )
     for key, per_map in study["worst"].items():
         for name, worst in per_map.items():
             for part, label in (("mean", "object"), ("rim", "rim")):
@@ -287,9 +315,9 @@ def held_out_table(study: dict) -> Table:
     ['the layered model', 'a.hdr', 1.0, 0.5, 0.8]
     """
     keys = ("thickness_mm", "tio2_pct", "gloss", "index", "tint", "mean", "p95", "max", "centre",
-            "rim", "swap_mean", "swap_rim")  # fmt: skip
+            "rim", "swap_mean", "swap_rim", "noise_mean")  # fmt: skip
     head = ["model", "map", "thickness mm", "TiO2 %", "gloss", "index", "tint"]
-    swapped = ["mean, oracle's specular", "rim, oracle's specular"]
+    swapped = ["mean, oracle's specular", "rim, oracle's specular", "oracle's own noise, mean"]
     return Table(
         [*head, "mean", "p95", "max", "centre", "rim", *swapped],
         [[MODELS[r["model"]], r["map"], *(r.get(k, "") for k in keys)] for r in study["rows"]],
@@ -299,8 +327,9 @@ def held_out_table(study: dict) -> Table:
         "map. A tint is a spot colour: the hybrid multiplies its diffuse term by it (Eq. (2), "
         "Herbert et al.), the oracle and the layered model take it as a dye in the slab (erratum "
         "E115), so on a translucent chip they differ by design as well as by approximation. The "
-        "last two columns put the oracle's specular term in the layered model's place: what they "
-        "leave is the error of its body and transmission, the rest is its split-sum specular "
-        "(erratum E108)",
+        "columns 'oracle's specular' put the oracle's specular term in the layered model's "
+        "place: what they leave is the error of its body and transmission, the rest is its "
+        "specular term (erratum E108). The last column is the judge's own noise: the oracle "
+        "against itself at another seed (erratum E117)",
         "{:.3g}",
     )
