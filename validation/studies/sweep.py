@@ -34,7 +34,7 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from reference.errors import format_allowed, require, require_positive_int
+from reference.errors import SpecrefError, format_allowed, require, require_positive_int
 from reference.files import write_text_atomic
 from reference.registry import Registry
 from reference.scene.loader import read_toml_file
@@ -344,10 +344,20 @@ def _check_material(value, where: str) -> dict:
         f"{where}: each material is an inline table with brdf = NAME and its parameters, "
         f"got {value!r}",
     )
+    for key, number in value.items():
+        # NaN and infinities have no JSON spelling: refused here, not as malformed TOML
+        require(
+            not isinstance(number, float) or math.isfinite(number),
+            f"{where}.{key}: must be finite, got {number}",
+        )
     import shrm  # noqa: F401  (registers isotropic_brdf)
 
     scene_text = sphere_scene_toml("unused.hdr", _material_lines(value), 2).rsplit("[[lights]]")[0]
-    loads_scene(scene_text, where)
+    try:
+        loads_scene(scene_text, where)
+    except SpecrefError as error:  # the sphere scene's material "m" is the sweep's entry
+        message = str(error).replace(f"{where}: materials.m.", f"{where}.")
+        raise SpecrefError(message.replace(f"{where}: materials.m: ", f"{where}: ")) from None
     return value
 
 
@@ -389,9 +399,9 @@ def _check_values(file: str, key: str, values, allowed) -> list:
         f"{file}: grid.{key}: must be a non-empty list, got {values!r}",
     )
     checked = []
-    for value in values:
+    for index, value in enumerate(values):
         if callable(allowed) and allowed not in (int, float):
-            checked.append(allowed(value, f"{file}: grid.{key}"))
+            checked.append(allowed(value, f"{file}: grid.{key}[{index}]"))
             continue
         checked.append(value)
         if allowed is int:
