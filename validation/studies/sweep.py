@@ -223,6 +223,12 @@ def _check_painting_light(value, where: str) -> str:
         f"{where}: unknown light {value!r}; allowed: {allowed} (MAP one of "
         f"{', '.join(ENVIRONMENTS)})",
     )
+    # NaN turned the ceiling into a NaN image, refused later naming only the "plane light"
+    require(
+        abs(float(azimuth)) <= 360.0,
+        f"{where}: {value!r}: AZIMUTH_DEG must be a number of degrees in [-360, 360], "
+        f"got {azimuth}",
+    )
     return value
 
 
@@ -366,9 +372,22 @@ def _check_environment(base: Path):
         require(isinstance(value, str), f"{where}: must be file names, got {value!r}")
         path = Path(value) if Path(value).is_absolute() else base / value
         require(path.is_file(), f"{where}: {value}: file not found")
+        _check_environment_map(str(path), where)
         return str(path)
 
     return check
+
+
+def _check_environment_map(path: str, where: str) -> None:
+    # read once here as the cells' scenes read it, so that a map they would refuse (not 2:1,
+    # not finite, channels of no colour) is one line naming the sweep file, before any cell
+    from reference.scene.loader import loads_scene
+    from validation.studies.env_accuracy import sphere_scene_toml
+
+    try:
+        loads_scene(sphere_scene_toml(path, size=2), where)
+    except SpecrefError as error:
+        raise SpecrefError(str(error).replace(f"{where}: lights[0].file: ", f"{where}: ")) from None
 
 
 def _shrm_kind() -> SweepKind:

@@ -151,6 +151,11 @@ def test_impastor_sweep_matches_the_direct_computation(tmp_path, monkeypatch):
             r"grid.lights\[1\]: unknown light 'lamp'; allowed: fluoresc",
         ),
         (('"lamp_panel:4"', '"env:nosuch.hdr:0"'), r"grid.lights\[1\]: unknown light 'env:nosuch"),
+        # a NaN azimuth was refused by the first cell as "plane light: image: must be finite"
+        (
+            ('"lamp_panel:4"', '"env:studio_small_03_1k.hdr:nan"'),
+            r"p.toml: grid.lights\[1\]: .*AZIMUTH_DEG must be a number of degrees in \[-360, 360\]",
+        ),
         (("alphas = [0.05, 0.2]", "alphas = [0.05, 2]"), r"grid.alphas: must be numbers in"),
         (("alphas = [0.05, 0.2]", "alphas = []"), r"grid.alphas: must be a non-empty list"),
     ],
@@ -215,6 +220,9 @@ def test_shrm_sweep_matches_the_direct_computation(tmp_path):
         (('brdf = "ggx"', 'brdf = "gx"'), r"s.toml: grid.materials.*'gx'"),
         (("alpha = 0.3", "alpha = -1"), r"s.toml: grid.materials\[0\]: alpha: must be >= 0"),
         (('["sky.exr"]', '["none.exr"]'), r"grid.environments\[0\]: none.exr: file not found"),
+        # maps the cells' scenes refuse were refused by the first cell, naming "<string>"
+        (('["sky.exr"]', '["square.exr"]'), r"s.toml: grid.environments\[0\]: .*must be 2:1"),
+        (('["sky.exr"]', '["nan.exr"]'), r"s.toml: grid.environments\[0\]: .*must be finite"),
         (("tolerances = [0.01]", "tolerances = [0]"), r"grid.tolerances: must be numbers in"),
         # NaN has no JSON spelling: it was "malformed TOML" at a line the sweep file lacks
         (("alpha = 0.3", "alpha = nan"), r"s.toml: grid.materials\[0\].alpha: must be finite"),
@@ -227,7 +235,13 @@ def test_shrm_sweep_matches_the_direct_computation(tmp_path):
     ],
 )
 def test_bad_shrm_sweeps_are_one_line(tmp_path, edit, message):
+    import numpy as np
+
+    from reference.images.formats import write_exr
+
     _sky(tmp_path)
+    write_exr(tmp_path / "square.exr", np.ones((8, 8, 3)))
+    write_exr(tmp_path / "nan.exr", np.where(np.eye(8, 16)[..., None] > 0, np.nan, np.ones(3)))
     path = tmp_path / "s.toml"
     path.write_text(SHRM_GRID.replace(*edit))
     with pytest.raises(SpecrefError, match=message):
