@@ -639,6 +639,16 @@ def _spectrum(doc, key, where, n):
 MAX_WHITE_CD_M2 = 10_000.0
 
 
+#: Bounds of a display file's per-channel keys, with what each bounds: an offset o of the tone
+#: response ((1 − o) d + o)^γ beyond ±0.5 leaves too little gain to calibrate (0.99 ended in a
+#: singular matrix); a primary drifted by more than 50 nm is another primary.
+CHANNEL_BOUNDS = {
+    "offset": (-0.5, 0.5, "", "each channel's offset o of ((1 - o) d + o)^gamma"),
+    "shift_nm": (-50.0, 50.0, " nm", "each channel's drift at zero drive"),
+    "black_leak": (0.0, 100.0, "", "each channel's relative leak into the black"),
+}
+
+
 def spectral_display_from_doc(doc: dict, where: str = "display file") -> SpectralDisplay:
     """A spectral display from a display file (JSON; format in ``docs/display.md``).
 
@@ -678,6 +688,13 @@ def spectral_display_from_doc(doc: dict, where: str = "display file") -> Spectra
         shape = () if key.endswith("cd_m2") else (3,)
         array = require_finite(value, f"{where}: {key}")
         require(array.shape == shape, f"{where}: {key}: must have shape {shape}, got {array.shape}")
+        if key in CHANNEL_BOUNDS:  # 1e308 made NaN drives, 0.99 a singular matrix
+            low, high, unit, meaning = CHANNEL_BOUNDS[key]
+            require(
+                bool(((array >= low) & (array <= high)).all()),
+                f"{where}: {key}: {meaning} must be in [{low:g}, {high:g}]{unit}, "
+                f"got {array.tolist()}",
+            )
     if "gamma" in kwargs:
         gamma = np.asarray(kwargs["gamma"], dtype=float)
         require(
@@ -738,6 +755,11 @@ def _replace(display, **changes):
 
 def _with_ramps(display, ramps, where) -> SpectralDisplay:
     require(isinstance(ramps, dict), f"{where}: ramps: must be an object with drive, R, G, B")
+    for key in ("drive", "R", "G", "B"):  # a missing one was "must be finite, got nan"
+        require(key in ramps, f"{where}: ramps: missing key {key!r}; it needs drive, R, G and B")
+    unknown = sorted(set(ramps) - {"drive", "R", "G", "B"})
+    if unknown:
+        raise SpecrefError(f"{where}: ramps: unknown key {unknown[0]!r}; allowed: B, G, R, drive")
     drive = require_finite(ramps.get("drive"), f"{where}: ramps.drive")
     require(
         drive.ndim == 1 and drive.size >= 2 and drive[0] == 0 and drive[-1] == 1,

@@ -67,6 +67,13 @@ def _make(tmp_path: Path, name: str) -> Path:
         path.write_text('{"gamma": [0, 0, 0]}')
     elif name == "bright.json":
         path.write_text('{"white_cd_m2": 1e308}')
+    elif name in ("offset.json", "offset99.json", "shift.json"):
+        key, value = {"offset.json": ("offset", 1e308), "offset99.json": ("offset", 0.99)}.get(
+            name, ("shift_nm", 1e308)
+        )
+        path.write_text(f'{{"{key}": [{value}, 0, 0]}}')
+    elif name == "no-blue.json":
+        path.write_text('{"ramps": {"drive": [0, 1], "R": [0, 1], "G": [0, 1]}}')
     elif name in ("negative.csv", "percent.csv"):
         value = -0.5 if name == "negative.csv" else 5.0
         path.write_text(f"R,G,B,380,780\n0.2,0.2,0.2,0.3,0.3\n0.5,0.4,0.3,{value},0.3\n")
@@ -95,6 +102,15 @@ CASES = [
     # messages that name the cause (gamma 0 was "white outside the gamut", '' was ".: not found")
     (["display", "calibrate", "--display", "{gamma0.json}", "-o", "{d.cal}"],
      "gamma0.json: gamma: each channel's exponent must be in (0, 10], got [0.0, 0.0, 0.0]"),
+    # NaN drives named no file; 0.99 was a LinAlgError traceback; shift_nm 1e308 was accepted
+    (["display", "calibrate", "--display", "{offset.json}", "-o", "{d.cal}"],
+     "offset.json: offset: each channel's offset o of ((1 - o) d + o)^gamma must be in [-0.5"),
+    (["display", "calibrate", "--display", "{offset99.json}", "-o", "{d.cal}"],
+     "offset99.json: offset: each channel's offset o"),
+    (["display", "calibrate", "--display", "{shift.json}", "-o", "{d.cal}"],
+     "shift.json: shift_nm: each channel's drift at zero drive must be in [-50, 50] nm"),
+    (["display", "calibrate", "--display", "{no-blue.json}", "-o", "{d.cal}"],
+     "no-blue.json: ramps: missing key 'B'"),  # was "ramps.B: must be finite, got nan"
     (["env", "spectralize", VENICE, "--model", "", "-o", "{out.exr}"],
      "argument --model: an empty file name"),
     (["compare", "{nan.exr}", "{fine.exr}"], "nan.exr: 1 pixels hold NaN or infinite values"),
