@@ -33,6 +33,7 @@ from reference.errors import require, require_finite
 
 __all__ = [
     "FRESNEL_LUT_SIZE",
+    "MAX_REFRACTIVE_INDEX",
     "FresnelLUT",
     "fresnel_dielectric",
     "fresnel_diffuse",
@@ -44,6 +45,11 @@ __all__ = [
 #: (``tests/reference/materials/test_fresnel.py``;
 #: towards n = 1 the curve steepens at grazing incidence: 1.3e-6 at n = 1.05, 6e-4 at n = 1.0001).
 FRESNEL_LUT_SIZE = 4097
+
+#: The largest refractive index an input file may state: the cos θ table is checked up to it, and
+#: no transparent dielectric of a scene exceeds it (rutile TiO2 2.6-2.9, diamond 2.42, polymers
+#: 1.3-1.7). An index of 1e11 was accepted by scenes.
+MAX_REFRACTIVE_INDEX = 3.0
 
 
 def _check_index(n, where: str) -> np.ndarray:

@@ -40,7 +40,11 @@ import numpy as np
 
 from reference.colour.spectra import DEFAULT_GRID, SpectralGrid
 from reference.errors import SpecrefError, require, require_finite
-from reference.materials.fresnel import fresnel_dielectric, fresnel_diffuse
+from reference.materials.fresnel import (
+    MAX_REFRACTIVE_INDEX,
+    fresnel_dielectric,
+    fresnel_diffuse,
+)
 from reference.scene.loader import read_toml_file
 
 __all__ = [
@@ -95,14 +99,35 @@ class PolymerConstituents:
     name: str = "polymer"
 
 
+#: Bounds of a constituents file's numbers (the forms are in the shipped file): K and S up to
+#: 1e4 per mm (opaque within 0.1 µm: any chip), scattering no steeper than Rayleigh's λ⁻⁴, widths
+#: and the absorption edge within the spectrum. S_exponent = 1e308 made infinite S, refused by
+#: km_slab naming neither file nor key.
+CONSTITUENT_BOUNDS = {
+    "index": (1.0, MAX_REFRACTIVE_INDEX, "a refractive index, > 1"),
+    "K_0": (0.0, 1e4, "1/mm"),
+    "K_blue": (0.0, 1e4, "1/mm"),
+    "K_tau_nm": (0.0, 1000.0, "nm, > 0"),
+    "S_560": (0.0, 1e4, "1/mm"),
+    "S_exponent": (0.0, 4.0, "the power of 560/λ, at most Rayleigh's 4"),
+    "K_edge": (0.0, 1e4, "1/mm"),
+    "edge_nm": (0.0, 2000.0, "nm"),
+    "edge_width_nm": (0.0, 1000.0, "nm, > 0"),
+    "K_floor": (0.0, 1e4, "1/mm"),
+}
+
+
 def _number(table: dict, key: str, where: str) -> float:
     require(key in table, f"{where}: missing key {key!r}")
     value = table[key]
+    low, high, meaning = CONSTITUENT_BOUNDS[key]
     require(
-        isinstance(value, int | float) and not isinstance(value, bool) and np.isfinite(value),
-        f"{where}.{key}: must be a finite number, got {value!r}",
+        isinstance(value, int | float)
+        and not isinstance(value, bool)
+        and np.isfinite(value)
+        and low <= value <= high,
+        f"{where}.{key}: must be a number in [{low:g}, {high:g}] ({meaning}), got {value!r}",
     )
-    require(value >= 0, f"{where}.{key}: must be >= 0, got {value!r}")
     return float(value)
 
 

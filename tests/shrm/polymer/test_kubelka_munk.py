@@ -170,11 +170,20 @@ def test_constituents_file_errors(tmp_path):
         polymer_constituents(GRID_31, path)
     text = DEFAULT_CONSTITUENTS.read_text()
     path.write_text(text.replace("index = 1.54", "index = 0.9"))
+    with pytest.raises(SpecrefError, match=r"base\.index: must be a number in \[1, 3\]"):
+        polymer_constituents(GRID_31, path)
+    path.write_text(text.replace("index = 1.54", "index = 1"))
     with pytest.raises(SpecrefError, match=r"base\.index: must be > 1"):
         polymer_constituents(GRID_31, path)
     path.write_text(text.replace("K_0 = 0.02", "K_0 = -0.02"))
-    with pytest.raises(SpecrefError, match=r"base\.K_0: must be >= 0"):
+    with pytest.raises(SpecrefError, match=r"base\.K_0: must be a number in \[0, 10000\] \(1/mm\)"):
         polymer_constituents(GRID_31, path)
+    # 1e308 made infinite K or S, refused by km_slab naming neither the file nor the key
+    for key, value in (("S_exponent = 2.0", "S_exponent = 1e308"), ("K_0 = 0.02", "K_0 = 1e308")):
+        path.write_text(text.replace(key, value))
+        name = key.split()[0]
+        with pytest.raises(SpecrefError, match=rf"c.toml: base\.{name}: must be a number in \["):
+            polymer_constituents(GRID_31, path)
 
 
 def test_shipped_constituents_look_like_hdpe_and_tio2():

@@ -37,6 +37,11 @@ def _make(tmp_path: Path, name: str) -> Path:
         from shrm.polymer.kubelka_munk import DEFAULT_CONSTITUENTS
 
         path.write_text(Path(DEFAULT_CONSTITUENTS).read_text().replace("[base]", "[base]\nfoo = 1"))
+    elif name == "steep.toml":  # scattering as λ^-1e308
+        from shrm.polymer.kubelka_munk import DEFAULT_CONSTITUENTS
+
+        text = Path(DEFAULT_CONSTITUENTS).read_text()
+        path.write_text(text.replace("S_exponent = 2.0", "S_exponent = 1e308"))
     elif name == "mat.toml":
         path.write_text('name = "brick"\n[material]\nk_d = 0.4\nk_s = 0.4\nn = 50\n')
     elif name == "sweep.toml":
@@ -132,6 +137,8 @@ CASES = [
     (["render", "{empty}", "-o", "{out.png}"], "empty: is a folder, not a TOML file"),
     (["polymer", "characterize", "-o", "{out.csv}", "--constituents", "{extra-key.toml}"],
      "extra-key.toml: base.foo: unknown key; allowed:"),
+    (["polymer", "characterize", "-o", "{out.csv}", "--constituents", "{steep.toml}"],
+     "steep.toml: base.S_exponent: must be a number in [0, 4]"),  # was "km_slab: S: ..."
     (["polymer", "characterize", "-o", "{out.csv}", "--thickness", "1,2", "--tio2", "0,101"],
      "--tio2: each TiO2 load must be in [0, 100] % by weight"),
     (["polymer", "characterize", "-o", "{out.csv}", "--thickness", "1,1e308", "--tio2", "0,1"],
