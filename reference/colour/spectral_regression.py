@@ -58,6 +58,7 @@ from __future__ import annotations
 import functools
 import itertools
 import json
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from fractions import Fraction
@@ -66,7 +67,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from reference.errors import SpecrefError, require
+from reference.errors import SpecrefError, format_allowed, require
 from reference.registry import Registry
 
 __all__ = [
@@ -958,6 +959,52 @@ def save_regression(model: SpectralRegression, path) -> Path:
     return write_text_atomic(path, json.dumps(document, indent=1) + "\n")
 
 
+#: The keys of a model file, by its version.
+_MODEL_KEYS = {
+    1: ("features", "degree", "coefficients", "wavelengths_nm", "ridge", "illuminant", "camera",
+        "training_set"),
+}  # fmt: skip
+_MODEL_KEYS[2] = (*_MODEL_KEYS[1], "loss", "spectral_weight")
+_MODEL_KEYS[3] = (*_MODEL_KEYS[2], "augmentation")
+
+
+def _is_number(value, kind) -> bool:
+    # JSON numbers; a whole number for int; booleans are not numbers here
+    allowed = int if kind is int else (int, float)
+    return isinstance(value, allowed) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def _model_array(document: dict, key: str, ndim: int) -> np.ndarray:
+    # a model file's array, its shape and finiteness named by key (the path is added by the caller)
+    what = "a list of numbers" if ndim == 1 else "a list of rows of numbers, all of one length"
+    value = document[key]
+    rows = value if ndim == 2 and isinstance(value, list) else [value] if ndim == 1 else []
+    for i, row in enumerate(rows):  # the first entry that is not a number, or a ragged row
+        where = f"{key}[{i}]" if ndim == 2 else key
+        if not isinstance(row, list):
+            break
+        require(
+            ndim == 1 or len(row) == len(rows[0]),
+            f"{where}: has {len(row)} values, {key}[0] has {len(rows[0])}; rows are of one length",
+        )
+        for j, number in enumerate(row):
+            require(
+                _is_number(number, float),
+                f"{where}[{j}]: must be a finite number, got {number!r:.40}",
+            )
+    try:
+        array = np.array(value, dtype=np.float64)
+    except (TypeError, ValueError, OverflowError):
+        array = np.empty((0,))
+    require(
+        array.ndim == ndim and array.size > 0 and not isinstance(value, str),
+        f"{key}: must be {what}, got {value!r:.40}",
+    )
+    require(bool(np.isfinite(array).all()), f"{key}: must be finite numbers")
+    require(ndim == 2 or bool((np.diff(array) > 0).all()), f"{key}: must increase")
+    return array
+
+
 def load_regression(path, wavelengths_nm=None) -> SpectralRegression:
     """Read a model file; with ``wavelengths_nm``, require the model's grid to be that grid.
 
@@ -987,12 +1034,29 @@ def load_regression(path, wavelengths_nm=None) -> SpectralRegression:
             f"{path}: {FORMAT} version {version!r}; this specref reads versions "
             f"{', '.join(map(str, _READABLE_VERSIONS))} (refit with `specref env fit`)",
         )
+        missing = [key for key in _MODEL_KEYS[version] if key not in document]
+        if missing:
+            raise SpecrefError(
+                f"{path}: missing key {missing[0]!r}; a version {version} model file holds "
+                f"{', '.join(_MODEL_KEYS[version])}"
+            )
         weight = document["spectral_weight"] if version >= 2 else None
+        require(
+            isinstance(document["features"], str) and _is_number(document["degree"], int),
+            f"{path}: features, degree: must be a name ({format_allowed(REGRESSION_FEATURES)}) "
+            f"and a whole number, got {document['features']!r:.30}, {document['degree']!r:.30}",
+        )
+        for key in ("ridge", "spectral_weight"):
+            value = document.get(key)
+            require(
+                _is_number(value, float) or (key == "spectral_weight" and value is None),
+                f"{path}: {key}: must be a number, got {value!r:.40}",
+            )
         model = SpectralRegression(
             document["features"],
             document["degree"],
-            np.array(document["coefficients"], dtype=np.float64),
-            np.array(document["wavelengths_nm"], dtype=np.float64),
+            _model_array(document, "coefficients", 2),
+            _model_array(document, "wavelengths_nm", 1),
             float(document["ridge"]),
             str(document["illuminant"]),
             str(document["camera"]),

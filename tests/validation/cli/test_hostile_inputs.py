@@ -42,6 +42,19 @@ def _make(tmp_path: Path, name: str) -> Path:
 
         text = Path(DEFAULT_CONSTITUENTS).read_text()
         path.write_text(text.replace("S_exponent = 2.0", "S_exponent = 1e308"))
+    elif name.startswith("model-"):  # the shipped model file, one key spoilt
+        import json
+
+        doc = json.loads(Path(data_path("spectral_regression_sRGB.json")).read_text())
+        if name == "model-x.json":
+            doc["coefficients"][0][0] = "x"
+        elif name == "model-ragged.json":
+            doc["coefficients"][1].pop()
+        elif name == "model-range.json":
+            doc["wavelengths_nm"] = "380-780"
+        else:
+            del doc["coefficients"]
+        path.write_text(json.dumps(doc))
     elif name == "mat.toml":
         path.write_text('name = "brick"\n[material]\nk_d = 0.4\nk_s = 0.4\nn = 50\n')
     elif name == "sweep.toml":
@@ -89,6 +102,15 @@ CASES = [
     (["env", "fit", "--target", "{binary.csv}", "-o", "{out.json}"], "not a UTF-8 CSV text file"),
     (["env", "spectralize", VENICE, "--model", "{list.json}", "-o", "{out.exr}"],
      "not a specref-spectral-regression file"),
+    # each was "malformed model file (ValueError)", "(KeyError)" or "(TypeError)"
+    (["env", "spectralize", VENICE, "--model", "{model-x.json}", "-o", "{out.exr}"],
+     "model-x.json: coefficients[0][0]: must be a finite number, got 'x'"),
+    (["env", "spectralize", VENICE, "--model", "{model-ragged.json}", "-o", "{out.exr}"],
+     "model-ragged.json: coefficients[1]: has 40 values, coefficients[0] has 41; rows are of one"),
+    (["env", "spectralize", VENICE, "--model", "{model-range.json}", "-o", "{out.exr}"],
+     "model-range.json: wavelengths_nm: must be a list of numbers, got '380-780'"),
+    (["env", "spectralize", VENICE, "--model", "{model-none.json}", "-o", "{out.exr}"],
+     "model-none.json: missing key 'coefficients'; a version 2 model file holds features, degree,"),
     (["env", "convert", "{truncated.hdr}", "{out.zarr}"], "truncated Radiance HDR image"),
     (["env", "convert", "{zero.hdr}", "{out.zarr}"], "an image of 0 × 16 pixels"),
     (["env", "spectralize", "{zero.hdr}", "--model", "default", "-o", "{out.exr}"],
