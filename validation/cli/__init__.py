@@ -111,9 +111,12 @@ def run() -> int:
 def main(argv: list[str] | None = None) -> int:
     """Run the ``specref`` command; return the exit code (2 for bad input).
 
+    A usage error (an unknown flag, a value its flag refuses while parsing) exits from the
+    parser with code 2, as argparse does.
+
     Examples
     --------
-    >>> main(["report", "--only", "no-such-section", "--out", "/tmp/specref-doctest"])
+    >>> main(["sweep", "/nonexistent/sweep.toml"])
     2
     """
     import shrm  # noqa: F401  (registers the environment-light shaders before any rendering)

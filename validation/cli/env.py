@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
-from validation.cli.parser import Parser, input_file, output_file, registry_option
+from validation.cli.parser import Parser, input_file, number_in, output_file, registry_option
+
+#: The most rows a block or chunk may hold (the libraries' own bound).
+MAX_ROWS = 1 << 20
 
 
 def _cmd_env_fit(args) -> int:
@@ -81,6 +84,7 @@ def add_parser(sub) -> None:
     """Add ``specref env fit|spectralize|convert|preview`` to the subcommand parsers ``sub``."""
     from reference.colour.spectral_regression import (
         DEFAULT_LOSS,
+        MAX_RIDGE,
         REGRESSION_FEATURES,
         REGRESSION_LOSSES,
     )
@@ -105,7 +109,12 @@ def add_parser(sub) -> None:
     )
     f.add_argument("--degree", type=int, default=4, help="1-5 (polynomial), 1-4 (root)")
     registry_option(f, "--loss", REGRESSION_LOSSES, "fitted loss (E44)", default=DEFAULT_LOSS)
-    f.add_argument("--ridge", type=float, default=None, help="fixed ridge strength (default: CV)")
+    f.add_argument(
+        "--ridge",
+        type=number_in(0.0, MAX_RIDGE),
+        default=None,
+        help=f"fixed ridge strength, 0 to {MAX_RIDGE:g} (default: CV)",
+    )
     f.add_argument(
         "--spectral-weight",
         type=float,
@@ -134,7 +143,12 @@ def add_parser(sub) -> None:
     s.add_argument(
         "--model", type=input_file, required=True, help="model .json from `env fit`, or 'default'"
     )
-    s.add_argument("--rows", type=int, default=None, help="rows per block (default: 2^17 pixels)")
+    s.add_argument(
+        "--rows",
+        type=number_in(1, MAX_ROWS, integer=True),
+        default=None,
+        help="rows per block (default: 2^17 pixels)",
+    )
     s.add_argument(
         "-o", "--out", type=output_file, required=True, help="output .exr, .tif or .zarr"
     )
@@ -182,7 +196,7 @@ def _add_convert(env) -> None:
     )
     c.add_argument(
         "--rows",
-        type=int,
+        type=number_in(1, MAX_ROWS, integer=True),
         default=None,
         help="rows per chunk (default: about 21.5 MB of float32 per chunk)",
     )

@@ -18,6 +18,7 @@ __all__ = [
     "input_file",
     "key_or_input_file",
     "nonnegative_int",
+    "number_in",
     "output_file",
     "output_file_or_stdout",
     "painting_input",
@@ -207,6 +208,36 @@ def nonnegative_int(value: str) -> int:
     return number
 
 
+def number_in(low: float, high: float, integer: bool = False):
+    """An argparse ``type=`` for a finite number in [low, high] (a whole number with ``integer``).
+
+    The message names the flag (argparse prefixes ``argument --FLAG:``), where the library's
+    check, reached later, named only the quantity.
+
+    Examples
+    --------
+    >>> number_in(1, 1 << 20, integer=True)("64")
+    64
+    >>> number_in(0, 1)("-1")
+    Traceback (most recent call last):
+    ...
+    argparse.ArgumentTypeError: must be a number in [0, 1], got '-1'
+    """
+    what = "a whole number" if integer else "a number"
+    bounds = f"[{low}, {high}]" if integer else f"[{low:g}, {high:g}]"
+
+    def check(value: str):
+        try:
+            number = int(value) if integer else float(value)
+        except ValueError:
+            number = None
+        if number is None or not low <= number <= high:  # NaN fails the comparison too
+            raise argparse.ArgumentTypeError(f"must be {what} in {bounds}, got {value!r}")
+        return number
+
+    return check
+
+
 def port_number(value: str) -> int:
     """A TCP port, 0 (any free port) to 65535, for argparse's ``type=``.
 
@@ -357,6 +388,12 @@ def registry_option(parser, flag: str, registry, help: str, where=None, **kwargs
     >>> action = registry_option(Parser(prog="x"), "--shape", shapes, "the shape", default="disc")
     >>> action.help
     'the shape: disc, lobe[:S] (default disc)'
+    >>> action.type("lobe:4"), action.type("disc")
+    ('lobe:4', 'disc')
+    >>> action.type("cube")
+    Traceback (most recent call last):
+    ...
+    argparse.ArgumentTypeError: unknown value 'cube'; allowed: disc, lobe[:S]
     """
     keys = [key for key in registry if where is None or where(key, _entry(registry, key))]
     shown = []
@@ -366,6 +403,20 @@ def registry_option(parser, flag: str, registry, help: str, where=None, **kwargs
     text = f"{help}: {', '.join(shown)}"
     if kwargs.get("default") is not None:
         text += f" (default {kwargs['default']})"
+
+    def key(value: str) -> str:
+        # checked while parsing, so that the message names the flag (the library's did not, and
+        # an option no part of the input used, --texel-placement without an environment, was
+        # never checked); a parameter is the library's to check
+        base, colon, _ = value.partition(":")
+        parametric = colon and base in keys and isinstance(_entry(registry, base), ParametricMethod)
+        if value not in keys and not parametric:
+            raise argparse.ArgumentTypeError(
+                f"unknown value {value!r}; allowed: {', '.join(shown)}"
+            )
+        return value
+
+    kwargs.setdefault("type", key)
     action = parser.add_argument(flag, help=text, **kwargs)
     action.registry = registry
     action.registry_keys = keys

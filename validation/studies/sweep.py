@@ -127,6 +127,35 @@ def phong_cell(cell: dict, state=None) -> dict:
     return {k: row[k] for k in ("segments", "rms_display", "rms_linear", "rms", "overshoot")}
 
 
+def _check_phong_material(base: Path):
+    def check(value, where: str) -> str:
+        # loaded once here, so that a missing or bad material file names the sweep file (a
+        # missing one was "R99: file not found" from the first cell, relative to the current folder)
+        from phong_table.materialfile import load_material_file
+
+        keys = _phong_materials()
+        require(
+            isinstance(value, str),
+            f"{where}: must be Phong scene keys ({', '.join(keys)}) or material files, "
+            f"got {value!r}",
+        )
+        if value in keys:
+            return value
+        path = Path(value) if Path(value).is_absolute() else base / value
+        require(
+            path.is_file(),
+            f"{where}: {value!r}: neither a Phong scene key ({', '.join(keys)}) nor a material "
+            f"file beside the sweep file",
+        )
+        try:
+            load_material_file(path)
+        except SpecrefError as error:
+            raise SpecrefError(f"{where}: {error}") from None
+        return str(path)
+
+    return check
+
+
 def _phong_kind() -> SweepKind:
     from phong_table.interpolation import INTERPOLATION_METHODS
     from phong_table.placement import PLACEMENT_METHODS
@@ -135,7 +164,7 @@ def _phong_kind() -> SweepKind:
     return SweepKind(
         "phong",
         lists={
-            "materials": None,  # scene keys or material files, checked when loaded
+            "materials": _check_phong_material,  # bound to the sweep file's folder when loaded
             "views": list(VIEWS),
             "placements": PLACEMENT_METHODS.names(),
             "interpolations": INTERPOLATION_METHODS.names(),
@@ -485,9 +514,12 @@ def load_sweep(path, large: bool = False) -> tuple[SweepKind, list[dict]]:
     require(not unknown, f"{file}: grid: unknown keys {unknown}; allowed: {format_allowed(keys)}")
     missing = sorted(set(keys) - set(grid))
     require(not missing, f"{file}: grid: missing keys {missing}")
-    lists = dict(kind.lists)
-    if lists.get("environments") is _check_environment:
-        lists["environments"] = _check_environment(path.parent)
+    lists = {  # checks of file names, relative to the sweep file's folder
+        key: allowed(path.parent)
+        if allowed in (_check_environment, _check_phong_material)
+        else allowed
+        for key, allowed in kind.lists.items()
+    }
     axes = {key: _check_values(file, key, grid[key], allowed) for key, allowed in lists.items()}
     scalars = {}
     for key in kind.scalars:

@@ -22,7 +22,9 @@ def test_bad_input_exits_2_with_one_line_and_no_traceback(tmp_path):
     assert "Traceback" not in result.stderr
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1
-    assert lines[0].startswith("specref: error: unknown report section 'nonexistent'; allowed:")
+    assert lines[0].startswith(
+        "specref: error: argument --only: unknown value 'nonexistent'; allowed:"
+    )
 
 
 def test_usage_errors_exit_2_on_one_line():

@@ -103,7 +103,7 @@ BAD_INPUT = {
     "unknown EXR output": (
         GOOD.replace("{k_d}", "1"),
         ["--exr", "out.exr", "--exr-output", "rgb"],
-        "unknown render output 'rgb'; allowed: display, spectral, xyz",
+        "argument --exr-output: unknown value 'rgb'; allowed: display, xyz, spectral",
     ),
     "JSON suffix": (GOOD.replace("{k_d}", "1"), ["--json", "out.txt"], "--json: the output must"),
 }

@@ -112,6 +112,18 @@ CASES = [
     (["env", "spectralize", VENICE, "--model", "{model-none.json}", "-o", "{out.exr}"],
      "model-none.json: missing key 'coefficients'; a version 2 model file holds features, degree,"),
     (["env", "convert", "{truncated.hdr}", "{out.zarr}"], "truncated Radiance HDR image"),
+    # flags named while parsing: the library's messages named no flag, and a texel placement was
+    # not checked at all in a scene without an environment map
+    (["render", "data:examples/phong-sphere.toml", "-o", "{out.png}", "--exr-output", "hdr"],
+     "argument --exr-output: unknown value 'hdr'; allowed: display, xyz, spectral"),
+    (["render", "data:examples/phong-sphere.toml", "-o", "{out.png}", "--texel-placement", "edge"],
+     "argument --texel-placement: unknown value 'edge'; allowed: centred, mitsuba"),
+    (["env", "convert", VENICE, "{out.zarr}", "--rows", "0"],
+     "argument --rows: must be a whole number in [1, 1048576], got '0'"),
+    (["env", "spectralize", VENICE, "--model", "default", "--rows", "0", "-o", "{out.exr}"],
+     "argument --rows: must be a whole number in [1, 1048576], got '0'"),
+    (["env", "fit", "--ridge", "-1", "-o", "{out.json}"],
+     "argument --ridge: must be a number in [0, 1], got '-1'"),
     (["env", "convert", "{zero.hdr}", "{out.zarr}"], "an image of 0 × 16 pixels"),
     (["env", "spectralize", "{zero.hdr}", "--model", "default", "-o", "{out.exr}"],
      "an image of 0 × 16 pixels"),
@@ -202,6 +214,7 @@ def test_one_line_and_exit_2(argv, message, tmp_path, capsys):
     assert not (tmp_path / "out.zarr").exists()
     assert not (tmp_path / "out.exr").exists()
     assert not (tmp_path / "d.cal").exists()
+    assert not (tmp_path / "out.png").exists()
 
 
 def test_a_sweep_grid_beyond_its_bound_is_refused_before_any_cell(tmp_path, capsys):

@@ -70,9 +70,16 @@ def test_serial_sweep_matches_the_direct_computation(tmp_path):
         (("resolution = 16", ""), r"grid: missing keys \['resolution'\]"),
         (("[grid]", "[grids]"), r"unknown keys \['grids'\]"),
         (("materials = [", "materials = "), r"malformed TOML"),
+        # a missing or bad material was refused by the first cell, naming only the material
+        (('"R1", "R3"', '"R1", "R99"'), r"s.toml: grid.materials\[1\]: 'R99': neither a Phong"),
+        (
+            ('"R1", "R3"', '"bad.toml"'),
+            r"s.toml: grid.materials\[0\]: .*bad.toml: material.n: must",
+        ),
     ],
 )
 def test_bad_sweep_files_are_one_line(tmp_path, edit, message):
+    (tmp_path / "bad.toml").write_text('name = "b"\n[material]\nk_d = 0.4\nk_s = 0.4\nn = -5\n')
     path = tmp_path / "s.toml"
     path.write_text(GRID.replace(*edit))
     with pytest.raises(SpecrefError, match=message):
