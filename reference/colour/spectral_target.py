@@ -458,6 +458,10 @@ def _columns(path, header, rows, names) -> np.ndarray:
 #: excess of fluorescent or glossy patches (ours, E104); -0.5 or 5.0 is a wrong file or unit.
 REFLECTANCE_RANGE = (-0.05, 1.5)
 
+#: The largest camera RGB a target file may hold: the white diffuser is 1, so ten times it is no
+#: patch of a reflective target (8-bit counts, 0-255, are a wrong unit; 1e308 was fitted).
+MAX_TARGET_RGB = 10.0
+
 
 def read_target(path, spectra_path=None, grid: SpectralGrid = GRID_41):
     r"""Read a measured camera target: RGB of the patches and their reflectances on ``grid``.
@@ -478,7 +482,8 @@ def read_target(path, spectra_path=None, grid: SpectralGrid = GRID_41):
     ------
     SpecrefError
         Missing columns, patch counts that differ, a grid that does not cover ``grid``,
-        negative or NaN RGB, reflectances outside :data:`REFLECTANCE_RANGE`.
+        RGB that is NaN or outside [0, :data:`MAX_TARGET_RGB`], reflectances outside
+        :data:`REFLECTANCE_RANGE`.
 
     Examples
     --------
@@ -508,9 +513,11 @@ def read_target(path, spectra_path=None, grid: SpectralGrid = GRID_41):
         len(RGB) == len(values),
         f"{spectra_file}: {len(values)} spectra for {len(RGB)} RGB patches in {path}",
     )
+    bad = ~(np.isfinite(RGB) & (RGB >= 0) & (RGB <= MAX_TARGET_RGB)).all(axis=1)
     require(
-        np.isfinite(RGB).all() and (RGB >= 0).all(),
-        f"{path}: RGB must be finite and >= 0 (found NaN, inf or negative values)",
+        not bad.any(),
+        f"{path}: patch {int(np.argmax(bad)) + 1}: RGB must be finite and in "
+        f"[0, {MAX_TARGET_RGB:g}] (linear camera RGB, white diffuser = 1)",
     )
     low, high = REFLECTANCE_RANGE
     bad = ~(np.isfinite(values) & (values >= low) & (values <= high)).all(axis=1)

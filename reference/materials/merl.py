@@ -56,6 +56,7 @@ from reference.materials.isotropic import isotropic_directions
 from reference.materials.table import MAX_TABLE_ANGLES, BRDFTable
 
 __all__ = [
+    "MAX_MERL_ALBEDO",
     "MERLBRDF",
     "MERL_BYTES",
     "MERL_DIMENSIONS",
@@ -497,6 +498,11 @@ def write_merl_brdf(path, brdf, params: dict | None = None) -> Path:
     return Path(path)
 
 
+#: The largest directional albedo at normal incidence that a MERL file may have: energy
+#: conservation allows 1; the rest is room for measurement error.
+MAX_MERL_ALBEDO = 1.5
+
+
 def read_merl_brdf(path) -> MERLBRDF:
     """Read a MERL BRDF file (Matusik et al. 2003), checked.
 
@@ -517,7 +523,8 @@ def read_merl_brdf(path) -> MERLBRDF:
     SpecrefError
         One line naming the file: not found or unreadable, shorter than its header, dimensions
         other than (90, 90, 180), a size other than :data:`MERL_BYTES` (truncated or extra
-        bytes), NaN or infinite values, or no value with data.
+        bytes), NaN or infinite values, no value with data, or an albedo at normal incidence
+        above :data:`MAX_MERL_ALBEDO`.
 
     Examples
     --------
@@ -541,8 +548,18 @@ def read_merl_brdf(path) -> MERLBRDF:
         )
     require(bool((stored >= 0).any()), f"{path}: no MERL value with data (all are negative)")
     # Matusik et al. 2003: BRDF = stored value × scale, per channel; channel axis last
-    values = np.moveaxis(stored, 0, -1) * MERL_SCALES
-    return MERLBRDF(values, name=path.stem)
+    merl = MERLBRDF(np.moveaxis(stored, 0, -1) * MERL_SCALES, name=path.stem)
+    with np.errstate(over="ignore", invalid="ignore"):
+        # energy conservation: a file of 1e308 was read, and its albedo printed as 300 digits
+        albedo = merl_albedo(merl, 0.0)
+    if not np.all(albedo <= MAX_MERL_ALBEDO):  # NaN and inf fail too
+        channel = int(np.argmax(~(albedo <= MAX_MERL_ALBEDO)))
+        raise SpecrefError(
+            f"{path}: albedo at normal incidence {albedo[channel]:.4g} in {_CHANNELS[channel]}; "
+            f"a surface reflects at most the light it receives (<= {MAX_MERL_ALBEDO:g} allowed, "
+            "room for measurement error): a wrong scale or not a MERL BRDF"
+        )
+    return merl
 
 
 def _read_merl_values(path: Path) -> np.ndarray:

@@ -360,6 +360,12 @@ def _header(dims=(90, 90, 180)):
         ("extra", r"extra\.binary: 34,992,020 bytes; .*: extra bytes at the end$"),
         ("nan", r"nan\.binary: 2 NaN or infinite values .*first: green, theta_h bin 3, theta_d"),
         ("negative", r"negative\.binary: no MERL value with data \(all are negative\)"),
+        # 1e308 was read (brdf check printed an albedo of 300 digits)
+        (
+            "huge",
+            r"huge\.binary: albedo at normal incidence 2\.094e\+305 in red; .*\(<= 1\.5 allowed",
+        ),
+        ("bright", r"bright\.binary: albedo at normal incidence 2 in red"),
         ("missing", r"missing\.binary: file not found"),
         ("folder", r"folder\.binary: unreadable MERL BRDF"),
     ],
@@ -382,6 +388,11 @@ def test_bad_files_give_one_line_naming_the_file(files, tmp_path, case, match):
         path.write_bytes(_header() + values.tobytes())
     elif case == "negative":
         path.write_bytes(_header() + np.full(3 * N_BINS, -1.0).tobytes())
+    elif case == "huge":
+        path.write_bytes(_header() + np.full(3 * N_BINS, 1e308).tobytes())
+    elif case == "bright":  # a Lambertian BRDF of albedo 2 in every channel
+        stored = np.broadcast_to((2.0 / np.pi / MERL_SCALES)[:, None], (3, N_BINS))
+        path.write_bytes(_header() + np.ascontiguousarray(stored).tobytes())
     elif case == "folder":
         path.mkdir()
     with pytest.raises(SpecrefError, match=match) as error:
@@ -406,7 +417,7 @@ def test_bad_values_and_arguments_are_refused(tmp_path):
 
 
 def test_write_read_round_trip_is_exact_for_values(tmp_path, rng):
-    values = rng.uniform(0.0, 5.0, (90, 90, 180, 3))
+    values = rng.uniform(0.0, 0.3, (90, 90, 180, 3))  # albedo about 0.47: read back (<= 1.5)
     values[0, 0, :3] = -1.0  # no data
     path = write_merl_brdf(tmp_path / "r.binary", values)
     assert path.stat().st_size == MERL_BYTES

@@ -169,7 +169,7 @@ def test_bad_input_one_line_exit_2(tmp_path, rng, capsys):
     _expect_error(
         capsys,
         ["env", "fit", "--target", str(tmp_path / "neg.csv"), "-o", str(tmp_path / "m.json")],
-        "RGB must be finite and >= 0",
+        "neg.csv: patch 1: RGB must be finite and in [0, 10]",
     )
     # a degree outside 1…5, an out-of-range ridge strength
     _expect_error(

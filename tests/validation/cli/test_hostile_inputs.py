@@ -92,6 +92,8 @@ def _make(tmp_path: Path, name: str) -> Path:
         path.write_text(f'{{"{key}": [{value}, 0, 0]}}')
     elif name == "no-blue.json":
         path.write_text('{"ramps": {"drive": [0, 1], "R": [0, 1], "G": [0, 1]}}')
+    elif name == "huge-rgb.csv":
+        path.write_text("R,G,B,380,780\n0.2,0.2,0.2,0.3,0.3\n0.5,0.4,1e308,0.3,0.3\n")
     elif name in ("negative.csv", "percent.csv"):
         value = -0.5 if name == "negative.csv" else 5.0
         path.write_text(f"R,G,B,380,780\n0.2,0.2,0.2,0.3,0.3\n0.5,0.4,0.3,{value},0.3\n")
@@ -158,6 +160,8 @@ CASES = [
      "patch 2: reflectances must be finite and in [-0.05, 1.5]"),
     (["env", "fit", "--target", "{percent.csv}", "-o", "{out.json}"],
      "patch 2: reflectances must be finite and in [-0.05, 1.5]"),
+    (["env", "fit", "--target", "{huge-rgb.csv}", "-o", "{out.json}"],  # was fitted
+     "huge-rgb.csv: patch 2: RGB must be finite and in [0, 10] (linear camera RGB, white"),
     # compare against nothing: a black reference or an empty mask was "no lit pixels", exit 0
     (["compare", "{fine.exr}", "{nan-stderr.exr}"], "Y.stderr: 1 pixels hold NaN, infinite or"),
     (["compare", "{fine.exr}", "{black.exr}"], "nothing to compare: no pixel of the reference"),
