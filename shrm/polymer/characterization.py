@@ -52,6 +52,7 @@ from scipy.interpolate import RegularGridInterpolator
 from reference.colour.spectra import DEFAULT_GRID, SpectralGrid
 from reference.errors import SpecrefError, require
 from reference.files import atomic_write
+from reference.materials.fresnel import MAX_REFRACTIVE_INDEX
 from shrm.polymer.kubelka_munk import PolymerConstituents, polymer_K_S, slab_measured
 
 __all__ = [
@@ -374,7 +375,11 @@ def read_characterization(path) -> Characterization:
     }
     for key, default in (("index", 1.54), ("backing_white", 0.9)):
         meta[key] = _float(str(meta.get(key, default)), f"{path}: # {key}")
-    require(meta["index"] > 1, f"{path}: # index: must be > 1, got {meta['index']:g}")
+    require(
+        1 < meta["index"] <= MAX_REFRACTIVE_INDEX,
+        f"{path}: # index: a refractive index must be in (1, {MAX_REFRACTIVE_INDEX:g}], "
+        f"got {meta['index']:g}",
+    )
     require(
         0 < meta["backing_white"] <= 1,
         f"{path}: # backing_white: a reflectance, in (0, 1], got {meta['backing_white']:g}",

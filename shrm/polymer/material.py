@@ -41,6 +41,7 @@ import numpy as np
 
 from reference.colour.spectra import SpectralGrid
 from reference.errors import SpecrefError, require, require_nonnegative
+from reference.materials.fresnel import MAX_REFRACTIVE_INDEX
 from reference.materials.types import MATERIAL_TYPES, MaterialType
 from reference.registry import Method, Registry
 from reference.scene.lights import EnvironmentLight
@@ -836,7 +837,15 @@ def _parse_polymer(reader, table: dict, key: str, name: str) -> PolymerMaterial:
             )
     index = None
     if "index" in table:
-        index = reader.number(table["index"], f"{key}.index", 1.0, exclusive_minimum=True)
+        value = table["index"]
+        number = isinstance(value, int | float) and not isinstance(value, bool)
+        if number and value > MAX_REFRACTIVE_INDEX:  # 1e11 was accepted
+            reader.fail(
+                f"{key}.index",
+                f"a refractive index must be in (1, {MAX_REFRACTIVE_INDEX:g}] (polymers 1.3-1.7, "
+                f"rutile 2.6-2.9), got {value:g}",
+            )
+        index = reader.number(value, f"{key}.index", 1.0, exclusive_minimum=True)
     effect = None
     if "effect" in table:
         value = table["effect"]

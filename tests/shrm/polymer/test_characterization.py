@@ -146,6 +146,10 @@ def test_a_backing_that_is_no_reflectance_and_a_partial_range_are_refused(tmp_pa
                                 for line in lines) + "\n")  # fmt: skip
     with pytest.raises(SpecrefError, match=r"bright\.csv: # backing_white: a reflectance, in"):
         read_characterization(bright)
+    dense = tmp_path / "dense.csv"  # an index of 1e308 was read and rendered
+    dense.write_text("\n".join(line.replace("# index: 1.54", "# index: 1e308") for line in lines))
+    with pytest.raises(SpecrefError, match=r"dense\.csv: # index: a refractive index must be in"):
+        read_characterization(dense)
     header = next(i for i, line in enumerate(lines) if line.startswith("thickness_mm"))
     keep = 3 + sum(float(w) <= 500 for w in lines[header].split(",")[3:])
     narrow = tmp_path / "narrow.csv"

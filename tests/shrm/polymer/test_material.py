@@ -253,6 +253,9 @@ def test_modulation_image_is_looked_up_by_uv(sky, tmp_path):
         ("tio2 = 5.0", r"materials.p.tio2: must be in \[0, 2\] % \(the characterization's grid\)"),
         ("index = 1.0", r"materials.p.index: must be > 1, got 1.0$"),
         ("index = 0.5", r"materials.p.index: must be > 1, got 0.5$"),
+        # 1e11 was accepted; 1e308 was refused only as beyond the scenes' ±1e12
+        ("index = 5", r"materials.p.index: a refractive index must be in \(1, 3\] \(polymers"),
+        ("index = 1e308", r"materials.p.index: a refractive index must be in \(1, 3\]"),
         ('tint = "lemon"', r"materials.p.tint: .*spot_colours.csv: unknown tint 'lemon'; closest"),
         ("tint = 1.5", r"materials.p.tint: must be in \[0, 1\], got a maximum of 1.5$"),
         ("gloss = 2.0", r"materials.p.gloss: must be <= 1, got 2.0$"),
