@@ -557,9 +557,10 @@ def rough_specular_samples_mis(
     """Sums of the rough-specular estimator with the map sampled too (Veach's balance heuristic).
 
     The interface term of the oracle (physical counterpart of ``I_s F_r`` in Eq. (1), Herbert
-    et al.), as :func:`rough_specular_samples` estimates it. Each sample is a pair: a GGX visible normal (as :func:`rough_specular_samples`, from
-    ``u[..., 0:2]``) and a direction drawn from the map (:func:`environment_sampling`, from
-    ``u[..., 2:4]``). Each direction ``i`` adds ``f_s cos θ_i L(i) / (p_v(i) + p_e(i))``
+    et al.), as :func:`rough_specular_samples` estimates it. Each sample is a pair: a GGX
+    visible normal (from ``u[..., 0:2]``) and a direction drawn from the map
+    (:func:`environment_sampling`, from ``u[..., 2:4]``). Each direction ``i`` adds
+    ``f_s cos θ_i L(i) / (p_v(i) + p_e(i))``
     (Veach & Guibas 1995, the balance heuristic with one sample per technique), and since
     ``f_s cos θ_i = F(o·h) G_1(i) p_v(i)`` for the separable Smith GGX of Eq. (20), Walter et al.
     2007, that is ``F(o·h) G_1(i) L(i) p_v / (p_v + p_e)``. Unbiased like the visible normals
