@@ -205,7 +205,9 @@ _WRITER = textwrap.dedent(
     value = np.arange(200_000.0)
 
     def hang(path, written, total):
-        marker.write_text(f"{written} {total}")
+        # the marker appears whole (renamed into place): the test reads it as soon as it exists
+        marker.with_suffix(".part").write_text(f"{written} {total}")
+        marker.with_suffix(".part").rename(marker)
         time.sleep(60)
 
     if mode == "hang":

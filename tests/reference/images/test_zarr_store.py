@@ -159,8 +159,10 @@ def test_cli_convert_and_project(tmp_path, capsys):
     )
     z, e = np.load(tmp_path / "z.npz"), np.load(tmp_path / "e.npz")
     assert np.max(np.abs(z["coeffs"] - e["coeffs"])) <= 1e-12 * np.abs(e["coeffs"]).max()
-    assert main(["env", "convert", str(tmp_path / "m.exr"), str(out), "--rows", "0"]) == 2
-    assert "rows per chunk" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as refused:  # a flag's value refused while parsing
+        main(["env", "convert", str(tmp_path / "m.exr"), str(out), "--rows", "0"])
+    assert refused.value.code == 2
+    assert "argument --rows: must be a whole number in [1, " in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("bad", [np.nan, np.inf])
