@@ -42,14 +42,20 @@ def _fresnel_dielectric(cos_i, n):
 
 
 @njit
-def _latlong_bilinear_taps(H, W, dx, dy, dz):
-    """The texels and weights of a bilinear look-up at a direction (``latlong_lookup_bilinear``)."""
+def _latlong_uv(dx, dy, dz):
+    """Lat-long texture coordinates of a unit direction (``direction_to_latlong_uv``)."""
     u = math.atan2(dx, -dz) / (2.0 * math.pi)
     if u < 0.0:
         u += 1.0
     if u >= 1.0:
         u = 0.0
-    v = math.acos(min(max(dy, -1.0), 1.0)) / math.pi
+    return u, math.acos(min(max(dy, -1.0), 1.0)) / math.pi
+
+
+@njit
+def _latlong_bilinear_taps(H, W, dx, dy, dz):
+    """The texels and weights of a bilinear look-up at a direction (``latlong_lookup_bilinear``)."""
+    u, v = _latlong_uv(dx, dy, dz)
     x = u * W - 0.5
     y = min(max(v * H - 0.5, 0.0), H - 1.0)
     x0 = math.floor(x)
@@ -166,12 +172,7 @@ def _vndf_pdf_local(ox, oy, oz, ix, iy, iz, alpha):
 @njit
 def _texel_of_direction(H, W, dx, dy, dz):
     """The row-major texel whose solid angle holds a unit direction (``_texel_of``)."""
-    u = math.atan2(dx, -dz) / (2.0 * math.pi)
-    if u < 0.0:
-        u += 1.0
-    if u >= 1.0:
-        u = 0.0
-    v = math.acos(min(max(dy, -1.0), 1.0)) / math.pi
+    u, v = _latlong_uv(dx, dy, dz)
     return min(math.floor(v * H), H - 1) * W + min(math.floor(u * W), W - 1)
 
 

@@ -619,39 +619,23 @@ def rough_specular_samples_mis(
 def _rough_specular_kernel_call(normal, view, radiance, alpha, n, u):
     from shrm.polymer._kernels import rough_specular_samples_kernel
 
-    P, nb = normal.shape[0], radiance.shape[-1]
-    total, total_sq = np.zeros((P, nb)), np.zeros((P, nb))
-    rough_specular_samples_kernel(
-        np.ascontiguousarray(normal, dtype=np.float64),
-        np.ascontiguousarray(view, dtype=np.float64),
-        np.ascontiguousarray(radiance, dtype=np.float64),
-        float(alpha),
-        float(n),
-        np.ascontiguousarray(u, dtype=np.float64),
-        total,
-        total_sq,
-    )
-    return total, total_sq
+    return _sums_by(rough_specular_samples_kernel, normal, view, radiance, alpha, n, u)
 
 
 def _rough_specular_mis_call(normal, view, radiance, alpha, n, u, sampling=None):
     from shrm.polymer._kernels import rough_specular_mis_kernel
 
+    cdf, pdf = environment_sampling(radiance) if sampling is None else sampling
+    return _sums_by(rough_specular_mis_kernel, normal, view, radiance, alpha, n, u, cdf, pdf)
+
+
+def _sums_by(kernel, normal, view, radiance, alpha, n, u, *extra):
+    """A rough-specular kernel's sums and sums of squares ``(P, n_bands)`` each."""
     P, nb = normal.shape[0], radiance.shape[-1]
     total, total_sq = np.zeros((P, nb)), np.zeros((P, nb))
-    cdf, pdf = environment_sampling(radiance) if sampling is None else sampling
-    rough_specular_mis_kernel(
-        np.ascontiguousarray(normal, dtype=np.float64),
-        np.ascontiguousarray(view, dtype=np.float64),
-        np.ascontiguousarray(radiance, dtype=np.float64),
-        float(alpha),
-        float(n),
-        np.ascontiguousarray(u, dtype=np.float64),
-        cdf,
-        pdf,
-        total,
-        total_sq,
-    )
+    contiguous = (np.ascontiguousarray(a, dtype=np.float64) for a in (normal, view, radiance))
+    u = np.ascontiguousarray(u, dtype=np.float64)
+    kernel(*contiguous, float(alpha), float(n), u, *extra, total, total_sq)
     return total, total_sq
 
 
