@@ -586,7 +586,10 @@ def run_tasks(
     client : distributed.Client, optional
         Use this client (and leave it open) instead of making one.
     progress : bool
-        A progress bar on stderr (never under CI or without a terminal).
+        Progress on stderr (never under CI): a bar on a terminal; serially, without one, a line
+        with the expected time once the tasks have run a couple of seconds
+        (:class:`reference.progress.Progress`) and a line per shared build that runs over a
+        second. A cluster's bar shows on a terminal only.
     retries : int
         Times a task is run again after its worker died.
     default : str, optional
