@@ -33,6 +33,7 @@ __all__ = [
     "output_error",
     "read_json",
     "remove_stale_temporaries",
+    "require_input_file",
     "same_file",
     "temporary_prefix",
     "write_bytes_atomic",
@@ -299,6 +300,13 @@ def _store_entry(entry: Path) -> bool:
     return chunk_key or entry.name in STORE_FILES or entry.name.startswith(".")
 
 
+#: Why a path cannot be looked up at all, by errno, in the words of the refusals.
+_LOOKUP_ERRORS = {
+    errno.ENAMETOOLONG: "a name in the path is too long for the file system",
+    errno.ELOOP: "a loop of symbolic links",
+}
+
+
 def _existing_inputs(inputs) -> list[Path]:
     """The inputs that exist; names the file system cannot look up at all are refused."""
     found = []
@@ -308,8 +316,7 @@ def _existing_inputs(inputs) -> list[Path]:
         except FileNotFoundError:
             continue  # the command says "file not found" in its own words
         except OSError as error:
-            reason = {errno.ENAMETOOLONG: "a name in the path is too long for the file system",
-                      errno.ELOOP: "a loop of symbolic links"}.get(error.errno)  # fmt: skip
+            reason = _LOOKUP_ERRORS.get(error.errno)
             if reason is None:
                 raise
             raise SpecrefError(f"{source}: cannot read ({reason})") from None
@@ -320,6 +327,39 @@ def _existing_inputs(inputs) -> list[Path]:
         )
         found.append(source)
     return found
+
+
+def require_input_file(path) -> Path:
+    """``path`` as a regular file to read, or a one-line error that says what it is instead.
+
+    Missing (``file not found``), a folder, a loop of symbolic links, a name too long for the
+    file system, or a device, FIFO or socket (``/dev/zero`` never ends, a FIFO waits for a
+    writer): each is named as such, where ``is_file()`` called them all "not found".
+
+    Examples
+    --------
+    >>> require_input_file("/nonexistent.exr")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: /nonexistent.exr: file not found
+    >>> require_input_file("/tmp")
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: /tmp: cannot read (a folder, not a file)
+    """
+    path = Path(path)
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        raise SpecrefError(f"{path}: file not found") from None
+    except OSError as error:
+        reason = _LOOKUP_ERRORS.get(error.errno, error.strerror)
+        raise SpecrefError(f"{path}: cannot read ({reason})") from None
+    require(not stat.S_ISDIR(mode), f"{path}: cannot read (a folder, not a file)")
+    require(
+        stat.S_ISREG(mode), f"{path}: cannot read (a device or special file, not a regular file)"
+    )
+    return path
 
 
 #: Files of an input folder that the write policy looks at (a painting folder, a data folder):

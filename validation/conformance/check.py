@@ -66,11 +66,11 @@ def read_render(path, colourspace: str | None = None) -> np.ndarray:
     reference.errors.SpecrefError: /nonexistent.exr: file not found
     """
     from reference.colour.colorimetry import display_RGB_to_XYZ
+    from reference.files import require_input_file
     from reference.images.formats import read_exr
     from reference.scene.compare import exr_to_XYZ
 
-    path = Path(path)
-    require(path.is_file(), f"{path}: file not found")
+    path = require_input_file(path)  # a folder, a FIFO or a link loop named as such
     XYZ, info = exr_to_XYZ(path)
     if colourspace is not None and info["kind"] == "rgb" and path.suffix.lower() == ".exr":
         image, names = read_exr(path)

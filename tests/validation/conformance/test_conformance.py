@@ -8,6 +8,7 @@ process.
 from __future__ import annotations
 
 import json
+import os
 import tomllib
 import xml.etree.ElementTree as ET
 
@@ -227,6 +228,11 @@ def test_monte_carlo_noise_passes_and_bias_fails(references, tmp_path):
          "colorchecker-a.exr"),
         (lambda d, ref: _write(d / "colourchecker-a.exr", ref.XYZ), "no conformance scene named"),
         (lambda d, ref: None, "no renders"),
+        (lambda d, ref: os.mkfifo(d / "colorchecker-a.exr"), "not a regular file"),
+        (lambda d, ref: (d / "colorchecker-a.exr").mkdir(), "cannot read (a folder, not a file)"),
+        (lambda d, ref: (os.symlink(d / "colorchecker-a.exr", d / "loop"),
+                         os.symlink(d / "loop", d / "colorchecker-a.exr")),
+         "a loop of symbolic links"),
         (lambda d, ref: write_exr(d / "colorchecker-a.exr", ref.XYZ[..., :2].astype(np.float32),
                                   ["U", "V"]), "no X, Y, Z"),
     ],
