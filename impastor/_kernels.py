@@ -217,15 +217,20 @@ def _horizon_along(h, pixel_size, j, i, phi, max_steps, step, h_max):
 
 
 @njit
-def horizon_map_kernel(h, pixel_size, n_sectors, max_steps, step, out):
-    """Twin of ``horizon_map``: each sector marched along its centre azimuth."""
-    H, W = h.shape
+def horizon_map_kernel(h, pixel_size, n_sectors, max_steps, step, row0, out):
+    """Twin of ``horizon_map``: each sector marched along its centre azimuth, rows from row0.
+
+    ``out`` holds the rows ``row0 .. row0 + len(out)``: the wrapper calls it a band at a time.
+    """
+    W = h.shape[1]
     h_max = h.max()
     for s in range(n_sectors):
         phi = (s + 0.5) * 2.0 * math.pi / n_sectors
-        for j in range(H):
+        for j in range(out.shape[0]):
             for i in range(W):
-                out[j, i, s] = _horizon_along(h, pixel_size, j, i, phi, max_steps, step, h_max)
+                out[j, i, s] = _horizon_along(
+                    h, pixel_size, row0 + j, i, phi, max_steps, step, h_max
+                )
 
 
 @njit

@@ -43,6 +43,7 @@ from reference.registry import Method, Registry
 
 __all__ = [
     "BACKENDS",
+    "HORIZON_BAND_TEXELS",
     "HORIZON_METHODS",
     "horizon_at_texels",
     "horizon_images_to_map",
@@ -102,6 +103,11 @@ def _horizon_along(h, pixel_size, phi, max_steps, step):
     return np.arctan(best)
 
 
+#: Texel-sectors per call of the horizon map's kernel: a 512² map of 36 sectors is 2¹⁵ of them
+#: per band (about 0.1 s), so Ctrl-C and SIGTERM are handled between bands.
+HORIZON_BAND_TEXELS = 1 << 15
+
+
 def horizon_map(
     height,
     pixel_size: float,
@@ -148,7 +154,10 @@ def horizon_map(
     step = _check_step(step, "horizon map")
     out = np.zeros((*h.shape, S))
     if backend == "numba":
-        horizon_map_kernel(h, pixel_size, S, steps, step, out)
+        # a band of rows per call, so a signal (Ctrl-C) is handled within a fraction of a second
+        band = max(1, HORIZON_BAND_TEXELS // (h.shape[1] * S))
+        for row0 in range(0, h.shape[0], band):
+            horizon_map_kernel(h, pixel_size, S, steps, step, row0, out[row0 : row0 + band])
         return out
     for s in range(S):
         # Sector s is marched along its centre azimuth (s + ½) 2π/S.

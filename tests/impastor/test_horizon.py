@@ -182,3 +182,15 @@ def test_horizon_map_agrees_with_ray_marching_at_every_elevation(seed):
         assert (per_elevation <= 0.02).all(), (label, per_elevation.round(4))
         # The first version (one-pixel steps, one sector; erratum E95) does worse.
         assert max(result["one_pixel_steps"][label]) > max(per_elevation)
+
+
+def test_horizon_map_in_bands_equals_the_reference(monkeypatch, rng):
+    """The kernel called a band of rows at a time (so a signal is handled between bands)."""
+    import sys
+
+    horizon = sys.modules["impastor.horizon"]
+    h = rng.normal(size=(13, 16)) * 1e-3
+    expected = horizon.horizon_map(h, 1e-3, 5, 9, backend="numpy")
+    monkeypatch.setattr(horizon, "HORIZON_BAND_TEXELS", 3 * 16 * 5)  # bands of 3 rows, one of 1
+    got = horizon.horizon_map(h, 1e-3, 5, 9, backend="numba")
+    np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-14)
