@@ -125,6 +125,7 @@ def main(argv: list[str] | None = None) -> int:
 
     parser = build_parser()
     args = parser.parse_args(argv)
+    vars(args).pop("_specref_given", None)  # the parser's record of the options given once
     # glibc's default mmap threshold makes NumPy's large temporaries an mmap and a munmap each, in
     # system calls that slowed long sweeps (docs/scale-out.md); the workers set the same.
     # Streamed commands map each chunk on its own and return it to the system when freed,

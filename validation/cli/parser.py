@@ -30,8 +30,34 @@ __all__ = [
 ]
 
 
+class _StoreOnce(argparse._StoreAction):
+    """argparse's ``store``, refusing an option given twice (the last one silently won)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        given = namespace.__dict__.setdefault("_specref_given", set())
+        if option_string is not None and self.dest in given:
+            parser.error(f"argument {'/'.join(self.option_strings)}: given more than once")
+        given.add(self.dest)
+        super().__call__(parser, namespace, values, option_string)
+
+
 class Parser(argparse.ArgumentParser):
-    """argparse with one-line usage errors and exit code 2 (argparse's code for usage errors)."""
+    """argparse with one-line usage errors and exit code 2 (argparse's code for usage errors).
+
+    An option that takes one value may be given once: ``-o a.png -o b.png`` is refused.
+
+    Examples
+    --------
+    >>> p = Parser(prog="x")
+    >>> _ = p.add_argument("-o", "--out")
+    >>> p.parse_args(["-o", "a.png"]).out
+    'a.png'
+    """
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.register("action", None, _StoreOnce)
+        self.register("action", "store", _StoreOnce)
 
     def error(self, message):
         """Print a one-line usage error naming the subcommand's help, and exit with code 2."""

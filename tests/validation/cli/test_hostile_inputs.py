@@ -292,3 +292,27 @@ def test_equations_check_outside_a_checkout_says_so(tmp_path, monkeypatch, capsy
         "specref: error: docs/equations.md: not found; --check compares a checkout's "
         "docs/equations.md (run it in the repository, or give -o FILE)"
     )
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["render", "data:examples/phong-sphere.toml", "-o", "a.png", "-o", "b.png"],
+        ["render", "data:examples/phong-sphere.toml", "-o", "a.png", "--width", "8",
+         "--width", "4"],
+        ["sh", "project", "data:environments/venice_sunset_1k.hdr", "--order", "2", "--order", "4",
+         "-o", "x.npz"],
+    ],
+)  # fmt: skip
+def test_an_option_given_twice_is_refused_in_one_line(argv, tmp_path, capsys, monkeypatch):
+    """The last one silently won: `-o a.png -o b.png` wrote b.png alone."""
+    from validation.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as refused:
+        main(argv)
+    assert refused.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "given more than once" in err
+    assert not any(tmp_path.iterdir())
