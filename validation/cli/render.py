@@ -17,8 +17,13 @@ def _cmd_render(args) -> int:
 
     import phong_table  # noqa: F401  (registers its shaders, if any)
     import shrm  # noqa: F401  (registers the environment-light shaders, if any)
+    from reference.errors import require
     from reference.scene.render import render_scene_file
 
+    require(
+        args.exr_output is None or args.exr is not None,
+        f"--exr-output {args.exr_output}: says what the EXR holds; give --exr OUT.exr too",
+    )
     result = render_scene_file(
         args.scene,
         png=args.output,
@@ -28,7 +33,7 @@ def _cmd_render(args) -> int:
         supersample=args.supersample,
         oracle=args.oracle,
         texel_placement=args.texel_placement,
-        exr_output=args.exr_output,
+        exr_output=args.exr_output or "display",
         accuracy=args.accuracy,
         json=args.json,
         progress=sys.stderr,
@@ -86,8 +91,7 @@ def add_parser(sub) -> None:
         p,
         "--exr-output",
         RENDER_OUTPUTS,
-        "what the EXR holds, see docs/render-outputs.md",
-        default="display",
+        "what the --exr file holds (default display), see docs/render-outputs.md",
     )
     p.add_argument(
         "--accuracy",

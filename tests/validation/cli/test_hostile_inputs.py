@@ -118,6 +118,9 @@ CASES = [
     # not checked at all in a scene without an environment map
     (["render", "data:examples/phong-sphere.toml", "-o", "{out.png}", "--exr-output", "hdr"],
      "argument --exr-output: unknown value 'hdr'; allowed: display, xyz, spectral"),
+    # what the EXR holds, without an EXR (it was ignored without a word)
+    (["render", "data:examples/phong-sphere.toml", "-o", "{out.png}", "--exr-output", "xyz"],
+     "--exr-output xyz: says what the EXR holds; give --exr OUT.exr too"),
     (["render", "data:examples/phong-sphere.toml", "-o", "{out.png}", "--texel-placement", "edge"],
      "argument --texel-placement: unknown value 'edge'; allowed: centred, mitsuba"),
     (["env", "convert", VENICE, "{out.zarr}", "--rows", "0"],
