@@ -57,7 +57,7 @@ from reference.materials.fresnel import fresnel_dielectric
 from reference.registry import Method, Registry
 from shrm.polymer.oracle import (
     Coupling,
-    _frame,
+    _local_views,
     _reflect_weight,
     _sample_visible_normal,
     _smith_G1,
@@ -352,13 +352,8 @@ def fis_specular_latlong(
     u = hammersley(samples)
     out = np.zeros((N.shape[0], levels[0].shape[2]))
     for s in range(0, N.shape[0], 1024):
-        T, B = _frame(N[s : s + 1024])
         n_s = N[s : s + 1024]
-        o = np.stack([np.einsum("ij,ij->i", V[s : s + 1024], A) for A in (T, B, n_s)], axis=-1)
-        o[:, 2] = np.maximum(o[:, 2], 1e-6)
-        o = np.broadcast_to(
-            (o / np.linalg.norm(o, axis=-1, keepdims=True))[:, None], (len(o), samples, 3)
-        )
+        T, B, o = _local_views(n_s, V[s : s + 1024], (len(n_s), samples))
         h = _sample_visible_normal(o, alpha, *np.broadcast_to(u.T[:, None], (2, len(o), samples)))
         weight, i = _reflect_weight(o, h, alpha, n)
         wi = i[..., 0:1] * T[:, None] + i[..., 1:2] * B[:, None] + i[..., 2:3] * n_s[:, None]

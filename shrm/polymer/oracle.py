@@ -180,6 +180,15 @@ def _frame(N):
     return T, B
 
 
+def _local_views(N, V, shape):
+    """Tangent frames (T, B) and the views in them, above the surface, broadcast to shape + (3,)."""
+    T, B = _frame(N)
+    o = np.stack([np.einsum("ij,ij->i", V, A) for A in (T, B, N)], axis=-1)
+    o[:, 2] = np.maximum(o[:, 2], 1e-6)
+    o = o / np.linalg.norm(o, axis=-1, keepdims=True)
+    return T, B, np.broadcast_to(o[:, None, :], (*shape, 3))
+
+
 def _sample_visible_normal(o, alpha, u1, u2):
     """GGX visible normals for local view directions ``o`` (Heitz 2018, listing 1)."""
     Vh = np.stack([alpha * o[..., 0], alpha * o[..., 1], o[..., 2]], axis=-1)
@@ -470,11 +479,7 @@ def rough_specular_samples(normal, view, radiance, alpha, n, u) -> tuple[np.ndar
     """
     N = np.asarray(normal, dtype=np.float64)
     V = np.asarray(view, dtype=np.float64)
-    T, B = _frame(N)
-    o = np.stack([np.einsum("ij,ij->i", V, A) for A in (T, B, N)], axis=-1)
-    o[:, 2] = np.maximum(o[:, 2], 1e-6)
-    o = o / np.linalg.norm(o, axis=-1, keepdims=True)
-    o = np.broadcast_to(o[:, None, :], (*u.shape[:2], 3))
+    T, B, o = _local_views(N, V, u.shape[:2])
     h = _sample_visible_normal(o, alpha, u[..., 0], u[..., 1])
     weight, i = _reflect_weight(o, h, alpha, n)
     wi = i[..., 0:1] * T[:, None] + i[..., 1:2] * B[:, None] + i[..., 2:3] * N[:, None]
@@ -595,11 +600,7 @@ def rough_specular_samples_mis(
     V = np.asarray(view, dtype=np.float64)
     H, W = radiance.shape[:2]
     cdf, pdf = environment_sampling(radiance) if sampling is None else sampling
-    T, B = _frame(N)
-    o = np.stack([np.einsum("ij,ij->i", V, A) for A in (T, B, N)], axis=-1)
-    o[:, 2] = np.maximum(o[:, 2], 1e-6)
-    o = o / np.linalg.norm(o, axis=-1, keepdims=True)
-    o = np.broadcast_to(o[:, None, :], (*u.shape[:2], 3))
+    T, B, o = _local_views(N, V, u.shape[:2])
     h = _sample_visible_normal(o, alpha, u[..., 0], u[..., 1])
     i_v = 2.0 * np.einsum("...k,...k->...", o, h)[..., None] * h - o
     world = np.stack([T, B, N], axis=1)  # local (t, b, n) to world: i @ world
