@@ -47,7 +47,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from scipy.interpolate import RegularGridInterpolator
 
 from reference.colour.spectra import DEFAULT_GRID, SpectralGrid
 from reference.errors import SpecrefError, require
@@ -151,6 +150,9 @@ class Characterization:
                     f"characterization: {name}: must be in [{axis[0]:g}, {axis[-1]:g}] (the grid), "
                     f"got {np.atleast_1d(value)[np.atleast_1d(outside)][0]!r}"
                 )
+        # imported here: SciPy's interpolate costs every command's start-up about 0.3 s
+        from scipy.interpolate import RegularGridInterpolator
+
         d, c = np.broadcast_arrays(d, c)
         points = np.stack([np.log(d), c], axis=-1).reshape(-1, 2)
         out = {}

@@ -40,3 +40,33 @@ def test_report_via_main(tmp_path, capsys):
     assert (tmp_path / "index.html").is_file()
     assert "index.html" in capsys.readouterr().out
     assert build_parser().parse_args(["report"]).out == "report"
+
+
+#: Libraries that cost a command's start-up a tenth of a second or more each and that no command
+#: needs before it runs: imported where they are used.
+_HEAVY_AT_START = (
+    "colour",
+    "dask",
+    "distributed",
+    "imageio",
+    "matplotlib",
+    "OpenEXR",
+    "scipy.interpolate",
+    "scipy.optimize",
+    "scipy.special",
+    "tifffile",
+    "zarr",
+)
+
+
+def test_the_command_line_starts_without_the_heavy_libraries():
+    script = (
+        "import sys, validation.cli; validation.cli.build_parser(); "
+        "print(' '.join(sorted(sys.modules)))"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, check=True
+    )
+    loaded = set(done.stdout.split())
+    assert {"validation.cli", "shrm", "impastor", "phong_table"} <= loaded
+    assert sorted(set(_HEAVY_AT_START) & loaded) == []
