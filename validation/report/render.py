@@ -55,6 +55,8 @@ def _td(value, fmt: str) -> str:
 
 
 def _cell(value, fmt: str) -> str:
+    if value is None:  # not measured (e.g. a figure an older benchmark file lacks)
+        return "—"
     if isinstance(value, float | np.floating):
         return fmt.format(float(value)) if math.isfinite(value) else "—"
     return str(value)
