@@ -72,6 +72,7 @@ __all__ = [
     "GLOSS_ALPHA_MAX",
     "ORACLE_KERNELS",
     "PHONG_EXPONENT_MAX",
+    "SPECULAR_CHUNK_SAMPLES",
     "OracleResult",
     "body_factors",
     "coupled_irradiance",
@@ -824,6 +825,12 @@ def coupled_irradiance(
     return out
 
 
+#: Sample pairs per call of the rough lobe's estimator (:func:`polymer_oracle`): the rounds go a
+#: band of pixels at a time, so their random numbers take at most 4 × 8 bytes × this (64 MiB) and
+#: each call runs for a fraction of a second (an interrupt is heard between calls).
+SPECULAR_CHUNK_SAMPLES = 1 << 21
+
+
 class _Rounds(NamedTuple):
     """The Monte Carlo rounds of the specular lobe (:func:`polymer_oracle`'s keywords)."""
 
@@ -849,8 +856,16 @@ def _specular(N, V, radiance, n, alpha, scale, rounds: _Rounds):
     sampling = environment_sampling(radiance)
     total, total_sq, M, batch = np.zeros((P, nb)), np.zeros((P, nb)), 0, int(samples)
     while True:
-        t, t2 = call(N, V, radiance, alpha, n, rng.random((P, batch, 4)), sampling)
-        total, total_sq, M = total + t, total_sq + t2, M + batch
+        # a band of pixels at a time (their random numbers drawn in the same order as for all
+        # at once): the draws stay within SPECULAR_CHUNK_SAMPLES pairs and Ctrl-C is heard
+        # between bands
+        chunk = max(1, SPECULAR_CHUNK_SAMPLES // batch)
+        for s in range(0, P, chunk):
+            u = rng.random((min(chunk, P - s), batch, 4))
+            t, t2 = call(N[s : s + chunk], V[s : s + chunk], radiance, alpha, n, u, sampling)
+            total[s : s + chunk] += t
+            total_sq[s : s + chunk] += t2
+        M += batch
         mean = total / M
         se = np.sqrt(np.maximum(total_sq / M - mean**2, 0.0) / max(M - 1, 1))
         rel = float(

@@ -186,6 +186,34 @@ def test_standard_error_shrinks_as_one_over_sqrt_n():
     np.testing.assert_array_equal(again.specular, runs[256].specular)
 
 
+@pytest.mark.parametrize("backend", ["numba", "numpy"])
+def test_rounds_in_bands_of_pixels_give_the_same_image(monkeypatch, backend):
+    # the rounds go a band of pixels at a time (bounded memory, an interrupt heard between
+    # bands); the bands draw their random numbers in the same order, so the image is the same
+    import shrm.polymer.oracle as oracle
+    from validation.report.sections.polymer import synthetic_environment
+
+    env = synthetic_environment(16)
+    N, V, _ = _views(9)
+    settings = {"tol": 0.0, "samples": 32, "max_samples": 64, "backend": backend}
+    whole = polymer_oracle(N, V, env, 0.0, 0.0, 0.0, 1.54, 0.5, **settings)
+    calls = []
+    real_call = oracle._rough_specular_mis_call if backend == "numba" else None
+    monkeypatch.setattr(oracle, "SPECULAR_CHUNK_SAMPLES", 4 * 32 + 1)  # bands of 4 pixels
+    if real_call is not None:
+
+        def counted(normal, *args):
+            calls.append(len(normal))
+            return real_call(normal, *args)
+
+        monkeypatch.setattr(oracle, "_rough_specular_mis_call", counted)
+    banded = polymer_oracle(N, V, env, 0.0, 0.0, 0.0, 1.54, 0.5, **settings)
+    np.testing.assert_array_equal(banded.specular, whole.specular)
+    np.testing.assert_array_equal(banded.standard_error, whole.standard_error)
+    if real_call is not None:
+        assert calls == [4, 4, 1, 4, 4, 1]  # two rounds of 32 pairs, 9 pixels in bands of 4
+
+
 def test_rounds_stop_at_the_tolerance():
     N, V, _ = _views(6)
     out = polymer_oracle(N, V, np.ones((16, 32, 1)), [0.1], [1.0], 1.0, 1.54, 0.7, tol=0.01)
