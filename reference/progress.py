@@ -18,11 +18,14 @@ import threading
 import time
 from typing import TextIO
 
-__all__ = ["ANNOUNCE_AFTER", "Progress", "StageTimer", "format_seconds"]
+__all__ = ["ANNOUNCE_AFTER", "LINE_EVERY", "Progress", "StageTimer", "format_seconds"]
 
 #: Seconds after which a command's stage is announced (``StageTimer(after=...)``): quick stages,
 #: and a refusal of bad input in its one line, print nothing else.
 ANNOUNCE_AFTER = 1.0
+#: Seconds between a long loop's lines off a terminal, after its estimate (:class:`Progress`): the
+#: share done and the time left, measured on the work done so far.
+LINE_EVERY = 30.0
 
 
 def format_seconds(seconds: float) -> str:
@@ -59,6 +62,9 @@ class Progress:
         The unit's name, for the bar.
     estimate_after : float
         Seconds of work after which the expected total is written (line mode).
+    line_every : float
+        Seconds between the lines that follow the estimate (line mode): the share done and the
+        time left.
 
     Examples
     --------
@@ -79,11 +85,13 @@ class Progress:
         stream: TextIO | None = None,
         unit: str = "rows",
         estimate_after: float = 2.0,
+        line_every: float = LINE_EVERY,
     ):
         self.desc, self.total, self.stream, self.unit = desc, int(total), stream, unit
-        self.estimate_after = estimate_after
+        self.estimate_after, self.line_every = estimate_after, line_every
         self.done = 0
         self._estimated = False
+        self._last_line = 0.0
         self._bar = None
         self._start = time.perf_counter()
 
@@ -103,9 +111,20 @@ class Progress:
         if self._bar is not None:
             self._bar.update(n)
             return
+        if self.stream is None:
+            return
         elapsed = time.perf_counter() - self._start
-        if self.stream is not None and not self._estimated and elapsed >= self.estimate_after:
-            self._estimated = True
+        if self._estimated:
+            if self.done < self.total and elapsed - self._last_line >= self.line_every:
+                self._last_line = elapsed
+                left = elapsed * (self.total - self.done) / max(self.done, 1)
+                self._write(
+                    f"{100 * self.done / self.total:.0f} % in {format_seconds(elapsed)}, "
+                    f"about {format_seconds(left)} left"
+                )
+            return
+        if elapsed >= self.estimate_after:
+            self._estimated, self._last_line = True, elapsed
             if self.done >= self.total:  # nothing left to estimate: only the closing line
                 return
             expected = elapsed * self.total / max(self.done, 1)
