@@ -222,3 +222,24 @@ def require_positive_int(value, where: str, maximum: int | None = None) -> int:
 
 
 __all__ += ["require_positive_int"]
+
+
+def require_between(value, where: str, low: float, high: float) -> float:
+    """Return ``value`` as a float after checking it is a real number with ``low < value < high``.
+
+    Examples
+    --------
+    >>> require_between(0.25, "tol", 0, 100)
+    0.25
+    >>> require_between(float("nan"), "tol", 0, 100)
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: tol: must be a number in (0, 100), got nan
+    """
+    ok = isinstance(value, int | float | np.integer | np.floating) and not isinstance(value, bool)
+    ok = ok and math.isfinite(value) and low < value < high
+    require(ok, f"{where}: must be a number in ({low:g}, {high:g}), got {value!r}")
+    return float(value)
+
+
+__all__ += ["require_between"]

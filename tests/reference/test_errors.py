@@ -8,6 +8,7 @@ from reference.errors import (
     SpecrefError,
     format_allowed,
     require,
+    require_between,
     require_choice,
     require_finite,
     require_nonnegative,
@@ -47,3 +48,11 @@ def test_choices_and_ints():
     for bad in (0, -1, 2.5, True, "3", 10**9):
         with pytest.raises(SpecrefError, match=r"w: must be an integer in \[1, 100\]"):
             require_positive_int(bad, "w", maximum=100)
+
+
+def test_require_between_refuses_all_but_a_real_number_inside_the_open_interval():
+    assert require_between(3, "t", 0, 10) == 3.0
+    assert require_between(np.float32(0.5), "t", 0, 1) == 0.5
+    for bad in (0, 10, -1.0, float("nan"), float("inf"), True, "3", None, [1.0]):
+        with pytest.raises(SpecrefError, match=r"^t: must be a number in \(0, 10\), got "):
+            require_between(bad, "t", 0, 10)
