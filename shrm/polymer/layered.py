@@ -16,9 +16,11 @@ three terms from maps prefiltered once per environment, index and gloss, with th
 - **specular**: smooth interface: ``F(θ_o) L(r)``, the oracle's mirror look-up. Rough:
   ``E_ρ(θ_o) L̄``, the interface's directional albedo (the oracle's table) times the environment
   averaged over the pixel's own lobe by filtered importance sampling (Colbert & Křivánek 2007) of
-  the oracle's estimator, read from the map's mip pyramid (:func:`fis_specular_latlong`); or, with
-  ``specular="split_sum_Karis"``, Karis 2013's split sum, the environment prefiltered by the GGX
-  lobe about the mirror direction ``r`` for ``n = v = r`` (erratum E108).
+  the oracle's estimator, read from the map's mip pyramid (:func:`fis_specular_latlong`), with as
+  many samples as a pilot finds the map, index and gloss need for a tolerance in lightness
+  (:func:`fis_samples_from_tolerance`, erratum E118); or, with ``specular="split_sum_Karis"``,
+  Karis 2013's split sum, the environment prefiltered by the GGX lobe about the mirror direction
+  ``r`` for ``n = v = r`` (erratum E108).
 
 ``exit(θ_o) = (1 − E_ρ(θ_o)) / (π (1 − k_e))`` and the slab's ``ρ_out`` and ``τ`` are the
 oracle's (:func:`shrm.polymer.oracle.body_factors`). Thickness and TiO2 (the slab) change only
@@ -28,6 +30,7 @@ and the index choose the maps.
 
 References
 ----------
+CIE 15:2004. Colorimetry, 3rd ed. (CIE 1976 lightness L*).
 Colbert, M., Křivánek, J. (2007). GPU-based importance sampling. GPU Gems 3, ch. 20.
 Heitz, E. (2018). Sampling the GGX distribution of visible normals. JCGT 7(4).
 Karis, B. (2013). Real shading in Unreal Engine 4. SIGGRAPH course notes (the split sum).
@@ -43,7 +46,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reference.errors import require, require_choice, require_finite, require_positive_int
+from reference.errors import (
+    require,
+    require_between,
+    require_choice,
+    require_finite,
+    require_positive_int,
+)
 from reference.geometry.envmap import (
     check_latlong_shape,
     latlong_lookup_bilinear,
@@ -69,12 +78,19 @@ from shrm.polymer.oracle import (
 
 __all__ = [
     "FIS_BIAS",
-    "FIS_SAMPLES",
+    "FIS_MAX_SAMPLES",
+    "FIS_PILOT_CAMERAS",
+    "FIS_PILOT_SIZE",
+    "FIS_PILOT_START",
+    "FIS_TOL",
     "LAYERED_KERNELS",
     "LAYERED_SPECULAR",
     "PREFILTER_MAX_ROWS",
+    "FisPilot",
     "LayeredMaps",
     "coupled_irradiance_latlong",
+    "fis_pilot_pixels",
+    "fis_samples_from_tolerance",
     "fis_specular_latlong",
     "ggx_prefiltered_latlong",
     "layered_maps",
@@ -91,10 +107,24 @@ PREFILTER_MAX_ROWS = 64
 #: sampling of the true lobe (:func:`fis_specular_latlong`, the default) or Karis's split sum
 #: (:func:`ggx_prefiltered_latlong`; erratum E108).
 LAYERED_SPECULAR = ("fis_Colbert", "split_sum_Karis")
-#: Filtered importance sampling: Hammersley samples of the lobe per pixel, and the bias added to
-#: the pyramid level (Colbert & Křivánek 2007 add 1; 0 reads a sharper level). Chosen on the first
-#: draw of held-out chips (erratum E108), which the report no longer uses.
-FIS_SAMPLES, FIS_BIAS = 128, 0.0
+#: Filtered importance sampling's bias added to the pyramid level (Colbert & Křivánek 2007 add 1;
+#: 0 reads a sharper level). Chosen on the first draw of held-out chips (erratum E108), which the
+#: report no longer uses.
+FIS_BIAS = 0.0
+#: Filtered importance sampling's tolerance: the CIE 1976 lightness difference ΔL* of the
+#: specular term alone (a black chip's colour, the worst case) that the pilot's sample count may
+#: leave, over a white of the map's mean radiance (:func:`fis_samples_from_tolerance`, erratum
+#: E118): a quarter of the ΔE00 of 1 that the report holds a real-time polymer model to, as the
+#: judge's own noise is held to a quarter.
+FIS_TOL = 0.25
+#: The pilot's first sample count and its cap, Hammersley samples per pixel: the cap is the
+#: oracle's own (``polymer_oracle(max_samples=4096)``), so the model never samples more than its
+#: judge.
+FIS_PILOT_START, FIS_MAX_SAMPLES = 16, 4096
+#: The pilot's pixels: orthographic spheres of this many pixels across, seen from each of these
+#: directions (the six axes: every normal, seen from the front and at the rim).
+FIS_PILOT_SIZE = 16
+FIS_PILOT_CAMERAS = ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1))
 
 
 def _box_rows(radiance: np.ndarray, rows: int) -> np.ndarray:
@@ -227,7 +257,10 @@ class LayeredMaps:
     levels : tuple of ndarray
         The environment's mip pyramid (filtered importance sampling's; empty otherwise).
     samples : int
-        Samples per pixel of filtered importance sampling.
+        Samples per pixel of filtered importance sampling: the pilot's choice, or the one given
+        (0 where it is not used: a smooth interface or the split sum).
+    pilot : FisPilot or None
+        How the pilot chose ``samples`` (None where they were given or are not used).
     """
 
     radiance: np.ndarray
@@ -239,7 +272,8 @@ class LayeredMaps:
     alpha: float
     method: str = "split_sum_Karis"
     levels: tuple = ()
-    samples: int = FIS_SAMPLES
+    samples: int = 0
+    pilot: FisPilot | None = None
 
 
 def layered_maps(
@@ -247,7 +281,8 @@ def layered_maps(
     n: float = 1.54,
     gloss: float = 1.0,
     specular: str = "fis_Colbert",
-    samples: int = FIS_SAMPLES,
+    samples: int | None = None,
+    tol: float = FIS_TOL,
 ) -> LayeredMaps:
     """Prefilter an environment for the layered model (once per map, index and gloss).
 
@@ -262,46 +297,67 @@ def layered_maps(
     specular : str
         The rough interface's reflection, one of :data:`LAYERED_SPECULAR`: ``"fis_Colbert"``
         keeps the map's mip pyramid, ``"split_sum_Karis"`` prefilters it by the GGX lobe.
-    samples : int
-        Samples per pixel of ``"fis_Colbert"``.
+    samples : int, optional
+        Samples per pixel of ``"fis_Colbert"``; by default the pilot chooses them
+        (:func:`fis_samples_from_tolerance`, erratum E118).
+    tol : float
+        The pilot's tolerance, ΔL* in (0, 100) (:data:`FIS_TOL`); not read when ``samples`` is
+        given.
 
     Returns
     -------
     LayeredMaps
 
+    Raises
+    ------
+    SpecrefError
+        For a bad map, index, gloss, method, sample count or tolerance.
+
     Examples
     --------
     >>> maps = layered_maps(np.ones((16, 32, 2)), 1.5, 0.8, "split_sum_Karis")
-    >>> maps.E_front.shape, maps.specular.shape, round(maps.alpha, 3)
-    ((16, 32, 2), (16, 32, 2), 0.1)
-    >>> [level.shape[0] for level in layered_maps(np.ones((16, 32, 2)), 1.5, 0.8).levels]
-    [16, 8, 4, 2, 1]
+    >>> maps.E_front.shape, maps.specular.shape, round(maps.alpha, 3), maps.samples
+    ((16, 32, 2), (16, 32, 2), 0.1, 0)
+    >>> maps = layered_maps(np.ones((16, 32, 2)), 1.5, 0.8)       # a uniform sky needs few
+    >>> [level.shape[0] for level in maps.levels], maps.samples, maps.pilot.met
+    ([16, 8, 4, 2, 1], 32, True)
+    >>> layered_maps(np.ones((16, 32, 2)), 1.5, 0.8, samples=256).samples
+    256
     """
     radiance = np.asarray(require_finite(radiance, "layered polymer: radiance"), dtype=np.float64)
     check_latlong_shape(radiance.shape, "layered polymer: radiance")
     require((radiance >= 0).all(), "layered polymer: radiance must be >= 0")
     require(float(n) > 1.0, f"layered polymer: n: refractive index must be > 1, got {n!r}")
     require_choice(specular, LAYERED_SPECULAR, "layered polymer: specular")
-    require_positive_int(samples, "layered polymer: samples")
+    if samples is not None:
+        samples = require_positive_int(samples, "layered polymer: samples", 1 << 20)
+    tol = require_between(tol, "layered polymer: tol (ΔL*)", 0.0, 100.0)
     alpha = gloss_alpha(gloss)
     front, back = interface_coupling(float(n), alpha), interface_coupling(float(n), 0.0)
-    rough = alpha > 0.0
+    fis = alpha > 0.0 and specular == "fis_Colbert"
+    levels = tuple(latlong_mip_pyramid(radiance)) if fis else ()
+    pilot = None
+    if fis and samples is None:
+        # K from the tolerance: the pilot doubles it until the lightness settles (erratum E118)
+        pilot = fis_samples_from_tolerance(levels, alpha, float(n), tol)
+        samples = pilot.samples
     return LayeredMaps(
         radiance,
         coupled_irradiance_latlong(radiance, front),
         coupled_irradiance_latlong(radiance, back),
-        ggx_prefiltered_latlong(radiance, alpha) if rough and specular != "fis_Colbert" else None,
+        ggx_prefiltered_latlong(radiance, alpha) if alpha > 0.0 and not fis else None,
         float(n),
         float(gloss),
         alpha,
         specular,
-        tuple(latlong_mip_pyramid(radiance)) if rough and specular == "fis_Colbert" else (),
-        int(samples),
+        levels,
+        int(samples) if fis else 0,
+        pilot,
     )
 
 
 def fis_specular_latlong(
-    normal, view, levels, alpha: float, n: float, samples: int = FIS_SAMPLES, bias=FIS_BIAS
+    normal, view, levels, alpha: float, n: float, samples: int, bias=FIS_BIAS
 ) -> np.ndarray:
     """The environment averaged over the rough interface's lobe, by filtered importance sampling.
 
@@ -328,7 +384,7 @@ def fis_specular_latlong(
     alpha, n : float
         GGX width (> 0) and index.
     samples : int
-        K.
+        K (:func:`fis_samples_from_tolerance` chooses it for a map, index and gloss).
     bias : float
         Added to every level.
 
@@ -339,11 +395,11 @@ def fis_specular_latlong(
     Examples
     --------
     >>> up, side = np.array([[0.0, 1.0, 0.0]]), np.array([[0.0, 0.0, 1.0]])
-    >>> fis_specular_latlong(up, up, latlong_mip_pyramid(np.ones((16, 32, 1))), 0.2, 1.5)
+    >>> fis_specular_latlong(up, up, latlong_mip_pyramid(np.ones((16, 32, 1))), 0.2, 1.5, 64)
     array([[1.]])
     >>> sky = np.concatenate([np.ones((8, 32, 1)), np.zeros((8, 32, 1))])   # bright above
     >>> levels = latlong_mip_pyramid(sky)
-    >>> print(fis_specular_latlong(side, side, levels, 0.3, 1.5).round(3))  # half the lobe's sky
+    >>> print(fis_specular_latlong(side, side, levels, 0.3, 1.5, 128).round(3))  # half the sky
     [[0.5]]
     """
     N = np.asarray(normal, dtype=np.float64)
@@ -370,7 +426,7 @@ def fis_specular_latlong(
     return out
 
 
-def _fis_compiled(normal, view, levels, alpha, n, samples=FIS_SAMPLES, bias=FIS_BIAS):
+def _fis_compiled(normal, view, levels, alpha, n, samples, bias=FIS_BIAS):
     """:func:`fis_specular_latlong` by its numba twin (the pyramid packed in one array)."""
     from shrm.polymer._kernels import layered_fis_kernel
 
@@ -383,6 +439,163 @@ def _fis_compiled(normal, view, levels, alpha, n, samples=FIS_SAMPLES, bias=FIS_
     u = hammersley(samples)
     layered_fis_kernel(N, V, flat, heights, offsets, float(alpha), float(n), u, float(bias), out)
     return out
+
+
+@dataclass(frozen=True)
+class FisPilot:
+    """How :func:`fis_samples_from_tolerance` chose filtered importance sampling's K.
+
+    Parameters
+    ----------
+    samples : int
+        K, samples per pixel.
+    tol : float
+        The tolerance, ΔL*.
+    change : float
+        The pilot's ΔL* between K/2 and K (its estimate of K's error; ``inf`` if it took no step).
+    met : bool
+        ``change <= tol``; False when the cap stopped the doubling first.
+    changes : tuple of (int, float)
+        Every step of the doubling: K and its ΔL* from K/2.
+    """
+
+    samples: int
+    tol: float
+    change: float
+    met: bool
+    changes: tuple = ()
+
+
+def fis_pilot_pixels(size: int = FIS_PILOT_SIZE):
+    """The pilot's pixels: an orthographic unit sphere seen from each of :data:`FIS_PILOT_CAMERAS`.
+
+    Parameters
+    ----------
+    size : int
+        Pixels across each sphere's image.
+
+    Returns
+    -------
+    normal, view : ndarray, shape (P, 3)
+        Unit normals at the pixels whose centres fall on a sphere, and the unit vector towards
+        that sphere's camera.
+    camera : ndarray of int, shape (P,)
+        The index of the pixel's camera in :data:`FIS_PILOT_CAMERAS`.
+
+    Examples
+    --------
+    >>> N, V, camera = fis_pilot_pixels(4)
+    >>> N.shape, int(camera.max()), bool((np.einsum("ij,ij->i", N, V) > 0).all())
+    ((72, 3), 5, True)
+    """
+    size = require_positive_int(size, "layered polymer: pilot size", 1024)
+    x = (np.arange(size) + 0.5) / size * 2.0 - 1.0
+    X, Y = np.meshgrid(x, -x)
+    on = X**2 + Y**2 < 1.0
+    # the sphere in the camera's frame (x right, y up, z towards the camera)
+    local = np.stack([X[on], Y[on], np.sqrt(1.0 - X[on] ** 2 - Y[on] ** 2)], axis=-1)
+    normals, views = [], []
+    for eye in np.asarray(FIS_PILOT_CAMERAS, dtype=np.float64):
+        up = np.array([0.0, 1.0, 0.0]) if abs(eye[1]) < 0.9 else np.array([0.0, 0.0, -1.0])
+        right = np.cross(up, eye)
+        right /= np.linalg.norm(right)
+        normals.append(local @ np.stack([right, np.cross(eye, right), eye]))
+        views.append(np.broadcast_to(eye, local.shape))
+    camera = np.repeat(np.arange(len(FIS_PILOT_CAMERAS)), len(local))
+    return np.concatenate(normals), np.concatenate(views), camera
+
+
+def _pilot_lightness(levels, alpha: float, n: float, size: int, backend: str):
+    """``lightness(K)``, L* of ``E_ρ(θ_o) L̄_K`` at the pilot's pixels, and their cameras."""
+    import colour
+
+    N, V, camera = fis_pilot_pixels(size)
+    # one channel, the band mean: the lobe average is linear, so this is the bands' mean average
+    grey = [np.ascontiguousarray(level.mean(axis=-1, keepdims=True)) for level in levels]
+    H, W = grey[0].shape[:2]
+    white = float((latlong_pixel_solid_angles(H, W) * grey[0][..., 0]).sum() / (4.0 * np.pi))
+    cos_o = np.clip(np.einsum("ij,ij->i", N, V), 1e-6, 1.0)
+    E_rho = 1.0 - interface_coupling(n, alpha).lookup(cos_o)
+    fis = _fis_compiled if backend == "numba" else fis_specular_latlong
+
+    def lightness(K: int) -> np.ndarray:
+        Y = E_rho * fis(N, V, grey, alpha, n, K)[:, 0] / max(white, 1e-300)
+        # CIE 1976 lightness of Y against the white (colour-science, Y in 0..100)
+        return colour.colorimetry.lightness_CIE1976(100.0 * Y, 100.0)
+
+    return lightness, camera
+
+
+def fis_samples_from_tolerance(
+    levels,
+    alpha: float,
+    n: float,
+    tol: float = FIS_TOL,
+    max_samples: int = FIS_MAX_SAMPLES,
+    size: int = FIS_PILOT_SIZE,
+    backend: str = "numba",
+) -> FisPilot:
+    """Filtered importance sampling's K for one map, index and gloss, from a tolerance in ΔL*.
+
+    Colbert & Křivánek 2007 fix K; here a pilot chooses it (erratum E118). At the pilot's pixels
+    (:func:`fis_pilot_pixels`: every normal, from the front and at the rim) it takes the specular
+    term alone, ``E_ρ(θ_o) L̄`` (:func:`fis_specular_latlong` on the band mean of the map), as the
+    colour of a black chip, the worst case, with CIE 1976 lightness ``L*`` against a white of the
+    map's mean radiance (a white Lambertian surface's radiance averaged over its orientations).
+    Starting at :data:`FIS_PILOT_START`, K doubles until the change of ``L*`` from K/2 to K,
+    averaged over each sphere's pixels and taken at the worst sphere, is at most ``tol``; K is
+    returned. Each K reads its own Hammersley points and pyramid levels, so the estimates at K/2
+    and K err almost independently and the change is about as large as K/2's error, and larger
+    than K's. At ``max_samples`` the doubling stops, ``met`` is False.
+
+    Parameters
+    ----------
+    levels : sequence of ndarray
+        The map's mip pyramid (``reference.geometry.envmap.latlong_mip_pyramid``).
+    alpha, n : float
+        GGX width (> 0) and index.
+    tol : float
+        ΔL* in (0, 100).
+    max_samples : int
+        The cap, >= 2 :data:`FIS_PILOT_START`.
+    size : int
+        Pixels across each of the pilot's spheres.
+    backend : {"numba", "numpy"}
+        :func:`fis_specular_latlong` or its numba twin.
+
+    Returns
+    -------
+    FisPilot
+
+    Examples
+    --------
+    >>> from reference.geometry.envmap import latlong_mip_pyramid
+    >>> room = np.full((16, 32, 1), 0.05)
+    >>> room[3, 9] = 200.0                                            # one small bright lamp
+    >>> pilot = fis_samples_from_tolerance(latlong_mip_pyramid(room), 0.2, 1.5, 0.5, size=8)
+    >>> pilot.samples > 32, pilot.met, pilot.change <= 0.5
+    (True, True, True)
+    """
+    tol = require_between(tol, "layered polymer: tol (ΔL*)", 0.0, 100.0)
+    cap = require_positive_int(max_samples, "layered polymer: max_samples", 1 << 20)
+    least = 2 * FIS_PILOT_START
+    message = f"layered polymer: max_samples: must be >= {least} (twice the pilot's start)"
+    require(cap >= least, f"{message}, got {cap}")
+    require_choice(backend, ("numba", "numpy"), "layered polymer: backend")
+    require(float(alpha) > 0.0, f"layered polymer: alpha must be > 0, got {alpha!r}")
+    lightness, camera = _pilot_lightness(levels, float(alpha), float(n), size, backend)
+    K, before, changes = FIS_PILOT_START, lightness(FIS_PILOT_START), []
+    while cap >= 2 * K:
+        K, after = 2 * K, lightness(2 * K)
+        # the worst sphere's mean |ΔL*| between K/2 and K
+        step = np.abs(after - before)
+        change = max(float(step[camera == c].mean()) for c in np.unique(camera))
+        changes.append((K, change))
+        if change <= tol:
+            return FisPilot(K, tol, change, True, tuple(changes))
+        before = after
+    change = changes[-1][1] if changes else float("inf")
+    return FisPilot(K, tol, change, False, tuple(changes))
 
 
 def layered_pixel_parts(normal, view, maps: LayeredMaps) -> dict:

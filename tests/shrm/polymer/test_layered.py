@@ -16,8 +16,11 @@ from reference.geometry.envmap import latlong_pixel_directions, latlong_pixel_so
 from reference.materials.isotropic import ggx_distribution
 from shrm.polymer.kubelka_munk import polymer_constituents, polymer_K_S
 from shrm.polymer.layered import (
+    FIS_PILOT_START,
+    FIS_TOL,
     LAYERED_KERNELS,
     coupled_irradiance_latlong,
+    fis_samples_from_tolerance,
     ggx_prefiltered_latlong,
     layered_maps,
     layered_pixel_parts,
@@ -267,3 +270,112 @@ def test_a_tinted_slab_agrees_with_the_oracle_as_an_untinted_one_does(maps32):
     plain = layered_terms(N, V, maps, K, S, 1.5)["body"]
     ratio = out["body"].sum(axis=0) / plain.sum(axis=0)
     assert np.corrcoef(ratio, tint)[0, 1] > 0.9
+
+
+def _room(seed, H=16):
+    # a dim room lit by three small lamps of one texel each, placed by a seeded generator
+    rng = np.random.default_rng(seed)
+    env = rng.uniform(0.02, 0.08, (H, 2 * H, 2))
+    for _ in range(3):
+        env[rng.integers(1, H // 2), rng.integers(2 * H)] = rng.uniform(50.0, 200.0)
+    return env
+
+
+def _pilot_error(levels, alpha, K, K_ref, size=8):
+    # the pilot's own measure at K against a much larger K: the worst sphere's mean |ΔL*|
+    from shrm.polymer.layered import _pilot_lightness
+
+    lightness, camera = _pilot_lightness(levels, alpha, 1.5, size, "numba")
+    step = np.abs(lightness(K) - lightness(K_ref))
+    return max(step[camera == c].mean() for c in np.unique(camera))
+
+
+def test_the_pilot_needs_more_samples_under_small_lamps_than_under_a_uniform_sky():
+    # Erratum E118: a uniform sky is exact at any K (the estimate is normalized by its own
+    # weights), so the pilot stops at its first step; small lamps need many samples to settle
+    from reference.geometry.envmap import latlong_mip_pyramid
+
+    uniform = layered_maps(np.ones((16, 32, 2)), 1.5, 0.7)
+    assert uniform.samples == 2 * FIS_PILOT_START
+    assert uniform.pilot.met
+    assert uniform.pilot.tol == FIS_TOL
+    lamps = fis_samples_from_tolerance(latlong_mip_pyramid(_room(1)), 0.15, 1.5, 1.0, size=8)
+    assert lamps.samples >= 16 * uniform.samples, lamps
+    assert lamps.met, lamps
+    assert lamps.change <= 1.0, lamps
+    # each step's change is recorded, and only the last one is within the tolerance
+    assert [K for K, _ in lamps.changes][-1] == lamps.samples
+    assert all(change > 1.0 for _, change in lamps.changes[:-1]), lamps
+
+
+@pytest.mark.parametrize(("seed", "gloss"), [(1, 0.8), (3, 0.6)])
+def test_the_pilots_samples_meet_its_tolerance_against_sixteen_times_as_many(seed, gloss):
+    # Source: the same filtered importance sampling at 16 K (its own convergence: each doubling
+    # of K shrinks the error by about 1/sqrt(2), so 16 K is within a quarter of K's error). The
+    # pilot's K, chosen from the change between K/2 and K, is within the tolerance of it
+    from reference.geometry.envmap import latlong_mip_pyramid
+    from shrm.polymer.oracle import gloss_alpha
+
+    levels, alpha = latlong_mip_pyramid(_room(seed)), gloss_alpha(gloss)
+    pilot = fis_samples_from_tolerance(levels, alpha, 1.5, 1.0, size=8)
+    assert pilot.met, pilot
+    assert _pilot_error(levels, alpha, pilot.samples, 16 * pilot.samples) <= pilot.tol
+    # and a cap below what the tolerance needs is stated, not hidden
+    capped = fis_samples_from_tolerance(levels, alpha, 1.5, 1.0, pilot.samples // 2, size=8)
+    assert capped.samples == pilot.samples // 2, capped
+    assert not capped.met, capped
+
+
+def test_an_explicit_sample_count_overrides_the_pilot(maps32):
+    # samples= fixes K: no pilot runs, and the specular term is filtered importance sampling at K
+    from shrm.polymer.layered import fis_specular_latlong
+
+    N, V = _sphere(6)
+    env = maps32["studio_small_03_1k.hdr"]
+    maps = layered_maps(env, HDPE.index, 0.6, samples=48)
+    assert maps.samples == 48
+    assert maps.pilot is None
+    cos_o = np.clip(np.einsum("ij,ij->i", N, V), 1e-6, 1.0)
+    E_rho = 1.0 - interface_coupling(HDPE.index, maps.alpha).lookup(cos_o)
+    lobe = fis_specular_latlong(N, V, maps.levels, maps.alpha, HDPE.index, 48)
+    got = layered_pixel_parts(N, V, maps)["specular"]
+    np.testing.assert_allclose(got, E_rho[:, None] * lobe, rtol=1e-12)
+    chosen = layered_maps(env, HDPE.index, 0.6)
+    assert chosen.pilot is not None
+    assert chosen.samples == chosen.pilot.samples
+    # a smooth interface and the split sum take no samples
+    assert layered_maps(env, HDPE.index, 1.0).samples == 0
+    assert layered_maps(env, HDPE.index, 0.6, "split_sum_Karis", samples=48).samples == 0
+
+
+@pytest.mark.parametrize("tol", [0.0, -0.5, 100.0, float("nan"), float("inf"), "0.25", True, None])
+def test_bad_tolerances_are_refused(tol):
+    with pytest.raises(SpecrefError, match=r"layered polymer: tol \(ΔL\*\): must be a number in"):
+        layered_maps(np.ones((8, 16, 1)), 1.5, 0.8, tol=tol)
+
+
+def test_bad_pilot_settings_are_refused():
+    from reference.geometry.envmap import latlong_mip_pyramid
+
+    levels = latlong_mip_pyramid(np.ones((8, 16, 1)))
+    with pytest.raises(SpecrefError, match="max_samples: must be >= 32"):
+        fis_samples_from_tolerance(levels, 0.2, 1.5, max_samples=16)
+    with pytest.raises(SpecrefError, match="unknown layered polymer: backend 'cuda'"):
+        fis_samples_from_tolerance(levels, 0.2, 1.5, backend="cuda")
+    with pytest.raises(SpecrefError, match="alpha must be > 0"):
+        fis_samples_from_tolerance(levels, 0.0, 1.5)
+
+
+def test_the_pilot_is_the_same_with_the_numpy_reference_and_the_numba_twin():
+    # the pilot runs fis_specular_latlong or its numba twin (LAYERED_KERNELS["fis"]): the same
+    # lightness at every step, so the same K
+    from reference.geometry.envmap import latlong_mip_pyramid
+
+    levels = latlong_mip_pyramid(_room(2, H=8))
+    args = (levels, 0.2, 1.5, 0.05, 256, 4)
+    numba, numpy = (fis_samples_from_tolerance(*args, backend=b) for b in ("numba", "numpy"))
+    assert numba.samples == numpy.samples
+    assert numba.met == numpy.met
+    np.testing.assert_allclose(
+        [c for _, c in numba.changes], [c for _, c in numpy.changes], rtol=1e-12, atol=1e-12
+    )
