@@ -470,7 +470,25 @@ def _held_out_text(study: dict) -> str:
         f"{study['settings']['rows']} rows, spectralized), a {study['settings']['size']}² sphere. "
         f"Targets for a real-time polymer model: worst object mean ΔE00 <= {TARGETS['mean']:g} "
         f"and rim mean <= {TARGETS['rim']:g} per map. {found[0].upper()}{found[1:]}."
+        + _samples_text(study)
         + _noise_text(study)
+    )
+
+
+def _samples_text(study: dict) -> str:
+    """The layered model's sample counts (its pilot's, erratum E118) and the oracle's pairs."""
+    if not study.get("samples"):
+        return ""
+    fis = {m: s["fis"] for m, s in study["samples"].items() if s["fis"]}
+    if not fis:
+        return ""
+    name = max(fis, key=lambda m: max(fis[m]))
+    low, high = min(min(k) for k in fis.values()), max(fis[name])
+    pairs = max(s["oracle_pairs"] for s in study["samples"].values())
+    return (
+        f" The layered model's filtered importance sampling took {low} to {high} samples per "
+        f"pixel, the most under {name}, as its pilot chose them per map, index and gloss for a "
+        f"tolerance (erratum E118); the oracle took up to {pairs} pairs per pixel."
     )
 
 
@@ -579,7 +597,9 @@ def _failure_text(oracle: dict) -> str:
         f"1 − F_r in Eq. (1), Herbert et al.; erratum E34). The hybrid's frame is {ratio:.0f}× "
         "faster than the converged oracle's. The layered model (shrm.polymer.layered) on the "
         f"same chip: mean ΔE00 {layered['mean']:.2f} (rim {layered['rim']:.2f}), its maps "
-        f"{layered['maps_seconds']:.2f} s, a frame {1e3 * layered['seconds']:.1f} ms, a re-shade "
+        f"{layered['maps_seconds']:.2f} s (its pilot's choice of {layered.get('samples', '?')} "
+        "samples per pixel included, erratum E118), a frame "
+        f"{1e3 * layered['seconds']:.1f} ms, a re-shade "
         f"{1e3 * layered['reshade_seconds']:.2f} ms; with the split sum in place of its filtered "
         f"importance sampling: mean {split['mean']:.2f} (rim {split['rim']:.2f}), maps "
         f"{split['maps_seconds']:.2f} s, a frame {1e3 * split['seconds']:.1f} ms."

@@ -361,7 +361,8 @@ def _layered_speed(
     ``specular``: the interface's reflection (``shrm.polymer.layered.LAYERED_SPECULAR``).
 
     The maps' time includes the interface's coupling tables, built uncached as a cold process
-    builds them.
+    builds them, and the pilot that chooses filtered importance sampling's ``samples`` (erratum
+    E118; 0 for the split sum).
     """
     constituents = polymer_constituents()
     K, S = polymer_K_S(constituents, BASE["tio2_pct"])
@@ -376,6 +377,7 @@ def _layered_speed(
     parts = layered_pixel_parts(N, V, maps)
     return {
         "maps_seconds": maps_seconds,
+        "samples": maps.samples,
         "seconds": _seconds(lambda: layered_terms(N, V, maps, K, S, d)),
         "reshade_seconds": _seconds(lambda: layered_shade_parts(parts, K, S, 2.0 * d, maps)),
         **object_delta_E_stats(colour.delta_E(result, reference), N[:, 2]),

@@ -29,10 +29,10 @@ def test_report_polymer_section_quick(tmp_path):
     # Held out: every shipped map, the object and rim targets of a real-time model. Herbert's
     # hybrid misses them under studio_small_03 (object mean about 2, rim above 3; far more on a
     # tinted chip, whose tint it multiplies in while the oracle takes a dye, erratum E115). The
-    # layered model with its filtered importance sampling meets both under venice and fagans and
-    # beats the same model with Karis's split sum on every map, over the object and at the rim;
-    # under studio_small_03 it misses on the near-black chip, where the small lamps' highlights
-    # are all there is to see. One check per map states the oracle's own noise (two seeds).
+    # layered model with its filtered importance sampling, its sample count from a tolerance
+    # (erratum E118: more samples where small lamps' highlights are all a near-black chip shows),
+    # meets both on every map and beats the same model with Karis's split sum on every map, over
+    # the object and at the rim. One check per map states the oracle's own noise (two seeds).
     noise = [c for c in held_out if c["name"].startswith("the layered oracle's own noise")]
     assert len(noise) == 4
     assert all(0 <= c["measured"] < 1.0 for c in noise), noise
@@ -51,9 +51,16 @@ def test_report_polymer_section_quick(tmp_path):
     for part in ("object", "rim"):
         fis, split = by_map(MODELS["layered"], part), by_map(MODELS["layered_split_sum"], part)
         assert all(fis[m]["measured"] < split[m]["measured"] for m in fis), (fis, split)
-        assert all(fis[m]["passed"] for m in ("venice_sunset_1k.hdr", "st_fagans_interior_1k.hdr"))
+        assert all(fis[m]["passed"] for m in fis), fis
     rows = section["held_out"]["rows"]
     assert len(rows) == 3 * 4 * section["held_out"]["settings"]["chips"]
+    # the layered model's sample count is its pilot's, stated per row: more under studio_small_03's
+    # small lamps than under venice's sky (erratum E118)
+    samples = section["held_out"]["samples"]
+    assert min(samples["studio_small_03_1k.hdr"]["fis"]) > max(
+        samples["venice_sunset_1k.hdr"]["fis"]
+    )
+    assert all(r["fis_samples"] >= 32 for r in rows if r["model"] == "layered")
     # where the layered model's error lies: with the oracle's specular term in its place, every
     # held-out chip under every map agrees with the oracle far within the targets (its body and
     # transmission are the oracle's terms from prefiltered maps), so what it misses is its specular
