@@ -55,3 +55,20 @@ def test_a_broken_render_fails_with_the_right_diagnosis(proof, scene, mistake):
     assert found["made"] == mistake
     assert not found["passed"]
     assert found["diagnosis"]["mistake"] == mistake, found["diagnosis"]
+
+
+def test_the_rgb_mistake_renders_without_mitsubas_warnings(tmp_path, capfd):
+    # Mitsuba's RGB variant clamps the chart's out-of-gamut colours, which is the mistake the
+    # suite makes on purpose: no warning on the report's console; the spectral variant keeps them
+    from validation.conformance.export import export_scenes
+    from validation.conformance.mitsuba import render_mitsuba
+
+    export_scenes(tmp_path, "mitsuba", spp=1)
+    capfd.readouterr()
+    render_mitsuba(tmp_path / "colorchecker-fl2.xml", tmp_path / "x.exr", variant="scalar_rgb")
+    captured = capfd.readouterr()
+    assert "WARN" not in captured.out + captured.err
+    import mitsuba as mi
+
+    render_mitsuba(tmp_path / "colorchecker-fl2.xml", tmp_path / "y.exr")
+    assert mi.log_level() == mi.LogLevel.Warn
