@@ -49,10 +49,9 @@ def add_parser(sub) -> None:
         "the settings its checks need (the full-resolution studies and long sweeps at their "
         "quick settings: --full runs them in full). index.html is rewritten after every "
         "section, so a stopped run leaves a readable page. Measured on a shared two-core "
-        "machine: 1 min 55 s – 2 min 42 s with the default two processes (3 min 26 s – 4 min "
-        "48 s of CPU, the latest run with speed against accuracy for the SH order, the RGB "
-        "upsamplers and the channel count); --full 40 min (with make bench, 54-59 min), 1 h "
-        "48 min beside other work.",
+        "machine with nothing else running: 2 min 51 s with the default two processes (5 min "
+        "7 s of CPU; earlier runs 1 min 55 s – 2 min 42 s); --full 31 min (with make bench, "
+        "50 min; earlier 54-66 min), 1 h 48 min beside other work.",
     )
     p.add_argument(
         "--out", type=folder_name, default="report", help="output folder (default: report)"
@@ -67,7 +66,7 @@ def add_parser(sub) -> None:
         "--full",
         action="store_true",
         help="every section at its full settings: the full-resolution maps and long sweeps "
-        "(make results; 54 min to 1 h 48 min on two cores)",
+        "(make results; 50 min to 1 h 48 min on two cores)",
     )
     registry_option(
         p, "--only", REPORT_SECTIONS, "run only these sections", nargs="+", metavar="SECTION"
