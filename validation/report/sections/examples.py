@@ -282,8 +282,9 @@ def _startup_blocks(startup: dict | None) -> list:
     caption = (
         "phong-sphere.toml at its own size through the compiled table shader, in a fresh "
         "`python` process (make bench, group startup-render). The last two columns come from "
-        "the same process with numba started before the first render (a one-line cached "
-        "kernel's first call, numba's own start-up, which any numba program pays once)"
+        "another fresh process, same script and cache, with numba started before the first "
+        "render (a one-line cached kernel's first call: numba's own start-up, which any numba "
+        "program pays once)"
     )
     if "warm_ratio_past_numba" in startup:
         caption += (
