@@ -227,6 +227,9 @@ __all__ += ["require_positive_int"]
 def require_between(value, where: str, low: float, high: float) -> float:
     """Return ``value`` as a float after checking it is a real number with ``low < value < high``.
 
+    ``where`` names the quantity in the message (empty: the message starts at "must be", for a
+    caller that names it itself, e.g. a scene file's key).
+
     Examples
     --------
     >>> require_between(0.25, "tol", 0, 100)
@@ -238,7 +241,8 @@ def require_between(value, where: str, low: float, high: float) -> float:
     """
     ok = isinstance(value, int | float | np.integer | np.floating) and not isinstance(value, bool)
     ok = ok and math.isfinite(value) and low < value < high
-    require(ok, f"{where}: must be a number in ({low:g}, {high:g}), got {value!r}")
+    prefix = f"{where}: " if where else ""
+    require(ok, f"{prefix}must be a number in ({low:g}, {high:g}), got {value!r}")
     return float(value)
 
 

@@ -23,9 +23,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
-import numpy as np
-
-from reference.errors import SpecrefError, format_allowed, require
+from reference.errors import SpecrefError, format_allowed, require, require_between
 from reference.registry import Registry
 
 __all__ = [
@@ -61,10 +59,6 @@ class RenderOption:
 RENDER_OPTIONS = Registry("render option", RenderOption)
 
 
-def _is_number(value) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool)
-
-
 def check_fraction(value, maximum: float = 1.0) -> float:
     """A number in ``(0, maximum)``: a relative tolerance.
 
@@ -77,11 +71,7 @@ def check_fraction(value, maximum: float = 1.0) -> float:
     ...
     reference.errors.SpecrefError: must be a number in (0, 1), got nan
     """
-    require(
-        _is_number(value) and bool(np.isfinite(value)) and 0 < value < maximum,
-        f"must be a number in (0, {maximum:g}), got {value!r}",
-    )
-    return float(value)
+    return require_between(value, "", 0.0, maximum)
 
 
 def check_int_range(value, low: int, high: int) -> int:
