@@ -90,6 +90,8 @@ def write_png(path, image, text: dict | None = None) -> Path:
 def read_png(path) -> np.ndarray:
     """Read a PNG (or another image imageio reads without plugins) as float64 in [0, 1], (H, W, C).
 
+    A PNG keeps its bit depth (8 or 16 bits a channel; a palette is expanded to RGB).
+
     Examples
     --------
     >>> read_png("/nonexistent.png")
@@ -102,13 +104,37 @@ def read_png(path) -> np.ndarray:
     path = Path(path)
     require(path.is_file(), f"{path}: file not found")
     try:
-        image = iio.imread(path, plugin="pillow")
-    except Exception as error:  # imageio raises many kinds; all mean "not a readable image"
+        image = _png_decode(path) if _is_png(path) else iio.imread(path, plugin="pillow")
+    except SpecrefError:
+        raise
+    except Exception as error:  # the decoders raise many kinds; all mean "not a readable image"
         raise SpecrefError(f"{path}: cannot read image ({error.__class__.__name__})") from None
     image = np.asarray(image)
     scale = float(np.iinfo(image.dtype).max) if image.dtype.kind in "ui" else 1.0
     image = image.astype(np.float64) / scale
     return image[..., None] if image.ndim == 2 else image
+
+
+_PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def _is_png(path: Path) -> bool:
+    with open(path, "rb") as f:
+        return f.read(8) == _PNG_SIGNATURE
+
+
+def _png_decode(path: Path) -> np.ndarray:
+    """A PNG at its own bit depth (Pillow reads 16-bit colour PNGs as 8 bits), size checked."""
+    import imagecodecs
+
+    data = path.read_bytes()
+    # IHDR: width and height, big-endian, right after the signature and the chunk's header
+    width, height = int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
+    require(
+        0 < width * height <= MAX_IMAGE_PIXELS,
+        f"{path}: {width} × {height} pixels; at most {MAX_IMAGE_PIXELS} are read",
+    )
+    return imagecodecs.png_decode(data)
 
 
 def spectral_channel_names(wavelengths_nm) -> list[str]:

@@ -39,6 +39,31 @@ def test_png_round_trip(tmp_path, rng):
     np.testing.assert_array_equal(np.round(read * 255).astype(np.uint8), image)
 
 
+def test_png_keeps_16_bits_and_expands_palettes(tmp_path):
+    # Source: imagecodecs' and Pillow's encoders (Pillow's reader truncates 16-bit colour to 8)
+    import imagecodecs
+    from PIL import Image
+
+    values = np.arange(0, 65535, 2731, dtype=np.uint16)[:24].reshape(2, 4, 3)
+    (tmp_path / "a.png").write_bytes(imagecodecs.png_encode(values))
+    np.testing.assert_array_equal(read_png(tmp_path / "a.png"), values / 65535.0)
+    grey = np.arange(12, dtype=np.uint8).reshape(3, 4) * 20
+    Image.fromarray(grey).convert("P").save(tmp_path / "p.png")
+    np.testing.assert_array_equal(
+        read_png(tmp_path / "p.png"), np.repeat(grey[..., None], 3, -1) / 255
+    )
+
+
+def test_a_png_claiming_too_many_pixels_is_refused_before_decoding(tmp_path):
+    import imagecodecs
+
+    data = bytearray(imagecodecs.png_encode(np.zeros((2, 2, 3), np.uint8)))
+    data[16:24] = (10**6).to_bytes(4, "big") * 2  # IHDR: 10⁶ × 10⁶ pixels, CRC not redone
+    (tmp_path / "big.png").write_bytes(bytes(data))
+    with pytest.raises(SpecrefError, match="at most"):
+        read_png(tmp_path / "big.png")
+
+
 @pytest.mark.parametrize("half", [False, True])
 def test_exr_round_trip(tmp_path, rng, half):
     image = rng.uniform(0, 100, (6, 4, 3))
