@@ -307,10 +307,27 @@ class CalibratedDisplay:
     path: str = ""
 
     def share(self, values) -> np.ndarray:
-        """Each channel's share above the black for device values in [0, 1] (the curve)."""
+        """Each channel's share of its primary for device values ``(..., 3)`` in [0, 1].
+
+        The calibration makes every gray ``(G, G, G)`` show the white's chromaticity at the
+        curve's luminance, ``Y_t(G) W``, whatever the colour of the display's own black ``K``
+        (erratum E47): the channels' shares on the gray axis are ``s(G) = P⁻¹ (Y_t(G) W − K)``,
+        and each channel keeps its own, ``s_c(v_c) = Y_t(v_c) + k_c (Y_t(v_c) − 1)`` with
+        ``k = P⁻¹ K`` (``W = K + P 1``). A neutral black (``k_c = Y_K / (1 − Y_K)``) gives
+        every channel the curve, ``(Y_t − Y_K) / (1 − Y_K)``.
+        """
         black = self.black_XYZ[1]
-        curve = curve_target(self.curve, np.clip(values, 0.0, 1.0), black)
-        return np.maximum(curve - black, 0.0) / (1.0 - black)
+        Y_t = curve_target(self.curve, np.clip(values, 0.0, 1.0), black)
+        k = np.linalg.solve(self.P, self.black_XYZ)
+        return np.maximum(Y_t + k * (Y_t - 1.0), 0.0)
+
+    def values_for_share(self, share) -> np.ndarray:
+        """Device values ``(..., 3)`` whose channels have ``share``: :meth:`share` inverted."""
+        G = np.linspace(0.0, 1.0, 4097)
+        tables = np.maximum.accumulate(self.share(np.repeat(G[:, None], 3, axis=1)), axis=0)
+        tables += np.linspace(0.0, 1e-12, G.size)[:, None]
+        share = np.asarray(share, dtype=np.float64)
+        return np.stack([np.interp(share[..., c], tables[:, c], G) for c in range(3)], axis=-1)
 
 
 def load_calibrated_display(cal_path) -> CalibratedDisplay:
@@ -376,9 +393,7 @@ def XYZ_to_calibrated_values(XYZ, display: CalibratedDisplay) -> tuple[np.ndarra
     XYZ = np.asarray(XYZ, dtype=np.float64)
     rho = np.linalg.solve(display.P, (XYZ - display.black_XYZ)[..., None])[..., 0]
     in_gamut = ((rho >= -1e-3) & (rho <= 1 + 1e-3)).all(axis=-1)
-    G = np.linspace(0.0, 1.0, 4097)
-    share = np.maximum.accumulate(display.share(G)) + np.linspace(0.0, 1e-12, G.size)
-    return np.interp(np.clip(rho, 0.0, 1.0), share, G), in_gamut
+    return display.values_for_share(rho), in_gamut
 
 
 def calibrated_values_to_XYZ(values, display: CalibratedDisplay) -> np.ndarray:
