@@ -3,7 +3,10 @@
 A folder of renders holds one image per scene, named ``<scene>.exr`` (or ``.hdr``), at the scene's
 size, in one of the layouts of ``reference.scene.compare.exr_to_XYZ``: channels ``X, Y, Z``;
 spectral channels (``S0.550,000000nm`` or ``550nm``); or linear ``R, G, B`` of the colourspace
-given (``colourspace``, default the file's specref metadata, else sRGB). Per scene, over the
+given (``colourspace``, default the file's specref metadata, else sRGB). A scene for a calibrated
+display takes device values instead (``<scene>.png``, 8 or 16 bits), and both its render and its
+reference are compared as the display shows them (:mod:`validation.conformance.display`). Per
+scene, over the
 pixels of full coverage whose reference Y is at least 1 % of its peak and whose reference
 standard error is at most 10 % of their Y (an edge inside a surface, such as a patch's border,
 depends on the pixel filter as a silhouette does):
@@ -41,6 +44,7 @@ __all__ = [
     "check_folder",
     "check_outputs",
     "check_render",
+    "compared_images",
     "read_render",
     "summary_table",
 ]
@@ -55,8 +59,11 @@ MAX_REL_STDERR = 0.1
 K_SIGMA = 3.0
 
 
-def read_render(path, colourspace: str | None = None) -> np.ndarray:
+def read_render(path, colourspace: str | None = None, name: str | None = None) -> np.ndarray:
     """A user's render as XYZ ``(H, W, 3)`` (module docstring), NaN refused.
+
+    ``name``: the scene; a scene for a calibrated display reads device values and returns what
+    the display shows for them.
 
     Examples
     --------
@@ -69,8 +76,12 @@ def read_render(path, colourspace: str | None = None) -> np.ndarray:
     from reference.files import require_input_file
     from reference.images.formats import read_exr
     from reference.scene.compare import exr_to_XYZ
+    from validation.conformance.display import read_device_values, scene_display
 
     path = require_input_file(path)  # a folder, a FIFO or a link loop named as such
+    display = scene_display(name) if name is not None else None
+    if display is not None:
+        return display.shown(read_device_values(path))
     XYZ, info = exr_to_XYZ(path)
     if colourspace is not None and info["kind"] == "rgb" and path.suffix.lower() == ".exr":
         image, names = read_exr(path)
@@ -156,12 +167,16 @@ def block_metrics(XYZ: np.ndarray, ref, tolerance_Y: float, tolerance_dE: float)
 def _diagnose(name: str, XYZ: np.ndarray, ref, scene, found: dict, folder=None) -> dict | None:
     """The best explanation among the scene's diagnoses, or None."""
     from validation.conformance.diagnose import DIAGNOSES, DiagnosisContext, diagnosis_variants
+    from validation.conformance.display import scene_display
 
     ctx = DiagnosisContext(name, ref, XYZ)
+    display = scene_display(name)
     tried = []
     for key in scene.catches:
         diagnosis = DIAGNOSES.lookup(key)
         for label, variant in diagnosis_variants(diagnosis, ctx, folder):
+            if display is not None:  # what the display shows for the mistaken frame
+                variant = display.round_trip(variant)
             alt = dataclasses.replace(ref, XYZ=variant)
             m = block_metrics(XYZ, alt, scene.tolerance_Y, scene.tolerance_dE)
             tried.append((key, label, m))
@@ -223,14 +238,12 @@ def check_render(
     >>> found["passed"], found["block_rel_Y"] < 1e-6
     (True, True)
     """
-    from validation.conformance.references import load_reference, reference_folder
+    from validation.conformance.references import reference_folder
     from validation.conformance.scenes import CONFORMANCE_SCENES
 
     scene = CONFORMANCE_SCENES.lookup(name)
-    XYZ = read_render(path, colourspace)
     folder = Path(references) if references is not None else reference_folder()
-    _check_size(name, path, XYZ)
-    ref = load_reference(name, folder, progress)
+    XYZ, ref = compared_images(name, path, folder, colourspace, progress)
     found = {"scene": name, "file": str(path), **block_metrics(
         XYZ, ref, scene.tolerance_Y, scene.tolerance_dE)}  # fmt: skip
     if diagnose and not found["passed"]:
@@ -238,6 +251,36 @@ def check_render(
             progress(f"{name}: failed; trying the mistakes it catches")
         found["diagnosis"] = _diagnose(name, XYZ, ref, scene, found, folder)
     return found
+
+
+def compared_images(name: str, path, references, colourspace=None, progress=None) -> tuple:
+    """The render and the reference as the check compares them: ``(XYZ (H, W, 3), Reference)``.
+
+    A scene for a calibrated display gives both as the display shows them (the render's device
+    values, the reference's through its device values, out-of-gamut colours clipped alike).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from reference.images.formats import write_exr
+    >>> from validation.conformance.references import load_reference
+    >>> refs = pathlib.Path(tempfile.mkdtemp())
+    >>> XYZ = load_reference("colorchecker-d65", refs).XYZ.astype(np.float32)
+    >>> path = write_exr(refs / "r.exr", XYZ, ["X", "Y", "Z"])
+    >>> render, ref = compared_images("colorchecker-d65", path, refs)
+    >>> bool(np.allclose(render, ref.XYZ, rtol=1e-6, atol=0))
+    True
+    """
+    from validation.conformance.display import scene_display
+    from validation.conformance.references import load_reference
+
+    XYZ = read_render(path, colourspace, name)
+    _check_size(name, path, XYZ)
+    ref = load_reference(name, references, progress)
+    display = scene_display(name)
+    if display is not None:
+        ref = dataclasses.replace(ref, XYZ=display.round_trip(ref.XYZ))
+    return XYZ, ref
 
 
 def _check_size(name: str, path, XYZ: np.ndarray) -> None:
@@ -255,22 +298,39 @@ def _check_size(name: str, path, XYZ: np.ndarray) -> None:
 
 
 def _render_files(folder: Path) -> dict[str, Path]:
+    from validation.conformance.display import scene_display
     from validation.conformance.scenes import CONFORMANCE_SCENES
 
     require(folder.is_dir(), f"{folder}: not a folder")
     files = {}
+    names = CONFORMANCE_SCENES.names()
     for path in sorted(folder.iterdir()):
-        if path.suffix.lower() not in (".exr", ".hdr"):
+        suffix, stem = path.suffix.lower(), path.name[: -len(path.suffix)]
+        display = stem in names and scene_display(stem) is not None
+        # a PNG is the render of a frame for a calibrated display, else a preview (passed over),
+        # and that frame's PNG is its render whatever lies beside it
+        if suffix == ".png" and not display:
             continue
-        stem = path.name[: -len(path.suffix)]
+        if suffix not in (".exr", ".hdr", ".png") or (
+            display and suffix != ".png" and (folder / f"{stem}.png").exists()
+        ):
+            continue
         require(
-            stem in CONFORMANCE_SCENES.names(),
-            f"{path}: no conformance scene named {stem!r}; allowed: "
-            f"{', '.join(CONFORMANCE_SCENES.names())}",
+            stem in names,
+            f"{path}: no conformance scene named {stem!r}; allowed: {', '.join(names)}",
+        )
+        require(
+            not display or suffix == ".png",
+            f"{path}: {stem} is a frame for a calibrated display; its render is the device "
+            f"values sent to it, as {stem}.png (8 or 16 bits)",
         )
         require(stem not in files, f"{path}: a second render of {stem} (also {files.get(stem)})")
         files[stem] = path
-    require(files, f"{folder}: no renders (.exr or .hdr named after the scenes)")
+    require(
+        files,
+        f"{folder}: no renders (.exr or .hdr named after the scenes, .png for a calibrated "
+        "display)",
+    )
     return files
 
 
@@ -306,7 +366,7 @@ def check_folder(folder, references=None, colourspace=None, progress=None) -> di
         except SpecrefError as error:
             raise SpecrefError(f"colourspace: {error}") from None
     for name, path in files.items():  # bad input is refused before the references are rendered
-        _check_size(name, path, read_render(path, colourspace))
+        _check_size(name, path, read_render(path, colourspace, name))
     if references is not None and Path(references).exists():  # its manifest, before any line
         from validation.conformance.references import _read_manifest
 

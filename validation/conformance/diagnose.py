@@ -20,7 +20,13 @@ render passes (or comes closest):
   of intensity ``L r²`` at its centre (right far from it, wrong at the terminator and in a
   highlight, which then has the point's shape, not the light's);
 - ``environment_mirrored``, ``environment_rotated_90`` (either way), ``environment_rotated_180``:
-  the lat-long map read flipped left-right or turned about the vertical axis.
+  the lat-long map read flipped left-right or turned about the vertical axis;
+- ``display_srgb``, ``display_primaries_ignored``, ``display_curve_ignored``, ``display_linear``:
+  the colour-management mistakes of a frame for a calibrated display
+  (:mod:`validation.conformance.display`).
+
+In a scene for a calibrated display every variant is what the display shows for it (its device
+values through the display's model), as the render is.
 
 Half a texel (a map's rows read at Mitsuba's ``v = j/(H − 1)`` instead of ``(j + ½)/H``) is not
 among them: on the 32-row maps it moves the spheres' images by 0.5-1.7 times the tolerance, too
@@ -257,6 +263,28 @@ def _environment_variants(transforms: dict) -> Callable[[DiagnosisContext], list
     return variants
 
 
+_DISPLAY_LABELS = {
+    "display_srgb": "sRGB's primaries and transfer function",
+    "display_primaries_ignored": "the {curve} curve on sRGB's primaries",
+    "display_curve_ignored": "sRGB's transfer function on the display's primaries",
+    "display_linear": "the display's primaries without the {curve} curve",
+}
+
+
+def _display_mistake(mistake: str) -> Callable[[DiagnosisContext], list]:
+    def variants(ctx: DiagnosisContext) -> list:
+        from validation.conformance.display import display_mistake_values, scene_display
+
+        display = scene_display(ctx.name)
+        if display is None:
+            return []
+        values = display_mistake_values(mistake, ctx.reference.XYZ, display)
+        label = _DISPLAY_LABELS[mistake].format(curve=display.calibration.curve)
+        return [(label, display.shown(values))]
+
+    return variants
+
+
 def _with_image(light, image):
     return dataclasses.replace(light, image=np.ascontiguousarray(image))
 
@@ -328,3 +356,16 @@ DIAGNOSES.register(
         rendered=True,
     )
 )
+for _key, _explanation in (
+    ("display_srgb", "the frame was encoded for an sRGB monitor, not for the calibrated display"),
+    (
+        "display_primaries_ignored",
+        "the calibration's curve was applied to sRGB's primaries, not the display's",
+    ),
+    (
+        "display_curve_ignored",
+        "the display's primaries with the sRGB transfer function, not the calibration's curve",
+    ),
+    ("display_linear", "the display's linear channel values were sent without its curve"),
+):
+    DIAGNOSES.register(Diagnosis(_key, _explanation, _display_mistake(_key)))

@@ -1,8 +1,9 @@
 """The conformance scenes in other renderers' formats: specref's own files and Mitsuba 3 XML.
 
 ``specref conformance export DIR --format specref|mitsuba`` writes every scene the format can
-express, with what they need beside them (maps, spectra), and ``scenes.json``: per scene its size,
-what it tests, the mistakes it catches, and the scenes the format cannot express, with why.
+express, with what they need beside them (maps, spectra, the calibrated display), and
+``scenes.json``: per scene its size, what it tests, the mistakes it catches, what its render holds,
+and the scenes the format cannot express, with why.
 
 **Mitsuba 3** (scene format version 3.0.0, a spectral variant): the camera as a ``perspective`` or
 ``orthographic`` sensor with ``fov_axis = "y"`` and a ``lookat`` transform; an ``hdrfilm`` of the
@@ -270,6 +271,16 @@ def _copy_data(text: str, out: Path) -> str:
     return _DATA.sub(copy, text)
 
 
+def _render_kind(data: dict) -> str:
+    """What ``specref conformance check`` reads for a scene (docs/conformance.md)."""
+    calibration = data.get("display", {}).get("calibration")
+    if calibration is not None:
+        return (
+            f"device values for the display of {calibration} (.png, or .exr with R, G, B in [0, 1])"
+        )
+    return "scene-referred .exr: X, Y, Z, spectral channels or linear R, G, B (or .hdr)"
+
+
 def export_scenes(folder, fmt: str = "specref", spp: int = 64) -> dict:
     """Write every scene ``fmt`` can express into ``folder``; return the index (``scenes.json``).
 
@@ -306,6 +317,10 @@ def export_scenes(folder, fmt: str = "specref", spp: int = 64) -> dict:
             write_exr(out / "maps" / path.name, texels_repeated(read_exr(path)[0][..., :3]))
         elif path.suffix == ".exr":
             shutil.copyfile(path, out / "maps" / path.name)
+    if fmt == "specref":  # the calibrated display a scene names, beside it (.cal, .ti3, .json)
+        check_output_folder(out / "displays")
+        for path in sorted(data_path("conformance/displays").iterdir()):
+            shutil.copyfile(path, out / "displays" / path.name)
     index = {"format": fmt, "scenes": {}, "cannot_express": {}}
     for scene in CONFORMANCE_SCENES.values():
         why = scene.cannot_export.get(fmt)
@@ -324,6 +339,7 @@ def export_scenes(folder, fmt: str = "specref", spp: int = 64) -> dict:
             "height": data["render"]["height"],
             "tests": scene.tests,
             "catches": list(scene.catches),
+            "render": _render_kind(data),
         }
     write_text_atomic(out / "scenes.json", json.dumps(index, indent=1) + "\n")
     return index

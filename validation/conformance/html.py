@@ -36,11 +36,9 @@ def _shown(XYZ: np.ndarray, scale: float) -> str:
 
 
 def _scene_block(row: dict, references, colourspace=None) -> str:
-    from validation.conformance.check import _compared, read_render
-    from validation.conformance.references import load_reference
+    from validation.conformance.check import _compared, compared_images
 
-    ref = load_reference(row["scene"], references)
-    XYZ = read_render(row["file"], colourspace)
+    XYZ, ref = compared_images(row["scene"], row["file"], references, colourspace)
     scale = max(float(np.percentile(ref.XYZ[..., 1], 99)), 1e-12)
     mask = _compared(ref)
     rel = np.where(

@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 from reference.registry import Registry
 
 __all__ = [
+    "CALIBRATED_DISPLAY",
     "CONFORMANCE_SCENES",
     "ENVIRONMENT_MAPS",
     "ConformanceScene",
@@ -45,6 +46,18 @@ ENVIRONMENT_MAPS = {
 }
 #: Rows of those maps.
 MAP_ROWS = 32
+#: The calibrated display of the display scene (``data:conformance/displays/<stem>.cal`` with its
+#: ``.ti3``, ``.json`` and ``.cube``), as ``specref display calibrate`` writes them: the built-in
+#: simulated display with wide LED-like primaries, calibrated to D65 and Herbert's L* curve
+#: (Eq. (7), Herbert et al.), so that sRGB's primaries and transfer function are both wrong.
+CALIBRATED_DISPLAY = {
+    "stem": "led-wide-d65-lstar",
+    "primaries": "led_wide",
+    "white": "D65",
+    "curve": "lstar",
+    "points": 15,
+    "seed": 0,
+}
 
 
 @dataclass(frozen=True)
@@ -173,7 +186,7 @@ def _sphere_lit(material: list[str], illuminant: str) -> Callable[[], str]:
     return body
 
 
-def _chart(illuminant: str) -> Callable[[], str]:
+def _chart(illuminant: str, display: tuple = ()) -> Callable[[], str]:
     def body() -> str:
         return "\n".join([
             FINE_GRID,
@@ -184,6 +197,7 @@ def _chart(illuminant: str) -> Callable[[], str]:
             "[[objects]]", 'type = "rectangle"', "point = [0, 0, 0]", "normal = [0, 0, 1]",
             "u_axis = [1, 0, 0]", "size = [0.6, 0.4]", 'material = "chart"',
             "[[lights]]", 'type = "ambient"', f'spectrum = {{ illuminant = "{illuminant}" }}',
+            *display,
         ])  # fmt: skip
 
     return body
@@ -304,6 +318,22 @@ for _illuminant, _what in (
          *_SCALE_MISTAKES),
         _chart(_illuminant),
     ))  # fmt: skip
+CONFORMANCE_SCENES.register(ConformanceScene(
+    "colorchecker-d65-calibrated-display",
+    "a display-calibrated frame: the D65 chart as device values for a calibrated display (wide "
+    "LED-like primaries, D65 white, Herbert's L* curve; data:conformance/displays/), the frame "
+    "an application sends once the calibration is in the video card; the check reads a PNG or "
+    "R, G, B in [0, 1] and compares what the display shows",
+    ("display_srgb", "display_primaries_ignored", "display_curve_ignored", "display_linear",
+     "Y_scaled"),
+    _chart("D65", (
+        "[display]", f'calibration = "displays/{CALIBRATED_DISPLAY["stem"]}.cal"',
+        # the white patch at 72 % of the display's white: a render 20 % too bright is not clipped
+        "exposure = 0.8",
+    )),
+    {"mitsuba": "Mitsuba 3 writes scene-referred XYZ; the device values of a calibrated display "
+                "are a colour-management step after the render (its chart is colorchecker-d65)"},
+))  # fmt: skip
 # The tests hold each scene to the mistakes it lists (each, made on purpose, fails and is named).
 _ENV_MISTAKES = (
     "environment_mirrored", "environment_rotated_90", "environment_rotated_180",

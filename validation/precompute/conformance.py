@@ -8,6 +8,9 @@ Run ``python -m validation.precompute.conformance`` to rewrite them from
   the SHA-256 of the reference files as rendered here;
   :func:`validation.conformance.references.ensure_references`), which the tests check a fresh
   render against;
+- ``displays/<stem>.cal`` (with ``.ti3``, ``.json``, ``.cube``): the calibrated display of the
+  display scene (:data:`validation.conformance.scenes.CALIBRATED_DISPLAY`), as ``specref display
+  calibrate`` writes it, the summary's file names made relative;
 - ``maps/<key>.exr``: each map of ``ENVIRONMENT_MAPS`` box-averaged to 32 × 64 texels (the mean
   of the texels of each of 32 × 64 near-equal blocks, ``np.array_split``), 32-bit float RGB in
   the source's orientation (Mitsuba 3's lat-long convention; docs/conventions.md).
@@ -27,6 +30,7 @@ from reference.files import write_text_atomic
 from reference.images.formats import read_exr, read_hdr, write_exr
 from validation.conformance.references import ensure_references
 from validation.conformance.scenes import (
+    CALIBRATED_DISPLAY,
     CONFORMANCE_SCENES,
     ENVIRONMENT_MAPS,
     MAP_ROWS,
@@ -55,12 +59,36 @@ def small_map(name: str, rows: int = MAP_ROWS) -> np.ndarray:
     return box_average(np.asarray(image, dtype=np.float64), rows)
 
 
+def write_calibrated_display(folder) -> Path:
+    """Calibrate the display of :data:`CALIBRATED_DISPLAY` and write its files into ``folder``.
+
+    Returns the ``.cal``'s path. The calibration is seeded: a second run writes the same tables
+    (the ``.ti3``'s date aside).
+    """
+    from reference.display.calibration import calibrate_display
+    from reference.display.calibration_files import write_calibration
+    from reference.display.spectral import spectral_display
+
+    c = CALIBRATED_DISPLAY
+    display = spectral_display(c["primaries"])
+    calibration = calibrate_display(
+        display, c["white"], c["curve"], points=c["points"], seed=c["seed"]
+    )
+    path = Path(folder) / f"{c['stem']}.cal"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    summary = write_calibration(path, display, calibration, seed=c["seed"])
+    summary["files"] = {k: Path(v).name for k, v in summary["files"].items()}
+    write_text_atomic(path.with_suffix(".json"), json.dumps(summary, indent=1) + "\n")
+    return path
+
+
 def main(folder=None) -> None:
     """Write every scene file and map into ``folder`` (default the package's data folder)."""
     folder = Path(folder) if folder is not None else data_root() / "conformance"
     (folder / "maps").mkdir(parents=True, exist_ok=True)
     for key, name in ENVIRONMENT_MAPS.items():
         write_exr(folder / "maps" / f"{key}.exr", small_map(name).astype(np.float32))
+    write_calibrated_display(folder / "displays")
     for scene in CONFORMANCE_SCENES.values():
         write_text_atomic(folder / f"{scene.name}.toml", scene_text(scene))
     with tempfile.TemporaryDirectory() as tmp:

@@ -17,12 +17,13 @@ import pytest
 
 from reference.data import data_path
 from reference.errors import SpecrefError
-from reference.images.formats import read_exr, write_exr
+from reference.images.formats import read_exr, write_exr, write_png
 from reference.scene.loader import load_scene
 from reference.scene.render import render_scene
 from validation.cli import main
 from validation.conformance.check import check_folder, check_render
 from validation.conformance.diagnose import DIAGNOSES, DiagnosisContext, diagnosis_variants
+from validation.conformance.display import scene_display
 from validation.conformance.export import export_scenes, mitsuba_xml
 from validation.conformance.references import (
     REFERENCE_OPTIONS,
@@ -50,6 +51,15 @@ def references(conformance_references):
 
 def _write(path, XYZ):
     return write_exr(path, np.asarray(XYZ, dtype=np.float32), ["X", "Y", "Z"])
+
+
+def _render(folder, name, XYZ):
+    """``XYZ`` as a renderer writes it for the scene: device values in an 8-bit PNG for a
+    calibrated display (what ``specref render`` writes), else an XYZ EXR."""
+    display = scene_display(name)
+    if display is None:
+        return _write(folder / f"{name}.exr", XYZ)
+    return write_png(folder / f"{name}.png", display.values(XYZ))
 
 
 def test_the_shipped_scene_files_are_what_the_registry_writes():
@@ -158,7 +168,7 @@ def test_every_reference_passes_its_own_check_from_the_command_line(references, 
     renders = tmp_path / "renders"
     renders.mkdir()
     for name in NAMES:
-        _write(renders / f"{name}.exr", load_reference(name, references).XYZ)
+        _render(renders, name, load_reference(name, references).XYZ)
     out = tmp_path / "check.json"
     code = main(["conformance", "check", str(renders), "--references", str(references),
                  "--json", str(out), "--html", str(tmp_path / "check.html")])  # fmt: skip
@@ -189,7 +199,7 @@ def test_each_mistake_a_scene_lists_fails_and_is_named(references, tmp_path, nam
     else:
         ctx = DiagnosisContext(name, ref, ref.XYZ)
         label, broken = diagnosis_variants(DIAGNOSES.lookup(key), ctx, references)[-1]
-    found = check_render(name, _write(tmp_path / f"{name}.exr", broken), references)
+    found = check_render(name, _render(tmp_path, name, broken), references)
     assert not found["passed"], (name, label)
     diagnosis = found["diagnosis"]
     assert diagnosis["mistake"] == key, diagnosis
@@ -303,11 +313,15 @@ def test_the_specref_export_is_self_contained_and_renders_the_same(tmp_path):
     assert not index["cannot_express"]
     text = (tmp_path / "out" / "lambert-point-orange-a.toml").read_text()
     assert "data:" not in tomllib.loads(text)["materials"]["m"]["k_d"]["csv"]
-    for name in ("lambert-point-orange-a", "lambert-env-venice"):
+    for name in ("lambert-point-orange-a", "lambert-env-venice",
+                 "colorchecker-d65-calibrated-display"):  # fmt: skip
         exported = render_scene(load_scene(tmp_path / "out" / f"{name}.toml"), width=16,
                                 options=REFERENCE_OPTIONS)  # fmt: skip
         shipped = render_scene(load_scene(scene_path(name)), width=16, options=REFERENCE_OPTIONS)
         np.testing.assert_array_equal(exported.XYZ, shipped.XYZ)
+        # the PNG: device values for the calibrated display the folder carries beside the scene
+        np.testing.assert_array_equal(exported.encoded, shipped.encoded)
+    assert index["scenes"]["colorchecker-d65-calibrated-display"]["render"].startswith("device")
 
 
 def test_list_and_export_from_the_command_line(tmp_path, capsys):
