@@ -729,15 +729,23 @@ def _shade_layered(surface: Surface, material: PolymerMaterial, light, ctx) -> n
     """Spectral radiance of the layered model (``shrm.polymer.layered``), maps cached per light."""
     from shrm.environment import _state
     from shrm.polymer.kubelka_munk import km_tinted_K, polymer_constituents, polymer_K_S
-    from shrm.polymer.layered import layered_maps, layered_terms
+    from shrm.polymer.layered import FIS_TOL, layered_maps, layered_terms
     from shrm.polymer.oracle import interface_coupling
 
     constituents = polymer_constituents(ctx.grid)
     n = constituents.index if material.index is None else float(material.index)
     state = _state(light, ctx)
-    key = ("layered", n, float(material.gloss))
+    tol = float(ctx.options.get("polymer_fis_tol", FIS_TOL))  # checked by the scene loader
+    key = ("layered", n, float(material.gloss), tol)
     if key not in state:
-        state[key] = layered_maps(state["radiance"], n, material.gloss)
+        state[key] = layered_maps(state["radiance"], n, material.gloss, tol=tol)
+    pilot = state[key].pilot
+    if pilot is not None:  # K chosen from the tolerance (erratum E118), in the render's metadata
+        ctx.record("polymer_layered", material.name, {
+            "samples": pilot.samples, "fis_tol": pilot.tol,
+            "pilot_change": pilot.change if np.isfinite(pilot.change) else None,
+            "met": pilot.met,
+        })  # fmt: skip
     K, S = polymer_K_S(constituents, material.tio2_pct)
     # erratum E115: the tint as a dye in the slab, through the front surface's r_i
     r_t = interface_coupling(state[key].n, state[key].alpha).r_i
@@ -900,4 +908,10 @@ register_render_option(
     "polymer_oracle_tol",
     check_fraction,
     "the polymer oracle's Monte Carlo tolerance (default 0.005)",
+)
+register_render_option(
+    "polymer_fis_tol",
+    lambda value: check_fraction(value, 100.0),
+    "the layered polymer model's tolerance, ΔL* of a black chip's specular between K/2 and K "
+    "filtered importance samples (default 0.25, erratum E118)",
 )

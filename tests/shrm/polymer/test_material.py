@@ -166,6 +166,26 @@ def test_the_layered_model_is_selectable_and_shades_its_terms():
     assert cached_map_names(light).count("layered") == 1
 
 
+def test_the_layered_models_tolerance_is_a_render_option_and_its_k_is_recorded():
+    # render.options.polymer_fis_tol sets the pilot's ΔL* (erratum E118): a looser tolerance
+    # stops the doubling sooner; each choice is kept apart and recorded with its pilot
+    from shrm.environment import cached_map_names
+    from shrm.polymer.layered import FIS_TOL
+
+    light = EnvironmentLight(np.linspace(0.2, 1.0, 16 * 32 * 3).reshape(16, 32, 3))
+    surface = _one_pixel((0.0, 1.0, 0.0), (0.6, 0.8, 0.0))
+    m = PolymerMaterial(0.9, 0.3, gloss=0.5, model="layered", name="chip")
+    found = {}
+    for tol in (FIS_TOL / 8, 20.0):
+        ctx = ShadingContext(GRID, options={"environment_size": 8, "polymer_fis_tol": tol})
+        shade_polymer_environment(surface, m, light, ctx)
+        found[tol] = ctx.records["polymer_layered"]["chip"]
+        assert found[tol]["fis_tol"] == tol
+    assert found[20.0]["samples"] < found[FIS_TOL / 8]["samples"], found
+    assert found[20.0]["met"]
+    assert cached_map_names(light).count("layered") == 2
+
+
 def test_effect_term_is_the_effect_pigment_through_its_shrm():
     # Source: Eq. (1) with Tint 0 and Mod_effect 1 is E_effect plus the surface and transmission
     # terms, which do not depend on Mod_effect; E_effect alone is what the isotropic_brdf shader
