@@ -41,6 +41,7 @@ from validation.conformance.scenes import (
 from validation.precompute.conformance import small_map
 
 NAMES = CONFORMANCE_SCENES.names()
+DISPLAY = "colorchecker-d65-calibrated-display"
 
 
 @pytest.fixture(scope="module")
@@ -245,6 +246,14 @@ def test_monte_carlo_noise_passes_and_bias_fails(references, tmp_path):
          "a loop of symbolic links"),
         (lambda d, ref: write_exr(d / "colorchecker-a.exr", ref.XYZ[..., :2].astype(np.float32),
                                   ["U", "V"]), "no X, Y, Z"),
+        # the frame for a calibrated display (as large as colorchecker-a) takes device values
+        (lambda d, ref: _write(d / f"{DISPLAY}.exr", ref.XYZ),
+         "its render is the device values sent to it"),
+        (lambda d, ref: (d / f"{DISPLAY}.hdr").write_bytes(b"#?RADIANCE\n"), f"as {DISPLAY}.png"),
+        (lambda d, ref: write_png(d / f"{DISPLAY}.png", ref.XYZ[:, 1:]), "width × height"),
+        (lambda d, ref: write_png(d / f"{DISPLAY}.png", ref.XYZ[..., 1]), "1 channels"),
+        (lambda d, ref: (d / f"{DISPLAY}.png").write_bytes(b"not a png"), "cannot read image"),
+        (lambda d, ref: write_png(d / "colorchecker-a.png", ref.XYZ), "no renders"),
     ],
 )  # fmt: skip
 def test_bad_renders_are_refused_in_one_line_and_nothing_is_written(

@@ -12,7 +12,6 @@ from reference.display.cgats import read_cal, read_ti3
 from reference.images.formats import write_exr, write_png
 from reference.scene.loader import load_scene
 from reference.scene.render import render_scene
-from validation.cli import main
 from validation.conformance.check import check_render
 from validation.conformance.display import display_mistake_values, scene_display
 from validation.conformance.references import load_reference
@@ -100,37 +99,3 @@ def test_the_shipped_display_files_are_what_the_precompute_writes(tmp_path):
     assert json.loads(made.with_suffix(".json").read_text()) == json.loads(
         shipped.with_suffix(".json").read_text()
     )
-
-
-def _xyz_exr(folder, ref):
-    write_exr(folder / f"{NAME}.exr", ref.XYZ.astype(np.float32), list("XYZ"))
-
-
-@pytest.mark.parametrize(
-    ("make", "message"),
-    [
-        (_xyz_exr, "its render is the device values sent to it"),
-        (lambda d, ref: (d / f"{NAME}.hdr").write_bytes(b"#?RADIANCE\\n"),
-         f"as {NAME}.png"),
-        (lambda d, ref: write_png(d / f"{NAME}.png", np.zeros((40, 59, 3))), "width × height"),
-        (lambda d, ref: write_png(d / f"{NAME}.png", np.zeros((40, 60))), "1 channels"),
-        (lambda d, ref: (d / f"{NAME}.png").write_bytes(b"not a png"), "cannot read image"),
-        (lambda d, ref: write_png(d / "colorchecker-d65.png", np.zeros((40, 60, 3))),
-         "no renders"),
-    ],
-)  # fmt: skip
-def test_bad_device_value_renders_are_refused_in_one_line(
-    reference, tmp_path, capsys, make, message
-):
-    folder, ref = reference
-    renders = tmp_path / "renders"
-    renders.mkdir()
-    make(renders, ref)
-    out = tmp_path / "out.json"
-    code = main(["conformance", "check", str(renders), "--references", str(folder),
-                 "--json", str(out)])  # fmt: skip
-    err = capsys.readouterr().err.strip()
-    assert code == 2, err
-    assert message in err, err
-    assert len(err.splitlines()) == 1, err
-    assert not out.exists()
