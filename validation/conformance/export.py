@@ -275,9 +275,7 @@ def _render_kind(data: dict) -> str:
     """What ``specref conformance check`` reads for a scene (docs/conformance.md)."""
     calibration = data.get("display", {}).get("calibration")
     if calibration is not None:
-        return (
-            f"device values for the display of {calibration} (.png, or .exr with R, G, B in [0, 1])"
-        )
+        return f"device values for the display of {calibration} (.png, 8 or 16 bits)"
     return "scene-referred .exr: X, Y, Z, spectral channels or linear R, G, B (or .hdr)"
 
 
