@@ -322,8 +322,8 @@ CONFORMANCE_SCENES.register(ConformanceScene(
     "colorchecker-d65-calibrated-display",
     "a display-calibrated frame: the D65 chart as device values for a calibrated display (wide "
     "LED-like primaries, D65 white, Herbert's L* curve; data:conformance/displays/), the frame "
-    "an application sends once the calibration is in the video card; the check reads a PNG or "
-    "R, G, B in [0, 1] and compares what the display shows",
+    "an application sends once the calibration is in the video card; the check reads the PNG of "
+    "device values and compares what the display shows",
     ("display_srgb", "display_primaries_ignored", "display_curve_ignored", "display_linear",
      "Y_scaled"),
     _chart("D65", (
