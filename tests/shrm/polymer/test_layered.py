@@ -92,28 +92,47 @@ def test_body_and_transmission_agree_with_the_oracle_on_real_maps(maps32, gloss)
             assert err_trans.max() < 0.05, (name, gloss)
 
 
-def _specular_error(env, gloss, method, rim=False):
-    # the rough specular term against the oracle's sampled lobe: mean |Δ| over the mean, over the
-    # sphere or its rim (cos θ_v < 0.3)
+@pytest.fixture(scope="module")
+def specular_means(maps32):
+    """The rough specular term's band means over a 24 px sphere, the model's and the oracle's.
+
+    Each is computed once for the module: the oracle's sampled lobe depends on the map and the
+    gloss only (not on the model it is set against, nor on the pixels an error is taken over).
+    """
     N, V = _sphere(24)
     K, S = polymer_K_S(HDPE, 0.5)
-    maps = layered_maps(env, HDPE.index, gloss, method)
-    got = layered_terms(N, V, maps, K, S, 1.5)["specular"].mean(axis=1)
-    want = polymer_oracle(N, V, env, K, S, 1.5, HDPE.index, gloss, tol=0.005).specular.mean(axis=1)
+    found = {}
+
+    def means(name, gloss, method):
+        env = maps32[name]
+        if (name, gloss, method) not in found:
+            maps = layered_maps(env, HDPE.index, gloss, method)
+            found[name, gloss, method] = layered_terms(N, V, maps, K, S, 1.5)["specular"].mean(1)
+        if (name, gloss) not in found:
+            oracle = polymer_oracle(N, V, env, K, S, 1.5, HDPE.index, gloss, tol=0.005)
+            found[name, gloss] = oracle.specular.mean(axis=1)
+        return N, found[name, gloss, method], found[name, gloss]
+
+    return means
+
+
+def _specular_error(specular_means, name, gloss, method, rim=False):
+    # the rough specular term against the oracle's sampled lobe: mean |Δ| over the mean, over the
+    # sphere or its rim (cos θ_v < 0.3)
+    N, got, want = specular_means(name, gloss, method)
     at = N[:, 2] < 0.3 if rim else slice(None)
     return np.abs(got[at] - want[at]).mean() / want[at].mean()
 
 
-def test_the_rough_specular_is_the_split_sum_of_the_oracles_lobe(maps32):
+def test_the_rough_specular_is_the_split_sum_of_the_oracles_lobe(specular_means):
     # Karis's split sum: exact under a uniform sky (test above); on venice the mean error of the
     # term is a few per cent (its n = v = r lobe)
-    env = maps32["venice_sunset_1k.hdr"]
     for gloss, bound in ((0.8, 0.07), (0.5, 0.12)):
-        error = _specular_error(env, gloss, "split_sum_Karis")
+        error = _specular_error(specular_means, "venice_sunset_1k.hdr", gloss, "split_sum_Karis")
         assert error < bound, (gloss, error)
 
 
-def test_filtered_importance_sampling_follows_the_lobe_where_the_split_sum_cannot(maps32):
+def test_filtered_importance_sampling_follows_the_lobe_where_the_split_sum_cannot(specular_means):
     # The pixel's own lobe, filtered, against the oracle's sampled lobe: on venice within 2-3 %
     # over the sphere and at its rim (cos θ_v < 0.3), a third of the split sum's error or less
     # (its n = v = r lobe errs by 5-9 % over the sphere, 14-22 % at the rim); studio_small_03's
@@ -123,8 +142,8 @@ def test_filtered_importance_sampling_follows_the_lobe_where_the_split_sum_canno
     for name, (sphere, rim_bound, ratio) in bounds.items():
         for gloss in (0.8, 0.5):
             for rim in (False, True):
-                fis = _specular_error(maps32[name], gloss, "fis_Colbert", rim)
-                split = _specular_error(maps32[name], gloss, "split_sum_Karis", rim)
+                fis = _specular_error(specular_means, name, gloss, "fis_Colbert", rim)
+                split = _specular_error(specular_means, name, gloss, "split_sum_Karis", rim)
                 assert fis < (rim_bound if rim else sphere), (name, gloss, rim, fis)
                 assert fis < ratio * split, (name, gloss, rim, fis, split)
 
