@@ -56,6 +56,12 @@ def _latlong_uv(dx, dy, dz):
 def _latlong_bilinear_taps(H, W, dx, dy, dz):
     """The texels and weights of a bilinear look-up at a direction (``latlong_lookup_bilinear``)."""
     u, v = _latlong_uv(dx, dy, dz)
+    return _latlong_taps_at(H, W, u, v)
+
+
+@njit
+def _latlong_taps_at(H, W, u, v):
+    """:func:`_latlong_bilinear_taps` at the direction's lat-long coordinates ``(u, v)``."""
     x = u * W - 0.5
     y = min(max(v * H - 0.5, 0.0), H - 1.0)
     x0 = math.floor(x)
@@ -72,6 +78,16 @@ def _latlong_bilinear_add(image, dx, dy, dz, weight, x_out):
         top = image[y0, x0, b] * (1 - fx) + image[y0, x1, b] * fx
         bottom = image[y1, x0, b] * (1 - fx) + image[y1, x1, b] * fx
         x_out[b] = weight * (top * (1 - fy) + bottom * fy)
+
+
+@njit
+def _latlong_bilinear_accumulate(image, u, v, weight, out):
+    """out[b] += weight × bilinear look-up of the lat-long map at coordinates ``(u, v)``."""
+    x0, x1, y0, y1, fx, fy = _latlong_taps_at(image.shape[0], image.shape[1], u, v)
+    for b in range(image.shape[2]):
+        top = image[y0, x0, b] * (1 - fx) + image[y0, x1, b] * fx
+        bottom = image[y1, x0, b] * (1 - fx) + image[y1, x1, b] * fx
+        out[b] += weight * (top * (1 - fy) + bottom * fy)
 
 
 @njit
@@ -109,11 +125,22 @@ def _stretched_view(ox, oy, oz, alpha):
 @njit
 def _reflected_sample(ox, oy, oz, alpha, view, u1, u2):
     """A GGX visible normal h (Heitz 2018, listing 1) from two uniforms: o·h, i = 2 (o·h) h − o."""
-    vx, vy, vz, t1x, t1y, t1z, t2x, t2y, t2z, s = view
-    r = math.sqrt(u1)
     phi = 2.0 * math.pi * u2
-    q1 = r * math.cos(phi)
-    q2 = (1.0 - s) * math.sqrt(1.0 - q1 * q1) + s * r * math.sin(phi)
+    return _reflected_sample_at(
+        ox, oy, oz, alpha, view, math.sqrt(u1), math.cos(phi), math.sin(phi)
+    )
+
+
+@njit
+def _reflected_sample_at(ox, oy, oz, alpha, view, r, cos_phi, sin_phi):
+    """:func:`_reflected_sample` from the disk point's ``r = √u1``, ``cos φ`` and ``sin φ``.
+
+    They depend on the uniforms alone: a kernel that reads the same points at every pixel (the
+    Hammersley set of filtered importance sampling) computes them once.
+    """
+    vx, vy, vz, t1x, t1y, t1z, t2x, t2y, t2z, s = view
+    q1 = r * cos_phi
+    q2 = (1.0 - s) * math.sqrt(1.0 - q1 * q1) + s * r * sin_phi
     q3 = math.sqrt(max(0.0, 1.0 - q1 * q1 - q2 * q2))
     hx = alpha * (q1 * t1x + q2 * t2x + q3 * vx)
     hy = alpha * (q1 * t1y + q2 * t2y + q3 * vy)
@@ -170,32 +197,31 @@ def _vndf_pdf_local(ox, oy, oz, ix, iy, iz, alpha):
 
 
 @njit
-def _texel_of_direction(H, W, dx, dy, dz):
-    """The row-major texel whose solid angle holds a unit direction (``_texel_of``)."""
-    u, v = _latlong_uv(dx, dy, dz)
+def _texel_at(H, W, u, v):
+    """The row-major texel whose solid angle holds coordinates ``(u, v)`` (``_texel_of``)."""
     return min(math.floor(v * H), H - 1) * W + min(math.floor(u * W), W - 1)
 
 
 @njit
-def _mis_add(radiance, ox, oy, oz, ix, iy, iz, d, alpha, n, p_e, x, pair):
-    """pair[b] += F(o·h) G_1(i) L(i) p_v / (p_v + p_e) for one direction (local i, world d)."""
+def _mis_weight(ox, oy, oz, ix, iy, iz, alpha, n, p_e):
+    """F(o·h) G_1(i) p_v / (p_v + p_e) of one local direction i; −1 where p_v or cos θ_i <= 0.
+
+    The pair adds the weight times L(i) (none where it is −1: the direction adds nothing).
+    """
     p_v, oh = _vndf_pdf_local(ox, oy, oz, ix, iy, iz, alpha)
     if p_v <= 0.0 or iz <= 0.0:
-        return
+        return -1.0
     c2 = max(iz * iz, 1e-300)
     G = 2.0 / (1.0 + math.sqrt(1.0 + alpha * alpha * (1.0 - c2) / c2))
     # the balance heuristic's weight on the estimator F(o·h) G_1(i)
-    weight = _fresnel_dielectric(oh, n) * G * p_v / max(p_v + p_e, 1e-300)
-    _latlong_bilinear_add(radiance, d[0], d[1], d[2], weight, x)
-    for b in range(radiance.shape[2]):
-        pair[b] += x[b]
+    return _fresnel_dielectric(oh, n) * G * p_v / max(p_v + p_e, 1e-300)
 
 
 @njit
 def rough_specular_mis_kernel(N, V, radiance, alpha, n, u, cdf, pdf, total, total_sq):
     """Twin of ``shrm.polymer.oracle.rough_specular_samples_mis``: visible normals and the map."""
     H, W, nb = radiance.shape[0], radiance.shape[1], radiance.shape[2]
-    x, pair, d = np.empty(nb), np.empty(nb), np.empty(3)
+    pair, d = np.empty(nb), np.empty(3)
     for p in range(N.shape[0]):
         nx, ny, nz = N[p, 0], N[p, 1], N[p, 2]
         tx, ty, tz, bx, by, bz, ox, oy, oz = _frame_and_view(N, V, p)
@@ -207,8 +233,12 @@ def rough_specular_mis_kernel(N, V, radiance, alpha, n, u, cdf, pdf, total, tota
             d[0] = ix * tx + iy * bx + iz * nx
             d[1] = ix * ty + iy * by + iz * ny
             d[2] = ix * tz + iy * bz + iz * nz
-            p_e = pdf[_texel_of_direction(H, W, d[0], d[1], d[2])]
-            _mis_add(radiance, ox, oy, oz, ix, iy, iz, d, alpha, n, p_e, x, pair)
+            # the direction's lat-long coordinates: its texel's density and its look-up
+            u_d, v_d = _latlong_uv(d[0], d[1], d[2])
+            p_e = pdf[_texel_at(H, W, u_d, v_d)]
+            weight = _mis_weight(ox, oy, oz, ix, iy, iz, alpha, n, p_e)
+            if weight >= 0.0:
+                _latlong_bilinear_accumulate(radiance, u_d, v_d, weight, pair)
             # a direction of the map: a texel by its share, then uniformly in its solid angle
             u1, u2 = u[p, m, 2], u[p, m, 3]
             k = min(np.searchsorted(cdf, u1, side="right"), H * W - 1)
@@ -223,17 +253,20 @@ def rough_specular_mis_kernel(N, V, radiance, alpha, n, u, cdf, pdf, total, tota
             ix = d[0] * tx + d[1] * ty + d[2] * tz
             iy = d[0] * bx + d[1] * by + d[2] * bz
             iz = d[0] * nx + d[1] * ny + d[2] * nz
-            _mis_add(radiance, ox, oy, oz, ix, iy, iz, d, alpha, n, pdf[k], x, pair)
+            weight = _mis_weight(ox, oy, oz, ix, iy, iz, alpha, n, pdf[k])
+            if weight >= 0.0:
+                u_d, v_d = _latlong_uv(d[0], d[1], d[2])
+                _latlong_bilinear_accumulate(radiance, u_d, v_d, weight, pair)
             for b in range(nb):
                 total[p, b] += pair[b]
                 total_sq[p, b] += pair[b] * pair[b]
 
 
 @njit
-def _pyramid_bilinear_add(flat, offset, H, dx, dy, dz, weight, x_out):
-    """x_out[b] += weight × bilinear look-up of one packed pyramid level (W = 2H)."""
+def _pyramid_bilinear_add(flat, offset, H, u, v, weight, x_out):
+    """x_out[b] += weight × bilinear look-up of one packed pyramid level (W = 2H) at ``(u, v)``."""
     W = 2 * H
-    x0, x1, y0, y1, fx, fy = _latlong_bilinear_taps(H, W, dx, dy, dz)
+    x0, x1, y0, y1, fx, fy = _latlong_taps_at(H, W, u, v)
     for b in range(flat.shape[1]):
         top = flat[offset + y0 * W + x0, b] * (1 - fx) + flat[offset + y0 * W + x1, b] * fx
         bottom = flat[offset + y1 * W + x0, b] * (1 - fx) + flat[offset + y1 * W + x1, b] * fx
@@ -250,6 +283,11 @@ def layered_fis_kernel(N, V, flat, heights, offsets, alpha, n, u, bias, out):
     texel = (math.pi / H) * (2.0 * math.pi / (2 * H))
     sin_pole = math.sin(0.5 * math.pi / H)
     a2 = alpha * alpha
+    # the disk points of the K samples: the same at every pixel
+    r_k, cos_k, sin_k = np.empty(K), np.empty(K), np.empty(K)
+    for m in range(K):
+        phi = 2.0 * math.pi * u[m, 1]
+        r_k[m], cos_k[m], sin_k[m] = math.sqrt(u[m, 0]), math.cos(phi), math.sin(phi)
     for p in range(N.shape[0]):
         nx, ny, nz = N[p, 0], N[p, 1], N[p, 2]
         tx, ty, tz, bx, by, bz, ox, oy, oz = _frame_and_view(N, V, p)
@@ -259,7 +297,9 @@ def layered_fis_kernel(N, V, flat, heights, offsets, alpha, n, u, bias, out):
         x[:] = 0.0
         total = 0.0
         for m in range(K):
-            oh, ix, iy, iz, hz = _reflected_sample(ox, oy, oz, alpha, view, u[m, 0], u[m, 1])
+            oh, ix, iy, iz, hz = _reflected_sample_at(
+                ox, oy, oz, alpha, view, r_k[m], cos_k[m], sin_k[m]
+            )
             if iz <= 0.0:
                 continue
             # weight F(o·h) G_1(i) (Eq. (34), Walter et al. 2007)
@@ -279,8 +319,12 @@ def layered_fis_kernel(N, V, flat, heights, offsets, alpha, n, u, bias, out):
             lo = min(math.floor(level), top)
             t = level - lo
             hi = min(lo + 1, top)
-            _pyramid_bilinear_add(flat, offsets[lo], heights[lo], dx, dy, dz, weight * (1 - t), x)
-            _pyramid_bilinear_add(flat, offsets[hi], heights[hi], dx, dy, dz, weight * t, x)
+            # both levels read at the direction's lat-long coordinates; the upper one only where
+            # it has a share (at t = 0 it would add zeros)
+            u_d, v_d = _latlong_uv(dx, dy, dz)
+            _pyramid_bilinear_add(flat, offsets[lo], heights[lo], u_d, v_d, weight * (1 - t), x)
+            if t > 0.0:
+                _pyramid_bilinear_add(flat, offsets[hi], heights[hi], u_d, v_d, weight * t, x)
         if total > 0.0:
             for band in range(nb):
                 out[p, band] = x[band] / total
