@@ -224,6 +224,25 @@ def test_commands_refuse_unwritable_outputs_in_one_line(command, kind, tmp_path,
     assert MESSAGES[kind] in lines[0], lines[0]
 
 
+@pytest.mark.parametrize("kind", ["read-only", "full disk"])
+def test_phong_refuses_its_json_output_before_the_work(
+    kind, tmp_path, request, capsys, monkeypatch
+):
+    # the study is not run at all: on a cold kernel cache it ran 20 s and printed its progress
+    # before the one-line refusal
+    from validation.studies import phong_table1
+
+    def must_not_run(*args, **kwargs):
+        raise AssertionError("the study ran before the output was checked")
+
+    monkeypatch.setattr(phong_table1, "run_material", must_not_run)
+    argv = _commands(_outputs(tmp_path, kind, request), tmp_path)["phong --json"]
+    assert main(argv) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1, lines
+    assert MESSAGES[kind] in lines[0], lines[0]
+
+
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
