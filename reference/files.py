@@ -400,6 +400,8 @@ def check_outputs(outputs, inputs=(), stores=()) -> list[Path]:
     - a folder, a device, a FIFO or a socket (a rename onto ``/dev/null`` would replace the
       device node; specref never writes to special files: give a regular file name);
     - below a file, or has a name longer than the file system holds;
+    - in a folder where a file cannot be written (a read-only or full file system: a small probe
+      file is written there and removed);
     - the same file as an input (inodes compared: hard and symbolic links count), or as a file
       below an input folder (a painting folder, a data folder), or as another output of the same
       command.
@@ -452,6 +454,9 @@ def check_outputs(outputs, inputs=(), stores=()) -> list[Path]:
         _require_not_an_input(out, inputs, inside)
         for other in outputs[:k]:
             require(not same_file(out, other), f"{out}: the command would write it twice ({other})")
+        if out.parent.is_dir():  # a read-only or full file system, refused now, not after the work
+            with _write_errors(out):
+                _write_probe(out)
     for store in (Path(s) for s in stores):
         check_output_store(store)
         _require_not_an_input(store, inputs, {})
@@ -666,16 +671,19 @@ def check_output_file(path) -> Path:
         _require_file_target(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         remove_stale_temporaries(path)
-        fd, probe = tempfile.mkstemp(
-            prefix=temporary_prefix(path), suffix=".probe", dir=path.parent
-        )
-        try:
-            os.write(fd, b"specref")
-            os.fsync(fd)
-        finally:
-            os.close(fd)
-            os.unlink(probe)
+        _write_probe(path)
     return path
+
+
+def _write_probe(path: Path) -> None:
+    """Write, sync and remove a small file beside ``path`` (``path`` itself is not touched)."""
+    fd, probe = tempfile.mkstemp(prefix=temporary_prefix(path), suffix=".probe", dir=path.parent)
+    try:
+        os.write(fd, b"specref")
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+        os.unlink(probe)
 
 
 def check_output_folder(folder, marker: str | None = None) -> Path:
