@@ -31,9 +31,10 @@ def test_horizon_at_texels_is_the_map_at_those_texels(rng):
     rows, cols = rng.integers(0, 24, 40), rng.integers(0, 24, 40)
     full = horizon_map(h, 1e-3, 12, 8, "numba")
     for backend in ("numpy", "numba"):
-        np.testing.assert_array_equal(
-            horizon_at_texels(h, 1e-3, rows, cols, 12, 8, backend), full[rows, cols]
-        )
+        np.testing.assert_allclose(
+            horizon_at_texels(h, 1e-3, rows, cols, 12, 8, backend), full[rows, cols],
+            rtol=1e-13, atol=1e-16,
+        )  # fmt: skip
     with pytest.raises(SpecrefError, match="rows and cols must be indices"):
         horizon_at_texels(h, 1e-3, [30], [0])
 
