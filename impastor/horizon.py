@@ -39,6 +39,7 @@ from impastor._kernels import (
     ray_march_shadows_kernel,
 )
 from reference.errors import require, require_choice, require_finite, require_positive_int
+from reference.jit import kernel_input
 from reference.registry import Method, Registry
 
 __all__ = [
@@ -356,7 +357,8 @@ def ray_march_shadows(
     beta = np.ascontiguousarray(np.broadcast_to(np.asarray(beta, float), h.shape))
     if backend == "numba":
         out = np.zeros(h.shape, dtype=np.bool_)
-        ray_march_shadows_kernel(h, pixel_size, phi, beta, steps, step, out)
+        phi, beta = kernel_input(phi), kernel_input(beta)
+        ray_march_shadows_kernel(kernel_input(h), pixel_size, phi, beta, steps, step, out)
         return out
     return (beta > _horizon_along(h, pixel_size, phi, steps, step)) & (beta > 0.0)
 

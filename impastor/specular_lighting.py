@@ -49,6 +49,7 @@ from impastor.arealights import PlaneLight, light_plane_uv
 from impastor.point_lights import PointLights
 from reference.errors import require, require_choice, require_nonnegative, require_positive_int
 from reference.geometry.sampling import hammersley
+from reference.jit import kernel_input
 from reference.materials.brdf import (
     brdf_ward_duer_specular,
     frame_from_normal,
@@ -78,7 +79,8 @@ def _flat(points, normals, views, alpha):
     alpha = require_nonnegative(alpha, "specular: alpha")
     require(bool((alpha > 0).all()), f"specular: alpha: must be > 0, got {float(alpha.min()):g}")
     a = np.broadcast_to(alpha, shape)
-    as_c = lambda x, k: np.ascontiguousarray(x.reshape(-1, k) if k else x.reshape(-1))  # noqa: E731
+    # kernel inputs: one compiled signature whether the caller's arrays were broadcast or not
+    as_c = lambda x, k: kernel_input(x.reshape(-1, k) if k else x.reshape(-1))  # noqa: E731
     return as_c(p, 3), as_c(n, 3), as_c(v, 3), as_c(a, 0), shape
 
 

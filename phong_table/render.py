@@ -33,6 +33,7 @@ from phong_table.table import SpecularTable, build_table, check_interpolation, t
 from reference.display.encodings import linear_to_display
 from reference.errors import require, require_choice
 from reference.geometry.gbuffer import GBuffer, render_gbuffer
+from reference.jit import kernel_input
 from reference.registry import Method, Registry
 from reference.scene.lights import attenuation_Wang, point_light_vectors
 from reference.scene.shading import phong_cosines
@@ -230,6 +231,7 @@ def shading_buffer(
     attenuation = np.asarray(model.light.attenuation, dtype=np.float64)
     arrays = (geometry.position, geometry.normal, geometry.view, light_position, attenuation)
     if compiled:
+        arrays = tuple(kernel_input(x) for x in arrays)
         rows = _kernels.light_geometry_kernel(*arrays, np.empty((3, geometry.position.shape[0])))
     else:
         rows = light_geometry(*arrays)
@@ -325,9 +327,7 @@ def compiled_shader(
         bound = (model.diffuse_RGB, model.specular_weights, model.n, model.ambient_RGB)
 
         def shade(buffer: ShadingBuffer, out):
-            return _kernels.shade_exact_kernel(
-                buffer.cos_theta, buffer.t, buffer.f_att, *bound, out
-            )
+            return _kernels.shade_exact_kernel(*_buffer_inputs(buffer), *bound, out)
 
         return shade
     check_interpolation(interpolation, table.entries)
@@ -347,9 +347,14 @@ def compiled_shader(
     )
 
     def shade(buffer: ShadingBuffer, out):
-        return _kernels.shade_table_kernel(buffer.cos_theta, buffer.t, buffer.f_att, *bound, out)
+        return _kernels.shade_table_kernel(*_buffer_inputs(buffer), *bound, out)
 
     return shade
+
+
+def _buffer_inputs(buffer: ShadingBuffer) -> tuple:
+    """The buffer's cos θ, t and f_att as kernel inputs (one compiled signature for any view)."""
+    return tuple(kernel_input(row) for row in (buffer.cos_theta, buffer.t, buffer.f_att))
 
 
 def _exact_compiled(buffer: ShadingBuffer, model: SpectralPhong, out):

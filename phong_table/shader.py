@@ -25,6 +25,7 @@ from phong_table.placement import MAX_ENTRIES, PLACEMENT_METHODS, check_entries
 from phong_table.render import ShadingBuffer, compiled_shader
 from phong_table.table import build_table, check_interpolation
 from reference.errors import require
+from reference.jit import kernel_input
 from reference.registry import Method
 from reference.scene.options import (
     check_choice,
@@ -82,13 +83,13 @@ def shade_phong_point_table(surface, material, light, ctx) -> np.ndarray:
         observer=ctx.observer,
         weights_method=ctx.weights_method,
     )
-    position = np.ascontiguousarray(surface.position, dtype=np.float64)
+    position = kernel_input(surface.position)
     rows = _kernels.light_geometry_kernel(
         position,
-        np.ascontiguousarray(surface.normal, dtype=np.float64),
-        np.ascontiguousarray(surface.view, dtype=np.float64),
-        np.asarray(light.position, dtype=np.float64),
-        np.asarray(light.attenuation, dtype=np.float64),
+        kernel_input(surface.normal),
+        kernel_input(surface.view),
+        kernel_input(light.position),
+        kernel_input(light.attenuation),
         np.empty((3, position.shape[0])),
     )
     buffer = ShadingBuffer(None, *(np.ascontiguousarray(r) for r in rows))

@@ -18,6 +18,12 @@ Why the cache is safe (``tests/reference/test_jit.py`` shows each point):
 - a kernel calls only kernels of its own file (no ``_kernels.py`` imports another), so the file's
   stamp covers every function a cached kernel inlined.
 
+numba compiles a kernel once per signature, and an array's layout and write flag are part of it: a
+read-only array (a cached table, ``np.broadcast_to``) or a strided view where the kernel usually
+gets a fresh C-contiguous one compiles the whole kernel again (seconds for the largest). Callers
+pass a kernel's input arrays through :func:`kernel_input` (C-contiguous, read-only view, no copy
+when the array already is C-contiguous of its dtype), so every caller shares one signature.
+
 What a process with a warm cache still pays at its first render: numba sets up its typing and
 lowering registries once per process, when it loads the first cached kernel (tenths of a second,
 whatever the number of kernels), and each kernel's cached machine code is loaded at its first call.
@@ -32,10 +38,11 @@ import os
 from pathlib import Path
 
 import numba
+import numpy as np
 
 from reference.files import default_cache_dir
 
-__all__ = ["kernel_cache_dir", "njit"]
+__all__ = ["kernel_cache_dir", "kernel_input", "njit"]
 
 
 def kernel_cache_dir() -> Path:
@@ -61,3 +68,23 @@ numba.config.CACHE_DIR = str(kernel_cache_dir())
 
 #: ``numba.njit(cache=True)``: the decorator of every kernel (STYLE.md §6: never ``fastmath``).
 njit = functools.partial(numba.njit, cache=True)
+
+
+def kernel_input(x, dtype=np.float64) -> np.ndarray:
+    """``x`` as a kernel reads it: a C-contiguous, read-only view of ``dtype`` (None: its own).
+
+    No copy when ``x`` already is a C-contiguous array of that dtype; the view's write flag is off
+    whatever ``x``'s, so writable and read-only inputs share one compiled signature.
+
+    Examples
+    --------
+    >>> a = np.arange(6.0).reshape(2, 3)
+    >>> b = kernel_input(a[:, ::-1])
+    >>> b.flags.c_contiguous, b.flags.writeable, np.shares_memory(kernel_input(a), a)
+    (True, False, True)
+    >>> kernel_input(np.arange(3, dtype=np.float32), None).dtype
+    dtype('float32')
+    """
+    view = np.ascontiguousarray(x, dtype=dtype).view()
+    view.flags.writeable = False
+    return view

@@ -39,6 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from reference.errors import require, require_choice
+from reference.jit import kernel_input
 from reference.registry import Method, Registry
 from shrm.lobes import (
     DEFAULT_TOL,
@@ -244,8 +245,9 @@ def prefilter_bruteforce(image, kernel, directions, backend: str = "numba") -> n
         from shrm import _kernels
 
         if k.power is not None:
+            radiance = kernel_input(radiance)
             _kernels.prefilter_bruteforce_power_kernel(
-                n, omega, w, radiance, k.power[0], k.power[1], out
+                kernel_input(n), kernel_input(omega), kernel_input(w), radiance, *k.power, out
             )
         else:
             angles, values = k.table

@@ -34,6 +34,7 @@ from reference.geometry.envmap import (
     direction_to_latlong_uv,
     latlong_pixel_directions,
 )
+from reference.jit import kernel_input
 from reference.registry import Method, Registry
 
 __all__ = [
@@ -343,7 +344,8 @@ def latlong_to_cubemap(image, size: int = 64, backend: str = "numba", out=None) 
         f"latlong_to_cubemap: out must be a C-contiguous {image.dtype} array (6, {size}, {size}, "
         f"{C}), got {out.dtype} {out.shape}",
     )
-    _k.gather_bilinear_kernel(flat, taps, weights, texel, out.reshape(-1, C))
+    inputs = (kernel_input(x, None) for x in (flat, taps, weights, texel))
+    _k.gather_bilinear_kernel(*inputs, out.reshape(-1, C))
     return out
 
 
@@ -394,7 +396,8 @@ def latlong_blocks_to_cubemap(
         if backend == "numpy":
             gather_bilinear(flat, local, weights[lo:hi], texel[lo:hi], out=out)
         else:
-            _k.gather_bilinear_kernel(flat, local, weights[lo:hi], texel[lo:hi], out)
+            inputs = (kernel_input(x, None) for x in (flat, local, weights[lo:hi], texel[lo:hi]))
+            _k.gather_bilinear_kernel(*inputs, out)
 
     for start, block in blocks:
         block = np.asarray(block)

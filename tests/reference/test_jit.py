@@ -111,3 +111,43 @@ def test_every_kernel_is_cached_and_calls_only_its_own_file(path):
         for alias in node.names
     }
     assert not [m for m in imported if m.endswith("_kernels")], imported
+
+
+@pytest.mark.skipif(os.environ.get("NUMBA_DISABLE_JIT") == "1", reason="numba's signatures")
+def test_read_only_broadcast_and_strided_inputs_share_one_compiled_signature():
+    # A read-only (cached, broadcast) or strided input would otherwise compile a kernel again:
+    # seconds for the Phong table shader, once per layout (kernel_input makes them all one).
+    import numpy as np
+
+    from impastor import _kernels as impastor_kernels
+    from impastor.arealights import PlaneLight, booth_light_image
+    from impastor.point_lights import point_lights_from_plane
+    from impastor.specular_lighting import specular_point_lights
+    from phong_table import _kernels as phong_kernels
+    from phong_table.render import ShadingBuffer, compiled_shader
+    from phong_table.scenes import SCENES
+    from phong_table.table import build_table
+
+    model = SCENES.lookup("R1").build()
+    shade = compiled_shader(model, build_table(model, 32, "uniform"), "linear")
+    t = np.linspace(0.5, 1.0, 64)
+    read_only = t.copy()
+    read_only.flags.writeable = False
+    for t_view in (t, t[::-1], read_only, np.linspace(0.0, 1.0, 128)[::2]):
+        ones = np.broadcast_to(1.0, t_view.shape)
+        shade(ShadingBuffer(None, ones, t_view, ones), np.empty((t_view.size, 3)))
+        if t_view is t:
+            signatures = len(phong_kernels.shade_table_kernel.signatures)
+    assert len(phong_kernels.shade_table_kernel.signatures) == signatures
+
+    image = booth_light_image("fluorescent", 8, 4)
+    plane = PlaneLight(image, (-0.6, 0.6, -1.0), (1, 0, 0), (0, 0, 1), 1.2, 0.8)
+    lights = point_lights_from_plane(plane, "median_cut", 4)
+    P = np.zeros((5, 3))
+    up = np.tile([0.0, 1.0, 0.0], (5, 1))
+    specular_point_lights(P, up, up, 0.2, lights)
+    kernel = impastor_kernels.specular_point_lights_kernel
+    signatures = len(kernel.signatures)
+    specular_point_lights(P, np.array([0.0, 1.0, 0.0]), up, np.full(5, 0.2), lights)
+    specular_point_lights(P[:, ::1], up, np.broadcast_to(up[0], (5, 3)), 0.2, lights)
+    assert len(kernel.signatures) == signatures
