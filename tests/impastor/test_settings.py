@@ -61,11 +61,12 @@ def test_many_median_cut_lights_converge_to_the_brute_force(scene):
 
 
 def test_the_pilot_keeps_its_promise_on_the_frame(scene):
-    # the chosen settings meet the tolerance on the pilot and on a frame at a finer resolution,
-    # against the same brute force, and cost less than the fixed settings
+    # the chosen settings meet the tolerance on the pilot (400 of the frame's pixels) and on the
+    # whole frame, against the same brute force, and cost less than the fixed settings
     from impastor.settings import frame_cost
 
-    pilot = PaintingPilot(scene, 24)
+    pilot = PaintingPilot(scene, 96, pixels=400)
+    assert pilot.px.P.shape[0] == 400
     for tolerance in (0.02, 0.05):
         chosen = settings_from_tolerance(scene, tolerance, pilot=pilot)
         assert chosen.met
@@ -73,9 +74,9 @@ def test_the_pilot_keeps_its_promise_on_the_frame(scene):
         assert frame_cost(*chosen.render_options().values()) < frame_cost(
             *FIXED_SETTINGS.render_options().values()
         )
-        out = render_painting("A", 48, "hybrid", scene.painting, light_resolution=(32, 16),
+        out = render_painting("A", 96, "hybrid", scene.painting, light_resolution=(32, 16),
                               **chosen.render_options())  # fmt: skip
-        px = canvas_pixels(scene.painting, 48)
+        px = canvas_pixels(scene.painting, 96)
         reference = channels_to_XYZ(painting_brute_force(scene, px), scene.design)
         assert relative_rms_error(out["XYZ"][px.gbuffer.mask], reference) <= tolerance
 
@@ -117,3 +118,19 @@ def test_without_the_failsafe_the_hybrid_is_its_per_pixel_blend(scene):
     on = specular_hybrid_parts(px.P, px.N, px.V, alpha, plane, lights, 8)
     assert not off["failsafe"].any()
     np.testing.assert_array_equal(off["point_lights"], on["point_lights"])
+
+
+def test_the_pilots_pixels_are_a_stratified_sample_of_the_frames():
+    from impastor.settings import pilot_pixels
+
+    painting = impasto_painting(64, seed=71)
+    frame = canvas_pixels(painting, 128)
+    sample = pilot_pixels(painting, 128, count=300)
+    n = frame.P.shape[0]
+    # every pixel is one of the frame's, one in each run of n / 300 pixels, the same for a seed
+    key = {tuple(p): i for i, p in enumerate(map(tuple, frame.P))}
+    index = np.array([key[tuple(p)] for p in sample.P])
+    runs = (np.arange(301) * n) // 300
+    assert ((runs[:-1] <= index) & (index < runs[1:])).all()
+    np.testing.assert_array_equal(pilot_pixels(painting, 128, count=300).P, sample.P)
+    assert not np.array_equal(pilot_pixels(painting, 128, count=300, seed=1).P, sample.P)

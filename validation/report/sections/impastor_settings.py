@@ -15,7 +15,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from impastor.settings import PILOT_SIZE
 from validation.report import (
     Check,
     Headline,
@@ -27,6 +26,7 @@ from validation.report import (
 )
 from validation.studies.impastor_settings import (
     EQUAL_ERROR,
+    METHODS_SIZE,
     best_speedup_at_fixed_error,
     method_speed_accuracy,
     tolerance_study,
@@ -108,7 +108,7 @@ def settings_figures(ctx: ReportContext | None = None, study: SettingsStudy | No
         case["speedup_at_fixed_error"] = best_speedup_at_fixed_error(case)
     seed, light = study.cases[0]
     methods = method_speed_accuracy(
-        seed, light, min(PILOT_SIZE, study.size), study.light_resolution,
+        seed, light, min(METHODS_SIZE, study.size), study.light_resolution,
         repeats=study.repeats, backend=study.backend,
     )  # fmt: skip
     settings = {
@@ -209,9 +209,10 @@ def present(ctx: ReportContext, data: SectionData) -> list:
             "tolerance on the frame's error against brute force (erratum E96; `specref impastor "
             "render --tolerance`). Held-out paintings (seeds from 61; the method was designed on "
             f"41-44) at {study['size']}², each frame timed and measured on "
-            f"{cases[0]['eval_pixels']} of its own pixels against the brute force (every light "
-            "pixel shadowed by its own horizon test, the specular integral over every light "
-            f"sub-pixel). The pilot's brute force costs {pilot:.1f} s per painting and light, "
+            f"{cases[0]['eval_pixels']} of its own pixels, evenly spread, against the brute force "
+            "(every light pixel shadowed by its own horizon test, the specular integral over "
+            "every light sub-pixel); the pilot is a stratified sample of other pixels of the same "
+            f"frame. The pilot's brute force costs {pilot:.1f} s per painting and light, "
             "once; each tolerance's descent a few seconds more (the table's frames exclude both, "
             "as they exclude the horizon map)."
         ),
@@ -291,7 +292,8 @@ def _methods_blocks(ctx: ReportContext, methods: dict) -> list:
     return [
         Text(
             "Speed against accuracy of every lighting method (§3.5, Ferwerda): on the "
-            f"{methods['pixels']} visible canvas pixels of the first painting's pilot frame, each "
+            f"{methods['pixels']} visible canvas pixels of a {METHODS_SIZE}² frame of the first "
+            "painting, each "
             "method shades with N point lights and K FIS samples (N = K), shadows from the "
             "36-sector horizon, timed (best of the repeats, the horizon look-up included) and "
             "measured against the brute force above."
@@ -300,7 +302,7 @@ def _methods_blocks(ctx: ReportContext, methods: dict) -> list:
         Table(
             ["method", "N = K", "ms per pixel", "error (%)"],
             rows,
-            "Each lighting method's shading time and error on the pilot frame's pixels",
+            f"Each lighting method's shading time and error on a {METHODS_SIZE}² frame's pixels",
             "{:.3g}",
         ),
     ]
