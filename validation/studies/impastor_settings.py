@@ -36,6 +36,7 @@ from impastor.painting import (
 from impastor.settings import (
     FIXED_SETTINGS,
     LIGHT_LADDER,
+    PILOT_MARGIN,
     PaintingPilot,
     painting_brute_force,
     relative_rms_error,
@@ -166,13 +167,15 @@ def tolerance_case(task) -> dict:
         ``seed``, ``light``, ``pilot_seconds``, ``eval_pixels`` and ``rows``: per setting
         (``"fixed"`` first, then each tolerance) ``label``, ``tolerance``, ``settings``
         (N, K, S, fail-safe), ``pilot_error``, ``met``, ``choose_seconds``, ``frame_seconds``
-        and ``error`` (the frame's relative RMS against brute force).
+        and ``error`` (the frame's relative RMS against brute force); ``matched``: the same for
+        the settings chosen at no more than the fixed settings' pilot error (the tolerance that
+        error over :data:`~impastor.settings.PILOT_MARGIN`), the comparison at equal error.
 
     Examples
     --------
     >>> case = tolerance_case((61, "A", (0.05,), 16, (16, 8), 40, 1, "numpy"))
-    >>> [r["label"] for r in case["rows"]], case["rows"][1]["met"]
-    (['fixed', '5 %'], True)
+    >>> [r["label"] for r in case["rows"]], case["rows"][1]["met"], case["matched"]["label"]
+    (['fixed', '5 %'], True, "the fixed settings' error")
     """
     seed, light, tolerances, size, light_resolution, eval_pixels, repeats, backend = task
     spectra = load_paint_spectra()
@@ -186,24 +189,24 @@ def tolerance_case(task) -> dict:
     reference = channels_to_XYZ(
         painting_brute_force(scene, px.subset(index), backend), scene.design
     )
-    chosen, choose_seconds = [], []
-    for tolerance in (None, *tolerances):
+    # the ladder of tolerances, then the one whose promise is the fixed settings' own pilot error
+    matched = pilot.error(*FIXED_SETTINGS.render_options().values()) / PILOT_MARGIN
+    matched = min(max(matched, 1e-6), 0.5)
+    labels = ["fixed", *(f"{100 * t:g} %" for t in tolerances), "the fixed settings' error"]
+    chosen, choose_seconds = [FIXED_SETTINGS], [0.0]
+    for tolerance in (*tolerances, matched):
         start = time.perf_counter()
-        chosen.append(
-            FIXED_SETTINGS
-            if tolerance is None
-            else settings_from_tolerance(scene, tolerance, pilot=pilot)
-        )
-        choose_seconds.append(0.0 if tolerance is None else time.perf_counter() - start)
+        chosen.append(settings_from_tolerance(scene, tolerance, pilot=pilot))
+        choose_seconds.append(time.perf_counter() - start)
     frames, seconds = _frames(scene, light, size, chosen, spectra, repeats, backend)
     rows = []
-    for i, tolerance in enumerate((None, *tolerances)):
+    for i, settings in enumerate(chosen):
         rows.append({
-            "label": "fixed" if tolerance is None else f"{100 * tolerance:g} %",
-            "tolerance": tolerance,
-            "settings": chosen[i].render_options(),
-            "pilot_error": chosen[i].pilot_error,
-            "met": chosen[i].met,
+            "label": labels[i],
+            "tolerance": settings.tolerance,
+            "settings": settings.render_options(),
+            "pilot_error": settings.pilot_error,
+            "met": settings.met,
             "choose_seconds": choose_seconds[i],
             "frame_seconds": seconds[i],
             "error": relative_rms_error(frames[i][px.gbuffer.mask][index], reference),
@@ -213,7 +216,8 @@ def tolerance_case(task) -> dict:
         "light": light,
         "pilot_seconds": pilot_seconds,
         "eval_pixels": int(index.size),
-        "rows": rows,
+        "rows": rows[:-1],
+        "matched": rows[-1],
     }
 
 
@@ -226,6 +230,7 @@ def best_speedup_at_fixed_error(case: dict) -> float | None:
     """The fixed frame's time over the fastest tolerance frame at no more than its error.
 
     "No more" within :data:`EQUAL_ERROR`; None when no tolerance reached the fixed settings' error.
+    The frames are the ladder's and, where the case has it, ``matched``'s.
 
     Examples
     --------
@@ -236,6 +241,7 @@ def best_speedup_at_fixed_error(case: dict) -> float | None:
     2.0
     """
     fixed, *chosen = case["rows"]
+    chosen += [case["matched"]] if case.get("matched") else []
     times = [r["frame_seconds"] for r in chosen if r["error"] <= EQUAL_ERROR * fixed["error"]]
     return fixed["frame_seconds"] / min(times) if times else None
 

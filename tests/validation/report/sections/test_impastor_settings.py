@@ -56,7 +56,9 @@ def test_tiny_study_presents_a_chart_and_a_table(tmp_path):
     blocks = present(ReportContext(tmp_path, section="impastor-settings"), data)
     assert (tmp_path / "images" / "impastor-settings-time-vs-error.png").exists()
     tables = {b.caption.split(" ")[0]: b for b in blocks if hasattr(b, "rows")}
-    assert len(tables["Settings"].rows) == 2
+    # the fixed settings, the tolerance, and the settings chosen at the fixed settings' error
+    assert len(tables["Settings"].rows) == 3
+    assert case["matched"]["pilot_error"] <= case["matched"]["tolerance"]
     # every lighting method's time against its error, and the brute force they are measured on
     assert (tmp_path / "images" / "impastor-settings-methods.png").exists()
     methods = tables["Each"].rows
@@ -65,3 +67,22 @@ def test_tiny_study_presents_a_chart_and_a_table(tmp_path):
     assert names[-1] == "brute force"
     assert all(row[2] > 0 for row in methods)  # times measured
     assert all(row[3] > 0 for row in methods[:-1])  # errors against the brute force
+
+
+def test_the_matched_frame_counts_for_the_speed_up_and_the_promise():
+    case = _case(0.01, [("4 %", 0.04, True, 0.03, 0.4)])
+    assert case["speedup_at_fixed_error"] is None  # the ladder's frame is not at the fixed error
+    from validation.studies.impastor_settings import best_speedup_at_fixed_error
+
+    matched = dict(
+        case["rows"][1], label="matched", tolerance=0.012, error=0.0104, frame_seconds=1.0
+    )
+    case["matched"] = matched
+    case["speedup_at_fixed_error"] = best_speedup_at_fixed_error(case)
+    assert case["speedup_at_fixed_error"] == 2.0  # within 5 % of the fixed error, twice as fast
+    found = checks(SectionData({"cases": [case], "study": {}, "methods": {}}))
+    assert [c.passed for c in found] == [True, True]
+    case["matched"]["error"] = 0.013  # over its own tolerance and the fixed error
+    case["speedup_at_fixed_error"] = best_speedup_at_fixed_error(case)
+    found = checks(SectionData({"cases": [case], "study": {}, "methods": {}}))
+    assert [c.passed for c in found] == [False, False]
