@@ -6,7 +6,8 @@ shows that the two agree to ~1e-12:
 - :func:`shade_exact_kernel` ↔ ``phong_table.render.shade_exact``: the exact spectral shading, one
   ``ln t`` per pixel and one ``exp`` per band (the speed baseline);
 - :func:`shade_table_kernel` ↔ ``phong_table.render.shade_table``: the same pixels through a table
-  of Eq. (11), Wang et al. with any registered interpolation;
+  of Eq. (11), Wang et al. with any registered interpolation (it calls that interpolation's kernel
+  of :data:`TABLE_KERNELS`, which a render calls directly, so it compiles only that one);
 - :func:`table_error_kernel` ↔ ``phong_table.placement.table_error``: the node density of the
   error-equidistributing placement;
 - :func:`tabulate_kernel` ↔ ``phong_table.table.tabulate``: the table's values, slopes and index;
@@ -589,50 +590,94 @@ def shade_table_kernel(
     holds ``f_sp`` without ``f_att``, Erratum E18); writes ``out`` (N, 3). Pixels with ``t`` below
     ``zero_below`` (``SpecularTable.zero_below``: every interpolation of the table is exactly 0
     there) skip the lookup, as the exact kernel skips the bands whose ``t^n`` underflows; the
-    result is the same to the bit.
+    result is the same to the bit. ``code`` picks the interpolation's kernel of
+    :data:`TABLE_KERNELS`, which the render path calls directly.
     """
-    # one loop per interpolation and lookup (uniform or not), so that none tests either per pixel
-    # or on a miss (with the lookup's kind a runtime value, the uniform tables' loops ran up to 25 %
-    # slower; the eight loops take ~6 s to compile, against ~3.5 s for four)
+    args = (cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, inv_width, cubic, guide)
     if code == MONOTONE:
-        # the monotone cubics packed one row per interval: one cache line or two per miss
-        records = _monotone_records(nodes, values, inv_width, cubic)
-        if uniform:
-            _shade_monotone_loop(
-                cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, records, guide, steps,
-                True, zero_below, out,
-            )  # fmt: skip
-        else:
-            _shade_monotone_loop(
-                cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, records, guide, steps,
-                False, zero_below, out,
-            )  # fmt: skip
-    elif code == PARABOLIC:
-        # the t-parabolas written about their middle node, one row per stencil
-        records = _parabolic_records(nodes, values)
-        if uniform:
-            _shade_parabolic_loop(
-                cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, records, guide, steps,
-                True, zero_below, out,
-            )  # fmt: skip
-        else:
-            _shade_parabolic_loop(
-                cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, records, guide, steps,
-                False, zero_below, out,
-            )  # fmt: skip
-    elif code == PARABOLIC_W:
-        stencils, intervals = _parabolic_w_records(nodes, values, a)
-        if uniform:
-            _shade_parabolic_w_loop(
-                cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, stencils, intervals,
-                guide, steps, True, a, zero_below, out,
-            )  # fmt: skip
-        else:
-            _shade_parabolic_w_loop(
-                cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, stencils, intervals,
-                guide, steps, False, a, zero_below, out,
-            )  # fmt: skip
-    elif uniform:
+        return _shade_table_monotone_kernel(*args, steps, uniform, a, zero_below, out)
+    if code == PARABOLIC:
+        return _shade_table_parabolic_kernel(*args, steps, uniform, a, zero_below, out)
+    if code == PARABOLIC_W:
+        return _shade_table_parabolic_w_kernel(*args, steps, uniform, a, zero_below, out)
+    return _shade_table_linear_kernel(*args, steps, uniform, a, zero_below, out)
+
+
+# One kernel per interpolation, each with one pixel loop per lookup (uniform or not), so that no
+# loop tests either per pixel or on a miss (with the lookup's kind a runtime value, the uniform
+# tables' loops ran up to 25 % slower), and a render compiles only its interpolation's kernel: the
+# eight loops in one kernel took 6-9 s to compile, against 1.5-2.5 s for one kernel's two.
+
+
+@njit
+def _shade_table_monotone_kernel(
+    cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, inv_width, cubic, guide, steps,
+    uniform, a, zero_below, out,
+):  # fmt: skip
+    """:func:`shade_table_kernel` for the monotone cubic (the default; ``a`` unused)."""
+    # the monotone cubics packed one row per interval: one cache line or two per miss
+    records = _monotone_records(nodes, values, inv_width, cubic)
+    if uniform:
+        _shade_monotone_loop(
+            cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, records, guide, steps,
+            True, zero_below, out,
+        )  # fmt: skip
+    else:
+        _shade_monotone_loop(
+            cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, records, guide, steps,
+            False, zero_below, out,
+        )  # fmt: skip
+    return out
+
+
+@njit
+def _shade_table_parabolic_kernel(
+    cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, inv_width, cubic, guide, steps,
+    uniform, a, zero_below, out,
+):  # fmt: skip
+    """:func:`shade_table_kernel` for the t-parabola (``inv_width``, ``cubic``, ``a`` unused)."""
+    # the t-parabolas written about their middle node, one row per stencil
+    records = _parabolic_records(nodes, values)
+    if uniform:
+        _shade_parabolic_loop(
+            cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, records, guide, steps,
+            True, zero_below, out,
+        )  # fmt: skip
+    else:
+        _shade_parabolic_loop(
+            cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, records, guide, steps,
+            False, zero_below, out,
+        )  # fmt: skip
+    return out
+
+
+@njit
+def _shade_table_parabolic_w_kernel(
+    cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, inv_width, cubic, guide, steps,
+    uniform, a, zero_below, out,
+):  # fmt: skip
+    """:func:`shade_table_kernel` for the w-parabola (``inv_width``, ``cubic`` unused)."""
+    stencils, intervals = _parabolic_w_records(nodes, values, a)
+    if uniform:
+        _shade_parabolic_w_loop(
+            cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, stencils, intervals,
+            guide, steps, True, a, zero_below, out,
+        )  # fmt: skip
+    else:
+        _shade_parabolic_w_loop(
+            cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, stencils, intervals,
+            guide, steps, False, a, zero_below, out,
+        )  # fmt: skip
+    return out
+
+
+@njit
+def _shade_table_linear_kernel(
+    cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, inv_width, cubic, guide, steps,
+    uniform, a, zero_below, out,
+):  # fmt: skip
+    """:func:`shade_table_kernel` for linear interpolation (``cubic``, ``a`` unused)."""
+    if uniform:
         _shade_linear_loop(
             cos_theta, t, f_att, diffuse_RGB, ambient_RGB, nodes, values, inv_width, guide, steps,
             True, zero_below, out,
@@ -643,6 +688,15 @@ def shade_table_kernel(
             False, zero_below, out,
         )  # fmt: skip
     return out
+
+
+#: The table kernels by interpolation code (:data:`LINEAR`, :data:`PARABOLIC`, ...).
+TABLE_KERNELS = (
+    _shade_table_linear_kernel,
+    _shade_table_parabolic_kernel,
+    _shade_table_parabolic_w_kernel,
+    _shade_table_monotone_kernel,
+)
 
 
 @njit(inline="always")

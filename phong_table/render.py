@@ -341,13 +341,14 @@ def compiled_shader(
         table.guide,
         table.steps,
         table.uniform,
-        INTERPOLATION_METHODS.lookup(interpolation).code,
         table.an + 1.0,
         table.zero_below,
     )
+    # the interpolation's own kernel (shade_table_kernel's branch): a render compiles only it
+    kernel = _kernels.TABLE_KERNELS[INTERPOLATION_METHODS.lookup(interpolation).code]
 
     def shade(buffer: ShadingBuffer, out):
-        return _kernels.shade_table_kernel(*_buffer_inputs(buffer), *bound, out)
+        return kernel(*_buffer_inputs(buffer), *bound, out)
 
     return shade
 

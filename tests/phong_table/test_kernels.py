@@ -42,6 +42,28 @@ def test_table_kernel_equals_numpy(placement, interpolation, scene):
         _close(compiled, reference)
 
 
+def test_the_registered_table_kernel_is_each_interpolations_kernel():
+    # RENDER_METHODS' twin takes the interpolation's code and calls its kernel (TABLE_KERNELS),
+    # which the render path calls directly: the same pixels, bit for bit
+    from phong_table import _kernels
+    from phong_table.render import _buffer_inputs
+
+    model = SCENES.lookup("R2").build()
+    buffer = shading_buffer(sphere_gbuffer("near", 16), model, False)
+    table = build_table(model, 32, "error", compiled=True)
+    rows = _buffer_inputs(buffer)
+    head = (model.diffuse_RGB, model.ambient_RGB, table.nodes, table.values, table.inv_width,
+            table.cubic, table.guide, table.steps, table.uniform)  # fmt: skip
+    tail = (table.an + 1.0, table.zero_below)
+    for name in INTERPOLATION_METHODS.names():
+        code = INTERPOLATION_METHODS.lookup(name).code
+        out = np.empty((buffer.t.size, 3))
+        registered = RENDER_METHODS.lookup("table").kernel(*rows, *head, code, *tail, out.copy())
+        direct = _kernels.TABLE_KERNELS[code](*rows, *head, *tail, out)
+        np.testing.assert_array_equal(registered, direct)
+        _close(direct, shade_pixels(buffer, model, "table", table, name, compiled=False))
+
+
 def test_table_kernel_on_exact_node_hits():
     # pixels exactly on nodes and at 0 and 1 find the same interval as searchsorted
     model = SCENES.lookup("R1").build()

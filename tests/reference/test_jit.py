@@ -137,8 +137,8 @@ def test_read_only_broadcast_and_strided_inputs_share_one_compiled_signature():
         ones = np.broadcast_to(1.0, t_view.shape)
         shade(ShadingBuffer(None, ones, t_view, ones), np.empty((t_view.size, 3)))
         if t_view is t:
-            signatures = len(phong_kernels.shade_table_kernel.signatures)
-    assert len(phong_kernels.shade_table_kernel.signatures) == signatures
+            signatures = len(phong_kernels.TABLE_KERNELS[phong_kernels.LINEAR].signatures)
+    assert len(phong_kernels.TABLE_KERNELS[phong_kernels.LINEAR].signatures) == signatures
 
     image = booth_light_image("fluorescent", 8, 4)
     plane = PlaneLight(image, (-0.6, 0.6, -1.0), (1, 0, 0), (0, 0, 1), 1.2, 0.8)
