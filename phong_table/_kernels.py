@@ -976,7 +976,10 @@ def _place_seen_error_kernel(
     out = np.empty(entries + 1)
     if below:
         out[0], out[1] = 0.0, low
-    out[below : below + m + 1] = nodes
+    # element by element: a slice assignment compiles numba's shape-mismatch error message, which
+    # took 3 of the kernel's 5 s to compile
+    for q in range(m + 1):
+        out[below + q] = nodes[q]
     if t_hi < 1.0:
         out[entries - 1], out[entries] = high, 1.0
     return out
