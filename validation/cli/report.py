@@ -48,10 +48,11 @@ def add_parser(sub) -> None:
         description="Every section's figures, charts, images and target checks, each section at "
         "the settings its checks need (the full-resolution studies and long sweeps at their "
         "quick settings: --full runs them in full). index.html is rewritten after every "
-        "section, so a stopped run leaves a readable page. Measured on a shared two-core "
-        "machine with nothing else running: 2 min 51 s with the default two processes (5 min "
-        "7 s of CPU; earlier runs 1 min 55 s – 2 min 42 s); --full 31 min (with make bench, "
-        "50 min; earlier 54-66 min), 1 h 48 min beside other work.",
+        "section, so a stopped run leaves a readable page. Measured on shared two-core "
+        "machines with nothing else running: 2 min 19 s with the default two processes and an "
+        "empty kernel cache (3 min 51 s of CPU; 1 min 55 s – 2 min 51 s on a slower machine); "
+        "--full 31 min (with make bench, 50 min; earlier 54-66 min), 1 h 48 min beside other "
+        "work.",
     )
     p.add_argument(
         "--out", type=folder_name, default="report", help="output folder (default: report)"
