@@ -57,7 +57,7 @@ from impastor.point_lights import (
     point_lights_every_pixel,
 )
 from impastor.specular_lighting import specular_brute_force
-from reference.errors import require
+from reference.errors import require, require_positive_int
 from reference.registry import Method, Registry
 
 __all__ = [
@@ -295,6 +295,7 @@ def pilot_pixels(painting: dict, size: int, eye=EYE, count: int = PILOT_PIXELS, 
     >>> pilot_pixels(painting, 8, count=100).P.shape == canvas_pixels(painting, 8).P.shape
     True
     """
+    count = require_positive_int(count, "pilot: pixels", 1 << 24)
     px = canvas_pixels(painting, size, eye)
     n = px.P.shape[0]
     if n <= count:
