@@ -79,6 +79,11 @@ SETTINGS = {
 }
 # Targets (erratum E44; ΔE94, held-out ColorChecker unless said otherwise).
 TARGETS = {"D65 mean": 0.77, "D65 max": 1.5, "A mean": 1.0, "in-sample mean": 0.8}
+#: The speed benchmark's inputs (``make bench``, group spectral-env-2k), as the page names them.
+SPEED_INPUTS = {
+    "panorama": "on venice_sunset_1k (each pixel 2 × 2)",
+    "random": "on uniform random RGB in [0, 4] (the worst case for the projection)",
+}
 
 
 def relit_sRGB(spectra, illuminant: str) -> np.ndarray:
@@ -194,18 +199,7 @@ def spectral_environments(
     ]
     data.results["losses"] = (run or _serial)(_loss_figures, fits)
     data.results["recovery"] = {m: recovery_figures(m, (CC,))[CC] for m in s["recovery"]}
-    # Benchmark (make bench): spectralize throughput relative to the bare matrix product
-    medians = {
-        r.get("extra_info", {}).get("role"): r["stats"]["median"]
-        for records in (ctx.bench_groups("spectral-env") if ctx else {}).values()
-        for r in records
-    }
-    if {"baseline", "spectralize"} <= set(medians):
-        data.results["speed"] = {
-            "matmul_s": medians["baseline"],
-            "spectralize_s": medians["spectralize"],
-            "throughput_ratio": medians["baseline"] / medians["spectralize"],
-        }
+    data.results |= _speed_figures(ctx)
     # speed against accuracy of the render's upsamplers, on the panorama and the held-out sets
     data.results["upsamplers"] = upsampling_speed_accuracy(PANORAMA, methods=s["upsamplers"])
     panorama = _panorama(s["box"])
@@ -247,12 +241,17 @@ def present(ctx: ReportContext, data: SectionData) -> list:
     blocks += _degree_chart(ctx, data)
     if "speed" in data.results:
         speed = data.results["speed"]
+        found = [
+            f"{SPEED_INPUTS[source]} {speed[source]['spectralize_s']:.2f} s (throughput ratio "
+            f"{speed[source]['throughput_ratio']:.2f})"
+            for source in SPEED_INPUTS
+            if source in speed
+        ]
         blocks.append(
             Text(
-                "Speed (make bench, 2048×1024 to 41 bands): spectralize "
-                f"{speed['spectralize_s']:.2f} s, the bare matrix product of the same features "
-                f"{speed['matmul_s']:.2f} s "
-                f"(throughput ratio {speed['throughput_ratio']:.2f})."
+                "Speed (make bench, 2048×1024 to 41 bands, spectra with a negative value "
+                "projected, erratum E106): the bare matrix product of the same features "
+                f"{speed['matmul_s']:.2f} s; spectralize " + "; ".join(found) + "."
             )
         )
     if "upsamplers" in data.results:
@@ -592,16 +591,7 @@ def checks(data: SectionData) -> list[Check]:
         )
         for key, value in measured.items()
     ]
-    if "speed" in data.results:
-        ratio = data.results["speed"]["throughput_ratio"]
-        found.append(
-            Check(
-                "spectralize throughput / bare matmul, 2048×1024, 41 bands",
-                ">= 0.5",
-                ratio,
-                ratio >= 0.5,
-            )
-        )
+    found += speed_checks(data)
     if "nonnegative" in data.results:
         change = data.results["nonnegative"]["max_XYZ_change"]
         found.append(
@@ -644,6 +634,47 @@ def headlines(data: SectionData) -> list[Headline]:
             "target ≤ 1.0; Jakob 2019, what Mitsuba 3 and pbrt-v4 use: about 1.2",
         ),
     ]
+
+
+def speed_checks(data: SectionData) -> list[Check]:
+    """The throughput target on the real panorama (``make bench``; none without benchmarks).
+
+    Examples
+    --------
+    >>> speed_checks(SectionData({}))
+    []
+    """
+    if "panorama" not in data.results.get("speed", {}):
+        return []
+    # a real capture (the design input was random RGB, erratum E45): held out
+    ratio = data.results["speed"]["panorama"]["throughput_ratio"]
+    name = (
+        "spectralize throughput / bare matmul, 2048×1024 real panorama (venice_sunset_1k, each "
+        "pixel 2 × 2), 41 bands"
+    )
+    return [Check(name, ">= 0.5", ratio, ratio >= 0.5, "held out")]
+
+
+def _speed_figures(ctx) -> dict:
+    """``{"speed": ...}`` from ``make bench``: spectralize throughput against the bare product.
+
+    Per input of the benchmark (``panorama``: a real capture, ``random``: saturated RGB, the
+    worst case for erratum E106's projection), the spectralize median and its throughput ratio.
+    """
+    medians = {
+        (r.get("extra_info", {}).get("role"), r.get("extra_info", {}).get("input", "random")):
+        r["stats"]["median"]
+        for records in (ctx.bench_groups("spectral-env") if ctx else {}).values()
+        for r in records
+    }  # fmt: skip
+    matmul = next((s for (role, _), s in medians.items() if role == "baseline"), None)
+    spectralize = {source: s for (role, source), s in medians.items() if role == "spectralize"}
+    if matmul is None or not spectralize:
+        return {}
+    speed = {"matmul_s": matmul}
+    for source, seconds in spectralize.items():
+        speed[source] = {"spectralize_s": seconds, "throughput_ratio": matmul / seconds}
+    return {"speed": speed}
 
 
 SECTION = ReportSection(

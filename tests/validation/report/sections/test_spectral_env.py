@@ -93,3 +93,29 @@ def test_present_writes_every_image_and_table(tiny):
     assert f"mallett2019 is the fastest ({timed['seconds']:.2g} s" in captions
     assert "Root-polynomial 1 fitted with each loss" in captions
     assert "root_polynomial 2" in captions  # the left-out rows are named
+
+
+def test_speed_is_checked_on_the_real_panorama_and_the_worst_case_shown():
+    from validation.report import SectionData
+    from validation.report.sections.spectral_env import _speed_figures, speed_checks
+
+    def record(role, source, seconds):
+        extra = {"role": role, "input": source}
+        return {"group": "spectral-env-2k", "stats": {"median": seconds}, "extra_info": extra}
+
+    bench = {"benchmarks": [record("baseline", "panorama", 1.0),
+                            record("spectralize", "panorama", 1.6),
+                            record("spectralize", "random", 5.0)]}  # fmt: skip
+    figures = _speed_figures(ReportContext(out_dir=".", bench=bench))
+    speed = figures["speed"]
+    assert speed["panorama"]["throughput_ratio"] == pytest.approx(0.625)
+    assert speed["random"]["throughput_ratio"] == pytest.approx(0.2)
+    found = speed_checks(SectionData(figures))
+    assert len(found) == 1
+    assert found[0].passed
+    assert found[0].basis == "held out"
+    assert "venice_sunset_1k" in found[0].name
+    bench["benchmarks"][1]["stats"]["median"] = 2.5  # 0.4 of the product: fails
+    found = speed_checks(SectionData(_speed_figures(ReportContext(".", bench=bench))))
+    assert [c.passed for c in found] == [False]
+    assert _speed_figures(ReportContext(out_dir=".")) == {}
