@@ -51,8 +51,8 @@ def add_parser(sub) -> None:
         "section, so a stopped run leaves a readable page. Measured on shared two-core "
         "machines with nothing else running: 2 min 19 s with the default two processes and an "
         "empty kernel cache (3 min 51 s of CPU; 1 min 55 s – 2 min 51 s on a slower machine); "
-        "--full 31 min (with make bench, 50 min; earlier 54-66 min), 1 h 48 min beside other "
-        "work.",
+        "--full 25 min (with make bench, 38 min; 50-66 min on a slower machine), 1 h 48 min "
+        "beside other work.",
     )
     p.add_argument(
         "--out", type=folder_name, default="report", help="output folder (default: report)"
@@ -67,7 +67,7 @@ def add_parser(sub) -> None:
         "--full",
         action="store_true",
         help="every section at its full settings: the full-resolution maps and long sweeps "
-        "(make results; 50 min to 1 h 48 min on two cores)",
+        "(make results; 38 min to 1 h 48 min on two cores)",
     )
     registry_option(
         p, "--only", REPORT_SECTIONS, "run only these sections", nargs="+", metavar="SECTION"
