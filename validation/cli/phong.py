@@ -33,10 +33,6 @@ def _cmd_phong(args) -> int:
         return 0
     if args.file is not None:
         raise SpecrefError(f"specref phong: {args.file}: a file is taken by 'edit' only")
-    if args.json:  # refused before the work, not after it (and its progress lines)
-        from reference.files import check_output_file
-
-        check_output_file(args.json)
     if args.action == "table1":
         if args.images is not None:
             _write_images(args)
