@@ -58,6 +58,21 @@ def test_local_workers_exit_without_a_last_collection(client):
     assert all("reference.tasks" in names for names in found.values())
 
 
+def dask_settings(dask_worker=None):
+    import dask
+
+    from reference.tasks import QUIET_SETTINGS
+
+    return {key: dask.config.get(key) for key in QUIET_SETTINGS}
+
+
+def test_local_workers_keep_their_housekeeping_quiet(client):
+    # the event-loop watchdog and the dashboard's sampling, slowed where nothing reads them
+    from reference.tasks import QUIET_SETTINGS
+
+    assert list(client.run(dask_settings).values()) == [QUIET_SETTINGS] * 2
+
+
 #: The figures of ``specref phong table1`` that do not depend on the machine (timings do).
 TABLE1_FIGURES = ("scene", "view", "placement", "interpolation", "entries", "segments", "rms")
 
