@@ -407,9 +407,9 @@ def freeze_objects_for_exit() -> None:
     """Let this process exit without the interpreter's last collection over every object.
 
     When Python exits it runs the cyclic garbage collector over every object still alive; with
-    specref's packages loaded (colour-science alone defines hundreds of thousands of objects) that
-    took 0.4 s of every command's and every Dask worker's exit, longer than most commands' work
-    after their start-up. ``gc.freeze`` moves the live objects out of the collector's reach, so the
+    specref's packages and colour-science loaded that took 0.4-0.5 s of every command's and every
+    Dask worker's exit (measured from the command's return to the process's end: 0.55 s, and
+    0.06 s frozen). ``gc.freeze`` moves the live objects out of the collector's reach, so the
     exit skips them; ``atexit`` handlers, ``weakref.finalize`` callbacks (temporary folders) and
     reference-counted destructors still run. Called once a process's work is done: by the
     ``specref`` command after its command returned, by a worker at its teardown

@@ -63,12 +63,13 @@ def startup_model(startup: dict, cores: int) -> dict:
     run, is not used) on a machine of ``cores`` cores (docs/scale-out.md):
 
     - ``u(N) = u₁ + c·(N − 1)``: the CPU seconds of the command's processes (the client with its
-      scheduler and nannies, and the workers), a straight line by least squares through every N;
+      scheduler and nannies, and the workers), a straight line by least squares;
       ``c`` is one more worker's start (its interpreter, its imports, its kernels' loading);
     - ``s(N; P) = L + u(N) / min(N + 1, P)``: that CPU spread over the busy processes (the client
       and N workers) on P cores, and a latency ``L`` that no core shortens (process spawns,
-      handshakes); ``L`` is fitted on the design counts N ≤ ``cores`` and the model is checked on
-      the counts beyond them (held out), where the workers' starts compete for the cores.
+      handshakes). Both are fitted on the design counts N ≤ ``cores``; the counts beyond them,
+      where the workers' starts compete for the cores, are held out: the model's wall time there,
+      from the line's CPU, against the measured one.
 
     On a machine with a core per worker (P = N) the start-up is ``L + u(N)/N``, which tends to
     ``L + c``: each worker's own start stays on the way to its first task.
@@ -78,28 +79,28 @@ def startup_model(startup: dict, cores: int) -> dict:
     >>> m = startup_model({0: (1.7, 1.8), 1: (2.7, 2.8), 2: (3.0, 3.7), 3: (3.5, 4.7),
     ...                    4: (4.6, 6.6)}, cores=2)
     >>> round(m["latency_s"], 2), [round(v, 2) for v in m["cpu_s"]]
-    (1.25, [2.59, 1.24])
+    (1.23, [2.8, 0.9])
     >>> {n: round(v, 2) for n, v in m["held_out_error"].items()}
-    {3: 0.08, 4: -0.04}
+    {3: 0.01, 4: -0.14}
     >>> round(m["predict"](16, 16), 2)
-    2.57
+    2.24
     """
     import numpy as np
 
     counts = sorted(n for n in startup if n >= 1)
     wall = {n: startup[n][0] for n in counts}
     cpu = {n: startup[n][1] for n in counts}
-    if len(counts) > 1:
-        A = np.vstack([np.ones(len(counts)), np.subtract(counts, 1)]).T
-        u1, c = (float(v) for v in np.linalg.lstsq(A, [cpu[n] for n in counts], rcond=None)[0])
+    design = [n for n in counts if n <= cores] or counts[:1]
+    if len(design) > 1:
+        A = np.vstack([np.ones(len(design)), np.subtract(design, 1)]).T
+        u1, c = (float(v) for v in np.linalg.lstsq(A, [cpu[n] for n in design], rcond=None)[0])
     else:
-        u1, c = cpu[counts[0]], 0.0
+        u1, c = cpu[design[0]], 0.0
     c = max(c, 0.0)
 
     def u(n):
         return u1 + c * (n - 1)
 
-    design = [n for n in counts if n <= cores]
     L = float(np.mean([wall[n] - u(n) / min(n + 1, cores) for n in design]))
 
     def predict(n, P):
