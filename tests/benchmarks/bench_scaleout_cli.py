@@ -4,7 +4,7 @@ Group ``scaleout-cli`` (docs/scale-out.md, "How it scales, and what does not"; t
 Scale-out section fits its model to these figures):
 
 - ``cli-serial``: ``specref sweep GRID --scheduler serial``, a 6,144-cell Phong sweep (4 materials
-  × 2 views × 3 placements × 4 interpolations × 64 table sizes, resolution 448; over a minute
+  × 2 views × 3 placements × 4 interpolations × 64 table sizes, resolution 512; over a minute
   serially, as the targets ask), in a new process;
 - ``cli-workers``: the same sweep with ``--scheduler local:N`` for N = 1 … the cores present: a new
   local cluster of N workers, its start, the workers' imports and the shared exact renders
@@ -53,7 +53,7 @@ views = ["near", "far"]
 placements = ["importance", "uniform", "error"]
 interpolations = ["parabolic", "parabolic_w", "linear", "monotone"]
 entries = [{ENTRIES}]
-resolution = 448
+resolution = 512
 """
 CELLS, SHARED = 4 * 2 * 3 * 4 * 64, 4 * 2
 #: Rounds of the serial and the cluster sweeps (the fastest counts).
@@ -66,7 +66,7 @@ views = ["near"]
 placements = ["importance"]
 interpolations = ["parabolic"]
 entries = [40]
-resolution = 448
+resolution = 512
 """
 CORES = os.cpu_count() or 1
 SPECREF = os.path.join(os.path.dirname(sys.executable), "specref")
