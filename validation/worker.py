@@ -30,9 +30,11 @@ PACKAGES = ("reference", "phong_table", "shrm", "impastor", "validation.studies"
 
 def dask_setup(worker) -> None:
     """Import specref's packages on a starting worker and record what it runs on the worker."""
-    from reference.tasks import set_malloc_trim, specref_identity
+    from reference.tasks import WORKER_ARENAS, set_malloc_trim, specref_identity
 
-    set_malloc_trim()  # Dask's 64 KiB trim threshold makes every large NumPy temporary an mmap
+    # Dask's 64 KiB trim threshold makes every large NumPy temporary an mmap; the tasks' thread
+    # shares the main arena, where these thresholds hold
+    set_malloc_trim(arenas=WORKER_ARENAS)
     for name in PACKAGES:
         importlib.import_module(name)
     worker.specref_identity = specref_identity()

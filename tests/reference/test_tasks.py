@@ -73,6 +73,19 @@ def test_local_workers_keep_their_housekeeping_quiet(client):
     assert list(client.run(dask_settings).values()) == [QUIET_SETTINGS] * 2
 
 
+def allocator_environment(dask_worker=None):
+    keys = ("MALLOC_TRIM_THRESHOLD_", "MALLOC_MMAP_THRESHOLD_", "MALLOC_ARENA_MAX")
+    return [os.environ.get(key) for key in keys]
+
+
+def test_local_workers_allocate_from_one_arena_with_the_workers_thresholds(client):
+    # the tasks' thread shares the main arena, where the thresholds hold (reference.tasks)
+    from reference.tasks import WORKER_ARENAS, WORKER_MMAP_BYTES, WORKER_TRIM_BYTES
+
+    expected = [str(WORKER_TRIM_BYTES), str(WORKER_MMAP_BYTES), str(WORKER_ARENAS)]
+    assert list(client.run(allocator_environment).values()) == [expected] * 2
+
+
 #: The figures of ``specref phong table1`` that do not depend on the machine (timings do).
 TABLE1_FIGURES = ("scene", "view", "placement", "interpolation", "entries", "segments", "rms")
 
@@ -462,7 +475,7 @@ def process_id(_task):
 def test_local_n_starts_a_cluster_of_n_workers(monkeypatch):
     # and leaves this process's environment as it was: Dask's nannies write the workers'
     # allocator thresholds into it, which every process started later would inherit
-    for key in ("MALLOC_TRIM_THRESHOLD_", "MALLOC_MMAP_THRESHOLD_"):
+    for key in ("MALLOC_TRIM_THRESHOLD_", "MALLOC_MMAP_THRESHOLD_", "MALLOC_ARENA_MAX"):
         monkeypatch.delenv(key, raising=False)
     before = dict(os.environ)
     pids = run_tasks(process_id, range(6), scheduler="local:1", progress=False, grain=1)
