@@ -144,7 +144,7 @@ def test_command_line_figures_and_their_targets(tmp_path):
     assert found[names[0]] == (pytest.approx(70 / 42), False)
     assert found[names[1]] == (70.0, True)  # the sweep is long enough for its targets
     assert found[names[2]] == (pytest.approx(0.0, abs=1e-12), True)  # start-up, held out
-    assert "held out" in [c.basis for c in checks(data)]
+    assert [c.basis for c in checks(data)] == ["design"] * 2 + ["held out"] + ["design"] * 2
     assert found[names[3]][1] is False  # 3.5 s of latency in 70 s keeps 16 workers below 8x
     assert found[names[4]] == (pytest.approx(6.0), False)
     parts = present(ReportContext(out_dir=tmp_path), data)
