@@ -322,7 +322,7 @@ def _sweep_tables(s: dict) -> list:
     ]
     if "startup" in s:
         st = s["startup"]
-        model = {n: st["predict_here"][n] for n in st.get("predict_here", {})}
+        model = st.get("predict_here", {})
         starts = [
             [
                 n,
