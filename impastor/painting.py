@@ -44,7 +44,7 @@ from impastor.point_lights import (
     point_lights_every_pixel,
     point_lights_from_plane,
 )
-from impastor.specular_hybrid import specular_hybrid
+from impastor.specular_hybrid import specular_by_alpha_group, specular_hybrid
 from impastor.specular_lighting import specular_fis, specular_point_lights
 from reference.colour.colorimetry import XYZ_to_display_RGB
 from reference.colour.spectra import resample_spectrum, spectrum_from_csv, spectrum_from_dataset
@@ -561,6 +561,7 @@ def render_painting(
     n_channels: int = 6,
     tilt: float = 0.0,
     light_map=None,
+    by_group=None,
 ) -> dict:
     """Render a painting (the demo one by default) under a booth light through ImpastoR.
 
@@ -580,9 +581,10 @@ def render_painting(
     design, light_resolution, shadows, spectra, n_channels, light_map
         Pipeline settings (``spectra``: :func:`load_paint_spectra`; ``n_channels``: 3-10;
         ``light_map``: a captured room as the ceiling, :func:`booth_plane_light_from_map`).
-    n_lights, n_samples, n_sectors, failsafe
-        Point lights N, FIS samples K, horizon sectors S and the hybrid's fail-safe: fixed here
-        (32, 32, 36, on); :func:`impastor.settings.render_painting_to_tolerance` chooses them.
+    n_lights, n_samples, n_sectors, failsafe, by_group
+        Point lights N, FIS samples K, horizon sectors S, the hybrid's fail-safe and α groups on
+        one method (:func:`painting_specular_hybrid`): fixed here (32, 32, 36, on, none);
+        :func:`impastor.settings.render_painting_to_tolerance` chooses them.
     backend, progress
         ``"numba"`` kernels or their ``"numpy"`` twins (no JIT warm-up: for small images); a stream
         for a line per stage with its time (``specref impastor render``), optional.
@@ -597,7 +599,7 @@ def render_painting(
         ``XYZ`` (H, W, 3) in cd/m², ``sRGB`` encoded (H, W, 3) in [0, 1] (white = 1.2× the
         white diffuser's luminance), ``seconds`` per stage (``shadows`` is the horizon lookup,
         plus the horizon map the first time a height field is rendered: :func:`cached_horizon_map`),
-        ``settings`` (N, K, S, the fail-safe) and ``pose`` (``eye`` in m, ``tilt_deg``).
+        ``settings`` (N, K, S, fail-safe, ``by_group`` if any), ``pose`` (``eye``, m; ``tilt_deg``).
 
     Examples
     --------
@@ -611,8 +613,7 @@ def render_painting(
     scene, eye_canvas = posed_scene(rest, eye, tilt)
     px = canvas_pixels(painting, size, eye_canvas)
     timer = StageTimer(progress, f"painting {size}×{size} under {light}")
-    settings = {"n_lights": n_lights, "n_samples": n_samples, "n_sectors": n_sectors}
-    settings["failsafe"] = bool(failsafe)
+    settings = _frame_settings(n_lights, n_samples, n_sectors, failsafe, by_group)
     # once per height field, not per frame (§3.5.3, Ferwerda: a precomputed map)
     horizon = _horizon_at(painting, px, n_sectors, backend) if shadows else None
     L, E = shade_canvas(scene, px, settings, horizon, backend, timer)
@@ -621,6 +622,15 @@ def render_painting(
     XYZ, sRGB = _frame_images(px, L, E, scene.design)
     pose = {"eye": np.asarray(eye, float).tolist(), "tilt_deg": float(np.degrees(tilt))}
     return {"XYZ": XYZ, "sRGB": sRGB, "seconds": timer.seconds, "settings": settings, "pose": pose}
+
+
+def _frame_settings(n_lights, n_samples, n_sectors, failsafe, by_group) -> dict:
+    """A frame's settings as :func:`shade_canvas` reads them and the render records them."""
+    settings = {"n_lights": n_lights, "n_samples": n_samples, "n_sectors": n_sectors}
+    settings["failsafe"] = bool(failsafe)
+    if by_group:  # a method per group of similar α (the hybrid's; erratum E96)
+        settings["by_group"] = {int(g): str(m) for g, m in dict(by_group).items()}
+    return settings
 
 
 def _horizon_at(painting: dict, px, n_sectors: int, backend: str):
@@ -708,7 +718,8 @@ def shade_canvas(scene: PaintingScene, px, settings: dict, horizon, backend: str
     px : _CanvasPixels
         The pixels (:func:`canvas_pixels`).
     settings : dict
-        ``n_lights``, ``n_samples``, ``failsafe`` (the hybrid's; other methods ignore it).
+        ``n_lights``, ``n_samples``, ``failsafe`` and optionally ``by_group`` (the hybrid's:
+        :func:`painting_specular_hybrid`; other methods ignore both).
     horizon : callable or None
         Returns the horizon angles ``(n, S)`` at the pixels' texels; None for no shadows.
     backend : {"numba", "numpy"}
@@ -741,7 +752,9 @@ def shade_canvas(scene: PaintingScene, px, settings: dict, horizon, backend: str
         # Eq. (3), Ferwerda: L_out,j = ρ_d,j S_j E / π
         L_diffuse = rho_d * scene.S6 * E / np.pi
     with timer.stage("specular"):
-        extra = {"failsafe": settings["failsafe"]} if scene.lighting.failsafe else {}
+        extra = {}
+        if scene.lighting.failsafe:  # the hybrid: its fail-safe, and methods by α group
+            extra = {"failsafe": settings["failsafe"], "by_group": settings.get("by_group")}
         I_s = scene.lighting.reference(
             px.P, px.N, px.V, alpha, scene.plane, lights, settings["n_samples"], visibility,
             backend, **extra,
@@ -953,13 +966,16 @@ def painting_specular_fis(P, N, V, alpha, plane, lights, n_samples, visibility, 
 
 
 def painting_specular_hybrid(
-    P, N, V, alpha, plane, lights, n_samples, visibility, backend, failsafe: bool = True
-):
+    P, N, V, alpha, plane, lights, n_samples, visibility, backend, failsafe: bool = True,
+    by_group=None,
+):  # fmt: skip
     """The painting's gloss by the per-pixel hybrid of point lights and FIS.
 
     Eq. (4), Ferwerda, estimated both ways and mixed per pixel by the error estimates of
     :func:`specular_hybrid`. Parameters and result as in :func:`painting_specular_point_lights`;
-    ``failsafe=False`` skips the hybrid's fail-safe (its unbiased check of the choice).
+    ``failsafe=False`` skips the hybrid's fail-safe (its unbiased check of the choice);
+    ``by_group`` gives groups of similar α the point lights or FIS alone
+    (:func:`~impastor.specular_hybrid.specular_by_alpha_group`, erratum E96).
 
     Examples
     --------
@@ -967,6 +983,10 @@ def painting_specular_hybrid(
     >>> painting_specular_hybrid(*inputs).shape
     (4, 1)
     """
+    if by_group:
+        return specular_by_alpha_group(
+            P, N, V, alpha, plane, lights, n_samples, visibility, backend, failsafe, by_group
+        )
     return specular_hybrid(
         P, N, V, alpha, plane, lights, n_samples, visibility, backend, failsafe=failsafe
     )
@@ -995,7 +1015,8 @@ class PaintingLighting(Method):
         The key of :data:`impastor.point_lights.LIGHT_SAMPLING_METHODS` that makes the point
         lights (which the diffuse term always uses).
     failsafe : bool
-        ``reference`` takes ``failsafe=`` (the hybrid's fail-safe, which a tolerance may drop).
+        ``reference`` takes ``failsafe=`` (the hybrid's fail-safe, which a tolerance may drop) and
+        ``by_group=`` (a method per group of similar α, which a tolerance may choose).
     """
 
     sampling: str

@@ -56,6 +56,7 @@ from impastor.point_lights import (
     illuminance_point_lights,
     point_lights_every_pixel,
 )
+from impastor.specular_hybrid import GROUP_METHODS, alpha_groups
 from impastor.specular_lighting import specular_brute_force
 from reference.errors import require, require_positive_int
 from reference.registry import Method, Registry
@@ -63,7 +64,9 @@ from reference.registry import Method, Registry
 __all__ = [
     "BRUTE_FORCE_METHODS",
     "FIXED_SETTINGS",
+    "FRAME_COST",
     "LIGHT_LADDER",
+    "MIN_GROUP_PIXELS",
     "PILOT_MARGIN",
     "PILOT_PIXELS",
     "REFERENCE_SECTORS",
@@ -114,6 +117,11 @@ class PaintingSettings:
         The pilot's error at these settings: the promised bound.
     met : bool
         False when even the top of every ladder missed the tolerance on the pilot.
+    by_group : tuple of (int, str)
+        The groups of similar α (:func:`~impastor.specular_hybrid.alpha_groups`) that take the
+        point lights or FIS alone instead of the hybrid, sorted; the others take the hybrid.
+    shares : tuple of float or None
+        The pilot pixels' fractions on the point lights, FIS and the hybrid.
     """
 
     n_lights: int
@@ -123,6 +131,8 @@ class PaintingSettings:
     tolerance: float | None = None
     pilot_error: float | None = None
     met: bool = True
+    by_group: tuple = ()
+    shares: tuple | None = None
 
     def render_options(self) -> dict:
         """The keyword arguments of :func:`render_painting` for these settings."""
@@ -131,6 +141,7 @@ class PaintingSettings:
             "n_samples": self.n_samples,
             "n_sectors": self.n_sectors,
             "failsafe": self.failsafe,
+            "by_group": dict(self.by_group) or None,
         }
 
 
@@ -324,9 +335,8 @@ class PaintingPilot:
     ----------
     reference : ndarray, shape (n, 3)
         Brute-force XYZ at the pilot pixels (:func:`painting_brute_force`).
-    error : callable
-        ``error(n_lights, n_samples, n_sectors, failsafe)``: relative RMS error of the pipeline at
-        those settings on the pilot pixels (memoised).
+    groups : ndarray, shape (n,)
+        The pilot pixels' groups of similar α (:func:`~impastor.specular_hybrid.alpha_groups`).
     """
 
     def __init__(
@@ -342,6 +352,8 @@ class PaintingPilot:
         self.px = pilot_pixels(painting, size, eye, pixels)
         brute_force = painting_brute_force(scene, self.px, backend)
         self.reference = channels_to_XYZ(brute_force, scene.design)
+        alpha = canvas_materials(painting, scene.spectra, scene.design, self.px)[2]
+        self.groups = alpha_groups(alpha)
         height, pixel_size, rows, cols = (
             painting["height"], painting["pixel_size"], self.px.row, self.px.col
         )  # fmt: skip
@@ -349,48 +361,119 @@ class PaintingPilot:
             S: horizon_at_texels(height, pixel_size, rows, cols, S, 32, backend)
             for S in SECTOR_LADDER
         }
-        self.error = lru_cache(maxsize=None)(self._error)
+        self._squared = lru_cache(maxsize=None)(self._squared_errors)
 
-    def _error(self, n_lights: int, n_samples: int, n_sectors: int, failsafe: bool) -> float:
+    def switchable_groups(self) -> tuple:
+        """The groups that may take a method of their own: the hybrid's, with enough pixels."""
+        if not self.scene.lighting.failsafe:  # other lighting methods have one method
+            return ()
+        values, counts = np.unique(self.groups, return_counts=True)
+        return tuple(int(g) for g, c in zip(values, counts, strict=True) if c >= MIN_GROUP_PIXELS)
+
+    def error(self, n_lights, n_samples, n_sectors, failsafe, by_group=()) -> float:
+        """Relative RMS error of XYZ on the pilot's pixels at these settings (memoised shading).
+
+        ``by_group``: ``((group, method), ...)``, the groups on the point lights or FIS alone.
+        """
+        squared = self._squared(n_lights, n_samples, n_sectors, failsafe)
+        method = self._pixel_methods(by_group)
+        total = sum(np.sum(squared[m][method == m]) for m in squared if np.any(method == m))
+        return float(np.sqrt(total / np.sum(self.reference**2)))
+
+    def cost(self, n_lights, n_samples, n_sectors, failsafe, by_group=()) -> float:
+        """:func:`frame_cost` at these settings, with the pilot pixels' shares of each method."""
+        return frame_cost(n_lights, n_samples, n_sectors, failsafe, self.shares(by_group))
+
+    def shares(self, by_group=()) -> tuple:
+        """The pilot pixels' fractions on the point lights, FIS and the hybrid."""
+        method = self._pixel_methods(by_group)
+        return tuple(float(np.mean(method == m)) for m in GROUP_METHODS)
+
+    def _pixel_methods(self, by_group) -> np.ndarray:
+        method = np.full(self.groups.shape, "hybrid", dtype=object)
+        for group, key in by_group:
+            method[self.groups == group] = key
+        return method
+
+    def _squared_errors(self, n_lights, n_samples, n_sectors, failsafe) -> dict:
+        """Per method, each pilot pixel's squared XYZ error with every pixel on that method."""
         settings = {"n_lights": n_lights, "n_samples": n_samples, "failsafe": failsafe}
         horizon = self.horizons[n_sectors]
-        L, _ = shade_canvas(self.scene, self.px, settings, lambda: horizon, self.backend)
-        return relative_rms_error(channels_to_XYZ(L, self.scene.design), self.reference)
+        every = {int(g): None for g in np.unique(self.groups)}
+        squared = {}
+        for key in GROUP_METHODS if self.switchable_groups() else ("hybrid",):
+            only = None if key == "hybrid" else dict.fromkeys(every, key)
+            L, _ = shade_canvas(
+                self.scene, self.px, settings | {"by_group": only}, lambda: horizon, self.backend
+            )
+            squared[key] = np.sum((channels_to_XYZ(L, self.scene.design) - self.reference) ** 2, -1)
+        return squared
 
+
+#: The constants of :func:`frame_cost`: per point light for every pixel's shadow and diffuse
+#: light, per point light and per FIS sample on the hybrid, per FIS sample alone, the fail-safe.
+FRAME_COST = (1.3, 4.3, 1.3, 0.85, 74.0)
+#: A group of similar α needs this many pilot pixels to take a method of its own.
+MIN_GROUP_PIXELS = 32
 
 #: The ladders in the order of :class:`PaintingSettings`'s first four fields.
 _LADDERS = (LIGHT_LADDER, SAMPLE_LADDER, SECTOR_LADDER, (False, True))
 
 
-def frame_cost(n_lights: int, n_samples: int, n_sectors: int, failsafe: bool) -> float:
+def frame_cost(
+    n_lights: int, n_samples: int, n_sectors: int, failsafe: bool, shares=(0.0, 0.0, 1.0)
+) -> float:
     """A frame's cost model, in point-light evaluations per pixel (erratum E96).
 
-    The hybrid evaluates each point light six times per pixel (shadow test, diffuse, specular and
-    four sigma points), a FIS sample about as much as one and a half point lights over the K + K/2
-    samples of its two estimates, and its fail-safe about as much as 80 lights; a sector costs
-    only the horizon map's memory and precomputation (0.01). Fitted to frame times at 256²
-    on the design painting (seed 41); the report measures real frame times.
+    Every pixel tests each point light's shadow and sums its diffuse light (``c_d N``); a pixel
+    on the point lights alone evaluates the lobe once per light (``N``), one on FIS alone once
+    per sample (``c_f K``), and one on the hybrid evaluates the point lights and the four sigma
+    points of each, weighs each light's region against the lobe and takes FIS's ``K + K/2``
+    samples (``c_h N + c_hf K``), and its fail-safe (``c_s``). ``shares`` are the fractions of
+    the pixels on the point lights, FIS and the hybrid; a sector costs only the horizon map's
+    memory and precomputation (0.01). The constants (:data:`FRAME_COST`) are a least-squares fit to
+    the times of 20 frames at 256² on the design painting (seed 41: each method alone and the
+    hybrid with and without its fail-safe, N and K from 8 to 64; the model within 16 % of every
+    frame, within 6 % of the hybrid's); the report measures real frame times.
 
     Examples
     --------
-    >>> frame_cost(32, 32, 36, True), frame_cost(16, 16, 12, False)
-    (304.36, 112.12)
+    >>> frame_cost(32, 32, 36, True), frame_cost(16, 16, 12, False, (0.75, 0.25, 0.0))
+    (295.16, 36.32)
     """
-    return 6.0 * n_lights + n_samples + 80.0 * bool(failsafe) + 0.01 * n_sectors
+    c_d, c_h, c_hf, c_f, c_s = FRAME_COST
+    share_pl, share_fis, share_hybrid = shares
+    hybrid = c_h * n_lights + c_hf * n_samples + c_s * bool(failsafe)
+    per_method = share_pl * n_lights + share_fis * c_f * n_samples + share_hybrid * hybrid
+    return c_d * n_lights + per_method + 0.01 * n_sectors
+
+
+def _moves(pilot: PaintingPilot, current: tuple) -> list:
+    """Every one-step move from ``current``, ``(N, K, S, fail-safe, by_group)``.
+
+    A rung down one ladder, or a group of similar α off the hybrid onto the point lights or FIS.
+    """
+    *rungs, by_group = current
+    moves = []
+    for k, ladder in enumerate(_LADDERS):
+        rung = ladder.index(rungs[k])
+        if rung > 0:
+            moves.append((*rungs[:k], ladder[rung - 1], *rungs[k + 1 :], by_group))
+    switched = dict(by_group)
+    for group in pilot.switchable_groups():
+        if group not in switched:
+            for method in GROUP_METHODS[:-1]:
+                moves.append((*rungs, tuple(sorted({**switched, group: method}.items()))))
+    return moves
 
 
 def _descend(pilot: PaintingPilot, start: tuple, limit: float) -> tuple:
-    """From ``start``, one rung down at a time: the step that saves most cost within ``limit``."""
+    """From ``start``, one move at a time (:func:`_moves`): the largest saving within ``limit``."""
     current = start
     while True:
-        moves = []
-        for k, ladder in enumerate(_LADDERS):
-            rung = ladder.index(current[k])
-            if rung > 0:
-                candidate = (*current[:k], ladder[rung - 1], *current[k + 1 :])
-                moves.append((frame_cost(*current) - frame_cost(*candidate), candidate))
+        saving = [(pilot.cost(*current) - pilot.cost(*m), m) for m in _moves(pilot, current)]
         # cheapest first: the largest saving whose pilot error stays within the limit
-        for _, candidate in sorted(moves, key=lambda m: -m[0]):
+        for _, candidate in sorted(saving, key=lambda m: -m[0]):
             if pilot.error(*candidate) <= limit:
                 current = candidate
                 break
@@ -460,12 +543,17 @@ def settings_from_tolerance(
     """
     check_tolerance(tolerance)
     pilot = pilot or PaintingPilot(scene, size, backend, eye)
-    top = tuple(ladder[-1] for ladder in _LADDERS)
-    base = pilot.error(*top)
-    if base > PILOT_MARGIN * tolerance:
-        return PaintingSettings(*top, tolerance=float(tolerance), pilot_error=base, met=False)
-    chosen = _descend(pilot, top, PILOT_MARGIN * tolerance)
-    return PaintingSettings(*chosen, tolerance=float(tolerance), pilot_error=pilot.error(*chosen))
+    top = (*(ladder[-1] for ladder in _LADDERS), ())
+    met = pilot.error(*top) <= PILOT_MARGIN * tolerance
+    chosen = _descend(pilot, top, PILOT_MARGIN * tolerance) if met else top
+    return PaintingSettings(
+        *chosen[:-1],
+        tolerance=float(tolerance),
+        pilot_error=pilot.error(*chosen),
+        met=bool(met),
+        by_group=chosen[-1],
+        shares=tuple(round(share, 4) for share in pilot.shares(chosen[-1])),
+    )
 
 
 def render_painting_to_tolerance(

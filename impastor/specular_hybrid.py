@@ -56,10 +56,13 @@ __all__ = [
     "FAILSAFE_ROUNDS",
     "FAILSAFE_SAMPLES",
     "FAILSAFE_SEED",
+    "GROUP_METHODS",
     "SECOND_SET_SHIFT",
     "SPECULAR_METHODS",
+    "alpha_groups",
     "hybrid_error_estimates",
     "sigma_point_lights",
+    "specular_by_alpha_group",
     "specular_hybrid",
     "specular_hybrid_parts",
 ]
@@ -224,7 +227,7 @@ def _failsafe(P, N, V, a, light, lights, vis, backend, I_pl, I_fis, w_pl):
     carry the sums' noise get more samples until the choice is clear (erratum E17).
     """
     choice = np.zeros(P.shape[0], dtype=np.int64)
-    group = np.floor(2.0 * np.log2(a)).astype(np.int64)
+    group = alpha_groups(a)
     for g in np.unique(group):
         members = np.flatnonzero(group == g)
         sub = members[:: -(-members.size // FAILSAFE_PIXELS)]
@@ -499,6 +502,100 @@ def specular_hybrid(
     return specular_hybrid_parts(
         points, normals, views, alpha, light, lights, n_samples, visibility, backend, failsafe
     )["hybrid"]
+
+
+#: What a group of similar α may take instead of the per-pixel hybrid, cheapest first: the point
+#: lights alone (N evaluations per pixel), FIS alone (K), or the hybrid itself (5 N + 3 K / 2).
+GROUP_METHODS = ("point_lights", "fis", "hybrid")
+
+
+def alpha_groups(alpha) -> np.ndarray:
+    """Half-octave groups of roughness, ``⌊2 log2 α⌋``: the fail-safe's groups, and the settings'.
+
+    Examples
+    --------
+    >>> alpha_groups([0.01, 0.1, 0.12, 0.5]).tolist()
+    [-14, -7, -7, -2]
+    """
+    return np.floor(2.0 * np.log2(np.asarray(alpha, dtype=np.float64))).astype(np.int64)
+
+
+def specular_by_alpha_group(
+    points,
+    normals,
+    views,
+    alpha,
+    light: PlaneLight,
+    lights: PointLights,
+    n_samples: int = 32,
+    visibility=None,
+    backend: str = "numpy",
+    failsafe: bool = True,
+    methods=None,
+) -> np.ndarray:
+    """Eq. (4), Ferwerda, by one method per group of similar α: point lights, FIS or the hybrid.
+
+    Where the hybrid (:func:`specular_hybrid`) keeps the point lights at nearly every pixel of a
+    group, or FIS at nearly every one, that method alone gives the group the same light for a
+    fraction of the cost: the hybrid evaluates both, the sigma-point lights (4 N) and a second FIS
+    set (K/2) at every pixel. ``methods`` says which groups (:func:`alpha_groups`) take which
+    method of :data:`GROUP_METHODS`; a group it does not name takes the hybrid. The painting's
+    settings choose it from a tolerance (``impastor.settings``, erratum E96; specref's, not the
+    paper's).
+
+    Parameters
+    ----------
+    points, normals, views, alpha, light, lights, n_samples, visibility, backend, failsafe
+        As in :func:`specular_hybrid` (``failsafe`` for the groups on the hybrid).
+    methods : mapping of int to str, optional
+        Group to method; None: the hybrid everywhere.
+
+    Returns
+    -------
+    ndarray, shape (..., C)
+        Each pixel as its group's method has it; a group's pixels as that method alone would
+        shade them (the hybrid's fail-safe works per group, so it sees the same pixels).
+
+    Examples
+    --------
+    >>> from impastor.point_lights import point_lights_from_plane
+    >>> plane = PlaneLight(np.full((8, 8), 100.0), (-1, 1, -1), (1, 0, 0), (0, 0, 1), 2.0, 2.0)
+    >>> lights = point_lights_from_plane(plane, "median_cut", 4)
+    >>> up = np.array([0.0, 1.0, 0.0])
+    >>> P, N, a = np.zeros((2, 3)), np.tile(up, (2, 1)), np.array([0.05, 0.3])
+    >>> alpha_groups(a).tolist()
+    [-9, -4]
+    >>> I = specular_by_alpha_group(P, N, N, a, plane, lights, 16, methods={-4: "point_lights"})
+    >>> bool(np.allclose(I[1], specular_point_lights(P[1], up, up, 0.3, lights)))
+    True
+    """
+    methods = dict(methods or {})
+    for group, method in methods.items():
+        require(
+            method in GROUP_METHODS,
+            f"specular by α group: group {group}: method must be one of "
+            f"{', '.join(GROUP_METHODS)}, got {method!r}",
+        )
+    P, N, V, a, shape = _flat(points, normals, views, alpha)
+    vis = _visibility(visibility, shape, P.shape[0], len(lights.regions))
+    unique, inverse = np.unique(alpha_groups(a), return_inverse=True)
+    pixel_method = np.array([methods.get(int(g), "hybrid") for g in unique])[inverse]
+    out = np.zeros((P.shape[0], light.image.shape[-1] if light.image.ndim == 3 else 1))
+    for method in GROUP_METHODS:
+        take = np.flatnonzero(pixel_method == method)
+        if take.size == 0:
+            continue
+        p, n, v, a_t = P[take], N[take], V[take], a[take]
+        sub_vis = None if vis is None else vis[take]
+        if method == "point_lights":  # Eq. (2), Ferwerda, with the lobe
+            out[take] = specular_point_lights(p, n, v, a_t, lights, sub_vis, backend=backend)
+        elif method == "fis":
+            out[take] = specular_fis(p, n, v, a_t, light, n_samples, backend=backend)
+        else:
+            out[take] = specular_hybrid(
+                p, n, v, a_t, light, lights, n_samples, sub_vis, backend, failsafe
+            )
+    return out.reshape((*shape, -1))
 
 
 def _example_scene(rng):

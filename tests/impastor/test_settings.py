@@ -63,17 +63,16 @@ def test_many_median_cut_lights_converge_to_the_brute_force(scene):
 def test_the_pilot_keeps_its_promise_on_the_frame(scene):
     # the chosen settings meet the tolerance on the pilot (400 of the frame's pixels) and on the
     # whole frame, against the same brute force, and cost less than the fixed settings
-    from impastor.settings import frame_cost
-
     pilot = PaintingPilot(scene, 96, pixels=400)
     assert pilot.px.P.shape[0] == 400
+    fixed = FIXED_SETTINGS
     for tolerance in (0.02, 0.05):
         chosen = settings_from_tolerance(scene, tolerance, pilot=pilot)
         assert chosen.met
         assert chosen.pilot_error <= tolerance
-        assert frame_cost(*chosen.render_options().values()) < frame_cost(
-            *FIXED_SETTINGS.render_options().values()
-        )
+        assert pilot.cost(
+            chosen.n_lights, chosen.n_samples, chosen.n_sectors, chosen.failsafe, chosen.by_group
+        ) < pilot.cost(fixed.n_lights, fixed.n_samples, fixed.n_sectors, fixed.failsafe)
         out = render_painting("A", 96, "hybrid", scene.painting, light_resolution=(32, 16),
                               **chosen.render_options())  # fmt: skip
         px = canvas_pixels(scene.painting, 96)
@@ -86,7 +85,7 @@ def test_an_unreachable_tolerance_says_so(scene):
     chosen = settings_from_tolerance(scene, 1e-5, pilot=pilot)
     assert not chosen.met
     assert chosen.render_options() == {
-        "n_lights": 64, "n_samples": 64, "n_sectors": 48, "failsafe": True
+        "n_lights": 64, "n_samples": 64, "n_sectors": 48, "failsafe": True, "by_group": None
     }  # fmt: skip
     with pytest.raises(SpecrefError, match=r"--tolerance: must be a relative error in \(0, 1\)"):
         settings_from_tolerance(scene, 0.0, pilot=pilot)
@@ -134,3 +133,51 @@ def test_the_pilots_pixels_are_a_stratified_sample_of_the_frames():
     assert ((runs[:-1] <= index) & (index < runs[1:])).all()
     np.testing.assert_array_equal(pilot_pixels(painting, 128, count=300).P, sample.P)
     assert not np.array_equal(pilot_pixels(painting, 128, count=300, seed=1).P, sample.P)
+
+
+def test_each_alpha_group_takes_its_method(scene):
+    # a group's pixels are shaded as its method alone would shade them, the hybrid's fail-safe
+    # included (it works per group), with the shadows of the point lights
+    from impastor.painting import booth_plane_light
+    from impastor.point_lights import point_lights_from_plane
+    from impastor.specular_hybrid import alpha_groups, specular_by_alpha_group, specular_hybrid
+    from impastor.specular_lighting import specular_fis, specular_point_lights
+
+    px = canvas_pixels(scene.painting, 16)
+    plane = booth_plane_light("incandescent", 32, 16)
+    lights = point_lights_from_plane(plane, "median_cut", 8)
+    n = px.P.shape[0]
+    alpha = np.geomspace(0.01, 0.4, n)
+    visibility = np.random.default_rng(3).random((n, 8)) > 0.3
+    groups = alpha_groups(alpha)
+    methods = {int(groups[0]): "fis", int(groups[-1]): "point_lights"}
+    args = (px.P, px.N, px.V, alpha, plane, lights, 8, visibility, "numba")
+    mixed = specular_by_alpha_group(*args, methods=methods)
+    pl = specular_point_lights(px.P, px.N, px.V, alpha, lights, visibility, backend="numba")
+    fis = specular_fis(px.P, px.N, px.V, alpha, plane, 8, backend="numba")
+    first, last = groups == groups[0], groups == groups[-1]
+    np.testing.assert_array_equal(mixed[first], fis[first])
+    np.testing.assert_array_equal(mixed[last], pl[last])
+    rest = ~(first | last)
+    only = specular_hybrid(
+        px.P[rest], px.N[rest], px.V[rest], alpha[rest], plane, lights, 8, visibility[rest], "numba"
+    )
+    np.testing.assert_allclose(mixed[rest], only, rtol=1e-12)
+    with pytest.raises(SpecrefError, match="group -3: method must be one of point_lights, fis"):
+        specular_by_alpha_group(*args, methods={-3: "brute_force"})
+
+
+def test_the_pilots_error_is_its_pixels_shaded_at_those_settings(scene):
+    # the error the descent reads, combined from each method's errors, is the error of shading
+    # the pilot's pixels with the chosen groups' methods
+    from impastor.painting import shade_canvas
+
+    pilot = PaintingPilot(scene, 48, pixels=300)
+    chosen = settings_from_tolerance(scene, 0.05, pilot=pilot)
+    assert chosen.by_group, "the groups stayed on the hybrid: nothing to check"
+    assert sum(chosen.shares) == pytest.approx(1.0)
+    settings = chosen.render_options()
+    horizon = pilot.horizons[chosen.n_sectors]
+    L, _ = shade_canvas(scene, pilot.px, settings, lambda: horizon, "numba")
+    direct = relative_rms_error(channels_to_XYZ(L, scene.design), pilot.reference)
+    assert chosen.pilot_error == pytest.approx(direct, rel=1e-9)

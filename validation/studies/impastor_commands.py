@@ -336,6 +336,10 @@ def _describe_settings(settings: dict) -> str:
         f"N={settings['n_lights']} K={settings['n_samples']} S={settings['n_sectors']} "
         f"fail-safe {'on' if settings['failsafe'] else 'off'}"
     )
+    if settings.get("shares"):  # the α groups that took the point lights or FIS alone
+        text += ", pixels on point lights / FIS / hybrid {:.0f} / {:.0f} / {:.0f} %".format(
+            *(100 * x for x in settings["shares"])
+        )
     if settings.get("tolerance") is not None:
         verdict = "within" if settings["met"] else "MISSES"
         text += (

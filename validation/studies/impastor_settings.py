@@ -166,8 +166,10 @@ def tolerance_case(task) -> dict:
     dict
         ``seed``, ``light``, ``pilot_seconds``, ``eval_pixels`` and ``rows``: per setting
         (``"fixed"`` first, then each tolerance) ``label``, ``tolerance``, ``settings``
-        (N, K, S, fail-safe), ``pilot_error``, ``met``, ``choose_seconds``, ``frame_seconds``
-        and ``error`` (the frame's relative RMS against brute force); ``matched``: the same for
+        (N, K, S, fail-safe, the α groups off the hybrid), ``shares`` (the pilot pixels' on the
+        point lights, FIS and the hybrid; None for the fixed settings), ``pilot_error``,
+        ``met``, ``choose_seconds``, ``frame_seconds`` and ``error`` (the frame's relative RMS
+        against brute force); ``matched``: the same for
         the settings chosen at no more than the fixed settings' pilot error (the tolerance that
         error over :data:`~impastor.settings.PILOT_MARGIN`), the comparison at equal error.
 
@@ -190,7 +192,10 @@ def tolerance_case(task) -> dict:
         painting_brute_force(scene, px.subset(index), backend), scene.design
     )
     # the ladder of tolerances, then the one whose promise is the fixed settings' own pilot error
-    matched = pilot.error(*FIXED_SETTINGS.render_options().values()) / PILOT_MARGIN
+    fixed = FIXED_SETTINGS
+    # the fixed settings' own pilot error: the hybrid at every pixel, as they render
+    matched = pilot.error(fixed.n_lights, fixed.n_samples, fixed.n_sectors, fixed.failsafe)
+    matched /= PILOT_MARGIN
     matched = min(max(matched, 1e-6), 0.5)
     labels = ["fixed", *(f"{100 * t:g} %" for t in tolerances), "the fixed settings' error"]
     chosen, choose_seconds = [FIXED_SETTINGS], [0.0]
@@ -205,6 +210,7 @@ def tolerance_case(task) -> dict:
             "label": labels[i],
             "tolerance": settings.tolerance,
             "settings": settings.render_options(),
+            "shares": settings.shares,
             "pilot_error": settings.pilot_error,
             "met": settings.met,
             "choose_seconds": choose_seconds[i],
