@@ -624,19 +624,44 @@ def _correct(P, rho, dXYZ) -> np.ndarray:
     """Correct the linear drives through the model's Jacobian: ``Δρ = P⁻¹ ΔXYZ``.
 
     A channel that would go below zero (a target darker or more saturated than the black allows)
-    stays at zero, and the other two match the luminance first (weighted least squares, Y × 10).
+    stays at zero, and the others hold the luminance exactly and come as close to the colour as
+    they can (:func:`_holding_Y`): where the white's chromaticity is out of reach, the tone curve
+    is not given up for it.
+
+    Examples
+    --------
+    >>> P = np.array([[0.4, 0.35, 0.2], [0.2, 0.7, 0.1], [0.0, 0.1, 0.95]])
+    >>> new = _correct(P, np.array([0.01, 0.01, 0.01]), np.array([0.0, 0.01, -0.05]))
+    >>> bool(new[2] == 0.0), bool(np.isclose((P @ new)[1], 0.01 * P[1].sum() + 0.01))
+    (True, True)
     """
     new = rho + np.linalg.solve(P, dXYZ)
+    target = P @ rho + dXYZ  # the XYZ the channels must give
     free = new >= 0.0
-    if free.all():
-        return new
-    weights = np.array([1.0, 10.0, 1.0])
-    step, *_ = np.linalg.lstsq(
-        weights[:, None] * P[:, free], weights * (dXYZ + P[:, ~free] @ rho[~free]), rcond=None
-    )
-    new = np.zeros(3)
-    new[free] = rho[free] + step
+    while (new < 0.0).any() and free.any():
+        new = np.zeros(3)
+        new[free] = _holding_Y(P[:, free], target)
+        free &= new >= 0.0
     return np.maximum(new, 0.0)
+
+
+def _holding_Y(A, target) -> np.ndarray:
+    """``x`` with ``(A x)_Y = target_Y`` exactly, ``‖(A x − target)_{X,Z}‖`` least (Lagrange).
+
+    Examples
+    --------
+    >>> _holding_Y(np.array([[0.4], [0.2], [0.0]]), np.array([1.0, 0.5, 1.0])).tolist()
+    [2.5]
+    """
+    k = A.shape[1]
+    xz = A[[0, 2]]
+    # the normal equations of the X, Z residual, bordered by the luminance's constraint
+    kkt = np.zeros((k + 1, k + 1))
+    kkt[:k, :k] = xz.T @ xz
+    kkt[:k, k] = kkt[k, :k] = A[1]
+    rhs = np.concatenate([xz.T @ target[[0, 2]], [target[1]]])
+    solution, *_ = np.linalg.lstsq(kkt, rhs, rcond=None)
+    return solution[:k]
 
 
 def _interp_lut(lut, G) -> np.ndarray:
