@@ -377,7 +377,11 @@ class PaintingPilot:
         """
         squared = self._squared(n_lights, n_samples, n_sectors, failsafe)
         method = self._pixel_methods(by_group)
-        total = sum(np.sum(squared[m][method == m]) for m in squared if np.any(method == m))
+        require(
+            set(np.unique(method)) <= set(squared),
+            f"pilot: by_group {by_group!r}: only the hybrid's groups may take another method",
+        )
+        total = sum(np.sum(squared[m][method == m]) for m in squared)
         return float(np.sqrt(total / np.sum(self.reference**2)))
 
     def cost(self, n_lights, n_samples, n_sectors, failsafe, by_group=()) -> float:
@@ -552,7 +556,9 @@ def settings_from_tolerance(
         pilot_error=pilot.error(*chosen),
         met=bool(met),
         by_group=chosen[-1],
-        shares=tuple(round(share, 4) for share in pilot.shares(chosen[-1])),
+        shares=tuple(round(x, 4) for x in pilot.shares(chosen[-1]))
+        if pilot.switchable_groups()
+        else None,
     )
 
 
