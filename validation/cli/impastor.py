@@ -219,7 +219,7 @@ def _add_render(isub) -> None:
     )
     r.add_argument("--size", type=int, default=512, help="image side in pixels")
     registry_option(r, "--method", PAINTING_LIGHTING_METHODS, "specular lighting", default="hybrid")
-    r.add_argument("--out", type=output_file, default="impastor.png", help="output PNG")
+    r.add_argument("-o", "--out", type=output_file, default="impastor.png", help="output PNG")
     r.add_argument(
         "--counts",
         type=output_file,

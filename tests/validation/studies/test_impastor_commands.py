@@ -147,7 +147,7 @@ def test_cli_render_to_a_tolerance_records_its_settings(tmp_path, capsys):
 
     out = tmp_path / "p.png"
     argv = ["impastor", "render", "--size", "24", "--light", "A", "--tolerance", "0.05"]
-    assert main([*argv, "--out", str(out)]) == 0
+    assert main([*argv, "-o", str(out)]) == 0  # -o, as every command that writes a file
     summary = capsys.readouterr().out
     assert "within the tolerance 5 %" in summary
     settings = json.loads(iio.immeta(out)["specref"])
@@ -155,6 +155,15 @@ def test_cli_render_to_a_tolerance_records_its_settings(tmp_path, capsys):
     assert settings["met"]
     assert settings["pilot_error"] <= 0.05
     assert f"N={settings['n_lights']} K={settings['n_samples']}" in summary
+    # the pixels' shares of the point lights, FIS and the hybrid, in the summary and the PNG
+    shares = settings["shares"]
+    assert sum(shares) == pytest.approx(1.0, abs=1e-3)
+    assert (
+        "pixels on point lights / FIS / hybrid {:.0f} / {:.0f} / {:.0f} %".format(
+            *(100 * x for x in shares)
+        )
+        in summary
+    )
 
 
 def _tilted_booth():
