@@ -85,3 +85,48 @@ def test_the_command_exits_without_a_last_collection(tmp_path):
     )
     assert done.stdout.split() == ["2", "True"]
     assert done.stderr.count("\n") == 1  # the refusal's one line
+
+
+def _documented_command_lines():
+    """Every ``specref`` command line in the docs' code blocks (README, CONTRIBUTING, docs/)."""
+    import re
+    import shlex
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[3]
+    pages = [*sorted((root / "docs").glob("*.md")), root / "README.md", root / "CONTRIBUTING.md"]
+    lines = []
+    for page in pages:
+        if page.name == "results.md":  # generated
+            continue
+        in_block = False
+        for number, line in enumerate(page.read_text(encoding="utf-8").splitlines(), 1):
+            if line.startswith("```"):
+                in_block = not in_block
+                continue
+            text = re.sub(r"^\$ ", "", line.strip()).split(" # ")[0].split("  #")[0].strip()
+            # a usage line with placeholders ([options], A|B, <...>) is not a command
+            if (
+                in_block
+                and text.startswith("specref ")
+                and not re.search(r"[][|<>\\]|\.\.\.", text)
+            ):
+                lines.append((f"{page.name}:{number}", shlex.split(text)[1:]))
+    return lines
+
+
+def test_every_documented_command_line_parses(capsys):
+    # a documented command must be one a user can type: its options as the parser spells them
+    # (docs/impastor.md once said `impastor render -o`, which the command did not take)
+    lines = _documented_command_lines()
+    assert len(lines) >= 25
+    failed = []
+    for where, argv in lines:
+        try:
+            build_parser().parse_args(argv)
+        except SystemExit as exit_:
+            if exit_.code != 0:
+                failed.append(
+                    f"{where}: specref {' '.join(argv)}: {capsys.readouterr().err.strip()}"
+                )
+    assert not failed, "\n".join(failed)
