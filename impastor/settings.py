@@ -437,8 +437,8 @@ def frame_cost(
     the pixels on the point lights, FIS and the hybrid; a sector costs only the horizon map's
     memory and precomputation (0.01). The constants (:data:`FRAME_COST`) are a least-squares fit to
     the times of 20 frames at 256² on the design painting (seed 41: each method alone and the
-    hybrid with and without its fail-safe, N and K from 8 to 64; the model within 16 % of every
-    frame, within 6 % of the hybrid's); the report measures real frame times.
+    hybrid with and without its fail-safe, N and K from 8 to 64; the model within 7 % of the
+    hybrid's frames, within 30 % of the cheapest, 0.13 s); the report measures real frame times.
 
     Examples
     --------
