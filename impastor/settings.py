@@ -362,6 +362,7 @@ class PaintingPilot:
             for S in SECTOR_LADDER
         }
         self._squared = lru_cache(maxsize=None)(self._squared_errors)
+        self._squared_of = lru_cache(maxsize=None)(self._squared_of_method)
 
     def switchable_groups(self) -> tuple:
         """The groups that may take a method of their own: the hybrid's, with enough pixels."""
@@ -401,17 +402,21 @@ class PaintingPilot:
 
     def _squared_errors(self, n_lights, n_samples, n_sectors, failsafe) -> dict:
         """Per method, each pilot pixel's squared XYZ error with every pixel on that method."""
+        squared = {"hybrid": self._squared_of(n_lights, n_samples, n_sectors, failsafe, "hybrid")}
+        if self.switchable_groups():  # the point lights and FIS alone have no fail-safe: once
+            for key in GROUP_METHODS[:-1]:
+                squared[key] = self._squared_of(n_lights, n_samples, n_sectors, False, key)
+        return squared
+
+    def _squared_of_method(self, n_lights, n_samples, n_sectors, failsafe, key) -> np.ndarray:
+        """Each pilot pixel's squared XYZ error with every pixel on method ``key``."""
         settings = {"n_lights": n_lights, "n_samples": n_samples, "failsafe": failsafe}
         horizon = self.horizons[n_sectors]
-        every = {int(g): None for g in np.unique(self.groups)}
-        squared = {}
-        for key in GROUP_METHODS if self.switchable_groups() else ("hybrid",):
-            only = None if key == "hybrid" else dict.fromkeys(every, key)
-            L, _ = shade_canvas(
-                self.scene, self.px, settings | {"by_group": only}, lambda: horizon, self.backend
-            )
-            squared[key] = np.sum((channels_to_XYZ(L, self.scene.design) - self.reference) ** 2, -1)
-        return squared
+        only = None if key == "hybrid" else {int(g): key for g in np.unique(self.groups)}
+        L, _ = shade_canvas(
+            self.scene, self.px, settings | {"by_group": only}, lambda: horizon, self.backend
+        )
+        return np.sum((channels_to_XYZ(L, self.scene.design) - self.reference) ** 2, axis=-1)
 
 
 #: The constants of :func:`frame_cost`: per point light for every pixel's shadow and diffuse
