@@ -44,7 +44,11 @@ from impastor.point_lights import (
     point_lights_every_pixel,
     point_lights_from_plane,
 )
-from impastor.specular_hybrid import specular_by_alpha_group, specular_hybrid
+from impastor.specular_hybrid import (
+    check_group_methods,
+    specular_by_alpha_group,
+    specular_hybrid,
+)
 from impastor.specular_lighting import specular_fis, specular_point_lights
 from reference.colour.colorimetry import XYZ_to_display_RGB
 from reference.colour.spectra import resample_spectrum, spectrum_from_csv, spectrum_from_dataset
@@ -629,7 +633,7 @@ def _frame_settings(n_lights, n_samples, n_sectors, failsafe, by_group) -> dict:
     settings = {"n_lights": n_lights, "n_samples": n_samples, "n_sectors": n_sectors}
     settings["failsafe"] = bool(failsafe)
     if by_group:  # a method per group of similar α (the hybrid's; erratum E96)
-        settings["by_group"] = {int(g): str(m) for g, m in dict(by_group).items()}
+        settings["by_group"] = check_group_methods(by_group)
     return settings
 
 

@@ -60,6 +60,7 @@ __all__ = [
     "SECOND_SET_SHIFT",
     "SPECULAR_METHODS",
     "alpha_groups",
+    "check_group_methods",
     "hybrid_error_estimates",
     "sigma_point_lights",
     "specular_by_alpha_group",
@@ -520,6 +521,34 @@ def alpha_groups(alpha) -> np.ndarray:
     return np.floor(2.0 * np.log2(np.asarray(alpha, dtype=np.float64))).astype(np.int64)
 
 
+def check_group_methods(methods) -> dict:
+    """``methods`` as ``{int group: method}`` after checking it (one-line error).
+
+    Examples
+    --------
+    >>> check_group_methods({-4: "fis", np.int64(-3): "point_lights"})
+    {-4: 'fis', -3: 'point_lights'}
+    >>> check_group_methods({"rough": "fis"})
+    Traceback (most recent call last):
+    ...
+    reference.errors.SpecrefError: specular by α group: group 'rough': must be an integer (2 log2 α,
+    floored)
+    """
+    checked = {}
+    for group, method in dict(methods or {}).items():
+        require(
+            isinstance(group, int | np.integer) and not isinstance(group, bool),
+            f"specular by α group: group {group!r}: must be an integer (2 log2 α, floored)",
+        )
+        require(
+            method in GROUP_METHODS,
+            f"specular by α group: group {group}: method must be one of "
+            f"{', '.join(GROUP_METHODS)}, got {method!r}",
+        )
+        checked[int(group)] = str(method)
+    return checked
+
+
 def specular_by_alpha_group(
     points,
     normals,
@@ -569,13 +598,7 @@ def specular_by_alpha_group(
     >>> bool(np.allclose(I[1], specular_point_lights(P[1], up, up, 0.3, lights)))
     True
     """
-    methods = dict(methods or {})
-    for group, method in methods.items():
-        require(
-            method in GROUP_METHODS,
-            f"specular by α group: group {group}: method must be one of "
-            f"{', '.join(GROUP_METHODS)}, got {method!r}",
-        )
+    methods = check_group_methods(methods)
     P, N, V, a, shape = _flat(points, normals, views, alpha)
     vis = _visibility(visibility, shape, P.shape[0], len(lights.regions))
     unique, inverse = np.unique(alpha_groups(a), return_inverse=True)

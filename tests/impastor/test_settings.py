@@ -165,6 +165,10 @@ def test_each_alpha_group_takes_its_method(scene):
     np.testing.assert_allclose(mixed[rest], only, rtol=1e-12)
     with pytest.raises(SpecrefError, match="group -3: method must be one of point_lights, fis"):
         specular_by_alpha_group(*args, methods={-3: "brute_force"})
+    # a group that is not an integer is refused in one line before the render's work
+    with pytest.raises(SpecrefError, match=r"group 'rough': must be an integer \(2 log2 α"):
+        render_painting("A", 8, "hybrid", scene.painting, light_resolution=(16, 8),
+                        backend="numpy", by_group={"rough": "fis"})  # fmt: skip
 
 
 def test_the_pilots_error_is_its_pixels_shaded_at_those_settings(scene):
