@@ -181,6 +181,35 @@ def specular_brute_force_kernel(
         out[p] = acc
 
 
+@njit
+def specular_brute_force_shadowed_kernel(
+    P, N, V, alpha, horizon, frame, image, origin, A, B, l_A, l_B, n_light, supersample, out
+):
+    """Twin of ``specular_brute_force_shadowed``: every light sub-pixel, each shadow-tested."""
+    H, W = image.shape
+    s = supersample
+    sub_area = l_A * l_B / (H * W * s * s)
+    wi = np.empty(3)
+    for p in range(P.shape[0]):
+        acc = 0.0
+        for j in range(H):
+            for i in range(W):
+                L = image[j, i]
+                if L == 0.0:
+                    continue
+                for sj in range(s):
+                    b = (j + (sj + 0.5) / s) / H
+                    for si in range(s):
+                        a = (i + (si + 0.5) / s) / W
+                        x0 = origin[0] + a * l_A * A[0] + b * l_B * B[0]
+                        x1 = origin[1] + a * l_A * A[1] + b * l_B * B[1]
+                        x2 = origin[2] + a * l_A * A[2] + b * l_B * B[2]
+                        g = _lobe_geometry(x0, x1, x2, P[p], N[p], V[p], n_light, alpha[p], wi)
+                        if g > 0.0 and _above_horizon(wi[0], wi[1], wi[2], frame, horizon[p]):
+                            acc += g * L * sub_area
+        out[p] = acc
+
+
 # --- horizon maps (impastor.horizon) --------------------------------------------
 
 
@@ -244,10 +273,26 @@ def horizon_at_texels_kernel(h, pixel_size, rows, cols, n_sectors, max_steps, st
 
 
 @njit
+def _above_horizon(ix, iy, iz, frame, horizon):
+    """``horizon_lookup`` for one unit direction: above the texel's horizon, interpolated in φ."""
+    S = horizon.shape[0]
+    # light_azimuth_elevation in the canvas frame (T, B, N) = frame's rows
+    t = ix * frame[0, 0] + iy * frame[0, 1] + iz * frame[0, 2]
+    b = ix * frame[1, 0] + iy * frame[1, 1] + iz * frame[1, 2]
+    z = ix * frame[2, 0] + iy * frame[2, 1] + iz * frame[2, 2]
+    beta = math.asin(min(max(z, -1.0), 1.0))
+    if beta <= 0.0:
+        return False
+    x = (math.atan2(b, t) % (2.0 * math.pi)) / (2.0 * math.pi / S)
+    s0 = math.floor(x - 0.5)
+    f = x - 0.5 - s0
+    critical = (1.0 - f) * horizon[int(s0) % S] + f * horizon[int(s0 + 1) % S]
+    return beta > critical
+
+
+@njit
 def diffuse_brute_force_kernel(P, N, horizon, frame, position, L, n_light, pixel_area, out):
     """Twin of ``diffuse_brute_force``: Eq. (2), Ferwerda, over every light pixel, shadowed."""
-    S = horizon.shape[1]
-    width = 2.0 * math.pi / S
     for n in range(P.shape[0]):
         for m in range(position.shape[0]):
             dx, dy, dz = (
@@ -262,19 +307,7 @@ def diffuse_brute_force_kernel(P, N, horizon, frame, position, L, n_light, pixel
             cos_l = max(-(ix * n_light[0] + iy * n_light[1] + iz * n_light[2]), 0.0)
             if cos_s == 0.0 or cos_l == 0.0:
                 continue
-            # light_azimuth_elevation in the canvas frame (T, B, N) = frame's rows
-            t = ix * frame[0, 0] + iy * frame[0, 1] + iz * frame[0, 2]
-            b = ix * frame[1, 0] + iy * frame[1, 1] + iz * frame[1, 2]
-            z = ix * frame[2, 0] + iy * frame[2, 1] + iz * frame[2, 2]
-            beta = math.asin(min(max(z, -1.0), 1.0))
-            if beta <= 0.0:
-                continue
-            phi = math.atan2(b, t) % (2.0 * math.pi)
-            x = phi / width
-            s0 = math.floor(x - 0.5)
-            f = x - 0.5 - s0
-            critical = (1.0 - f) * horizon[n, int(s0) % S] + f * horizon[n, int(s0 + 1) % S]
-            if beta <= critical:
+            if not _above_horizon(ix, iy, iz, frame, horizon[n]):
                 continue
             g = cos_s * cos_l * pixel_area / d2
             for c in range(L.shape[1]):

@@ -34,8 +34,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from impastor._kernels import diffuse_brute_force_kernel
-from impastor.horizon import horizon_at_texels
+from impastor._kernels import diffuse_brute_force_kernel, specular_brute_force_shadowed_kernel
+from impastor.horizon import horizon_at_texels, horizon_lookup, light_azimuth_elevation
 from impastor.multispectral import channels_to_XYZ
 from impastor.painting import (
     EYE,
@@ -57,8 +57,8 @@ from impastor.point_lights import (
     point_lights_every_pixel,
 )
 from impastor.specular_hybrid import GROUP_METHODS, alpha_groups
-from impastor.specular_lighting import specular_brute_force
 from reference.errors import require, require_positive_int
+from reference.materials.brdf import brdf_ward_duer_specular
 from reference.registry import Method, Registry
 
 __all__ = [
@@ -82,6 +82,7 @@ __all__ = [
     "relative_rms_error",
     "render_painting_to_tolerance",
     "settings_from_tolerance",
+    "specular_brute_force_shadowed",
 ]
 
 #: The rungs each setting may take, cheapest first (N point lights, K FIS samples, S sectors).
@@ -217,6 +218,76 @@ def diffuse_brute_force(scene: PaintingScene, px, horizon, backend: str = "numba
     return E
 
 
+def specular_brute_force_shadowed(
+    scene: PaintingScene, px, horizon, backend: str = "numba", supersample=REFERENCE_SUPERSAMPLE
+):
+    """Specular integral at canvas pixels over every light sub-pixel, each with its shadow test.
+
+    Eq. (4), Ferwerda, integrated against the piecewise-constant light image with the geometry of
+    Eq. (2), Ferwerda, at every sub-pixel centre (``supersample``² per light pixel), a sub-pixel
+    counted only where its elevation is above the texel's horizon at its azimuth
+    (``horizon_lookup``, interpolated): §3.5.3, Ferwerda, leaves out of the rendering every
+    source under the horizon, the specular term's as well as the diffuse term's, as the point
+    lights do (``lights_visibility``). FIS has no shadows, so its error includes them.
+
+    Parameters
+    ----------
+    scene : PaintingScene
+    px : canvas pixels (:func:`impastor.painting.canvas_pixels`)
+    horizon : ndarray, shape (n, S)
+        Horizon angles at the pixels' texels.
+    backend : {"numba", "numpy"}
+        The NumPy reference loops over pixels (slow; for tests).
+    supersample : int
+        Sub-pixels per light pixel and axis.
+
+    Returns
+    -------
+    ndarray, shape (n, C)
+        The specular integral for ρ_s = 1, cd/m² (C = the light image's channels).
+
+    Examples
+    --------
+    >>> scene = painting_scene("D65", "hybrid", impasto_painting(16), light_resolution=(8, 4))
+    >>> px = canvas_pixels(scene.painting, 6)
+    >>> horizon = np.full((px.P.shape[0], 4), 0.9)
+    >>> I = specular_brute_force_shadowed(scene, px, horizon, "numpy")
+    >>> bool(np.allclose(I, specular_brute_force_shadowed(scene, px, horizon, "numba"), rtol=1e-12))
+    True
+    """
+    supersample = require_positive_int(supersample, "brute force: supersample", 256)
+    alpha = canvas_materials(scene.painting, scene.spectra, scene.design, px)[2]
+    horizon = np.ascontiguousarray(horizon, dtype=np.float64)
+    light, s = scene.plane, supersample
+    images = light.image[..., None] if light.image.ndim == 2 else light.image
+    out = np.zeros((px.P.shape[0], images.shape[-1]))
+    if backend == "numba":
+        frame, o, A, B = (np.asarray(x, dtype=np.float64) for x in
+                          (canvas_frame(), light.origin, light.A, light.B))  # fmt: skip
+        for c in range(images.shape[-1]):
+            specular_brute_force_shadowed_kernel(
+                px.P, px.N, px.V, alpha, horizon, frame, np.ascontiguousarray(images[..., c]), o,
+                A, B, light.l_A, light.l_B, light.n_light, s, out[:, c],
+            )  # fmt: skip
+        return out
+    H, W = light.shape
+    R, C = np.meshgrid((np.arange(H * s) + 0.5) / s, (np.arange(W * s) + 0.5) / s, indexing="ij")
+    X = light.pixel_positions(R, C).reshape(-1, 3)
+    L = np.repeat(np.repeat(images, s, axis=0), s, axis=1).reshape(-1, images.shape[-1])
+    for p in range(px.P.shape[0]):
+        to_light = X - px.P[p]
+        d2 = np.einsum("xi,xi->x", to_light, to_light)
+        I_n = to_light / np.sqrt(d2)[:, None]
+        cos_s, cos_l = I_n @ px.N[p], -(I_n @ light.n_light)
+        f = brdf_ward_duer_specular(I_n, px.V[p], px.N[p], alpha[p])
+        # §3.5.3, Ferwerda: a source under the texel's horizon is left out
+        phi, beta = light_azimuth_elevation(to_light, *canvas_frame())
+        lit = horizon_lookup(horizon[p][None, :], phi, beta)
+        g = np.where((cos_s > 0) & (cos_l > 0) & lit, f * cos_s * cos_l / d2, 0.0)
+        out[p] = (g * light.pixel_area / (s * s)) @ L
+    return out
+
+
 def _diffuse_example(rng):
     scene = painting_scene("D65", "hybrid", impasto_painting(16), light_resolution=(8, 4))
     px = canvas_pixels(scene.painting, 6)
@@ -236,6 +307,15 @@ BRUTE_FORCE_METHODS.register(
         _diffuse_example,
     )
 )
+BRUTE_FORCE_METHODS.register(
+    Method(
+        "specular",
+        specular_brute_force_shadowed,
+        specular_brute_force_shadowed_kernel,
+        "Eq. (4), Ferwerda (every light sub-pixel, shadowed)",
+        _diffuse_example,
+    )
+)
 
 
 def painting_brute_force(scene: PaintingScene, px, backend: str = "numba"):
@@ -243,8 +323,8 @@ def painting_brute_force(scene: PaintingScene, px, backend: str = "numba"):
 
     The diffuse radiance of Eq. (3), Ferwerda, from :func:`diffuse_brute_force` with the
     horizon at :data:`REFERENCE_SECTORS` sectors, plus Eq. (4), Ferwerda, integrated over every
-    light sub-pixel (:func:`specular_brute_force`; no shadows, as FIS and the fail-safe's
-    unbiased estimate have none).
+    light sub-pixel with the same horizon (:func:`specular_brute_force_shadowed`): §3.5.3,
+    Ferwerda, shadows both terms.
 
     Parameters
     ----------
@@ -268,8 +348,8 @@ def painting_brute_force(scene: PaintingScene, px, backend: str = "numba"):
         painting["height"], painting["pixel_size"], px.row, px.col, REFERENCE_SECTORS, 32, backend
     )
     E = diffuse_brute_force(scene, px, horizon, backend)
-    rho_d, rho_s, alpha = canvas_materials(painting, scene.spectra, scene.design, px)
-    I_s = specular_brute_force(px.P, px.N, px.V, alpha, scene.plane, REFERENCE_SUPERSAMPLE, backend)
+    rho_d, rho_s, _ = canvas_materials(painting, scene.spectra, scene.design, px)
+    I_s = specular_brute_force_shadowed(scene, px, horizon, backend)
     return rho_d * scene.S6 * E / np.pi + rho_s * scene.S6 * I_s
 
 

@@ -5,18 +5,27 @@ import pytest
 
 from impastor.horizon import horizon_at_texels, horizon_map
 from impastor.multispectral import channels_to_XYZ
-from impastor.painting import canvas_pixels, impasto_painting, painting_scene, render_painting
+from impastor.painting import (
+    canvas_materials,
+    canvas_pixels,
+    impasto_painting,
+    lights_visibility,
+    painting_scene,
+    render_painting,
+)
+from impastor.point_lights import point_lights_every_pixel
 from impastor.settings import (
     BRUTE_FORCE_METHODS,
     FIXED_SETTINGS,
     LIGHT_LADDER,
     PaintingPilot,
-    diffuse_brute_force,
     painting_brute_force,
     relative_rms_error,
     render_painting_to_tolerance,
     settings_from_tolerance,
+    specular_brute_force_shadowed,
 )
+from impastor.specular_lighting import specular_brute_force, specular_point_lights
 from reference.errors import SpecrefError
 
 
@@ -46,9 +55,27 @@ def test_brute_force_kernels_agree_with_numpy(method, rng):
     kernel = method.reference(scene, px, horizon, "numba")
     np.testing.assert_allclose(kernel, numpy, rtol=1e-12, atol=1e-12 * numpy.max())
     # the horizons shadow part of the light, never add any
-    open_sky = diffuse_brute_force(scene, px, np.zeros_like(horizon), "numba")
+    open_sky = method.reference(scene, px, np.zeros_like(horizon), "numba")
     assert (kernel <= open_sky * (1 + 1e-12)).all()
     assert (kernel < 0.99 * open_sky).any()
+
+
+def test_the_shadowed_specular_brute_force_is_every_light_pixel_shadowed(rng):
+    # two other paths: every light pixel a point light shadowed by lights_visibility, and the
+    # unshadowed brute force under an open sky
+    scene = painting_scene("A", "hybrid", impasto_painting(32, seed=3), light_resolution=(16, 8))
+    px = canvas_pixels(scene.painting, 12)
+    horizon = rng.uniform(0.3, 1.2, (px.P.shape[0], 9))
+    alpha = canvas_materials(scene.painting, scene.spectra, scene.design, px)[2]
+    every = point_lights_every_pixel(scene.plane)
+    visibility = lights_visibility(horizon, px.P, every)
+    shadowed = specular_brute_force_shadowed(scene, px, horizon, "numba", supersample=1)
+    as_lights = specular_point_lights(px.P, px.N, px.V, alpha, every, visibility, backend="numba")
+    np.testing.assert_allclose(shadowed, as_lights, rtol=1e-10, atol=1e-12 * as_lights.max())
+    open_sky = specular_brute_force_shadowed(scene, px, np.zeros_like(horizon), "numba")
+    unshadowed = specular_brute_force(px.P, px.N, px.V, alpha, scene.plane, 2, "numba")
+    np.testing.assert_allclose(open_sky, unshadowed, rtol=1e-12, atol=1e-14 * unshadowed.max())
+    assert (shadowed < 0.9 * open_sky).any()
 
 
 def test_many_median_cut_lights_converge_to_the_brute_force(scene):
