@@ -17,6 +17,9 @@ map of 18 sectors (specref: 36, erratum E95), and specref's hybrid always runs i
    error stays within :data:`PILOT_MARGIN` × the tolerance. When even the top misses it, the top
    is kept and the settings say so (``met=False``).
 
+:func:`settings_no_worse_than` runs the same descent against a baseline's pilot error instead (the
+fixed settings by default), with the pilot's own standard error of the difference as the margin.
+
 The error is the relative RMS of XYZ over the pixels (:func:`relative_rms_error`). The pilot's error
 at the chosen settings is the **promised bound**; the report checks the tolerance on held-out
 paintings, on frames at the render's resolution, against the same brute force, and times the
@@ -67,6 +70,8 @@ __all__ = [
     "FRAME_COST",
     "LIGHT_LADDER",
     "MIN_GROUP_PIXELS",
+    "NO_WORSE_THAN_FIXED",
+    "PAIRED_Z",
     "PILOT_MARGIN",
     "PILOT_PIXELS",
     "REFERENCE_SECTORS",
@@ -82,6 +87,7 @@ __all__ = [
     "relative_rms_error",
     "render_painting_to_tolerance",
     "settings_from_tolerance",
+    "settings_no_worse_than",
     "specular_brute_force_shadowed",
 ]
 
@@ -123,6 +129,10 @@ class PaintingSettings:
         point lights or FIS alone instead of the hybrid, sorted; the others take the hybrid.
     shares : tuple of float or None
         The pilot pixels' fractions on the point lights, FIS and the hybrid.
+    baseline : str or None
+        Set when the settings were chosen as no worse than a baseline's
+        (:func:`settings_no_worse_than`; ``tolerance`` is then the baseline's pilot error):
+        ``"fixed"`` for the fixed settings, ``"given"`` for others.
     """
 
     n_lights: int
@@ -134,6 +144,7 @@ class PaintingSettings:
     met: bool = True
     by_group: tuple = ()
     shares: tuple | None = None
+    baseline: str | None = None
 
     def render_options(self) -> dict:
         """The keyword arguments of :func:`render_painting` for these settings."""
@@ -456,14 +467,33 @@ class PaintingPilot:
 
         ``by_group``: ``((group, method), ...)``, the groups on the point lights or FIS alone.
         """
+        squared = self.pixel_squared_errors(n_lights, n_samples, n_sectors, failsafe, by_group)
+        return float(np.sqrt(np.sum(squared) / np.sum(self.reference**2)))
+
+    def pixel_squared_errors(self, n_lights, n_samples, n_sectors, failsafe, by_group=()):
+        """Each pilot pixel's squared XYZ error at these settings, shape (n,)."""
         squared = self._squared(n_lights, n_samples, n_sectors, failsafe)
         method = self._pixel_methods(by_group)
         require(
             set(np.unique(method)) <= set(squared),
             f"pilot: by_group {by_group!r}: only the hybrid's groups may take another method",
         )
-        total = sum(np.sum(squared[m][method == m]) for m in squared)
-        return float(np.sqrt(total / np.sum(self.reference**2)))
+        return np.select([method == m for m in squared], list(squared.values()))
+
+    def difference_sigma(self, settings, baseline) -> float:
+        """Standard error of ``error(*settings) − error(*baseline)`` from the pilot's pixels.
+
+        The pixels are a sample of the frame's: the difference of the two errors, a function of
+        the two sums of squared errors, varies with the sample. By the delta method, pixel ``i``
+        adds ``d_i = (q_i / e_a − p_i / e_b) / (2 ΣR²)`` to it (``q``, ``p`` the two settings'
+        squared errors, ``e`` their errors), and its standard error is ``√n · std(d)``: the
+        pixels taken as independent draws, which overstates the spread of a stratified sample.
+        """
+        q, p = self.pixel_squared_errors(*settings), self.pixel_squared_errors(*baseline)
+        total = np.sum(self.reference**2)
+        e_a, e_b = np.sqrt(np.sum(q) / total), np.sqrt(np.sum(p) / total)
+        d = (q / max(e_a, 1e-300) - p / max(e_b, 1e-300)) / (2.0 * total)
+        return float(np.sqrt(d.size) * np.std(d))
 
     def cost(self, n_lights, n_samples, n_sectors, failsafe, by_group=()) -> float:
         """:func:`frame_cost` at these settings, with the pilot pixels' shares of each method."""
@@ -556,14 +586,14 @@ def _moves(pilot: PaintingPilot, current: tuple) -> list:
     return moves
 
 
-def _descend(pilot: PaintingPilot, start: tuple, limit: float) -> tuple:
-    """From ``start``, one move at a time (:func:`_moves`): the largest saving within ``limit``."""
+def _descend(pilot: PaintingPilot, start: tuple, accept) -> tuple:
+    """From ``start``, one move at a time (:func:`_moves`): the largest saving ``accept`` takes."""
     current = start
     while True:
         saving = [(pilot.cost(*current) - pilot.cost(*m), m) for m in _moves(pilot, current)]
-        # cheapest first: the largest saving whose pilot error stays within the limit
+        # cheapest first: the largest saving whose pilot error ``accept`` allows
         for _, candidate in sorted(saving, key=lambda m: -m[0]):
-            if pilot.error(*candidate) <= limit:
+            if accept(candidate):
                 current = candidate
                 break
         else:
@@ -634,13 +664,90 @@ def settings_from_tolerance(
     pilot = pilot or PaintingPilot(scene, size, backend, eye)
     top = (*(ladder[-1] for ladder in _LADDERS), ())
     met = pilot.error(*top) <= PILOT_MARGIN * tolerance
-    chosen = _descend(pilot, top, PILOT_MARGIN * tolerance) if met else top
+    within = PILOT_MARGIN * tolerance
+    chosen = _descend(pilot, top, lambda c: pilot.error(*c) <= within) if met else top
     return PaintingSettings(
         *chosen[:-1],
         tolerance=float(tolerance),
         pilot_error=pilot.error(*chosen),
         met=bool(met),
         by_group=chosen[-1],
+        shares=tuple(round(x, 4) for x in pilot.shares(chosen[-1]))
+        if pilot.switchable_groups()
+        else None,
+    )
+
+
+#: ``tolerance`` of :func:`render_painting_to_tolerance` (``--tolerance fixed``): no worse than
+#: the fixed settings, on the pilot's evidence (:func:`settings_no_worse_than`).
+NO_WORSE_THAN_FIXED = "fixed"
+
+#: How many standard errors of the pilot's difference (:meth:`PaintingPilot.difference_sigma`)
+#: settings must stay below their baseline's pilot error to count as no worse (one-sided, 98 %).
+PAIRED_Z = 2.0
+
+
+def settings_no_worse_than(
+    scene: PaintingScene,
+    baseline: PaintingSettings = FIXED_SETTINGS,
+    size: int = 256,
+    backend: str = "numba",
+    pilot: PaintingPilot | None = None,
+    eye=EYE,
+    z: float = PAIRED_Z,
+) -> PaintingSettings:
+    """The cheapest settings whose error is, on the pilot's evidence, no worse than a baseline's.
+
+    The descent of :func:`settings_from_tolerance`, from the top of every ladder, accepts a move
+    when the pilot's error stays below ``baseline``'s by ``z`` standard errors of the difference
+    (:meth:`PaintingPilot.difference_sigma`): the two errors come from the same pixels, and the
+    frame's pixels would rank them otherwise about as often as their difference is within its
+    noise. Where no settings cheaper than ``baseline`` qualify (by :func:`frame_cost`), the
+    baseline is returned (erratum E96).
+
+    Parameters
+    ----------
+    scene : PaintingScene
+    baseline : PaintingSettings
+        The settings to match (default: the fixed 32/32/36 with the fail-safe).
+    size, backend, pilot, eye
+        As in :func:`settings_from_tolerance`.
+    z : float
+        Standard errors of margin, >= 0.
+
+    Returns
+    -------
+    PaintingSettings
+        ``tolerance`` is the baseline's pilot error and ``pilot_error`` the chosen settings'.
+
+    Examples
+    --------
+    >>> scene = painting_scene("D65", "hybrid", impasto_painting(32, seed=5),
+    ...                        light_resolution=(16, 8))
+    >>> pilot = PaintingPilot(scene, 12, "numpy")
+    >>> s = settings_no_worse_than(scene, pilot=pilot)
+    >>> s.pilot_error <= s.tolerance
+    True
+    """
+    require(np.isfinite(z) and z >= 0, f"no worse than: z must be >= 0, got {z!r}")
+    pilot = pilot or PaintingPilot(scene, size, backend, eye)
+    base = (baseline.n_lights, baseline.n_samples, baseline.n_sectors, baseline.failsafe,
+            tuple(baseline.by_group))  # fmt: skip
+    limit = pilot.error(*base)
+
+    def no_worse(candidate) -> bool:
+        return pilot.error(*candidate) + z * pilot.difference_sigma(candidate, base) <= limit
+
+    top = (*(ladder[-1] for ladder in _LADDERS), ())
+    chosen = _descend(pilot, top, no_worse) if no_worse(top) else base
+    if pilot.cost(*chosen) >= pilot.cost(*base):
+        chosen = base
+    return PaintingSettings(
+        *chosen[:-1],
+        tolerance=float(limit),
+        pilot_error=pilot.error(*chosen),
+        by_group=chosen[-1],
+        baseline="fixed" if baseline == FIXED_SETTINGS else "given",
         shares=tuple(round(x, 4) for x in pilot.shares(chosen[-1]))
         if pilot.switchable_groups()
         else None,
@@ -662,8 +769,9 @@ def render_painting_to_tolerance(
     ----------
     light, size, method, painting, progress
         As in :func:`render_painting`.
-    tolerance : float
-        Relative RMS error against brute force, > 0.
+    tolerance : float or "fixed"
+        Relative RMS error against brute force, > 0; or ``"fixed"``: the cheapest settings the
+        pilot finds no worse than the fixed 32/32/36 (:func:`settings_no_worse_than`).
     **options
         ``design``, ``light_resolution``, ``spectra``, ``light_map``, ``backend``, ``eye``,
         ``tilt`` of :func:`render_painting` (the pilot is made in the frame's pose and light).
@@ -683,17 +791,25 @@ def render_painting_to_tolerance(
     """
     from reference.progress import StageTimer
 
-    check_tolerance(tolerance)
+    if tolerance != NO_WORSE_THAN_FIXED:
+        check_tolerance(tolerance)
     painting = painting or impasto_painting(size)
     keys = ("design", "light_resolution", "spectra", "light_map")
     scene_options = {k: options[k] for k in keys if k in options}
     rest = painting_scene(light, method, painting, **scene_options)
     # the pilot sees the canvas in the frame's pose
     scene, eye = posed_scene(rest, options.get("eye", EYE), options.get("tilt", 0.0))
-    timer = StageTimer(progress, f"settings for a tolerance of {tolerance:g}")
+    fixed = tolerance == NO_WORSE_THAN_FIXED
+    timer = StageTimer(
+        progress,
+        "settings no worse than fixed" if fixed else f"settings for a tolerance of {tolerance:g}",
+    )
     with timer.stage("pilot"):
         backend = options.get("backend", "numba")
-        chosen = settings_from_tolerance(scene, tolerance, size, backend, eye=eye)
+        if fixed:
+            chosen = settings_no_worse_than(scene, FIXED_SETTINGS, size, backend, eye=eye)
+        else:
+            chosen = settings_from_tolerance(scene, tolerance, size, backend, eye=eye)
     out = render_painting(
         light, size, method, painting, progress=progress, **options, **chosen.render_options()
     )

@@ -23,6 +23,7 @@ from impastor.settings import (
     relative_rms_error,
     render_painting_to_tolerance,
     settings_from_tolerance,
+    settings_no_worse_than,
     specular_brute_force_shadowed,
 )
 from impastor.specular_lighting import specular_brute_force, specular_point_lights
@@ -105,6 +106,40 @@ def test_the_pilot_keeps_its_promise_on_the_frame(scene):
         px = canvas_pixels(scene.painting, 96)
         reference = channels_to_XYZ(painting_brute_force(scene, px), scene.design)
         assert relative_rms_error(out["XYZ"][px.gbuffer.mask], reference) <= tolerance
+
+
+def test_the_pilots_difference_sigma_is_the_bootstraps(scene):
+    # the delta method's standard error of one error minus another, against a paired bootstrap
+    # of the pilot's pixels (an independent estimate)
+    pilot = PaintingPilot(scene, 96, pixels=400)
+    a, b = (16, 16, 12, False, ()), (32, 32, 36, True, ())
+    sigma = pilot.difference_sigma(a, b)
+    q, p = pilot.pixel_squared_errors(*a), pilot.pixel_squared_errors(*b)
+    R = np.sum(pilot.reference**2, axis=-1)
+    draws = np.random.default_rng(7).integers(0, q.size, (2000, q.size))
+    boot = np.sqrt(q[draws].sum(1) / R[draws].sum(1)) - np.sqrt(p[draws].sum(1) / R[draws].sum(1))
+    assert sigma == pytest.approx(np.std(boot), rel=0.25)
+    assert pilot.difference_sigma(b, b) == 0.0
+
+
+def test_no_worse_than_the_fixed_settings_on_the_frame(scene):
+    # cheaper than the fixed settings, and on the whole frame no worse (within a twentieth)
+    pilot = PaintingPilot(scene, 96, pixels=400)
+    fixed = FIXED_SETTINGS
+    chosen = settings_no_worse_than(scene, fixed, pilot=pilot)
+    assert chosen.baseline == "fixed"
+    assert chosen.pilot_error <= chosen.tolerance == pilot.error(32, 32, 36, True)
+    assert pilot.cost(
+        chosen.n_lights, chosen.n_samples, chosen.n_sectors, chosen.failsafe, chosen.by_group
+    ) < pilot.cost(32, 32, 36, True)
+    px = canvas_pixels(scene.painting, 96)
+    reference = channels_to_XYZ(painting_brute_force(scene, px), scene.design)
+    errors = []
+    for settings in (fixed, chosen):
+        out = render_painting("A", 96, "hybrid", scene.painting, light_resolution=(32, 16),
+                              **settings.render_options())  # fmt: skip
+        errors.append(relative_rms_error(out["XYZ"][px.gbuffer.mask], reference))
+    assert errors[1] <= 1.05 * errors[0]
 
 
 def test_an_unreachable_tolerance_says_so(scene):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import sys
 
 from reference.tasks import SERIAL, add_scheduler_option
@@ -47,6 +48,21 @@ def _vector(text: str, option: str) -> tuple:
         f"{option}: must be x,y,z in metres, finite and within 100 m, got {text!r}",
     )
     return values
+
+
+def _tolerance(text: str):
+    """``--tolerance``: a relative error, or ``fixed`` (no worse than the fixed settings)."""
+    from impastor.settings import NO_WORSE_THAN_FIXED
+
+    if text == NO_WORSE_THAN_FIXED:
+        return text
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"must be a relative error in (0, 1) (0.02 is 2 %) or '{NO_WORSE_THAN_FIXED}', "
+            f"got {text!r}"
+        ) from None
 
 
 def _cmd_impastor_render(args) -> int:
@@ -254,10 +270,11 @@ def _add_render(isub) -> None:
     )
     r.add_argument(
         "--tolerance",
-        type=float,
+        type=_tolerance,
         metavar="T",
         help="choose the lights N, samples K, horizon sectors and the hybrid's fail-safe from a "
         "relative RMS error T of the frame against brute force (0.02 is 2 %%) instead of the "
-        "fixed 32/32/36 with the fail-safe; the PNG records the settings and the promised bound",
+        "fixed 32/32/36 with the fail-safe, or 'fixed': the cheapest settings no worse than "
+        "those; the PNG records the settings and the promised bound",
     )
     r.set_defaults(func=_cmd_impastor_render)

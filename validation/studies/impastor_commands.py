@@ -104,7 +104,7 @@ def render_for_cli(
     light_position=DEFAULT_LIGHT_POSITION,
     light_luminance: float | None = None,
     progress=None,
-    tolerance: float | None = None,
+    tolerance: float | str | None = None,
     painting=None,
     light_map=None,
 ) -> str:
@@ -115,7 +115,8 @@ def render_for_cli(
     booth's ceiling (:func:`impastor.painting.booth_plane_light_from_map`).
 
     ``progress`` (a stream) gets a line per stage of the render with its time. With
-    ``tolerance``, N, K, S and the fail-safe come from it (:mod:`impastor.settings`); the
+    ``tolerance``, N, K, S and the fail-safe come from it (:mod:`impastor.settings`; ``"fixed"``:
+    the cheapest settings no worse than the fixed ones); the
     settings used and the promised bound are in the summary and in the PNG's ``specref`` text
     chunk (JSON) either way.
 
@@ -322,9 +323,10 @@ def _check_before_render(tolerance, out, counts_out) -> None:
     from reference.files import check_output_file
 
     if tolerance is not None:
-        from impastor.settings import check_tolerance
+        from impastor.settings import NO_WORSE_THAN_FIXED, check_tolerance
 
-        check_tolerance(tolerance)
+        if tolerance != NO_WORSE_THAN_FIXED:
+            check_tolerance(tolerance)
     for path in (out, counts_out):
         if path is not None:
             check_output_file(path)
@@ -340,7 +342,13 @@ def _describe_settings(settings: dict) -> str:
         text += ", pixels on point lights / FIS / hybrid {:.0f} / {:.0f} / {:.0f} %".format(
             *(100 * x for x in settings["shares"])
         )
-    if settings.get("tolerance") is not None:
+    if settings.get("baseline"):  # chosen as no worse than the fixed settings
+        text += (
+            f", pilot error {100 * settings['pilot_error']:.2f} % no worse than the fixed "
+            f"settings' {100 * settings['tolerance']:.2f} % (chosen in "
+            f"{settings['choose_seconds']:.1f} s)"
+        )
+    elif settings.get("tolerance") is not None:
         verdict = "within" if settings["met"] else "MISSES"
         text += (
             f", pilot error {100 * settings['pilot_error']:.2f} % {verdict} the tolerance "

@@ -104,6 +104,7 @@ def test_cli_table1_writes_json(tmp_path, capsys):
         (["impastor", "render", "--light", "D66"], "unknown illuminant 'D66'"),
         (["impastor", "render", "--tolerance", "0"], "--tolerance: must be a relative error in"),
         (["impastor", "render", "--tolerance", "1e6"], "--tolerance: must be a relative error in"),
+        (["impastor", "render", "--tolerance", "loose"], "(0.02 is 2 %) or 'fixed', got 'loose'"),
         # the display's options are checked whether or not --counts uses them
         (["impastor", "render", "--screen-lux", "nan"], "--screen-lux: must be in [0, 200000]"),
         (["impastor", "render", "--screen-lux=-1000"], "--screen-lux: must be in"),
@@ -246,6 +247,22 @@ def test_render_light_options_reach_the_counts(tmp_path, capsys, monkeypatch):
         counts[luminance] = read_png(out)
     assert (counts["2000"] <= counts["0"]).all()
     assert (counts["2000"] < counts["0"]).any()
+
+
+def test_cli_render_no_worse_than_the_fixed_settings(tmp_path, capsys):
+    # --tolerance fixed: the cheapest settings the pilot finds no worse than 32/32/36
+    import json
+
+    import imageio.v3 as iio
+
+    out = tmp_path / "p.png"
+    argv = ["impastor", "render", "--size", "24", "--light", "A", "--tolerance", "fixed"]
+    assert main([*argv, "-o", str(out)]) == 0
+    summary = capsys.readouterr().out
+    assert "no worse than the fixed settings'" in summary
+    settings = json.loads(iio.immeta(out)["specref"])
+    assert settings["baseline"] == "fixed"
+    assert settings["pilot_error"] <= settings["tolerance"]  # the fixed settings' pilot error
 
 
 @pytest.mark.parametrize("value", ["nan", "-0.02", "inf", "0"])

@@ -69,7 +69,7 @@ def test_tiny_study_presents_a_chart_and_a_table(tmp_path):
     assert all(row[3] > 0 for row in methods[:-1])  # errors against the brute force
 
 
-def test_the_matched_frame_counts_for_the_speed_up_and_the_promise():
+def test_the_matched_frame_counts_for_the_speed_up_not_the_tolerances():
     case = _case(0.01, [("4 %", 0.04, True, 0.03, 0.4)])
     assert case["speedup_at_fixed_error"] is None  # the ladder's frame is not at the fixed error
     from validation.studies.impastor_settings import best_speedup_at_fixed_error
@@ -82,7 +82,8 @@ def test_the_matched_frame_counts_for_the_speed_up_and_the_promise():
     assert case["speedup_at_fixed_error"] == 2.0  # within 5 % of the fixed error, twice as fast
     found = checks(SectionData({"cases": [case], "study": {}, "methods": {}}))
     assert [c.passed for c in found] == [True, True]
-    case["matched"]["error"] = 0.013  # over its own tolerance and the fixed error
+    case["matched"]["error"] = 0.013  # over the fixed error: no speed-up at it
     case["speedup_at_fixed_error"] = best_speedup_at_fixed_error(case)
     found = checks(SectionData({"cases": [case], "study": {}, "methods": {}}))
-    assert [c.passed for c in found] == [False, False]
+    # its tolerance is the fixed settings' pilot error, not a promise: only the speed-up fails
+    assert [c.passed for c in found] == [True, False]
