@@ -77,3 +77,29 @@ def test_json_output_into_a_folder_is_refused_before_rendering(tmp_path, capsys)
     assert code == 2
     err = capsys.readouterr().err
     assert "is a folder" in err or "pip install" in err
+
+
+def test_the_plastic_check_reads_the_full_reports_figures():
+    # the polymer's opaque smooth limit against Mitsuba's plastic: a check in full reports, a
+    # pointer to --full in quick ones (its four renders at 16,384 spp take minutes)
+    from validation.report.sections.crosscheck import PLASTIC_TARGET, SECTION
+    from validation.report.types import SectionData, Table, Text
+
+    case = {"name": "sphere", "rms_z": 1.0, "expected_rms_z": 1.0, "mean_rel_Y": 0.0}
+    plastic = {"spp": 16384, "layered": 0.21, "oracle": 0.21, "lambert": 0.24, "seeds": 0.17,
+               "lambert_seeds": 0.16, "worst_block": 1.2, "sum_Y_ratio": 0.995}  # fmt: skip
+    results = {"available": True, "cases": [case], "plastic": plastic}
+    found = [c for c in SECTION.checks(SectionData(results)) if "plastic" in c.name]
+    assert [c.passed for c in found] == [True]
+    plastic["layered"] = PLASTIC_TARGET + 0.06
+    assert [c.passed for c in SECTION.checks(SectionData(results)) if "plastic" in c.name] == [
+        False
+    ]
+    from validation.report.sections.crosscheck import _plastic_blocks
+
+    assert isinstance(_plastic_blocks(plastic)[1], Table)
+    quick = _plastic_blocks(None)
+    assert isinstance(quick[0], Text)
+    assert "--full" in quick[0].text
+    results["plastic"] = None
+    assert not [c for c in SECTION.checks(SectionData(results)) if "plastic" in c.name]
