@@ -153,14 +153,18 @@ def specular_fis_kernel(
         out[p] = acc / K
 
 
-@njit
-def specular_brute_force_kernel(
-    P, N, V, alpha, image, origin, A, B, l_A, l_B, n_light, supersample, out
+@njit(inline="always")
+def _specular_sub_pixels(
+    P, N, V, alpha, image, origin, A, B, l_A, l_B, n_light, supersample, horizon, frame, out
 ):
-    """Twin of ``specular_brute_force``: the lobe summed over every light sub-pixel."""
+    """The loop of both specular brute-force kernels: the lobe over every light sub-pixel.
+
+    Each sub-pixel is shadow-tested against ``horizon`` (n, S) when S > 0.
+    """
     H, W = image.shape
     s = supersample
     sub_area = l_A * l_B / (H * W * s * s)
+    shadowed = horizon.shape[1] > 0
     wi = np.empty(3)
     for p in range(P.shape[0]):
         acc = 0.0
@@ -177,8 +181,23 @@ def specular_brute_force_kernel(
                         x1 = origin[1] + a * l_A * A[1] + b * l_B * B[1]
                         x2 = origin[2] + a * l_A * A[2] + b * l_B * B[2]
                         g = _lobe_geometry(x0, x1, x2, P[p], N[p], V[p], n_light, alpha[p], wi)
-                        acc += g * L * sub_area
+                        if g > 0.0 and (
+                            not shadowed or _above_horizon(wi[0], wi[1], wi[2], frame, horizon[p])
+                        ):
+                            acc += g * L * sub_area
         out[p] = acc
+
+
+@njit
+def specular_brute_force_kernel(
+    P, N, V, alpha, image, origin, A, B, l_A, l_B, n_light, supersample, out
+):
+    """Twin of ``specular_brute_force``: the lobe summed over every light sub-pixel."""
+    no_horizon = np.zeros((P.shape[0], 0))
+    _specular_sub_pixels(
+        P, N, V, alpha, image, origin, A, B, l_A, l_B, n_light, supersample, no_horizon,
+        np.eye(3), out,
+    )  # fmt: skip
 
 
 @njit
@@ -186,28 +205,9 @@ def specular_brute_force_shadowed_kernel(
     P, N, V, alpha, horizon, frame, image, origin, A, B, l_A, l_B, n_light, supersample, out
 ):
     """Twin of ``specular_brute_force_shadowed``: every light sub-pixel, each shadow-tested."""
-    H, W = image.shape
-    s = supersample
-    sub_area = l_A * l_B / (H * W * s * s)
-    wi = np.empty(3)
-    for p in range(P.shape[0]):
-        acc = 0.0
-        for j in range(H):
-            for i in range(W):
-                L = image[j, i]
-                if L == 0.0:
-                    continue
-                for sj in range(s):
-                    b = (j + (sj + 0.5) / s) / H
-                    for si in range(s):
-                        a = (i + (si + 0.5) / s) / W
-                        x0 = origin[0] + a * l_A * A[0] + b * l_B * B[0]
-                        x1 = origin[1] + a * l_A * A[1] + b * l_B * B[1]
-                        x2 = origin[2] + a * l_A * A[2] + b * l_B * B[2]
-                        g = _lobe_geometry(x0, x1, x2, P[p], N[p], V[p], n_light, alpha[p], wi)
-                        if g > 0.0 and _above_horizon(wi[0], wi[1], wi[2], frame, horizon[p]):
-                            acc += g * L * sub_area
-        out[p] = acc
+    _specular_sub_pixels(
+        P, N, V, alpha, image, origin, A, B, l_A, l_B, n_light, supersample, horizon, frame, out
+    )
 
 
 # --- horizon maps (impastor.horizon) --------------------------------------------
