@@ -663,8 +663,8 @@ def settings_from_tolerance(
     check_tolerance(tolerance)
     pilot = pilot or PaintingPilot(scene, size, backend, eye)
     top = (*(ladder[-1] for ladder in _LADDERS), ())
-    met = pilot.error(*top) <= PILOT_MARGIN * tolerance
     within = PILOT_MARGIN * tolerance
+    met = pilot.error(*top) <= within
     chosen = _descend(pilot, top, lambda c: pilot.error(*c) <= within) if met else top
     return PaintingSettings(
         *chosen[:-1],
