@@ -227,7 +227,96 @@ def prefilter_bruteforce_power_kernel(normals, directions, weights, radiance, s,
                 out[k, c] += radiance[p, c] * kern
 
 
+@njit
+def _phi_breaks(nx, ny, nz, H, W):
+    """Twin of ``shrm.texel_irradiance.phi_breaks`` (sorted, repeats kept)."""
+    columns = 2.0 * np.pi * np.arange(W + 1) / W
+    R, c = math.hypot(nx, nz), ny
+    if R == 0.0:
+        return columns
+    out = np.empty(W + 1 + 2 * (H - 1))
+    out[: W + 1] = columns
+    count = W + 1
+    phi_0 = math.atan2(nz, nx)
+    for e in range(1, H):
+        # R sin(φ − φ_0) = −c cot θ_e
+        s = -c / (math.tan(math.pi * e / H) * R)
+        if abs(s) <= 1.0:
+            arc = math.asin(s)
+            out[count] = (phi_0 + arc) % (2.0 * np.pi)
+            out[count + 1] = (phi_0 + np.pi - arc) % (2.0 * np.pi)
+            count += 2
+    return np.sort(out[:count])
+
+
+@njit
+def irradiance_texel_constant_kernel(normals, radiance, H, W, q_x, q_w, out):
+    """Twin of ``shrm.texel_irradiance.irradiance_texel_constant``: Σ_t L_t ∫_t max(0, n·ω) dω."""
+    T = np.zeros((H, W))
+    C = radiance.shape[1]
+    d_phi = 2.0 * np.pi / W
+    # θ/2 − sin 2θ / 4 and sin²θ / 2 at the row edges θ_e = eπ/H
+    edge_a = np.empty(H + 1)
+    edge_c = np.empty(H + 1)
+    for e in range(H + 1):
+        theta = math.pi * e / H
+        edge_a[e] = 0.5 * theta - 0.25 * math.sin(2.0 * theta)
+        edge_c[e] = 0.5 * math.sin(theta) ** 2
+    for p in range(normals.shape[0]):
+        c = normals[p, 1]
+        T[:, :] = 0.0
+        breaks = _phi_breaks(normals[p, 0], c, normals[p, 2], H, W)
+        for b in range(breaks.shape[0] - 1):
+            left, width = breaks[b], breaks[b + 1] - breaks[b]
+            if width <= 0.0:
+                continue
+            i = min(int((left + 0.5 * width) / d_phi), W - 1)
+            # between breaks the horizon stays in one row (or none): the rows wholly lit take
+            # Σ_k w_k F(edges), the row it crosses takes F(θ*) per node
+            mid = left + 0.5 * width
+            a_mid = normals[p, 0] * math.sin(mid) - normals[p, 2] * math.cos(mid)
+            star_row = min(int((math.atan2(c, -a_mid) % math.pi) * H / math.pi), H - 1)
+            if c > 0.0:
+                first, last = 0, star_row  # wholly lit rows [first, last)
+            elif c < 0.0:
+                first, last = star_row + 1, H
+            else:
+                first, last = 0, (H if a_mid > 0.0 else 0)
+                star_row = -1
+            A = 0.0
+            for k in range(q_x.shape[0]):
+                phi = left + 0.5 * width * (q_x[k] + 1.0)
+                a = normals[p, 0] * math.sin(phi) - normals[p, 2] * math.cos(phi)
+                w_k = 0.5 * width * q_w[k]
+                A += w_k * a
+                if star_row >= 0:
+                    # F(θ) = a (θ/2 − sin 2θ / 4) + c sin²θ / 2 at θ*, against the row's lit edge;
+                    # at θ*, (sin θ*, cos θ*) = (|c|, −a sgn c) / r with r = √(a² + c²)
+                    theta_star = math.atan2(c, -a) % math.pi
+                    r2 = a * a + c * c
+                    sin_2 = -2.0 * abs(c) * a * math.copysign(1.0, c) / r2
+                    F_star = a * (0.5 * theta_star - 0.25 * sin_2) + 0.5 * c * (c * c / r2)
+                    if c > 0.0:  # lit from the row's top edge down to θ*
+                        e = star_row
+                        T[star_row, i] += w_k * (F_star - a * edge_a[e] - c * edge_c[e])
+                    else:  # lit from θ* down to the row's bottom edge
+                        e = star_row + 1
+                        T[star_row, i] += w_k * (a * edge_a[e] + c * edge_c[e] - F_star)
+            for j in range(first, last):
+                # Σ_k w_k (F(θ_{j+1}) − F(θ_j)) = A Δ(θ/2 − sin 2θ/4) + c width Δ(sin²θ/2)
+                T[j, i] += A * (edge_a[j + 1] - edge_a[j]) + c * width * (edge_c[j + 1] - edge_c[j])
+        # E(n) = Σ_t L_t T_t(n)
+        for j in range(H):
+            for i in range(W):
+                t = T[j, i]
+                if t != 0.0:
+                    row = j * W + i
+                    for ch in range(C):
+                        out[p, ch] += t * radiance[row, ch]
+
+
 __all__ = [
+    "irradiance_texel_constant_kernel",
     "legendre_analysis_kernel",
     "legendre_synthesis_kernel",
     "legendre_table_kernel",

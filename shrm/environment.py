@@ -17,7 +17,9 @@ for a per-pixel tolerance on Y from the map's own spectrum (default 0.5 % mean, 
 pixels), and cached per environment. Each choice and the bound it promises is recorded in
 ``ctx.records["environment"]`` for the render metadata. With
 ``ctx.options["environment"] == "bruteforce"`` (``specref render --oracle``) each pixel integrates
-the whole map instead (:func:`shrm.prefilter.prefilter_bruteforce`).
+the whole map instead (:func:`shrm.prefilter.prefilter_bruteforce`; with
+``ctx.options["irradiance_quadrature"] == "texels"`` a Lambertian's irradiance integrates each
+texel's cosine exactly, :func:`shrm.texel_irradiance.irradiance_texel_constant`).
 
 A spectral environment (one channel per band) is resampled linearly onto the scene's grid; an RGB
 one is upsampled with ``reference.colour.upsampling.RGB_to_radiance_spectra`` (Mallett & Yuksel 2019
@@ -30,7 +32,7 @@ Options read from ``ctx.options``: ``environment`` (``"frequency"`` default, or 
 ``environment_accuracy`` (mean relative error of Y, default :data:`shrm.accuracy.DEFAULT_ACCURACY`),
 ``environment_tol`` (the older kernel-only tail tolerance of :func:`shrm.lobes.adaptive_order`;
 when given it replaces the accuracy rule), ``environment_size`` (cube face), ``upsampling``,
-``upsampling_model``.
+``upsampling_model``, ``irradiance_quadrature`` (``"fejer"`` default, or ``"texels"``).
 """
 
 from __future__ import annotations
@@ -48,12 +50,18 @@ from reference.materials.types import LambertMaterial, PhongMaterial
 from reference.registry import Method
 from reference.scene.lights import EnvironmentLight
 from reference.scene.metadata import DEFAULT_ACCURACY, check_accuracy
-from reference.scene.options import check_fraction, check_int_range, register_render_option
+from reference.scene.options import (
+    check_choice,
+    check_fraction,
+    check_int_range,
+    register_render_option,
+)
 from reference.scene.shading import SHADERS, Surface
 from shrm.accuracy import accuracy_order, bright_texels, sparse_convolution
 from shrm.lobes import adaptive_order, kernel_phong, parse_kernel
 from shrm.prefilter import MAX_PREFILTER_FACE, prefilter_bruteforce, prefilter_coefficients
 from shrm.sh import sh_evaluate
+from shrm.texel_irradiance import irradiance_texel_constant
 from shrm.transform import project_latlong
 
 __all__ = [
@@ -253,6 +261,9 @@ def _irradiance(surface: Surface, light, ctx) -> np.ndarray:
     if ctx.options.get("environment") == "bruteforce":
         ctx.record("environment", f"{light.name}:lambert", {"method": "bruteforce"})
         radiance = _state(light, ctx)["radiance"]
+        if ctx.options.get("irradiance_quadrature", "fejer") == "texels":
+            # each texel's cosine integrated exactly: a map constant over each texel (E102)
+            return irradiance_texel_constant(radiance, surface.normal)
         return prefilter_bruteforce(radiance, "lambert", surface.normal)
     L = _order(light, ctx, "lambert")
     cube = _frequency_map(light, ctx, "lambert", L, parse_kernel("lambert").Lambda(L))
@@ -367,6 +378,13 @@ register_render_option(
 )  # fmt: skip
 register_render_option(
     "environment_tol", check_fraction, "environment lights' kernel-only tolerance (erratum E76)"
+)
+register_render_option(
+    "irradiance_quadrature",
+    lambda value: check_choice(value, ["fejer", "texels"]),
+    "the brute force's Lambertian irradiance: the cosine at texel centres with Fejér's weights "
+    '("fejer", the default) or integrated over each texel of a map constant over each texel '
+    '("texels", the conformance references; shrm.texel_irradiance)',
 )
 register_render_option(
     "environment_size",

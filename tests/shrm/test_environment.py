@@ -108,6 +108,27 @@ def test_bruteforce_under_a_uniform_sky_converges():
     assert errors[1] < 1e-3
 
 
+def test_bruteforce_over_texels_is_the_white_furnace_at_any_height():
+    # irradiance_quadrature = "texels": each texel's cosine integrated (shrm.texel_irradiance),
+    # so a uniform sky gives k_d exactly however few rows the map has, where the Fejér brute
+    # force above is off by 3.2e-3 at 16 rows
+    env = EnvironmentLight(np.full((4, 8, 3), 1.0))
+    up = _up_surface()
+    lambert = LambertMaterial(np.full(41, 0.5))
+    options = {"environment": "bruteforce"}
+    fejer = shade_lambert_environment(up, lambert, env, ShadingContext(options=options))[0]
+    options = {**options, "irradiance_quadrature": "texels"}
+    texels = shade_lambert_environment(up, lambert, env, ShadingContext(options=options))[0]
+    white, _ = _uniform_sky(16, "frequency")
+    np.testing.assert_allclose(texels, 0.5 * white, rtol=1e-8)
+    assert abs(fejer[1] / texels[1] - 1) > 1e-2
+    from reference.scene.loader import loads_scene
+
+    with pytest.raises(SpecrefError, match="irradiance_quadrature: unknown value 'exact'") as error:
+        loads_scene('[render.options]\nirradiance_quadrature = "exact"\n')
+    assert "\n" not in str(error.value)
+
+
 def test_environment_shaders_frequency_vs_bruteforce(package_data):
     image = read_hdr(package_data / "environments" / "studio_small_03_1k.hdr")[::8, ::8].copy()
     env = EnvironmentLight(image, name="studio")
