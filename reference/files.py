@@ -15,6 +15,7 @@ import re
 import shutil
 import stat
 import tempfile
+import threading
 from pathlib import Path
 
 from reference.errors import SpecrefError, require
@@ -725,7 +726,10 @@ def check_output_folder(folder, marker: str | None = None) -> Path:
                     "replace them; give a new or empty folder"
                 )
         folder.mkdir(parents=True, exist_ok=True)
-    probe = write_bytes_atomic(folder / ".specref-write-probe", b"specref")
+    # a probe of this thread's own: processes and threads filling one folder at once must not
+    # remove each other's
+    own = f"{os.getpid()}-{threading.get_ident()}"
+    probe = write_bytes_atomic(folder / f".specref-write-probe-{own}", b"specref")
     probe.unlink()
     return folder
 

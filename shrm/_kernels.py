@@ -290,12 +290,9 @@ def irradiance_texel_constant_kernel(normals, radiance, H, W, q_x, q_w, out):
                 w_k = 0.5 * width * q_w[k]
                 A += w_k * a
                 if star_row >= 0:
-                    # F(θ) = a (θ/2 − sin 2θ / 4) + c sin²θ / 2 at θ*, against the row's lit edge;
-                    # at θ*, (sin θ*, cos θ*) = (|c|, −a sgn c) / r with r = √(a² + c²)
-                    theta_star = math.atan2(c, -a) % math.pi
-                    r2 = a * a + c * c
-                    sin_2 = -2.0 * abs(c) * a * math.copysign(1.0, c) / r2
-                    F_star = a * (0.5 * theta_star - 0.25 * sin_2) + 0.5 * c * (c * c / r2)
+                    # F(θ) = a (θ/2 − sin 2θ / 4) + c sin²θ / 2 at θ*, against the row's lit edge:
+                    # there (sin θ*, cos θ*) = (|c|, −a sgn c) / √(a² + c²), so F(θ*) = (a θ* + c)/2
+                    F_star = 0.5 * (a * (math.atan2(c, -a) % math.pi) + c)
                     if c > 0.0:  # lit from the row's top edge down to θ*
                         e = star_row
                         T[star_row, i] += w_k * (F_star - a * edge_a[e] - c * edge_c[e])

@@ -28,9 +28,11 @@ render passes (or comes closest):
 In a scene for a calibrated display every variant is what the display shows for it (its device
 values through the display's model), as the render is.
 
-Half a texel (a map's rows read at Mitsuba's ``v = j/(H − 1)`` instead of ``(j + ½)/H``) is not
-among them: on the 32-row maps it moves the spheres' images by 0.5-1.7 times the tolerance, too
-little to fail a scene or to be told apart.
+- ``environment_rows_offset``: the map's rows read half a texel off: at ``v = j/(H − 1)``
+  (align-corners interpolation, as Mitsuba 3 reads them) or shifted half a texel towards either
+  pole, instead of texel ``j`` spanning ``j/H`` to ``(j + 1)/H``. On the photographed maps it moves
+  the spheres' images by 0.5-1.7 times the tolerance, too little to be told apart; the ring scene
+  is made for it (errata E102).
 """
 
 from __future__ import annotations
@@ -289,6 +291,16 @@ def _with_image(light, image):
     return dataclasses.replace(light, image=np.ascontiguousarray(image))
 
 
+def _rows_shifted(light, towards: str):
+    """The map with its texel rows moved half a texel towards the zenith or the nadir."""
+    image = light.image
+    if towards == "zenith":  # texel j then holds the lower half of j and the upper half of j + 1
+        below = np.concatenate([image[1:], image[-1:]])
+        return _with_image(light, 0.5 * (image + below))
+    above = np.concatenate([image[:1], image[:-1]])
+    return _with_image(light, 0.5 * (image + above))
+
+
 DIAGNOSES.register(
     Diagnosis("Y_scaled", "the image is off by one factor (intensity or normalization)", _fit_scale)
 )
@@ -352,6 +364,22 @@ DIAGNOSES.register(
         "the environment map is turned 180° about the vertical axis",
         _environment_variants(
             {"180°": lambda x: _with_image(x, np.roll(x.image, x.image.shape[1] // 2, axis=1))}
+        ),
+        rendered=True,
+    )
+)
+DIAGNOSES.register(
+    Diagnosis(
+        "environment_rows_offset",
+        "the environment map's rows are read half a texel off",
+        _environment_variants(
+            {
+                "rows at v = j/(H − 1) (align-corners)": lambda x: dataclasses.replace(
+                    x, texel_placement="mitsuba"
+                ),
+                "rows half a texel towards the zenith": lambda x: _rows_shifted(x, "zenith"),
+                "rows half a texel towards the nadir": lambda x: _rows_shifted(x, "nadir"),
+            }
         ),
         rendered=True,
     )

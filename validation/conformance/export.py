@@ -7,7 +7,8 @@ and the scenes the format cannot express, with why.
 
 **Mitsuba 3** (scene format version 3.0.0, a spectral variant): the camera as a ``perspective`` or
 ``orthographic`` sensor with ``fov_axis = "y"`` and a ``lookat`` transform; an ``hdrfilm`` of the
-scene's size with ``pixel_format = "xyz"`` and a ``box`` filter; the ``path`` integrator with
+scene's size with ``pixel_format = "xyz"`` and a ``box`` filter; each map resampled for Mitsuba's
+placement of texels (:func:`texels_for_mitsuba`); the ``path`` integrator with
 ``max_depth = 2`` (direct light only: the scenes have one convex object, or a flat chart);
 Lambertian materials as ``diffuse``; the GGX conductor as ``roughconductor`` with
 ``distribution = "ggx"`` and ``material = "none"`` (F = 1). specref's units become Mitsuba's
@@ -33,7 +34,7 @@ import numpy as np
 from reference.errors import require
 from validation.conformance.scenes import CONFORMANCE_SCENES, scene_text
 
-__all__ = ["EXPORT_FORMATS", "export_scenes", "mitsuba_xml"]
+__all__ = ["EXPORT_FORMATS", "export_scenes", "mitsuba_xml", "texels_for_mitsuba"]
 
 #: Formats of ``specref conformance export``.
 EXPORT_FORMATS = ("specref", "mitsuba")
@@ -237,25 +238,48 @@ def mitsuba_xml(name: str, spp: int = 64) -> str:
     return "\n".join(lines).replace("$spp", str(int(spp))) + "\n"
 
 
-#: Each texel of a map becomes this many × this many in the Mitsuba export.
-TEXEL_REPEAT = 8
+#: Each texel of a map becomes this many × this many in the Mitsuba export: Mitsuba's blending of
+#: spectra between texels (erratum E81) then takes 0.19 % of the studio sphere's Y (0.38 % at 8,
+#: 0.09 % at 32; it falls as 1/k), in maps of 6 MB.
+TEXEL_REPEAT = 16
 
 
-def texels_repeated(image: np.ndarray, k: int = TEXEL_REPEAT) -> np.ndarray:
-    """A lat-long map with each texel repeated ``k × k`` times (float32), for Mitsuba 3.
+def texels_for_mitsuba(image: np.ndarray, k: int = TEXEL_REPEAT) -> np.ndarray:
+    """A map constant over each texel, as Mitsuba 3 must be given it: ``k H × k W`` (float32).
 
-    The scenes' maps are constant over each texel (``texel_placement = "centred"``); Mitsuba 3
-    interpolates bilinearly between texels, and between texels of different colour and brightness
-    it interpolates the upsampled spectrum's shape and scale apart (erratum E81). Repeated texels
-    confine both to a border of half a repeated texel, 1/k of the original's width.
+    The scenes' maps are constant over each texel (``texel_placement = "centred"``: texel ``j``
+    spans rows ``j/H`` to ``(j + 1)/H``). Mitsuba 3 interpolates bilinearly between samples it
+    places at ``u = (i + ½)/W`` and, in rows, at ``v = j/(H − 1)`` (src/emitters/envmap.cpp);
+    between texels of different colour it interpolates the upsampled spectrum's shape and scale
+    apart (erratum E81). So each column is repeated ``k`` times, which confines the blending to a
+    border of ``1/(2k)`` texel, and each of the ``k H`` rows is the mean of the map over the span
+    of ``v`` that Mitsuba's sample stands for, ``[v_r − Δ/2, v_r + Δ/2]`` with ``v_r = r/(kH − 1)``
+    and ``Δ = 1/(kH − 1)``: the linear interpolation of those means keeps every texel row's
+    integral and puts its edges where they are. Rows merely repeated 8 times would put each edge
+    up to half a repeated row (0.35° at 32 rows) towards the pole, and dim a bright row near it by
+    a few per cent (erratum E100).
 
     Examples
     --------
-    >>> texels_repeated(np.arange(2.0).reshape(1, 2, 1), 2)[..., 0]
+    >>> texels_for_mitsuba(np.arange(2.0).reshape(1, 2, 1), 2)[..., 0]
     array([[0., 0., 1., 1.],
            [0., 0., 1., 1.]], dtype=float32)
+    >>> rows = texels_for_mitsuba(np.array([[[0.0]], [[1.0]], [[0.0]]]), 2)[:, 0, 0]
+    >>> rows.round(4)                          # at v = r/5: the middle texel row's 1/3, kept
+    array([0.    , 0.    , 0.8333, 0.8333, 0.    , 0.    ], dtype=float32)
     """
-    return np.repeat(np.repeat(np.asarray(image), k, axis=0), k, axis=1).astype(np.float32)
+    image = np.asarray(image, dtype=np.float64)
+    H = image.shape[0]
+    R = k * H
+    v = np.arange(R) / (R - 1)
+    half = 0.5 / (R - 1)
+    lo, hi = np.clip(v - half, 0.0, 1.0), np.clip(v + half, 0.0, 1.0)
+    edges = np.arange(H + 1) / H
+    # the share of each texel row in each sample's span of v
+    overlap = np.minimum(hi[:, None], edges[None, 1:]) - np.maximum(lo[:, None], edges[None, :-1])
+    share = np.clip(overlap, 0.0, None) / (hi - lo)[:, None]
+    rows = np.einsum("rj,jw...->rw...", share, image)
+    return np.repeat(rows, k, axis=1).astype(np.float32)
 
 
 def _copy_data(text: str, out: Path) -> str:
@@ -312,7 +336,7 @@ def export_scenes(folder, fmt: str = "specref", spp: int = 64) -> dict:
     check_output_folder(out / "maps")
     for path in sorted(data_path("conformance/maps").iterdir()):
         if path.suffix == ".exr" and fmt == "mitsuba":
-            write_exr(out / "maps" / path.name, texels_repeated(read_exr(path)[0][..., :3]))
+            write_exr(out / "maps" / path.name, texels_for_mitsuba(read_exr(path)[0][..., :3]))
         elif path.suffix == ".exr":
             shutil.copyfile(path, out / "maps" / path.name)
     if fmt == "specref":  # the calibrated display a scene names, beside it (.cal, .ti3, .json)

@@ -146,6 +146,7 @@ def _broken_renders(scenes: Path, renders: Path, out: Path) -> dict[str, tuple[s
     from reference.colour.colorimetry import XYZ_to_display_RGB, display_RGB_to_XYZ
     from reference.display.encodings import encode_srgb
     from reference.images.formats import read_exr, write_exr
+    from validation.conformance.scenes import ring_map
 
     out.mkdir(parents=True, exist_ok=True)
     image = read_exr(scenes / "maps" / "venice.exr")[0][..., :3]
@@ -153,12 +154,21 @@ def _broken_renders(scenes: Path, renders: Path, out: Path) -> dict[str, tuple[s
     xml = (scenes / "lambert-env-venice.xml").read_text(encoding="utf-8")
     mirrored = out / "lambert-env-venice.xml"
     mirrored.write_text(xml.replace("maps/venice.exr", str(out / "venice-mirrored.exr")))
+    # the ring map's own 32 rows, which Mitsuba reads at v = j/(H − 1): half a texel off
+    write_exr(out / "ring-own-rows.exr", ring_map())
+    xml = (scenes / "lambert-env-ring.xml").read_text(encoding="utf-8")
+    own_rows = out / "lambert-env-ring.xml"
+    own_rows.write_text(xml.replace("maps/ring.exr", str(out / "ring-own-rows.exr")))
     XYZ = read_exr(renders / "lambert-point-d65.exr")[0][..., :3].astype(np.float64)
     encoded = display_RGB_to_XYZ(encode_srgb(np.clip(XYZ_to_display_RGB(XYZ), 0.0, None)))
     return {
         "lambert-env-venice": (
             "environment_mirrored",
             render_mitsuba(mirrored, out / "lambert-env-venice.exr", spp=256),
+        ),
+        "lambert-env-ring": (
+            "environment_rows_offset",
+            render_mitsuba(own_rows, out / "lambert-env-ring.exr", spp=256),
         ),
         "lambert-point-d65": (
             "srgb_encoded",
@@ -176,15 +186,16 @@ def _broken_renders(scenes: Path, renders: Path, out: Path) -> dict[str, tuple[s
 def run_mitsuba_proof(
     folder, names=None, broken: bool = True, references=None, progress=None
 ) -> dict:
-    """Export the scenes, render them in Mitsuba 3, check them; then check three broken renders.
+    """Export the scenes, render them in Mitsuba 3, check them; then check four broken renders.
 
     docs/conformance.md ("Proof on Mitsuba 3"): every scene Mitsuba 3 can express (or those of
     ``names``; :data:`QUICK_PROOF` for the report's default effort) is rendered at
     :func:`proof_spp` and checked against its reference; with ``broken``, the venice map mirrored,
-    the point-lit sphere's values sRGB-encoded and the FL2 chart rendered by Mitsuba's
-    ``scalar_rgb`` variant are checked too, each expected to fail with the mistake made (those
-    three scenes are then rendered whatever ``names`` says). ``references`` is the references'
-    folder (default ``folder/references``; rendered there where missing).
+    the ring map given to Mitsuba as its own 32 rows (which it reads at ``v = j/(H − 1)``), the
+    point-lit sphere's values sRGB-encoded and the FL2 chart rendered by Mitsuba's ``scalar_rgb``
+    variant are checked too, each expected to fail with the mistake made (the scenes of
+    :data:`QUICK_PROOF` are then rendered whatever ``names`` says). ``references`` is the
+    references' folder (default ``folder/references``; rendered there where missing).
 
     Returns
     -------

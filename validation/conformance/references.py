@@ -1,7 +1,9 @@
 """Reference images of the conformance scenes, with a per-pixel standard error and a manifest.
 
 Each scene is rendered by specref's oracle path: environment lights integrated by brute force over
-every texel (``options["environment"] = "bruteforce"``, ``specref render --oracle``), Phong
+every texel (``options["environment"] = "bruteforce"``, ``specref render --oracle``; a
+Lambertian's irradiance with each texel's cosine integrated exactly, as the maps are constant over
+each texel: ``irradiance_quadrature = "texels"``, :mod:`shrm.texel_irradiance`), Phong
 materials by the exact per-band evaluation, Eq. (2), Wang et al., sphere lights to 1e-3 of each
 pixel's value (``sphere_light_tol``; the quadrature's error is then far below the sub-samples').
 Each pixel is the box-filtered mean of its ``S × S`` sub-samples (the scene's ``supersample``), and
@@ -53,10 +55,11 @@ __all__ = [
 ]
 
 #: Version of the reference set; a change of a scene or of the oracle's output bumps it.
-REFERENCE_VERSION = 2
+REFERENCE_VERSION = 3
 #: Shader options of the oracle path.
 REFERENCE_OPTIONS = {
     "environment": "bruteforce",
+    "irradiance_quadrature": "texels",
     "phong": {"method": "exact"},
     "sphere_light_tol": 1e-3,
 }
@@ -209,7 +212,7 @@ def reference_folder() -> Path:
     Examples
     --------
     >>> reference_folder().name
-    'v2'
+    'v3'
     """
     from reference.files import default_cache_dir
 

@@ -31,7 +31,9 @@ __all__ = [
     "CALIBRATED_DISPLAY",
     "CONFORMANCE_SCENES",
     "ENVIRONMENT_MAPS",
+    "RING_MAP",
     "ConformanceScene",
+    "ring_map",
     "scene_path",
     "scene_text",
 ]
@@ -46,6 +48,33 @@ ENVIRONMENT_MAPS = {
 }
 #: Rows of those maps.
 MAP_ROWS = 32
+#: The synthetic map of ``lambert-env-ring`` (``data:conformance/maps/ring.exr``, :func:`ring_map`):
+#: a grey sky of radiance ``sky`` with the texel row ``row`` (5.6°-11.25° from the zenith) at
+#: ``ring``, relative to a white RGB texel of 1.
+RING_MAP = {"row": 1, "ring": 20.0, "sky": 0.2}
+
+
+def ring_map(rows: int = MAP_ROWS):
+    """The ring map (:data:`RING_MAP`), ``rows × 2 rows × 3`` linear RGB, float32.
+
+    Where a normal sees the ring at its horizon, the cosine across the ring's texel row changes
+    by a large fraction of itself, so the row's place on the sphere decides the pixel: a
+    renderer that reads the rows half a texel off changes the sphere's image by several times
+    the tolerance (the 1k maps' scenes change by 0.5-1.7 times it; errata E102).
+
+    Examples
+    --------
+    >>> m = ring_map()
+    >>> m.shape, float(m[1, 0, 0]), float(m[0, 0, 0])
+    ((32, 64, 3), 20.0, 0.2)
+    """
+    import numpy as np
+
+    image = np.full((rows, 2 * rows, 3), RING_MAP["sky"], dtype=np.float32)
+    image[RING_MAP["row"]] = RING_MAP["ring"]
+    return image
+
+
 #: The calibrated display of the display scene (``data:conformance/displays/<stem>.cal`` with its
 #: ``.ti3``, ``.json`` and ``.cube``), as ``specref display calibrate`` writes them: the built-in
 #: simulated display with wide LED-like primaries, calibrated to D65 and Herbert's L* curve
@@ -347,6 +376,15 @@ for _map in ENVIRONMENT_MAPS:
         _ENV_MISTAKES,
         _environment(_LAMBERT_HALF, _map),
     ))  # fmt: skip
+CONFORMANCE_SCENES.register(ConformanceScene(
+    "lambert-env-ring",
+    "a grey Lambertian sphere under a dim grey sky with a bright ring 5.6°-11.25° from the zenith "
+    "(one texel row of a 32-row map): where each texel row of the map sits, which a renderer "
+    "that reads the rows half a texel off moves by several times the tolerance where the ring "
+    "meets a normal's horizon",
+    ("environment_rows_offset", *_SCALE_MISTAKES),
+    _environment(_LAMBERT_HALF, "ring"),
+))  # fmt: skip
 CONFORMANCE_SCENES.register(ConformanceScene(
     "orange-env-venice",
     "a measured reflectance under an upsampled RGB environment (the product per wavelength)",

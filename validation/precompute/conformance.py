@@ -13,7 +13,8 @@ Run ``python -m validation.precompute.conformance`` to rewrite them from
   calibrate`` writes it, the summary's file names made relative;
 - ``maps/<key>.exr``: each map of ``ENVIRONMENT_MAPS`` box-averaged to 32 × 64 texels (the mean
   of the texels of each of 32 × 64 near-equal blocks, ``np.array_split``), 32-bit float RGB in
-  the source's orientation (Mitsuba 3's lat-long convention; docs/conventions.md).
+  the source's orientation (Mitsuba 3's lat-long convention; docs/conventions.md), and the
+  synthetic ``maps/ring.exr`` (:func:`validation.conformance.scenes.ring_map`).
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ from validation.conformance.scenes import (
     CONFORMANCE_SCENES,
     ENVIRONMENT_MAPS,
     MAP_ROWS,
+    ring_map,
     scene_text,
 )
 
@@ -88,6 +90,7 @@ def main(folder=None) -> None:
     (folder / "maps").mkdir(parents=True, exist_ok=True)
     for key, name in ENVIRONMENT_MAPS.items():
         write_exr(folder / "maps" / f"{key}.exr", small_map(name).astype(np.float32))
+    write_exr(folder / "maps" / "ring.exr", ring_map())
     write_calibrated_display(folder / "displays")
     for scene in CONFORMANCE_SCENES.values():
         write_text_atomic(folder / f"{scene.name}.toml", scene_text(scene))
@@ -97,7 +100,7 @@ def main(folder=None) -> None:
         )
     write_text_atomic(folder / "manifest.json", json.dumps(manifest, indent=1) + "\n")
     sys.stdout.write(
-        f"wrote {len(CONFORMANCE_SCENES)} scenes and {len(ENVIRONMENT_MAPS)} maps to {folder}\n"
+        f"wrote {len(CONFORMANCE_SCENES)} scenes and {len(ENVIRONMENT_MAPS) + 1} maps to {folder}\n"
     )
 
 

@@ -6,9 +6,9 @@ material swapped for a smooth, opaque polymer: in specref by the layered model
 (:mod:`shrm.polymer.layered`) and by the oracle (:func:`shrm.polymer.oracle.polymer_oracle`), in
 Mitsuba 3 as ``plastic`` (``nonlinear``, Weidlich & Wilkie 2007, the limit both specref models
 reach), at two seeds. The exported scene carries the map's conventions, which the suite solved on
-its Lambertian spheres; specref reads the map with its texels repeated as the export repeats them
-for Mitsuba (``validation.conformance.export.texels_repeated``): the scene's map is constant over
-each texel and the model's mirror look-up is bilinear (docs/herbert-polymer.md). The same scene
+its Lambertian spheres (``validation.conformance.export.texels_for_mitsuba``); specref reads the
+map with each texel repeated 8 × 8 (:data:`MIRROR_REPEAT`): the scene's map is constant over each
+texel and the model's mirror look-up is bilinear (docs/herbert-polymer.md). The same scene
 with its own grey Lambertian material, rendered by both, is the control: the pipeline's floor.
 
 Differences are mean ΔE00 over 4 × 4-pixel blocks inside the sphere, L*a*b* against a white
@@ -24,10 +24,19 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["PLASTIC_INDEX", "PLASTIC_RHO", "block_delta_E", "plastic_against_mitsuba"]
+__all__ = [
+    "MIRROR_REPEAT",
+    "PLASTIC_INDEX",
+    "PLASTIC_RHO",
+    "block_delta_E",
+    "plastic_against_mitsuba",
+]
 
 #: The polymer's refractive index and its Kubelka–Munk body's reflectance R_∞.
 PLASTIC_INDEX, PLASTIC_RHO = 1.54, 0.5
+#: Each texel repeated this many × this many times for the models' bilinear mirror look-up, so
+#: that it reads the map as constant over each texel but for a border of 1/16 texel.
+MIRROR_REPEAT = 8
 #: The conformance scene the study swaps the material of.
 SCENE = "lambert-env-studio"
 BLOCK = 4
@@ -63,11 +72,10 @@ def _specref_sphere(scene, model: str) -> tuple:
     from shrm.environment import cached_spectral_radiance
     from shrm.polymer.layered import layered_maps, layered_terms
     from shrm.polymer.oracle import polymer_oracle
-    from validation.conformance.export import TEXEL_REPEAT
 
     g, S = scene_gbuffer(scene), scene.render.supersample
     env = cached_spectral_radiance(scene.lights[0], ShadingContext(scene.grid))
-    repeated = np.repeat(np.repeat(env, TEXEL_REPEAT, axis=0), TEXEL_REPEAT, axis=1)
+    repeated = np.repeat(np.repeat(env, MIRROR_REPEAT, axis=0), MIRROR_REPEAT, axis=1)
     bands = env.shape[-1]
     # an opaque Kubelka–Munk body with R_∞ = ρ: K/S = (1 − ρ)² / (2ρ)
     S_km = np.full(bands, 1e3)

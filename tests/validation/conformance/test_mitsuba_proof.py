@@ -2,8 +2,9 @@
 
 Source: Mitsuba 3 (``scalar_spectral``), an independent spectral path tracer, renders the scenes
 ``specref conformance export --format mitsuba`` writes; ``specref conformance check`` must pass
-them all. The same renders broken on purpose (a mirrored map, sRGB-encoded values, Mitsuba's RGB
-variant under FL2) must fail with the right diagnosis. Needs the ``[mitsuba]`` extra (CI installs
+them all. The same renders broken on purpose (a mirrored map, the ring map's own rows that Mitsuba
+reads half a texel off, sRGB-encoded values, Mitsuba's RGB variant under FL2) must fail with the
+right diagnosis. Needs the ``[mitsuba]`` extra (CI installs
 it).
 """
 
@@ -46,6 +47,7 @@ def test_mitsuba_passes_every_scene_it_can_express(proof, capsys):
     ("scene", "mistake"),
     [
         ("lambert-env-venice", "environment_mirrored"),
+        ("lambert-env-ring", "environment_rows_offset"),
         ("lambert-point-d65", "srgb_encoded"),
         ("colorchecker-fl2", "rgb_rendering"),
     ],

@@ -3,7 +3,7 @@
 The figures come from :func:`validation.conformance.mitsuba.run_mitsuba_proof`, the function the
 proof test runs: the scenes Mitsuba 3 can express (the three of ``QUICK_PROOF`` under the
 default and quick efforts), checked as ``specref conformance check`` checks a user's renders,
-and three renders broken on purpose, each of which must fail with the mistake made. Shown when
+and four renders broken on purpose, each of which must fail with the mistake made. Shown when
 Mitsuba 3 is installed; otherwise the section says how to enable it (docs/conformance.md).
 """
 
