@@ -24,7 +24,7 @@ from validation.cli import main
 from validation.conformance.check import check_folder, check_render
 from validation.conformance.diagnose import DIAGNOSES, DiagnosisContext, diagnosis_variants
 from validation.conformance.display import scene_display
-from validation.conformance.export import export_scenes, mitsuba_xml
+from validation.conformance.export import TEXEL_REPEAT, export_scenes, mitsuba_xml
 from validation.conformance.references import (
     REFERENCE_OPTIONS,
     ensure_references,
@@ -283,29 +283,30 @@ def test_the_mitsuba_export_is_well_formed_and_lists_what_it_cannot_express(tmp_
     # the maps' texels are repeated 8 × 8 (docs/conformance.md)
     big = read_exr(tmp_path / "maps" / "venice.exr")[0]
     small = read_exr(data_path("conformance/maps/venice.exr"))[0]
-    assert big.shape[:2] == (8 * small.shape[0], 8 * small.shape[1])
-    _is_the_map_as_mitsuba_reads_it(big[..., :3].astype(np.float64), small[..., :3])
+    k = TEXEL_REPEAT
+    assert big.shape[:2] == (k * small.shape[0], k * small.shape[1])
+    _is_the_map_as_mitsuba_reads_it(big[..., :3].astype(np.float64), small[..., :3], k)
 
 
-def _is_the_map_as_mitsuba_reads_it(big, small):
-    """Columns repeated 8 times; Mitsuba's rows (at v = r/(R − 1), interpolated linearly) keep
+def _is_the_map_as_mitsuba_reads_it(big, small, k):
+    """Columns repeated k times; Mitsuba's rows (at v = r/(R − 1), interpolated linearly) keep
     each texel row's integral and, wherever a sample's span lies in one texel row, its value."""
     H, R = small.shape[0], big.shape[0]
-    for c in range(8):
-        np.testing.assert_array_equal(big[:, c::8], big[:, ::8])
+    for c in range(k):
+        np.testing.assert_array_equal(big[:, c::k], big[:, ::k])
     # the integral over v of the linear interpolation: trapezoid weights of the samples
     weights = np.full(R, 1.0 / (R - 1))
     weights[[0, -1]] *= 0.5
-    np.testing.assert_allclose(np.einsum("r,rwc->wc", weights, big[:, ::8]),
+    np.testing.assert_allclose(np.einsum("r,rwc->wc", weights, big[:, ::k]),
                                small.mean(axis=0), rtol=1e-5)  # fmt: skip
     v = np.arange(R) / (R - 1)
     half = 0.5 / (R - 1)
     inside = np.floor((v - half) * H) == np.floor(np.minimum(v + half, 1 - 1e-12) * H)
     rows = np.minimum((v * H).astype(int), H - 1)
-    np.testing.assert_allclose(big[inside, ::8], small[rows[inside]], rtol=1e-6)
+    np.testing.assert_allclose(big[inside, ::k], small[rows[inside]], rtol=1e-6)
     # and a texel row's edges where they are: the half-way point between a dark and a bright
     # row falls on the edge j/H (the ring map's second row) within 1 % of a texel (rows merely
-    # repeated put it 6 % of a texel towards the pole)
+    # repeated 8 times put it 6 % of a texel towards the pole)
     from validation.conformance.export import texels_for_mitsuba
     from validation.conformance.scenes import ring_map
 
