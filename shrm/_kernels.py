@@ -255,6 +255,8 @@ def irradiance_texel_constant_kernel(normals, radiance, H, W, q_x, q_w, out):
     T = np.zeros((H, W))
     C = radiance.shape[1]
     d_phi = 2.0 * np.pi / W
+    Q = q_x.shape[0]
+    a_k = np.empty(Q)
     # θ/2 − sin 2θ / 4 and sin²θ / 2 at the row edges θ_e = eπ/H
     edge_a = np.empty(H + 1)
     edge_c = np.empty(H + 1)
@@ -264,17 +266,24 @@ def irradiance_texel_constant_kernel(normals, radiance, H, W, q_x, q_w, out):
         edge_c[e] = 0.5 * math.sin(theta) ** 2
     for p in range(normals.shape[0]):
         c = normals[p, 1]
+        # a(φ) = n_x sin φ − n_z cos φ = R sin(φ − φ_0)
+        R = math.hypot(normals[p, 0], normals[p, 2])
+        phi_0 = math.atan2(normals[p, 2], normals[p, 0])
         T[:, :] = 0.0
         breaks = _phi_breaks(normals[p, 0], c, normals[p, 2], H, W)
         for b in range(breaks.shape[0] - 1):
             left, width = breaks[b], breaks[b + 1] - breaks[b]
             if width <= 0.0:
                 continue
-            i = min(int((left + 0.5 * width) / d_phi), W - 1)
+            mid = left + 0.5 * width
+            i = min(int(mid / d_phi), W - 1)
+            A = 0.0
+            for k in range(Q):
+                a_k[k] = R * math.sin(left + 0.5 * width * (q_x[k] + 1.0) - phi_0)
+                A += 0.5 * width * q_w[k] * a_k[k]
             # between breaks the horizon stays in one row (or none): the rows wholly lit take
             # Σ_k w_k F(edges), the row it crosses takes F(θ*) per node
-            mid = left + 0.5 * width
-            a_mid = normals[p, 0] * math.sin(mid) - normals[p, 2] * math.cos(mid)
+            a_mid = R * math.sin(mid - phi_0)
             star_row = min(int((math.atan2(c, -a_mid) % math.pi) * H / math.pi), H - 1)
             if c > 0.0:
                 first, last = 0, star_row  # wholly lit rows [first, last)
@@ -283,22 +292,16 @@ def irradiance_texel_constant_kernel(normals, radiance, H, W, q_x, q_w, out):
             else:
                 first, last = 0, (H if a_mid > 0.0 else 0)
                 star_row = -1
-            A = 0.0
-            for k in range(q_x.shape[0]):
-                phi = left + 0.5 * width * (q_x[k] + 1.0)
-                a = normals[p, 0] * math.sin(phi) - normals[p, 2] * math.cos(phi)
-                w_k = 0.5 * width * q_w[k]
-                A += w_k * a
-                if star_row >= 0:
-                    # F(θ) = a (θ/2 − sin 2θ / 4) + c sin²θ / 2 at θ*, against the row's lit edge:
-                    # there (sin θ*, cos θ*) = (|c|, −a sgn c) / √(a² + c²), so F(θ*) = (a θ* + c)/2
+            if star_row >= 0:
+                # F(θ) = a (θ/2 − sin 2θ / 4) + c sin²θ / 2 at θ*, against the row's lit edge:
+                # there (sin θ*, cos θ*) = (|c|, −a sgn c) / √(a² + c²), so F(θ*) = (a θ* + c)/2
+                e = star_row if c > 0.0 else star_row + 1
+                for k in range(Q):
+                    a = a_k[k]
                     F_star = 0.5 * (a * (math.atan2(c, -a) % math.pi) + c)
-                    if c > 0.0:  # lit from the row's top edge down to θ*
-                        e = star_row
-                        T[star_row, i] += w_k * (F_star - a * edge_a[e] - c * edge_c[e])
-                    else:  # lit from θ* down to the row's bottom edge
-                        e = star_row + 1
-                        T[star_row, i] += w_k * (a * edge_a[e] + c * edge_c[e] - F_star)
+                    F_edge = a * edge_a[e] + c * edge_c[e]
+                    lit = F_star - F_edge if c > 0.0 else F_edge - F_star
+                    T[star_row, i] += 0.5 * width * q_w[k] * lit
             for j in range(first, last):
                 # Σ_k w_k (F(θ_{j+1}) − F(θ_j)) = A Δ(θ/2 − sin 2θ/4) + c width Δ(sin²θ/2)
                 T[j, i] += A * (edge_a[j + 1] - edge_a[j]) + c * width * (edge_c[j + 1] - edge_c[j])
