@@ -38,7 +38,7 @@ def test_white_furnace_is_pi_for_every_normal(rng):
     n = _normals(rng, 40)
     for backend in ("numba", "numpy"):
         E = irradiance_texel_constant(np.ones((16, 32, 1)), n, backend=backend)
-        assert np.abs(E - np.pi).max() < 1e-8  # the default 4 nodes
+        assert np.abs(E - np.pi).max() < 1e-7  # the default 3 nodes
         E = irradiance_texel_constant(np.ones((16, 32, 1)), n, nodes=16, backend=backend)
         assert np.abs(E - np.pi).max() < 1e-12
 
@@ -91,7 +91,7 @@ def test_nodes_converge_and_the_fejer_brute_force_converges_to_it(rng):
     image = rng.random((8, 16, 2))
     n = _normals(rng, 12)
     best = irradiance_texel_constant(image, n, nodes=48)
-    assert np.abs(irradiance_texel_constant(image, n, nodes=4) / best - 1).max() < 1e-7
+    assert np.abs(irradiance_texel_constant(image, n) / best - 1).max() < 5e-6  # 3 nodes
     assert np.abs(irradiance_texel_constant(image, n, nodes=8) / best - 1).max() < 1e-10
     # the brute force on the map subdivided k × k: its error at the texels' edges falls as 1/k
     errors = []
