@@ -250,13 +250,54 @@ def _phi_breaks(nx, ny, nz, H, W):
 
 
 @njit
-def irradiance_texel_constant_kernel(normals, radiance, H, W, q_x, q_w, out):
-    """Twin of ``shrm.texel_irradiance.irradiance_texel_constant``: Σ_t L_t ∫_t max(0, n·ω) dω."""
-    T = np.zeros((H, W))
-    C = radiance.shape[1]
+def _texel_weights_into(T, nx, c, nz, H, W, q_x, q_w, a_k, edge_a, edge_c):
+    """T[j, i] = ∫_texel max(0, n·ω) dω (``shrm.texel_irradiance.texel_weights``), into ``T``."""
     d_phi = 2.0 * np.pi / W
     Q = q_x.shape[0]
-    a_k = np.empty(Q)
+    # a(φ) = n_x sin φ − n_z cos φ = R sin(φ − φ_0)
+    R = math.hypot(nx, nz)
+    phi_0 = math.atan2(nz, nx)
+    T[:, :] = 0.0
+    breaks = _phi_breaks(nx, c, nz, H, W)
+    for b in range(breaks.shape[0] - 1):
+        left, width = breaks[b], breaks[b + 1] - breaks[b]
+        if width <= 0.0:
+            continue
+        mid = left + 0.5 * width
+        i = min(int(mid / d_phi), W - 1)
+        A = 0.0
+        for k in range(Q):
+            a_k[k] = R * math.sin(left + 0.5 * width * (q_x[k] + 1.0) - phi_0)
+            A += 0.5 * width * q_w[k] * a_k[k]
+        # between breaks the horizon stays in one row (or none): the rows wholly lit take
+        # Σ_k w_k F(edges), the row it crosses takes F(θ*) per node
+        a_mid = a_k[Q // 2] if Q % 2 == 1 else R * math.sin(mid - phi_0)  # an odd rule's centre
+        star_row = min(int((math.atan2(c, -a_mid) % math.pi) * H / math.pi), H - 1)
+        if c > 0.0:
+            first, last = 0, star_row  # wholly lit rows [first, last)
+        elif c < 0.0:
+            first, last = star_row + 1, H
+        else:
+            first, last = 0, (H if a_mid > 0.0 else 0)
+            star_row = -1
+        if star_row >= 0:
+            # F(θ) = a (θ/2 − sin 2θ / 4) + c sin²θ / 2 at θ*, against the row's lit edge:
+            # there (sin θ*, cos θ*) = (|c|, −a sgn c) / √(a² + c²), so F(θ*) = (a θ* + c)/2
+            e = star_row if c > 0.0 else star_row + 1
+            for k in range(Q):
+                a = a_k[k]
+                F_star = 0.5 * (a * (math.atan2(c, -a) % math.pi) + c)
+                F_edge = a * edge_a[e] + c * edge_c[e]
+                lit = F_star - F_edge if c > 0.0 else F_edge - F_star
+                T[star_row, i] += 0.5 * width * q_w[k] * lit
+        for j in range(first, last):
+            # Σ_k w_k (F(θ_{j+1}) − F(θ_j)) = A Δ(θ/2 − sin 2θ/4) + c width Δ(sin²θ/2)
+            T[j, i] += A * (edge_a[j + 1] - edge_a[j]) + c * width * (edge_c[j + 1] - edge_c[j])
+
+
+@njit
+def irradiance_texel_constant_kernel(normals, radiance, H, W, q_x, q_w, out):
+    """Twin of ``shrm.texel_irradiance.irradiance_texel_constant``: Σ_t L_t ∫_t max(0, n·ω) dω."""
     # θ/2 − sin 2θ / 4 and sin²θ / 2 at the row edges θ_e = eπ/H
     edge_a = np.empty(H + 1)
     edge_c = np.empty(H + 1)
@@ -264,55 +305,16 @@ def irradiance_texel_constant_kernel(normals, radiance, H, W, q_x, q_w, out):
         theta = math.pi * e / H
         edge_a[e] = 0.5 * theta - 0.25 * math.sin(2.0 * theta)
         edge_c[e] = 0.5 * math.sin(theta) ** 2
-    for p in range(normals.shape[0]):
-        c = normals[p, 1]
-        # a(φ) = n_x sin φ − n_z cos φ = R sin(φ − φ_0)
-        R = math.hypot(normals[p, 0], normals[p, 2])
-        phi_0 = math.atan2(normals[p, 2], normals[p, 0])
-        T[:, :] = 0.0
-        breaks = _phi_breaks(normals[p, 0], c, normals[p, 2], H, W)
-        for b in range(breaks.shape[0] - 1):
-            left, width = breaks[b], breaks[b + 1] - breaks[b]
-            if width <= 0.0:
-                continue
-            mid = left + 0.5 * width
-            i = min(int(mid / d_phi), W - 1)
-            A = 0.0
-            for k in range(Q):
-                a_k[k] = R * math.sin(left + 0.5 * width * (q_x[k] + 1.0) - phi_0)
-                A += 0.5 * width * q_w[k] * a_k[k]
-            # between breaks the horizon stays in one row (or none): the rows wholly lit take
-            # Σ_k w_k F(edges), the row it crosses takes F(θ*) per node
-            a_mid = R * math.sin(mid - phi_0)
-            star_row = min(int((math.atan2(c, -a_mid) % math.pi) * H / math.pi), H - 1)
-            if c > 0.0:
-                first, last = 0, star_row  # wholly lit rows [first, last)
-            elif c < 0.0:
-                first, last = star_row + 1, H
-            else:
-                first, last = 0, (H if a_mid > 0.0 else 0)
-                star_row = -1
-            if star_row >= 0:
-                # F(θ) = a (θ/2 − sin 2θ / 4) + c sin²θ / 2 at θ*, against the row's lit edge:
-                # there (sin θ*, cos θ*) = (|c|, −a sgn c) / √(a² + c²), so F(θ*) = (a θ* + c)/2
-                e = star_row if c > 0.0 else star_row + 1
-                for k in range(Q):
-                    a = a_k[k]
-                    F_star = 0.5 * (a * (math.atan2(c, -a) % math.pi) + c)
-                    F_edge = a * edge_a[e] + c * edge_c[e]
-                    lit = F_star - F_edge if c > 0.0 else F_edge - F_star
-                    T[star_row, i] += 0.5 * width * q_w[k] * lit
-            for j in range(first, last):
-                # Σ_k w_k (F(θ_{j+1}) − F(θ_j)) = A Δ(θ/2 − sin 2θ/4) + c width Δ(sin²θ/2)
-                T[j, i] += A * (edge_a[j + 1] - edge_a[j]) + c * width * (edge_c[j + 1] - edge_c[j])
-        # E(n) = Σ_t L_t T_t(n)
-        for j in range(H):
-            for i in range(W):
-                t = T[j, i]
-                if t != 0.0:
-                    row = j * W + i
-                    for ch in range(C):
-                        out[p, ch] += t * radiance[row, ch]
+    a_k = np.empty(q_x.shape[0])
+    # the weights of a batch of normals, then E = T L for the batch at once (a matrix product)
+    batch = 256
+    T = np.empty((batch, H, W))
+    for start in range(0, normals.shape[0], batch):
+        count = min(batch, normals.shape[0] - start)
+        for p in range(count):
+            n = normals[start + p]
+            _texel_weights_into(T[p], n[0], n[1], n[2], H, W, q_x, q_w, a_k, edge_a, edge_c)
+        out[start : start + count] += np.dot(T[:count].reshape(count, H * W), radiance)
 
 
 __all__ = [
