@@ -60,7 +60,7 @@ def ring_map(rows: int = MAP_ROWS):
     Where a normal sees the ring at its horizon, the cosine across the ring's texel row changes
     by a large fraction of itself, so the row's place on the sphere decides the pixel: a
     renderer that reads the rows half a texel off changes the sphere's image by several times
-    the tolerance (the 1k maps' scenes change by 0.5-1.7 times it; errata E102).
+    the tolerance (the photographed maps' spheres change by 0.5-1.7 times it; errata E102).
 
     Examples
     --------
