@@ -32,10 +32,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from reference.errors import require, require_choice
+from reference.errors import require, require_choice, require_finite, require_positive_int
 from reference.registry import Method, Registry
 
 __all__ = [
+    "MAX_TEXEL_NODES",
     "TEXEL_IRRADIANCE_METHODS",
     "TEXEL_NODES",
     "irradiance_texel_constant",
@@ -45,6 +46,8 @@ __all__ = [
 
 #: Gauss–Legendre nodes between consecutive breaks in φ (:func:`phi_breaks`).
 TEXEL_NODES = 3
+#: The most nodes accepted (16 are exact to rounding on the maps the tests try).
+MAX_TEXEL_NODES = 64
 
 
 def _lit_rows(a: np.ndarray, c: float, H: int) -> tuple[np.ndarray, np.ndarray]:
@@ -175,23 +178,27 @@ def irradiance_texel_constant(
     >>> E[:, 0].round(7)                            # π under uniform unit radiance
     array([3.1415927, 3.1415927])
     """
-    image = np.asarray(image, dtype=np.float64)
+    image = require_finite(image, "irradiance_texel_constant: image")
     require(image.ndim == 3, f"irradiance_texel_constant: expected (H, W, C), got {image.shape}")
     require_choice(backend, ("numba", "numpy"), "texel irradiance backend")
-    require(int(nodes) >= 1, f"irradiance_texel_constant: nodes must be >= 1, got {nodes}")
+    nodes = require_positive_int(nodes, "irradiance_texel_constant: nodes", MAX_TEXEL_NODES)
     H, W, C = image.shape
-    n = np.asarray(normals, dtype=np.float64)
+    n = require_finite(normals, "irradiance_texel_constant: normals")
+    require(
+        n.ndim >= 1 and n.shape[-1] == 3,
+        f"irradiance_texel_constant: normals must be (..., 3), got {n.shape}",
+    )
     shape = n.shape[:-1]
     n = np.ascontiguousarray(n.reshape(-1, 3))
     radiance = np.ascontiguousarray(image.reshape(-1, C))
     if backend == "numba":
         from shrm import _kernels
 
-        x, w = np.polynomial.legendre.leggauss(int(nodes))
+        x, w = np.polynomial.legendre.leggauss(nodes)
         out = np.zeros((n.shape[0], C))
         _kernels.irradiance_texel_constant_kernel(n, radiance, H, W, x, w, out)
     else:
-        out = np.stack([texel_weights(p, H, W, int(nodes)).ravel() @ radiance for p in n])
+        out = np.stack([texel_weights(p, H, W, nodes).ravel() @ radiance for p in n])
     return out.reshape(*shape, C)
 
 

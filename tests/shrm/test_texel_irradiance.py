@@ -115,5 +115,13 @@ def test_breaks_hold_the_columns_and_the_horizon_crossings():
 def test_bad_input_is_refused_in_one_line():
     with pytest.raises(SpecrefError, match="expected \\(H, W, C\\)"):
         irradiance_texel_constant(np.ones((4, 8)), [[0, 1, 0]])
-    with pytest.raises(SpecrefError, match="nodes must be >= 1"):
-        irradiance_texel_constant(np.ones((4, 8, 1)), [[0, 1, 0]], nodes=0)
+    for nodes in (0, -3, 10**9):
+        with pytest.raises(SpecrefError, match="nodes"):
+            irradiance_texel_constant(np.ones((4, 8, 1)), [[0, 1, 0]], nodes=nodes)
+    with pytest.raises(SpecrefError, match="normals") as error:
+        irradiance_texel_constant(np.ones((4, 8, 1)), [[0, np.nan, 0]])
+    assert "\n" not in str(error.value)
+    with pytest.raises(SpecrefError, match="image"):
+        irradiance_texel_constant(np.full((4, 8, 1), np.inf), [[0, 1, 0]])
+    with pytest.raises(SpecrefError, match=r"must be \(\.\.\., 3\)"):
+        irradiance_texel_constant(np.ones((4, 8, 1)), [[0, 1]])
