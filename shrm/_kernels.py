@@ -228,29 +228,29 @@ def prefilter_bruteforce_power_kernel(normals, directions, weights, radiance, s,
 
 
 @njit
-def _phi_breaks(nx, ny, nz, H, W):
-    """Twin of ``shrm.texel_irradiance.phi_breaks`` (sorted, repeats kept)."""
-    columns = 2.0 * np.pi * np.arange(W + 1) / W
+def _phi_breaks_into(breaks, nx, ny, nz, H, W):
+    """Twin of ``shrm.texel_irradiance.phi_breaks`` into ``breaks`` (sorted); returns the count."""
+    for i in range(W + 1):
+        breaks[i] = 2.0 * np.pi * i / W
+    count = W + 1
     R, c = math.hypot(nx, nz), ny
     if R == 0.0:
-        return columns
-    out = np.empty(W + 1 + 2 * (H - 1))
-    out[: W + 1] = columns
-    count = W + 1
+        return count
     phi_0 = math.atan2(nz, nx)
     for e in range(1, H):
         # R sin(φ − φ_0) = −c cot θ_e
         s = -c / (math.tan(math.pi * e / H) * R)
         if abs(s) <= 1.0:
             arc = math.asin(s)
-            out[count] = (phi_0 + arc) % (2.0 * np.pi)
-            out[count + 1] = (phi_0 + np.pi - arc) % (2.0 * np.pi)
+            breaks[count] = (phi_0 + arc) % (2.0 * np.pi)
+            breaks[count + 1] = (phi_0 + np.pi - arc) % (2.0 * np.pi)
             count += 2
-    return np.sort(out[:count])
+    breaks[:count].sort()
+    return count
 
 
 @njit
-def _texel_weights_into(T, nx, c, nz, H, W, q_x, q_w, a_k, edge_a, edge_c):
+def _texel_weights_into(T, nx, c, nz, H, W, q_x, q_w, a_k, edge_a, edge_c, breaks):
     """T[j, i] = ∫_texel max(0, n·ω) dω (``shrm.texel_irradiance.texel_weights``), into ``T``."""
     d_phi = 2.0 * np.pi / W
     Q = q_x.shape[0]
@@ -258,8 +258,8 @@ def _texel_weights_into(T, nx, c, nz, H, W, q_x, q_w, a_k, edge_a, edge_c):
     R = math.hypot(nx, nz)
     phi_0 = math.atan2(nz, nx)
     T[:, :] = 0.0
-    breaks = _phi_breaks(nx, c, nz, H, W)
-    for b in range(breaks.shape[0] - 1):
+    count = _phi_breaks_into(breaks, nx, c, nz, H, W)
+    for b in range(count - 1):
         left, width = breaks[b], breaks[b + 1] - breaks[b]
         if width <= 0.0:
             continue
@@ -306,6 +306,7 @@ def irradiance_texel_constant_kernel(normals, radiance, H, W, q_x, q_w, out):
         edge_a[e] = 0.5 * theta - 0.25 * math.sin(2.0 * theta)
         edge_c[e] = 0.5 * math.sin(theta) ** 2
     a_k = np.empty(q_x.shape[0])
+    breaks = np.empty(W + 1 + 2 * (H - 1))
     # the weights of a batch of normals, then E = T L for the batch at once (a matrix product)
     batch = 256
     T = np.empty((batch, H, W))
@@ -313,7 +314,9 @@ def irradiance_texel_constant_kernel(normals, radiance, H, W, q_x, q_w, out):
         count = min(batch, normals.shape[0] - start)
         for p in range(count):
             n = normals[start + p]
-            _texel_weights_into(T[p], n[0], n[1], n[2], H, W, q_x, q_w, a_k, edge_a, edge_c)
+            _texel_weights_into(
+                T[p], n[0], n[1], n[2], H, W, q_x, q_w, a_k, edge_a, edge_c, breaks
+            )
         out[start : start + count] += np.dot(T[:count].reshape(count, H * W), radiance)
 
 
