@@ -314,9 +314,7 @@ def irradiance_texel_constant_kernel(normals, radiance, H, W, q_x, q_w, out):
         count = min(batch, normals.shape[0] - start)
         for p in range(count):
             n = normals[start + p]
-            _texel_weights_into(
-                T[p], n[0], n[1], n[2], H, W, q_x, q_w, a_k, edge_a, edge_c, breaks
-            )
+            _texel_weights_into(T[p], n[0], n[1], n[2], H, W, q_x, q_w, a_k, edge_a, edge_c, breaks)
         out[start : start + count] += np.dot(T[:count].reshape(count, H * W), radiance)
 
 
